@@ -1,0 +1,26 @@
+//! Shared value types of plumetrace.
+//!
+//! This crate is the vocabulary that the simulator side and the onboard side (guidance, behaviours,
+//! planners) have in common. It holds no randomness and no models, so the onboard side can depend on
+//! it without seeing anything a real vehicle could not know.
+//!
+//! Conventions, used everywhere in plumetrace:
+//! - positions in metres in a local tangent plane, `x` = East, `y` = North, `z` = height above the
+//!   seabed (positive up);
+//! - headings and courses in compass degrees (clockwise from North) at the edges (configs, logs,
+//!   plots), radians inside [`Heading`];
+//! - flow directions are the direction the water moves *towards*;
+//! - time in seconds, as an integer step count times a fixed `dt`.
+
+pub mod angle;
+pub mod frame;
+pub mod message;
+pub mod vehicle;
+
+pub use angle::{Heading, wrap_deg_180, wrap_deg_360, wrap_rad_pi};
+pub use frame::{Vec2, Vec3, bearing_between, heading_vector};
+pub use message::{Message, MessageBody, Recipient};
+pub use vehicle::{
+    ChemSample, Command, FlowSample, NavEstimate, RangeReturn, SensorSnapshot, VehicleId,
+    VehicleKind, VerticalCommand,
+};

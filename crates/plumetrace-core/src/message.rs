@@ -1,0 +1,57 @@
+//! Messages between vehicles (acoustic modem, radio) as the onboard side sees them.
+
+use crate::{Heading, Vec2, VehicleId};
+use serde::{Deserialize, Serialize};
+
+/// Who a message is for.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Recipient {
+    /// One vehicle.
+    Vehicle(VehicleId),
+    /// Every vehicle in range.
+    Broadcast,
+}
+
+/// What a message carries. New kinds are added as variants so that the link code stays exhaustive.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case", tag = "kind")]
+pub enum MessageBody {
+    /// An acoustic range measurement to the sender, with the sender's heading piggybacked.
+    RangeReply {
+        /// Measured slant range, m.
+        range_m: f64,
+        /// Sender's compass heading at transmission.
+        sender_heading: Heading,
+    },
+    /// A position report (e.g. a surface vehicle's GPS fix).
+    Position {
+        /// Reported position `(east, north)`, m.
+        pos_m: Vec2,
+    },
+    /// A chemical detection report.
+    Detection {
+        /// Where the sender detected chemical `(east, north)`, m.
+        pos_m: Vec2,
+        /// The reading that triggered it.
+        reading: f64,
+    },
+    /// Free text (operator notes, debugging).
+    Text {
+        /// The text.
+        text: String,
+    },
+}
+
+/// One message between vehicles.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Message {
+    /// Sender.
+    pub from: VehicleId,
+    /// Recipient.
+    pub to: Recipient,
+    /// Transmission time, s.
+    pub sent_s: f64,
+    /// Content.
+    pub body: MessageBody,
+}

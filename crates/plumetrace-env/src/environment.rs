@@ -1,0 +1,156 @@
+//! The environment: a flow field and a plume advanced together on a fixed time step.
+
+use crate::field::ConcentrationField;
+use crate::flow::{FlowField, FlowModel};
+use crate::obstacle::ObstacleSet;
+use crate::plume::FilamentPlume;
+use crate::{EnvError, Rect, SimRng, StreamId, stream_rng};
+use plumetrace_core::{Vec2, Vec3};
+
+/// The plume models: a live filament plume or a steady field.
+pub enum Plume {
+    /// Farrell filaments, advanced with the flow.
+    Filaments(Box<FilamentPlume>),
+    /// A steady field (Gaussian plume or a gridded file); it does not change with time.
+    Steady(Box<dyn ConcentrationField>),
+}
+
+impl std::fmt::Debug for Plume {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Plume::Filaments(p) => write!(f, "Plume::Filaments({} live)", p.len()),
+            Plume::Steady(_) => write!(f, "Plume::Steady"),
+        }
+    }
+}
+
+impl Plume {
+    /// Names and one-line descriptions of the plume models, for `list` commands and docs.
+    pub const REGISTRY: &'static [(&'static str, &'static str)] = &[
+        ("filaments", "Farrell et al. 2002 filament (puff) model: Poisson release, meander, intermittency"),
+        ("gaussian", "steady Gaussian plume of a continuous source in a uniform current (freshwater case)"),
+        ("gridded", "steady concentration grid read from a CSV file (x_m,y_m[,z_m],concentration)"),
+    ];
+
+    /// The filament plume, if this is one.
+    pub fn filaments(&self) -> Option<&FilamentPlume> {
+        match self {
+            Plume::Filaments(p) => Some(p),
+            Plume::Steady(_) => None,
+        }
+    }
+}
+
+impl ConcentrationField for Plume {
+    fn concentration(&self, p: Vec3) -> f64 {
+        match self {
+            Plume::Filaments(f) => f.concentration(p),
+            Plume::Steady(s) => s.concentration(p),
+        }
+    }
+    fn concentrations(&self, points: &[Vec3], out: &mut [f64]) {
+        match self {
+            Plume::Filaments(f) => f.concentrations(points, out),
+            Plume::Steady(s) => s.concentrations(points, out),
+        }
+    }
+}
+
+/// The simulated ocean: domain, flow, plume and obstacles, stepped at a fixed `dt`.
+///
+/// Time is the integer step count times `dt`. The flow and the plume each draw from their own
+/// random stream, so what vehicles do never changes the plume they meet.
+#[derive(Debug)]
+pub struct Environment {
+    domain: Rect,
+    flow: FlowModel,
+    plume: Plume,
+    obstacles: ObstacleSet,
+    dt_s: f64,
+    step: u64,
+    flow_rng: SimRng,
+    plume_rng: SimRng,
+}
+
+impl Environment {
+    /// An environment at t = 0 with random streams derived from `seed`.
+    pub fn new(domain: Rect, flow: FlowModel, plume: Plume, obstacles: ObstacleSet, dt_s: f64, seed: u64) -> Result<Self, EnvError> {
+        crate::error::require_positive("sim.dt_s", dt_s)?;
+        if let Some(limit) = flow.max_stable_dt_s() {
+            if dt_s > limit {
+                return Err(EnvError::invalid("sim.dt_s", format!("{dt_s} s is above the flow model's stable limit of {limit:.4} s")));
+            }
+        }
+        Ok(Environment {
+            domain,
+            flow,
+            plume,
+            obstacles,
+            dt_s,
+            step: 0,
+            flow_rng: stream_rng(seed, StreamId::Flow),
+            plume_rng: stream_rng(seed, StreamId::Plume),
+        })
+    }
+
+    /// Advances the flow, then the plume, by one step.
+    pub fn step(&mut self) -> Result<(), EnvError> {
+        let t_new = (self.step + 1) as f64 * self.dt_s;
+        self.flow.advance(t_new, self.dt_s, &mut self.flow_rng)?;
+        if let Plume::Filaments(p) = &mut self.plume {
+            p.step(&self.flow, self.dt_s, &mut self.plume_rng);
+        }
+        self.step += 1;
+        Ok(())
+    }
+
+    /// Current time, s.
+    pub fn time_s(&self) -> f64 {
+        self.step as f64 * self.dt_s
+    }
+
+    /// Steps taken.
+    pub fn steps(&self) -> u64 {
+        self.step
+    }
+
+    /// The time step, s.
+    pub fn dt_s(&self) -> f64 {
+        self.dt_s
+    }
+
+    /// The simulated region.
+    pub fn domain(&self) -> Rect {
+        self.domain
+    }
+
+    /// The flow field.
+    pub fn flow(&self) -> &FlowModel {
+        &self.flow
+    }
+
+    /// The plume.
+    pub fn plume(&self) -> &Plume {
+        &self.plume
+    }
+
+    /// Mutable plume access (e.g. to seed filaments at t = 0).
+    pub fn plume_mut(&mut self) -> &mut Plume {
+        &mut self.plume
+    }
+
+    /// The obstacles.
+    pub fn obstacles(&self) -> &ObstacleSet {
+        &self.obstacles
+    }
+
+    /// Water velocity at `p`, m/s.
+    pub fn flow_at(&self, p: Vec2) -> Vec2 {
+        self.flow.velocity(p)
+    }
+
+    /// Concentration at `p`.
+    pub fn concentration_at(&self, p: Vec3) -> f64 {
+        self.plume.concentration(p)
+    }
+}

@@ -1,0 +1,467 @@
+//! The meandering flow field of Farrell et al. (2002).
+//!
+//! A regular grid of `nx` x `ny` nodes covers the region, surrounded by a ring of boundary nodes one
+//! grid step outside it (the layout of the reference implementation, pompy). At each step:
+//! 1. the four corners of the ring are set to the mean flow plus second-order coloured noise, one
+//!    independent channel per corner and component ([`ColouredNoise`]);
+//! 2. the ring's edges are filled by linear ramps between the corners;
+//! 3. the interior is advanced one explicit Euler step of
+//!    `du/dt = -(u du/dx + v du/dy) + k_x/2 d2u/dx2 + k_y/2 d2u/dy2` (and the same for `v`) with
+//!    centred differences.
+//!
+//! Velocities between nodes are **bilinear** interpolations of the four surrounding nodes (the
+//! reference uses a cubic spline; bilinear is cheaper and keeps the field within the range of its
+//! nodes). Positions outside the grid take the value at the nearest edge.
+//!
+//! The explicit scheme is stable only for small enough steps; [`FarrellFlow::max_stable_dt_s`]
+//! gives the limit (the smaller of the diffusion limit `1 / (2 (Dx/dx^2 + Dy/dy^2))` with
+//! `D = k/2`, the centred-advection limit `2 min(D) / U^2` and the Courant limit
+//! `min(dx, dy) / U`, where `U` bounds the speed at the corners: mean speed plus four standard
+//! deviations of the corner noise). Building the field with a larger step is an error.
+
+use super::{FlowField, MeanFlow, axis_weight};
+use crate::error::{EnvError, require_non_negative, require_positive};
+use crate::{Rect, SimRng};
+use plumetrace_core::Vec2;
+use rand_distr::{Distribution, StandardNormal};
+use serde::{Deserialize, Serialize};
+
+/// Parameters of the Farrell flow field (defaults: pompy's `WindModel`).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct FarrellParams {
+    /// Grid nodes along x (East), >= 3.
+    pub nx: usize,
+    /// Grid nodes along y (North), >= 3.
+    pub ny: usize,
+    /// Diffusivity along x, m^2/s (`k_x` of the paper).
+    pub diffusivity_x_m2ps: f64,
+    /// Diffusivity along y, m^2/s.
+    pub diffusivity_y_m2ps: f64,
+    /// Noise input gain `G` (dimensionless).
+    pub noise_gain: f64,
+    /// Noise damping ratio `z` (dimensionless).
+    pub noise_damping: f64,
+    /// Noise bandwidth (undamped natural frequency) `w`, rad/s.
+    pub noise_bandwidth_radps: f64,
+    /// Use the original Farrell update, which scales the noise by `dt` instead of `sqrt(dt)` (its
+    /// amplitude then depends on the time step). Off by default.
+    pub original_noise_updates: bool,
+}
+
+impl Default for FarrellParams {
+    fn default() -> Self {
+        FarrellParams {
+            nx: 21,
+            ny: 21,
+            diffusivity_x_m2ps: 20.0,
+            diffusivity_y_m2ps: 20.0,
+            noise_gain: 2.0,
+            noise_damping: 0.1,
+            noise_bandwidth_radps: 0.2,
+            original_noise_updates: false,
+        }
+    }
+}
+
+/// Second-order coloured noise, integrated with Euler-Maruyama:
+/// `dx0 = x1 dt; dx1 = -(w^2 x0 + 2 z w x1) dt + G w^2 dW`.
+///
+/// Its stationary variance is `G^2 w / (4 z)` (for `z > 0`), and its correlation time is about
+/// `1 / (z w)`.
+#[derive(Debug, Clone)]
+pub struct ColouredNoise {
+    x0: Vec<f64>,
+    x1: Vec<f64>,
+    gain: f64,
+    damping: f64,
+    bandwidth: f64,
+    original: bool,
+}
+
+impl ColouredNoise {
+    /// `channels` independent channels starting at rest.
+    pub fn new(channels: usize, gain: f64, damping: f64, bandwidth_radps: f64, original_updates: bool) -> Self {
+        ColouredNoise {
+            x0: vec![0.0; channels],
+            x1: vec![0.0; channels],
+            gain,
+            damping,
+            bandwidth: bandwidth_radps,
+            original: original_updates,
+        }
+    }
+
+    /// Advances every channel by `dt_s`.
+    pub fn update(&mut self, dt_s: f64, rng: &mut SimRng) {
+        let w = self.bandwidth;
+        let a = w * w;
+        let b = 2.0 * self.damping * w;
+        let c = self.gain * w * w;
+        let noise_scale = if self.original { dt_s } else { dt_s.sqrt() };
+        for (x0, x1) in self.x0.iter_mut().zip(self.x1.iter_mut()) {
+            let n: f64 = StandardNormal.sample(rng);
+            let (p, q) = (*x0, *x1);
+            *x0 = p + dt_s * q;
+            *x1 = q - dt_s * (a * p + b * q) + c * noise_scale * n;
+        }
+    }
+
+    /// Current outputs (the `x0` of each channel).
+    pub fn output(&self) -> &[f64] {
+        &self.x0
+    }
+
+    /// The stationary variance `G^2 w / (4 z)` of the Euler-Maruyama form.
+    pub fn stationary_variance(&self) -> f64 {
+        self.gain * self.gain * self.bandwidth / (4.0 * self.damping)
+    }
+}
+
+/// The Farrell et al. (2002) meandering flow field (see the module docs).
+#[derive(Debug, Clone)]
+pub struct FarrellFlow {
+    params: FarrellParams,
+    mean: MeanFlow,
+    region: Rect,
+    dx_m: f64,
+    dy_m: f64,
+    inv_dx: f64,
+    inv_dy: f64,
+    /// Row-major `(ny + 2) x (nx + 2)`: index `j * (nx + 2) + i`, ring included.
+    u: Vec<f64>,
+    v: Vec<f64>,
+    /// Interior-only row-major `ny x nx` copies for fast interpolation.
+    u_int: Vec<f64>,
+    v_int: Vec<f64>,
+    noise: ColouredNoise,
+    time_s: f64,
+    max_stable_dt_s: f64,
+    max_speed_mps: f64,
+}
+
+impl FarrellFlow {
+    /// Builds the field over `region`, checking that `dt_s` is within the stable limit.
+    pub fn new(region: Rect, mean: MeanFlow, params: FarrellParams, dt_s: f64) -> Result<Self, EnvError> {
+        mean.validate("flow.mean")?;
+        if params.nx < 3 {
+            return Err(EnvError::invalid("flow.nx", format!("must be >= 3, got {}", params.nx)));
+        }
+        if params.ny < 3 {
+            return Err(EnvError::invalid("flow.ny", format!("must be >= 3, got {}", params.ny)));
+        }
+        if params.nx * params.ny > 4_000_000 {
+            return Err(EnvError::invalid("flow.nx", "nx * ny must be at most 4,000,000"));
+        }
+        require_positive("flow.diffusivity_x_m2ps", params.diffusivity_x_m2ps)?;
+        require_positive("flow.diffusivity_y_m2ps", params.diffusivity_y_m2ps)?;
+        require_non_negative("flow.noise_gain", params.noise_gain)?;
+        require_positive("flow.noise_damping", params.noise_damping)?;
+        require_positive("flow.noise_bandwidth_radps", params.noise_bandwidth_radps)?;
+        require_positive("sim.dt_s", dt_s)?;
+        let dx_m = region.width_m() / (params.nx - 1) as f64;
+        let dy_m = region.height_m() / (params.ny - 1) as f64;
+        let noise = ColouredNoise::new(
+            8,
+            params.noise_gain,
+            params.noise_damping,
+            params.noise_bandwidth_radps,
+            params.original_noise_updates,
+        );
+        let v0 = mean.velocity_at(0.0);
+        let n_all = (params.nx + 2) * (params.ny + 2);
+        let n_int = params.nx * params.ny;
+        let mut flow = FarrellFlow {
+            params,
+            mean,
+            region,
+            dx_m,
+            dy_m,
+            inv_dx: 1.0 / dx_m,
+            inv_dy: 1.0 / dy_m,
+            u: vec![v0.x; n_all],
+            v: vec![v0.y; n_all],
+            u_int: vec![v0.x; n_int],
+            v_int: vec![v0.y; n_int],
+            noise,
+            time_s: 0.0,
+            max_stable_dt_s: 0.0,
+            max_speed_mps: v0.norm(),
+        };
+        flow.max_stable_dt_s = flow.stable_dt_limit(dt_s);
+        if dt_s > flow.max_stable_dt_s {
+            return Err(EnvError::invalid(
+                "sim.dt_s",
+                format!(
+                    "{dt_s} s is above the Farrell flow grid's stable limit of {:.4} s \
+                     (grid step {:.2} m x {:.2} m); use a smaller dt_s, a coarser grid or larger diffusivities",
+                    flow.max_stable_dt_s, dx_m, dy_m
+                ),
+            ));
+        }
+        Ok(flow)
+    }
+
+    fn stable_dt_limit(&self, dt_s: f64) -> f64 {
+        let dxx = 0.5 * self.params.diffusivity_x_m2ps;
+        let dyy = 0.5 * self.params.diffusivity_y_m2ps;
+        let diffusion = 1.0 / (2.0 * (dxx / (self.dx_m * self.dx_m) + dyy / (self.dy_m * self.dy_m)));
+        // Corner noise amplitude; the original update's amplitude scales with sqrt(dt).
+        let mut sd = self.noise.stationary_variance().sqrt();
+        if self.params.original_noise_updates {
+            sd *= dt_s.sqrt();
+        }
+        let u_bound = self.mean.max_speed_mps() + 4.0 * sd * std::f64::consts::SQRT_2;
+        if u_bound <= 0.0 {
+            return diffusion;
+        }
+        let advection = 2.0 * dxx.min(dyy) / (u_bound * u_bound);
+        let courant = self.dx_m.min(self.dy_m) / u_bound;
+        diffusion.min(advection).min(courant)
+    }
+
+    /// The model parameters.
+    pub fn params(&self) -> &FarrellParams {
+        &self.params
+    }
+
+    /// The largest speed at any node after the last step, m/s.
+    pub fn max_speed_mps(&self) -> f64 {
+        self.max_speed_mps
+    }
+
+    /// Current corner noise outputs (u of the four corners, then v).
+    pub fn corner_noise(&self) -> &[f64] {
+        self.noise.output()
+    }
+
+    /// Interior node positions and velocities, for plots: `(x, y, u, v)` per node.
+    pub fn nodes(&self) -> Vec<[f64; 4]> {
+        let (nx, ny) = (self.params.nx, self.params.ny);
+        let mut out = Vec::with_capacity(nx * ny);
+        for j in 0..ny {
+            for i in 0..nx {
+                let k = j * nx + i;
+                out.push([
+                    self.region.x_min_m + i as f64 * self.dx_m,
+                    self.region.y_min_m + j as f64 * self.dy_m,
+                    self.u_int[k],
+                    self.v_int[k],
+                ]);
+            }
+        }
+        out
+    }
+
+    fn apply_boundary(&mut self, mean: Vec2) {
+        let (nx2, ny2) = (self.params.nx + 2, self.params.ny + 2);
+        let n = self.noise.output();
+        // Corners: (i=0,j=0), (i=last,j=0), (i=0,j=last), (i=last,j=last).
+        let cu = [mean.x + n[0], mean.x + n[1], mean.x + n[2], mean.x + n[3]];
+        let cv = [mean.y + n[4], mean.y + n[5], mean.y + n[6], mean.y + n[7]];
+        for (field, c) in [(&mut self.u, cu), (&mut self.v, cv)] {
+            let last_j = (ny2 - 1) * nx2;
+            for i in 0..nx2 {
+                let t = i as f64 / (nx2 - 1) as f64;
+                field[i] = c[0] + t * (c[1] - c[0]);
+                field[last_j + i] = c[2] + t * (c[3] - c[2]);
+            }
+            for j in 0..ny2 {
+                let t = j as f64 / (ny2 - 1) as f64;
+                field[j * nx2] = c[0] + t * (c[2] - c[0]);
+                field[j * nx2 + nx2 - 1] = c[1] + t * (c[3] - c[1]);
+            }
+        }
+    }
+
+    fn step_interior(&mut self, dt_s: f64) {
+        let (nx, ny) = (self.params.nx, self.params.ny);
+        let nx2 = nx + 2;
+        let hx = 0.5 * self.inv_dx;
+        let hy = 0.5 * self.inv_dy;
+        let kx = 0.5 * self.params.diffusivity_x_m2ps * self.inv_dx * self.inv_dx;
+        let ky = 0.5 * self.params.diffusivity_y_m2ps * self.inv_dy * self.inv_dy;
+        let mut max_sq: f64 = 0.0;
+        for j in 0..ny {
+            for i in 0..nx {
+                let c = (j + 1) * nx2 + (i + 1);
+                let (e, w, nn, s) = (c + 1, c - 1, c + nx2, c - nx2);
+                let (u, v) = (self.u[c], self.v[c]);
+                let du_dt = -(u * (self.u[e] - self.u[w]) * hx + v * (self.u[nn] - self.u[s]) * hy)
+                    + kx * (self.u[e] - 2.0 * u + self.u[w])
+                    + ky * (self.u[nn] - 2.0 * u + self.u[s]);
+                let dv_dt = -(u * (self.v[e] - self.v[w]) * hx + v * (self.v[nn] - self.v[s]) * hy)
+                    + kx * (self.v[e] - 2.0 * v + self.v[w])
+                    + ky * (self.v[nn] - 2.0 * v + self.v[s]);
+                let k = j * nx + i;
+                let (un, vn) = (u + du_dt * dt_s, v + dv_dt * dt_s);
+                self.u_int[k] = un;
+                self.v_int[k] = vn;
+                max_sq = max_sq.max(un * un + vn * vn);
+            }
+        }
+        // Write the interior back only after every node used the old values.
+        for j in 0..ny {
+            let row = (j + 1) * nx2 + 1;
+            self.u[row..row + nx].copy_from_slice(&self.u_int[j * nx..(j + 1) * nx]);
+            self.v[row..row + nx].copy_from_slice(&self.v_int[j * nx..(j + 1) * nx]);
+        }
+        // NaN propagates through max() as the other operand, so check separately.
+        self.max_speed_mps = if self.u_int.iter().chain(&self.v_int).all(|x| x.is_finite()) {
+            max_sq.sqrt()
+        } else {
+            f64::NAN
+        };
+    }
+
+    #[inline]
+    fn interp(&self, x: f64, y: f64) -> (f64, f64) {
+        let (nx, ny) = (self.params.nx, self.params.ny);
+        let (i, tx) = axis_weight(x, self.region.x_min_m, self.inv_dx, nx);
+        let (j, ty) = axis_weight(y, self.region.y_min_m, self.inv_dy, ny);
+        let k00 = j * nx + i;
+        let k10 = k00 + 1;
+        let k01 = k00 + nx;
+        let k11 = k01 + 1;
+        let (w00, w10, w01, w11) = ((1.0 - tx) * (1.0 - ty), tx * (1.0 - ty), (1.0 - tx) * ty, tx * ty);
+        let u = w00 * self.u_int[k00] + w10 * self.u_int[k10] + w01 * self.u_int[k01] + w11 * self.u_int[k11];
+        let v = w00 * self.v_int[k00] + w10 * self.v_int[k10] + w01 * self.v_int[k01] + w11 * self.v_int[k11];
+        (u, v)
+    }
+}
+
+impl FlowField for FarrellFlow {
+    fn name(&self) -> &'static str {
+        "farrell"
+    }
+    fn time_s(&self) -> f64 {
+        self.time_s
+    }
+    fn velocity(&self, pos_m: Vec2) -> Vec2 {
+        let (u, v) = self.interp(pos_m.x, pos_m.y);
+        Vec2::new(u, v)
+    }
+    fn velocities(&self, x: &[f64], y: &[f64], u: &mut [f64], v: &mut [f64]) {
+        for (((x, y), u), v) in x.iter().zip(y).zip(u.iter_mut()).zip(v.iter_mut()) {
+            let (a, b) = self.interp(*x, *y);
+            *u = a;
+            *v = b;
+        }
+    }
+    fn advance(&mut self, t_new_s: f64, dt_s: f64, rng: &mut SimRng) -> Result<(), EnvError> {
+        self.noise.update(dt_s, rng);
+        self.apply_boundary(self.mean.velocity_at(t_new_s));
+        self.step_interior(dt_s);
+        self.time_s = t_new_s;
+        // A runaway field is a bug or an unstable set-up: stop rather than emit garbage.
+        let limit = 100.0 * (1.0 + self.mean.max_speed_mps());
+        if !(self.max_speed_mps.is_finite() && self.max_speed_mps < limit) {
+            return Err(EnvError::Diverged {
+                time_s: t_new_s,
+                message: format!("largest node speed {} m/s (limit {limit} m/s)", self.max_speed_mps),
+            });
+        }
+        Ok(())
+    }
+    fn max_stable_dt_s(&self) -> Option<f64> {
+        Some(self.max_stable_dt_s)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::{StreamId, stream_rng};
+
+    fn pompy_region() -> Rect {
+        Rect { x_min_m: 0.0, x_max_m: 100.0, y_min_m: -50.0, y_max_m: 50.0 }
+    }
+
+    fn steady(speed: f64, toward: f64) -> MeanFlow {
+        MeanFlow::Steady { speed_mps: speed, toward_deg: toward }
+    }
+
+    #[test]
+    fn coloured_noise_variance_matches_theory() {
+        // G = 2, w = 0.2, z = 0.1: variance G^2 w / (4 z) = 2.0, correlation time ~50 s.
+        let mut noise = ColouredNoise::new(64, 2.0, 0.1, 0.2, false);
+        let mut rng = stream_rng(3, StreamId::Flow);
+        // dt = 0.01 s as in pompy's scenario: the Euler-Maruyama bias is then ~1 % (at 0.1 s it
+        // is ~12 %, because explicit Euler weakens the oscillator's damping).
+        let dt = 0.01;
+        for _ in 0..50_000 {
+            noise.update(dt, &mut rng); // 500 s burn-in, ten correlation times
+        }
+        let (mut sum, mut sum_sq, mut n) = (0.0, 0.0, 0.0);
+        for step in 0..600_000 {
+            noise.update(dt, &mut rng);
+            if step % 100 == 0 {
+                for &x in noise.output() {
+                    sum += x;
+                    sum_sq += x * x;
+                    n += 1.0;
+                }
+            }
+        }
+        let mean = sum / n;
+        let var = sum_sq / n - mean * mean;
+        let want = noise.stationary_variance();
+        assert!((want - 2.0).abs() < 1e-12);
+        eprintln!("coloured noise variance {var:.4}, theory {want}");
+        assert!((var - want).abs() / want < 0.06, "variance {var}, theory {want}");
+    }
+
+    #[test]
+    fn no_noise_keeps_uniform_mean() {
+        let params = FarrellParams { noise_gain: 0.0, ..FarrellParams::default() };
+        let mut f = FarrellFlow::new(pompy_region(), steady(1.0, 90.0), params, 0.01).unwrap();
+        let mut rng = stream_rng(1, StreamId::Flow);
+        for k in 1..=500 {
+            assert!(f.advance(f64::from(k) * 0.01, 0.01, &mut rng).is_ok());
+        }
+        let v = f.velocity(Vec2::new(37.0, 12.0));
+        assert!((v.x - 1.0).abs() < 1e-9 && v.y.abs() < 1e-9, "{v:?}");
+    }
+
+    #[test]
+    fn long_run_stays_finite_and_bounded() {
+        let mut f = FarrellFlow::new(pompy_region(), steady(1.0, 90.0), FarrellParams::default(), 0.05)
+            .unwrap_or_else(|e| panic!("{e}"));
+        let mut rng = stream_rng(11, StreamId::Flow);
+        let mut worst: f64 = 0.0;
+        for k in 1..=40_000u32 {
+            f.advance(f64::from(k) * 0.05, 0.05, &mut rng).unwrap_or_else(|e| panic!("{e}"));
+            worst = worst.max(f.max_speed_mps());
+        }
+        // 2000 s: corner noise sd is sqrt(2) m/s, so speeds stay well within 1 + 6 sd.
+        assert!(worst.is_finite() && worst < 1.0 + 6.0 * 2f64.sqrt(), "max speed {worst}");
+        assert!(worst > 1.2, "the field never meandered: max speed {worst}");
+    }
+
+    #[test]
+    fn rejects_unstable_dt() {
+        // 101 x 101 nodes over 100 m with k = 20: diffusion limit 1/(2*10*2) = 0.025 s.
+        let params = FarrellParams { nx: 101, ny: 101, ..FarrellParams::default() };
+        let err = FarrellFlow::new(pompy_region(), steady(1.0, 90.0), params, 0.05).err().map(|e| e.to_string());
+        let err = err.unwrap_or_default();
+        assert!(err.starts_with("sim.dt_s") && err.contains("stable limit"), "{err}");
+        assert!(FarrellFlow::new(pompy_region(), steady(1.0, 90.0), params, 0.02).is_ok());
+    }
+
+    #[test]
+    fn bilinear_interpolation_is_exact_on_nodes_and_linear_between() {
+        let mut f = FarrellFlow::new(pompy_region(), steady(0.0, 0.0), FarrellParams::default(), 0.01)
+            .unwrap_or_else(|e| panic!("{e}"));
+        // Impose u = x / 10 on the interior and check interpolation reproduces the linear field.
+        let nx = f.params.nx;
+        for j in 0..f.params.ny {
+            for i in 0..nx {
+                f.u_int[j * nx + i] = (i as f64 * f.dx_m) / 10.0;
+            }
+        }
+        for x in [0.0_f64, 2.5, 5.0, 33.3, 99.9, 100.0, 120.0, -5.0] {
+            let want = x.clamp(0.0, 100.0) / 10.0;
+            let got = f.velocity(Vec2::new(x, 7.0)).x;
+            assert!((got - want).abs() < 1e-9, "u({x}) = {got}, want {want}");
+        }
+    }
+}

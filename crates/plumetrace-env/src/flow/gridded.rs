@@ -1,0 +1,265 @@
+//! Flow read from a file: a regular grid, optionally with several time frames.
+//!
+//! The CSV file has a header and the columns `x_m,y_m,u_mps,v_mps` (East, North position; East,
+//! North velocity), plus an optional `t_s` column for time-varying fields. Every frame must cover
+//! the same regular grid (all combinations of its distinct `x_m` and `y_m` values, in any row
+//! order). Velocities are bilinear in space and linear in time; outside the grid the nearest edge
+//! value is used and outside the time span the nearest frame is held. The file format is kept
+//! behind [`GriddedFlow::from_csv`] so that other formats (NetCDF) can produce the same grid.
+
+use super::{FlowField, axis_weight};
+use crate::{EnvError, SimRng};
+use plumetrace_core::Vec2;
+use std::collections::BTreeMap;
+use std::path::Path;
+
+/// One time frame: `u` and `v` row-major `ny x nx`.
+#[derive(Debug, Clone)]
+struct Frame {
+    t_s: f64,
+    u: Vec<f64>,
+    v: Vec<f64>,
+}
+
+/// A regular-grid flow field, possibly time-varying.
+#[derive(Debug, Clone)]
+pub struct GriddedFlow {
+    x0_m: f64,
+    y0_m: f64,
+    inv_dx: f64,
+    inv_dy: f64,
+    nx: usize,
+    ny: usize,
+    frames: Vec<Frame>,
+    time_s: f64,
+    /// Index of the frame at or before the current time, and the blend towards the next one.
+    frame: usize,
+    blend: f64,
+}
+
+/// Distinct values of a coordinate, checked to be evenly spaced.
+fn regular_axis(values: &[f64], name: &str, path: &Path) -> Result<(f64, f64, usize), EnvError> {
+    let mut v: Vec<f64> = values.to_vec();
+    v.sort_by(f64::total_cmp);
+    v.dedup_by(|a, b| (*a - *b).abs() <= 1e-9 * (1.0 + b.abs()));
+    let file_err = |message: String| EnvError::File { path: path.to_path_buf(), message };
+    if v.len() < 2 {
+        return Err(file_err(format!("column {name} needs at least 2 distinct values, found {}", v.len())));
+    }
+    let step = (v[v.len() - 1] - v[0]) / (v.len() - 1) as f64;
+    for (k, w) in v.iter().enumerate() {
+        let expect = v[0] + k as f64 * step;
+        if (w - expect).abs() > 1e-6 * step.abs().max(1.0) {
+            return Err(file_err(format!(
+                "column {name} is not evenly spaced: value {w} where {expect} was expected"
+            )));
+        }
+    }
+    Ok((v[0], step, v.len()))
+}
+
+impl GriddedFlow {
+    /// Reads a gridded flow from a CSV file (see the module docs for the format).
+    pub fn from_csv(path: &Path) -> Result<Self, EnvError> {
+        let file_err = |message: String| EnvError::File { path: path.to_path_buf(), message };
+        let mut reader = csv::ReaderBuilder::new()
+            .trim(csv::Trim::All)
+            .from_path(path)
+            .map_err(|e| file_err(e.to_string()))?;
+        let headers = reader.headers().map_err(|e| file_err(e.to_string()))?.clone();
+        let col = |name: &str| headers.iter().position(|h| h == name);
+        let (Some(cx), Some(cy), Some(cu), Some(cv)) = (col("x_m"), col("y_m"), col("u_mps"), col("v_mps")) else {
+            return Err(file_err(format!(
+                "header must name x_m, y_m, u_mps, v_mps (and optionally t_s); found {:?}",
+                headers.iter().collect::<Vec<_>>()
+            )));
+        };
+        let ct = col("t_s");
+        let mut rows: Vec<[f64; 5]> = Vec::new();
+        for (k, rec) in reader.records().enumerate() {
+            let line = k + 2;
+            let rec = rec.map_err(|e| file_err(format!("line {line}: {e}")))?;
+            let get = |c: usize, name: &str| -> Result<f64, EnvError> {
+                let s = rec.get(c).unwrap_or("");
+                let x: f64 = s.parse().map_err(|_| file_err(format!("line {line}: {name} = {s:?} is not a number")))?;
+                if x.is_finite() { Ok(x) } else { Err(file_err(format!("line {line}: {name} = {s} is not finite"))) }
+            };
+            let t = match ct {
+                Some(c) => get(c, "t_s")?,
+                None => 0.0,
+            };
+            rows.push([t, get(cx, "x_m")?, get(cy, "y_m")?, get(cu, "u_mps")?, get(cv, "v_mps")?]);
+        }
+        if rows.is_empty() {
+            return Err(file_err("no data rows".into()));
+        }
+        let xs: Vec<f64> = rows.iter().map(|r| r[1]).collect();
+        let ys: Vec<f64> = rows.iter().map(|r| r[2]).collect();
+        let (x0, dx, nx) = regular_axis(&xs, "x_m", path)?;
+        let (y0, dy, ny) = regular_axis(&ys, "y_m", path)?;
+        // Group by time; BTreeMap over the bit pattern of a non-negative-normalised time keeps order.
+        let mut by_time: BTreeMap<i64, Vec<[f64; 5]>> = BTreeMap::new();
+        for r in rows {
+            // Times are keyed in microseconds so that equal times written differently group together.
+            by_time.entry((r[0] * 1e6).round() as i64).or_default().push(r);
+        }
+        let mut frames = Vec::with_capacity(by_time.len());
+        for (_, rows) in by_time {
+            let t_s = rows[0][0];
+            let mut u = vec![f64::NAN; nx * ny];
+            let mut v = vec![f64::NAN; nx * ny];
+            for r in &rows {
+                let i = ((r[1] - x0) / dx).round() as usize;
+                let j = ((r[2] - y0) / dy).round() as usize;
+                let k = j * nx + i;
+                if !u[k].is_nan() {
+                    return Err(file_err(format!("t_s = {t_s}: node ({}, {}) appears twice", r[1], r[2])));
+                }
+                u[k] = r[3];
+                v[k] = r[4];
+            }
+            if let Some(k) = u.iter().position(|x| x.is_nan()) {
+                return Err(file_err(format!(
+                    "t_s = {t_s}: grid node ({}, {}) is missing ({} x {} grid expected)",
+                    x0 + (k % nx) as f64 * dx,
+                    y0 + (k / nx) as f64 * dy,
+                    nx,
+                    ny
+                )));
+            }
+            frames.push(Frame { t_s, u, v });
+        }
+        Ok(GriddedFlow::from_frames_unchecked(x0, dx, nx, y0, dy, ny, frames))
+    }
+
+    fn from_frames_unchecked(x0: f64, dx: f64, nx: usize, y0: f64, dy: f64, ny: usize, frames: Vec<Frame>) -> Self {
+        let mut f = GriddedFlow {
+            x0_m: x0,
+            y0_m: y0,
+            inv_dx: 1.0 / dx,
+            inv_dy: 1.0 / dy,
+            nx,
+            ny,
+            frames,
+            time_s: 0.0,
+            frame: 0,
+            blend: 0.0,
+        };
+        f.set_time(0.0);
+        f
+    }
+
+    /// Number of time frames.
+    pub fn frame_count(&self) -> usize {
+        self.frames.len()
+    }
+
+    /// Grid size `(nx, ny)`.
+    pub fn grid_size(&self) -> (usize, usize) {
+        (self.nx, self.ny)
+    }
+
+    fn set_time(&mut self, t_s: f64) {
+        self.time_s = t_s;
+        let n = self.frames.len();
+        let k = self.frames.partition_point(|f| f.t_s <= t_s);
+        if k == 0 {
+            (self.frame, self.blend) = (0, 0.0);
+        } else if k >= n {
+            (self.frame, self.blend) = (n - 1, 0.0);
+        } else {
+            let (a, b) = (&self.frames[k - 1], &self.frames[k]);
+            (self.frame, self.blend) = (k - 1, (t_s - a.t_s) / (b.t_s - a.t_s));
+        }
+    }
+
+    #[inline]
+    fn sample(&self, frame: &Frame, i: usize, j: usize, tx: f64, ty: f64) -> (f64, f64) {
+        let k00 = j * self.nx + i;
+        let (k10, k01, k11) = (k00 + 1, k00 + self.nx, k00 + self.nx + 1);
+        let (w00, w10, w01, w11) = ((1.0 - tx) * (1.0 - ty), tx * (1.0 - ty), (1.0 - tx) * ty, tx * ty);
+        (
+            w00 * frame.u[k00] + w10 * frame.u[k10] + w01 * frame.u[k01] + w11 * frame.u[k11],
+            w00 * frame.v[k00] + w10 * frame.v[k10] + w01 * frame.v[k01] + w11 * frame.v[k11],
+        )
+    }
+}
+
+impl FlowField for GriddedFlow {
+    fn name(&self) -> &'static str {
+        "gridded"
+    }
+    fn time_s(&self) -> f64 {
+        self.time_s
+    }
+    fn velocity(&self, pos_m: Vec2) -> Vec2 {
+        let (i, tx) = axis_weight(pos_m.x, self.x0_m, self.inv_dx, self.nx);
+        let (j, ty) = axis_weight(pos_m.y, self.y0_m, self.inv_dy, self.ny);
+        let (u0, v0) = self.sample(&self.frames[self.frame], i, j, tx, ty);
+        if self.blend > 0.0 {
+            let (u1, v1) = self.sample(&self.frames[self.frame + 1], i, j, tx, ty);
+            let b = self.blend;
+            Vec2::new(u0 + b * (u1 - u0), v0 + b * (v1 - v0))
+        } else {
+            Vec2::new(u0, v0)
+        }
+    }
+    fn advance(&mut self, t_new_s: f64, _dt_s: f64, _rng: &mut SimRng) -> Result<(), EnvError> {
+        self.set_time(t_new_s);
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::{StreamId, stream_rng};
+    use std::io::Write;
+
+    fn write_tmp(name: &str, text: &str) -> std::path::PathBuf {
+        let dir = std::env::temp_dir().join(format!("plumetrace-gridded-{}-{name}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let p = dir.join("flow.csv");
+        let mut f = std::fs::File::create(&p).unwrap();
+        f.write_all(text.as_bytes()).unwrap();
+        p
+    }
+
+    #[test]
+    fn reads_grid_and_interpolates_in_space_and_time() {
+        let mut text = String::from("t_s,x_m,y_m,u_mps,v_mps\n");
+        for (t, scale) in [(0.0, 1.0), (10.0, 3.0)] {
+            for y in [0.0, 10.0] {
+                for x in [0.0, 10.0, 20.0] {
+                    text += &format!("{t},{x},{y},{},{}\n", scale * x / 10.0, -y / 10.0);
+                }
+            }
+        }
+        let p = write_tmp("ok", &text);
+        let mut f = GriddedFlow::from_csv(&p).unwrap();
+        assert_eq!(f.frame_count(), 2);
+        assert_eq!(f.grid_size(), (3, 2));
+        let v = f.velocity(Vec2::new(5.0, 5.0));
+        assert!((v.x - 0.5).abs() < 1e-12 && (v.y + 0.5).abs() < 1e-12, "{v:?}");
+        let mut rng = stream_rng(0, StreamId::Flow);
+        f.advance(5.0, 5.0, &mut rng).unwrap();
+        let v = f.velocity(Vec2::new(15.0, 0.0));
+        assert!((v.x - 1.5 * 2.0).abs() < 1e-12, "{v:?}");
+        f.advance(50.0, 45.0, &mut rng).unwrap();
+        let v = f.velocity(Vec2::new(15.0, 0.0));
+        assert!((v.x - 4.5).abs() < 1e-12, "held last frame: {v:?}");
+    }
+
+    #[test]
+    fn missing_node_and_bad_numbers_are_located() {
+        let p = write_tmp("missing", "x_m,y_m,u_mps,v_mps\n0,0,1,0\n10,0,1,0\n0,10,1,0\n");
+        let e = GriddedFlow::from_csv(&p).unwrap_err().to_string();
+        assert!(e.contains("missing") && e.contains("flow.csv"), "{e}");
+        let p = write_tmp("nan", "x_m,y_m,u_mps,v_mps\n0,0,1,0\n10,0,abc,0\n");
+        let e = GriddedFlow::from_csv(&p).unwrap_err().to_string();
+        assert!(e.contains("line 3") && e.contains("u_mps"), "{e}");
+        let p = write_tmp("hdr", "a,b\n1,2\n");
+        let e = GriddedFlow::from_csv(&p).unwrap_err().to_string();
+        assert!(e.contains("header"), "{e}");
+    }
+}

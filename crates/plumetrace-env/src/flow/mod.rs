@@ -1,0 +1,130 @@
+//! Flow (current) fields: where the water goes.
+//!
+//! Every model answers the same two questions through [`FlowField`]: the water velocity at a
+//! position at the field's current time, and how to advance to the next time. Stateful models
+//! (the Farrell field) hold one snapshot in time; analytic ones evaluate any time but are still
+//! advanced so that all models are driven the same way.
+//!
+//! Models:
+//! - [`UniformFlow`]: the same velocity everywhere, steady or varying in time ([`MeanFlow`]);
+//! - [`FarrellFlow`]: the meandering field of Farrell et al. (2002), driven by coloured noise at
+//!   the corners of a grid and advanced by explicit advection-diffusion;
+//! - [`GriddedFlow`]: a regular grid (optionally several time frames) read from a CSV file.
+
+mod farrell;
+mod gridded;
+mod mean;
+mod uniform;
+
+pub use farrell::{ColouredNoise, FarrellFlow, FarrellParams};
+pub use gridded::GriddedFlow;
+pub use mean::MeanFlow;
+pub use uniform::UniformFlow;
+
+use crate::{EnvError, SimRng};
+use plumetrace_core::Vec2;
+
+/// A water velocity field in the horizontal plane (`(east, north)` in m/s).
+pub trait FlowField: Send + Sync + std::fmt::Debug {
+    /// A short name for logs ("uniform", "farrell", ...).
+    fn name(&self) -> &'static str;
+
+    /// The field's current time, s.
+    fn time_s(&self) -> f64;
+
+    /// Water velocity at `pos_m` at the current time.
+    fn velocity(&self, pos_m: Vec2) -> Vec2;
+
+    /// Water velocities at many positions (the filament hot path); `x`, `y`, `u`, `v` have the
+    /// same length.
+    fn velocities(&self, x: &[f64], y: &[f64], u: &mut [f64], v: &mut [f64]) {
+        for i in 0..x.len().min(y.len()).min(u.len()).min(v.len()) {
+            let w = self.velocity(Vec2::new(x[i], y[i]));
+            u[i] = w.x;
+            v[i] = w.y;
+        }
+    }
+
+    /// Advances the field by `dt_s` to time `t_new_s` (the caller's step count times `dt_s`),
+    /// drawing any noise from `rng`.
+    fn advance(&mut self, t_new_s: f64, dt_s: f64, rng: &mut SimRng) -> Result<(), EnvError>;
+
+    /// The largest time step the model can be advanced with stably, if it has a limit.
+    fn max_stable_dt_s(&self) -> Option<f64> {
+        None
+    }
+}
+
+/// The flow models known to plumetrace, for static dispatch and for the model registry.
+#[derive(Debug)]
+pub enum FlowModel {
+    /// Uniform in space, steady or varying in time.
+    Uniform(UniformFlow),
+    /// Farrell et al. (2002) meandering field.
+    Farrell(Box<FarrellFlow>),
+    /// Read from a file.
+    Gridded(Box<GriddedFlow>),
+}
+
+impl FlowModel {
+    /// Names and one-line descriptions of the flow models, for `list` commands and docs.
+    pub const REGISTRY: &'static [(&'static str, &'static str)] = &[
+        ("uniform", "same velocity everywhere; steady or tidal (speed and direction varying in time)"),
+        ("farrell", "Farrell et al. 2002 meandering field: coloured-noise corners, advection-diffusion interior"),
+        ("gridded", "regular grid read from a CSV file (x_m,y_m,u_mps,v_mps[,t_s]), bilinear in space, linear in time"),
+    ];
+
+    fn inner(&self) -> &dyn FlowField {
+        match self {
+            FlowModel::Uniform(f) => f,
+            FlowModel::Farrell(f) => f.as_ref(),
+            FlowModel::Gridded(f) => f.as_ref(),
+        }
+    }
+
+    fn inner_mut(&mut self) -> &mut dyn FlowField {
+        match self {
+            FlowModel::Uniform(f) => f,
+            FlowModel::Farrell(f) => f.as_mut(),
+            FlowModel::Gridded(f) => f.as_mut(),
+        }
+    }
+}
+
+impl FlowField for FlowModel {
+    fn name(&self) -> &'static str {
+        self.inner().name()
+    }
+    fn time_s(&self) -> f64 {
+        self.inner().time_s()
+    }
+    fn velocity(&self, pos_m: Vec2) -> Vec2 {
+        self.inner().velocity(pos_m)
+    }
+    fn velocities(&self, x: &[f64], y: &[f64], u: &mut [f64], v: &mut [f64]) {
+        self.inner().velocities(x, y, u, v)
+    }
+    fn advance(&mut self, t_new_s: f64, dt_s: f64, rng: &mut SimRng) -> Result<(), EnvError> {
+        self.inner_mut().advance(t_new_s, dt_s, rng)
+    }
+    fn max_stable_dt_s(&self) -> Option<f64> {
+        self.inner().max_stable_dt_s()
+    }
+}
+
+/// Bilinear interpolation weights on a regular axis: index of the lower node (clamped to the grid)
+/// and the fraction towards the next node (clamped to [0, 1]). Positions outside the grid take the
+/// value at the nearest edge.
+#[inline]
+pub(crate) fn axis_weight(pos: f64, origin: f64, inv_step: f64, n: usize) -> (usize, f64) {
+    if n < 2 {
+        return (0, 0.0);
+    }
+    let f = (pos - origin) * inv_step;
+    let max_lower = (n - 2) as f64;
+    let fl = f.floor().clamp(0.0, max_lower);
+    let t = (f - fl).clamp(0.0, 1.0);
+    // `fl` is clamped to [0, n-2] so the cast cannot overflow; NaN positions clamp to 0.
+    let i = if fl.is_nan() { 0 } else { fl as usize };
+    (i, if t.is_nan() { 0.0 } else { t })
+}

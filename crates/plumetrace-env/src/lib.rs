@@ -1,0 +1,29 @@
+//! The simulated ocean of plumetrace.
+//!
+//! This crate is the simulator's truth: where the water goes ([`flow`]), where the chemical is
+//! ([`plume`], [`steady`]), what the vehicles must not enter ([`obstacle`]) and the seeded random
+//! streams that make every run reproducible ([`rng`]). The onboard side of plumetrace never
+//! depends on it: a planner only sees what a vehicle's sensors report.
+//!
+//! The main types are [`Environment`], which steps a flow field and a plume together, the
+//! [`FlowField`] trait with its four models, and [`ConcentrationField`], answered by the filament
+//! plume, the steady plume and gridded fields alike.
+
+pub mod domain;
+pub mod environment;
+pub mod error;
+pub mod field;
+pub mod flow;
+pub mod obstacle;
+pub mod plume;
+pub mod rng;
+pub mod steady;
+
+pub use domain::Rect;
+pub use environment::{Environment, Plume};
+pub use error::EnvError;
+pub use field::{ConcentrationField, GridSpec, MeanConcentrationGrid};
+pub use flow::{FlowField, FlowModel};
+pub use obstacle::{ObstacleSet, SoftObstacle};
+pub use plume::{FilamentParams, FilamentPlume, PlumeStats, Source, VerticalBoundary};
+pub use rng::{SimRng, StreamId, stream_rng};

@@ -1,0 +1,342 @@
+//! Filament storage, release, transport and growth.
+
+use super::index::CellIndex;
+use crate::error::{EnvError, require_finite, require_non_negative, require_positive};
+use crate::field::ConcentrationField;
+use crate::flow::FlowField;
+use crate::{Rect, SimRng};
+use plumetrace_core::Vec3;
+use rand_distr::{Distribution, Poisson, StandardNormal};
+use serde::{Deserialize, Serialize};
+use std::sync::OnceLock;
+
+/// A chemical source.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct Source {
+    /// Position `(east, north, height above seabed)`, m.
+    pub pos_m: Vec3,
+    /// Chemical released per second (mass units / s; concentrations come out in mass units / m^3).
+    pub mass_rate_per_s: f64,
+    /// Mean filament release rate, filaments / s (Poisson).
+    pub filament_rate_hz: f64,
+}
+
+/// How filaments behave at the seabed (z = 0) and surface.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub enum VerticalBoundary {
+    /// The seabed reflects filaments (and, with a depth, so does the surface); concentrations add
+    /// the mirror image so that no chemical is lost through the boundary.
+    Reflecting {
+        /// Water depth, m: where the surface reflects; `None` for no surface.
+        depth_m: Option<f64>,
+    },
+    /// No vertical boundary (the pompy behaviour).
+    Unbounded,
+}
+
+/// The centre-relative random walk of filaments.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub enum Dispersion {
+    /// Displacement variance `2 K dt` per axis per step.
+    Physical {
+        /// Horizontal diffusivity, m^2/s.
+        horizontal_m2ps: f64,
+        /// Vertical diffusivity, m^2/s.
+        vertical_m2ps: f64,
+    },
+    /// pompy's scaling: displacement `scale * N(0, 1) * dt` per axis per step (dt-dependent).
+    PompyCompatible {
+        /// pompy's `centre_rel_diff_scale`, m/s, per axis `[x, y, z]`.
+        scale_mps: [f64; 3],
+    },
+}
+
+/// Parameters of the filament model.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct FilamentParams {
+    /// Centre-relative dispersion.
+    pub dispersion: Dispersion,
+    /// Radius at release, m.
+    pub init_radius_m: f64,
+    /// Growth rate `gamma` of the squared radius, m^2/s.
+    pub growth_rate_m2ps: f64,
+    /// Concentration is cut off beyond this many radii.
+    pub cutoff_radii: f64,
+    /// At most this many live filaments; releases beyond it are suppressed and counted.
+    pub max_filaments: usize,
+    /// Vertical boundary behaviour.
+    pub vertical: VerticalBoundary,
+}
+
+impl Default for FilamentParams {
+    /// pompy's defaults for puff size and growth, a physical random walk, a reflecting seabed.
+    fn default() -> Self {
+        FilamentParams {
+            dispersion: Dispersion::Physical { horizontal_m2ps: 0.02, vertical_m2ps: 0.002 },
+            init_radius_m: 0.0316,
+            growth_rate_m2ps: 0.001,
+            cutoff_radii: 3.0,
+            max_filaments: 2_000_000,
+            vertical: VerticalBoundary::Reflecting { depth_m: None },
+        }
+    }
+}
+
+impl FilamentParams {
+    /// Checks every parameter; errors name the `plume.*` key.
+    pub fn validate(&self) -> Result<(), EnvError> {
+        match self.dispersion {
+            Dispersion::Physical { horizontal_m2ps, vertical_m2ps } => {
+                require_non_negative("plume.horizontal_diffusivity_m2ps", horizontal_m2ps)?;
+                require_non_negative("plume.vertical_diffusivity_m2ps", vertical_m2ps)?;
+            }
+            Dispersion::PompyCompatible { scale_mps } => {
+                for s in scale_mps {
+                    require_non_negative("plume.pompy_diff_scale_mps", s)?;
+                }
+            }
+        }
+        require_positive("plume.init_radius_m", self.init_radius_m)?;
+        require_non_negative("plume.growth_rate_m2ps", self.growth_rate_m2ps)?;
+        require_positive("plume.cutoff_radii", self.cutoff_radii)?;
+        if self.max_filaments == 0 {
+            return Err(EnvError::invalid("plume.max_filaments", "must be at least 1"));
+        }
+        if let VerticalBoundary::Reflecting { depth_m: Some(d) } = self.vertical {
+            require_positive("environment.depth_m", d)?;
+        }
+        Ok(())
+    }
+}
+
+/// Running totals of the plume.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
+pub struct PlumeStats {
+    /// Filaments alive now.
+    pub live: usize,
+    /// Filaments released so far.
+    pub released: u64,
+    /// Mass released so far.
+    pub released_mass: f64,
+    /// Filaments removed on leaving the domain.
+    pub exited: u64,
+    /// Mass removed on leaving the domain.
+    pub exited_mass: f64,
+    /// Releases suppressed by `max_filaments`.
+    pub suppressed: u64,
+}
+
+/// The filament plume: filaments stored as parallel arrays (structure of arrays).
+#[derive(Debug)]
+pub struct FilamentPlume {
+    params: FilamentParams,
+    domain: Rect,
+    sources: Vec<Source>,
+    release: Vec<Option<Poisson<f64>>>,
+    release_dt_s: f64,
+    pub(crate) x: Vec<f64>,
+    pub(crate) y: Vec<f64>,
+    pub(crate) z: Vec<f64>,
+    pub(crate) r2: Vec<f64>,
+    pub(crate) mass: Vec<f64>,
+    pub(crate) source: Vec<u16>,
+    u: Vec<f64>,
+    v: Vec<f64>,
+    stats: PlumeStats,
+    index: OnceLock<CellIndex>,
+}
+
+impl FilamentPlume {
+    /// A plume with no filaments yet.
+    pub fn new(domain: Rect, sources: Vec<Source>, params: FilamentParams) -> Result<Self, EnvError> {
+        params.validate()?;
+        if sources.len() > usize::from(u16::MAX) {
+            return Err(EnvError::invalid("sources", "at most 65535 sources"));
+        }
+        for (k, s) in sources.iter().enumerate() {
+            let key = |f: &str| format!("sources[{k}].{f}");
+            require_finite(&key("x_m"), s.pos_m.x)?;
+            require_finite(&key("y_m"), s.pos_m.y)?;
+            require_non_negative(&key("z_m"), s.pos_m.z)?;
+            require_non_negative(&key("mass_rate_per_s"), s.mass_rate_per_s)?;
+            require_non_negative(&key("filament_rate_hz"), s.filament_rate_hz)?;
+            if !domain.contains_xy(s.pos_m.x, s.pos_m.y) {
+                return Err(EnvError::invalid(
+                    key("x_m"),
+                    format!("source at ({}, {}) is outside the domain", s.pos_m.x, s.pos_m.y),
+                ));
+            }
+            if let VerticalBoundary::Reflecting { depth_m: Some(d) } = params.vertical {
+                if s.pos_m.z > d {
+                    return Err(EnvError::invalid(key("z_m"), format!("{} m is above the surface ({d} m)", s.pos_m.z)));
+                }
+            }
+        }
+        Ok(FilamentPlume {
+            params,
+            domain,
+            release: vec![None; sources.len()],
+            sources,
+            release_dt_s: f64::NAN,
+            x: Vec::new(),
+            y: Vec::new(),
+            z: Vec::new(),
+            r2: Vec::new(),
+            mass: Vec::new(),
+            source: Vec::new(),
+            u: Vec::new(),
+            v: Vec::new(),
+            stats: PlumeStats::default(),
+            index: OnceLock::new(),
+        })
+    }
+
+    /// The sources.
+    pub fn sources(&self) -> &[Source] {
+        &self.sources
+    }
+
+    /// The model parameters.
+    pub fn params(&self) -> &FilamentParams {
+        &self.params
+    }
+
+    /// Running totals.
+    pub fn stats(&self) -> PlumeStats {
+        PlumeStats { live: self.x.len(), ..self.stats }
+    }
+
+    /// Number of live filaments.
+    pub fn len(&self) -> usize {
+        self.x.len()
+    }
+
+    /// Whether there are no live filaments.
+    pub fn is_empty(&self) -> bool {
+        self.x.is_empty()
+    }
+
+    /// Total mass of the live filaments.
+    pub fn live_mass(&self) -> f64 {
+        self.mass.iter().sum()
+    }
+
+    /// Filament centres `(x, y, z)` and squared radii, for statistics and plots.
+    pub fn filaments(&self) -> impl Iterator<Item = (Vec3, f64)> + '_ {
+        (0..self.x.len()).map(|k| (Vec3::new(self.x[k], self.y[k], self.z[k]), self.r2[k]))
+    }
+
+    /// Releases `n` filaments at source `k` (also used to seed a plume at t = 0).
+    pub fn release_at_source(&mut self, k: usize, n: u64) {
+        let Some(s) = self.sources.get(k).copied() else { return };
+        let room = self.params.max_filaments.saturating_sub(self.x.len()) as u64;
+        let take = n.min(room);
+        self.stats.suppressed += n - take;
+        if take == 0 {
+            return;
+        }
+        let q = if s.filament_rate_hz > 0.0 { s.mass_rate_per_s / s.filament_rate_hz } else { 0.0 };
+        let r2 = self.params.init_radius_m * self.params.init_radius_m;
+        for _ in 0..take {
+            self.x.push(s.pos_m.x);
+            self.y.push(s.pos_m.y);
+            self.z.push(s.pos_m.z);
+            self.r2.push(r2);
+            self.mass.push(q);
+            self.source.push(k as u16);
+        }
+        self.stats.released += take;
+        self.stats.released_mass += q * take as f64;
+    }
+
+    /// Advances the plume by `dt_s` in `flow` (already advanced to the new time).
+    pub fn step(&mut self, flow: &dyn FlowField, dt_s: f64, rng: &mut SimRng) {
+        self.index = OnceLock::new();
+        self.release(dt_s, rng);
+        let n = self.x.len();
+        self.u.resize(n, 0.0);
+        self.v.resize(n, 0.0);
+        flow.velocities(&self.x, &self.y, &mut self.u, &mut self.v);
+        let (sx, sy, sz) = match self.params.dispersion {
+            Dispersion::Physical { horizontal_m2ps, vertical_m2ps } => {
+                let h = (2.0 * horizontal_m2ps * dt_s).sqrt();
+                (h, h, (2.0 * vertical_m2ps * dt_s).sqrt())
+            }
+            Dispersion::PompyCompatible { scale_mps } => (scale_mps[0] * dt_s, scale_mps[1] * dt_s, scale_mps[2] * dt_s),
+        };
+        let dr2 = self.params.growth_rate_m2ps * dt_s;
+        let (floor, ceiling) = match self.params.vertical {
+            VerticalBoundary::Reflecting { depth_m } => (0.0, depth_m.unwrap_or(f64::INFINITY)),
+            VerticalBoundary::Unbounded => (f64::NEG_INFINITY, f64::INFINITY),
+        };
+        let d = self.domain;
+        let mut keep = 0usize;
+        for k in 0..n {
+            let nx: f64 = StandardNormal.sample(rng);
+            let ny: f64 = StandardNormal.sample(rng);
+            let nz: f64 = StandardNormal.sample(rng);
+            let x = self.x[k] + self.u[k] * dt_s + sx * nx;
+            let y = self.y[k] + self.v[k] * dt_s + sy * ny;
+            let mut z = self.z[k] + sz * nz;
+            if z < floor {
+                z = 2.0 * floor - z;
+            }
+            if z > ceiling {
+                z = (2.0 * ceiling - z).max(floor);
+            }
+            let r2 = self.r2[k] + dr2;
+            if d.contains_xy(x, y) {
+                self.x[keep] = x;
+                self.y[keep] = y;
+                self.z[keep] = z;
+                self.r2[keep] = r2;
+                self.mass[keep] = self.mass[k];
+                self.source[keep] = self.source[k];
+                keep += 1;
+            } else {
+                self.stats.exited += 1;
+                self.stats.exited_mass += self.mass[k];
+            }
+        }
+        for v in [&mut self.x, &mut self.y, &mut self.z, &mut self.r2, &mut self.mass] {
+            v.truncate(keep);
+        }
+        self.source.truncate(keep);
+    }
+
+    fn release(&mut self, dt_s: f64, rng: &mut SimRng) {
+        if dt_s != self.release_dt_s {
+            self.release_dt_s = dt_s;
+            self.release = self
+                .sources
+                .iter()
+                .map(|s| Poisson::new(s.filament_rate_hz * dt_s).ok())
+                .collect();
+        }
+        for k in 0..self.sources.len() {
+            let n = match &self.release[k] {
+                Some(p) => p.sample(rng),
+                None => 0.0,
+            };
+            if n > 0.0 {
+                self.release_at_source(k, n as u64);
+            }
+        }
+    }
+
+    fn index(&self) -> &CellIndex {
+        self.index.get_or_init(|| CellIndex::build(self, self.domain, self.params.cutoff_radii, self.params.vertical))
+    }
+
+    /// Builds the query index now (it is otherwise built by the first query after a step); lets a
+    /// benchmark time the build apart from the queries.
+    pub fn prepare_queries(&self) {
+        let _ = self.index();
+    }
+}
+
+impl ConcentrationField for FilamentPlume {
+    fn concentration(&self, p: Vec3) -> f64 {
+        self.index().concentration(p)
+    }
+}
