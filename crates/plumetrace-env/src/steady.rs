@@ -58,7 +58,7 @@ impl GaussianPlume {
         require_positive("plume.horizontal_diffusivity_m2ps", k_cross_m2ps)?;
         require_positive("plume.vertical_diffusivity_m2ps", k_vert_m2ps)?;
         if let Some(d) = depth_m {
-            require_positive("environment.depth_m", d)?;
+            require_positive("domain.depth_m", d)?;
             if source_m.z > d {
                 return Err(EnvError::invalid("source.z_m", format!("{} m is above the surface ({d} m)", source_m.z)));
             }

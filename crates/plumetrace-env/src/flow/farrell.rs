@@ -144,19 +144,19 @@ impl FarrellFlow {
     pub fn new(region: Rect, mean: MeanFlow, params: FarrellParams, dt_s: f64) -> Result<Self, EnvError> {
         mean.validate("flow.mean")?;
         if params.nx < 3 {
-            return Err(EnvError::invalid("flow.nx", format!("must be >= 3, got {}", params.nx)));
+            return Err(EnvError::invalid("flow.farrell.nx", format!("must be >= 3, got {}", params.nx)));
         }
         if params.ny < 3 {
-            return Err(EnvError::invalid("flow.ny", format!("must be >= 3, got {}", params.ny)));
+            return Err(EnvError::invalid("flow.farrell.ny", format!("must be >= 3, got {}", params.ny)));
         }
         if params.nx * params.ny > 4_000_000 {
-            return Err(EnvError::invalid("flow.nx", "nx * ny must be at most 4,000,000"));
+            return Err(EnvError::invalid("flow.farrell.nx", "nx * ny must be at most 4,000,000"));
         }
-        require_positive("flow.diffusivity_x_m2ps", params.diffusivity_x_m2ps)?;
-        require_positive("flow.diffusivity_y_m2ps", params.diffusivity_y_m2ps)?;
-        require_non_negative("flow.noise_gain", params.noise_gain)?;
-        require_positive("flow.noise_damping", params.noise_damping)?;
-        require_positive("flow.noise_bandwidth_radps", params.noise_bandwidth_radps)?;
+        require_positive("flow.farrell.diffusivity_x_m2ps", params.diffusivity_x_m2ps)?;
+        require_positive("flow.farrell.diffusivity_y_m2ps", params.diffusivity_y_m2ps)?;
+        require_non_negative("flow.farrell.noise_gain", params.noise_gain)?;
+        require_positive("flow.farrell.noise_damping", params.noise_damping)?;
+        require_positive("flow.farrell.noise_bandwidth_radps", params.noise_bandwidth_radps)?;
         require_positive("sim.dt_s", dt_s)?;
         let dx_m = region.width_m() / (params.nx - 1) as f64;
         let dy_m = region.height_m() / (params.ny - 1) as f64;

@@ -103,7 +103,7 @@ impl FilamentParams {
             return Err(EnvError::invalid("plume.max_filaments", "must be at least 1"));
         }
         if let VerticalBoundary::Reflecting { depth_m: Some(d) } = self.vertical {
-            require_positive("environment.depth_m", d)?;
+            require_positive("domain.depth_m", d)?;
         }
         Ok(())
     }

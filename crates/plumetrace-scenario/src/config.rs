@@ -1,0 +1,287 @@
+//! The serde layer: a mirror of the scenario TOML. Types only; values are checked in
+//! [`crate::build`]. Every key carries its unit (`_m`, `_s`, `_mps`, `_deg`, `_m2ps`, `_hz`).
+
+use serde::{Deserialize, Serialize};
+use std::path::PathBuf;
+
+/// A whole scenario file.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ScenarioConfig {
+    /// Short name.
+    pub name: String,
+    /// One line saying what the scenario is for.
+    #[serde(default)]
+    pub description: String,
+    /// Run seed (overridable with `--seed`).
+    #[serde(default)]
+    pub seed: u64,
+    /// Time stepping.
+    pub sim: SimConfig,
+    /// The simulated region.
+    pub domain: DomainConfig,
+    /// The flow field.
+    pub flow: FlowConfig,
+    /// The plume model.
+    #[serde(default)]
+    pub plume: PlumeConfig,
+    /// Chemical sources.
+    #[serde(default)]
+    pub sources: Vec<SourceConfig>,
+    /// Soft obstacles (kelp).
+    #[serde(default)]
+    pub obstacles: Vec<ObstacleConfig>,
+    /// What a plume run writes.
+    #[serde(default)]
+    pub output: OutputConfig,
+}
+
+/// `[sim]`
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SimConfig {
+    /// Time step, s.
+    pub dt_s: f64,
+    /// Simulated duration, s.
+    pub duration_s: f64,
+}
+
+/// `[domain]`: the rectangle the simulation covers; filaments leaving it are removed.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct DomainConfig {
+    /// West edge, m.
+    pub x_min_m: f64,
+    /// East edge, m.
+    pub x_max_m: f64,
+    /// South edge, m.
+    pub y_min_m: f64,
+    /// North edge, m.
+    pub y_max_m: f64,
+    /// Water depth, m (the surface reflects filaments); absent = no surface.
+    pub depth_m: Option<f64>,
+}
+
+/// Which flow model.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum FlowKind {
+    /// Uniform in space (steady or tidal).
+    Uniform,
+    /// Farrell meandering field.
+    Farrell,
+    /// From a CSV file.
+    Gridded,
+}
+
+/// `[flow]`
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct FlowConfig {
+    /// Model name: "uniform", "farrell" or "gridded".
+    pub model: FlowKind,
+    /// Mean flow (uniform and farrell).
+    pub mean: Option<MeanFlowConfig>,
+    /// Farrell grid and noise parameters.
+    pub farrell: Option<FarrellConfig>,
+    /// CSV file for "gridded" (relative to the scenario file).
+    pub file: Option<PathBuf>,
+}
+
+/// `[flow.mean]`: steady (`speed_mps`, `toward_deg`) or tidal (`speed_min_mps`, `speed_max_mps`,
+/// `toward_min_deg`, `toward_max_deg`, `period_s`, optional `phase_deg`).
+#[derive(Debug, Clone, Default, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MeanFlowConfig {
+    /// Steady speed, m/s.
+    pub speed_mps: Option<f64>,
+    /// Steady direction (towards), compass degrees.
+    pub toward_deg: Option<f64>,
+    /// Tidal: lowest speed, m/s.
+    pub speed_min_mps: Option<f64>,
+    /// Tidal: highest speed, m/s.
+    pub speed_max_mps: Option<f64>,
+    /// Tidal: one end of the direction swing, degrees.
+    pub toward_min_deg: Option<f64>,
+    /// Tidal: other end of the direction swing, degrees.
+    pub toward_max_deg: Option<f64>,
+    /// Tidal: period, s.
+    pub period_s: Option<f64>,
+    /// Tidal: phase at t = 0, degrees.
+    pub phase_deg: Option<f64>,
+}
+
+/// `[flow.farrell]`: defaults are pompy's.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct FarrellConfig {
+    /// Grid nodes along x.
+    pub nx: usize,
+    /// Grid nodes along y.
+    pub ny: usize,
+    /// Diffusivity along x, m^2/s.
+    pub diffusivity_x_m2ps: f64,
+    /// Diffusivity along y, m^2/s.
+    pub diffusivity_y_m2ps: f64,
+    /// Corner noise gain.
+    pub noise_gain: f64,
+    /// Corner noise damping ratio.
+    pub noise_damping: f64,
+    /// Corner noise bandwidth, rad/s.
+    pub noise_bandwidth_radps: f64,
+    /// Original Farrell noise scaling (dt instead of sqrt(dt)).
+    pub original_noise_updates: bool,
+}
+
+impl Default for FarrellConfig {
+    fn default() -> Self {
+        let p = plumetrace_env::flow::FarrellParams::default();
+        FarrellConfig {
+            nx: p.nx,
+            ny: p.ny,
+            diffusivity_x_m2ps: p.diffusivity_x_m2ps,
+            diffusivity_y_m2ps: p.diffusivity_y_m2ps,
+            noise_gain: p.noise_gain,
+            noise_damping: p.noise_damping,
+            noise_bandwidth_radps: p.noise_bandwidth_radps,
+            original_noise_updates: p.original_noise_updates,
+        }
+    }
+}
+
+/// Which plume model.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum PlumeKind {
+    /// Farrell filaments.
+    Filaments,
+    /// Steady Gaussian plume (first source, mean flow at t = 0).
+    Gaussian,
+    /// Steady grid from a CSV file.
+    Gridded,
+}
+
+/// What the seabed does to filaments.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum SeabedKind {
+    /// Reflects (no chemical lost into the seabed).
+    Reflecting,
+    /// No boundary (pompy).
+    None,
+}
+
+/// `[plume]`
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct PlumeConfig {
+    /// Model name: "filaments", "gaussian" or "gridded".
+    pub model: PlumeKind,
+    /// Horizontal (cross-flow) diffusivity, m^2/s.
+    pub horizontal_diffusivity_m2ps: f64,
+    /// Vertical diffusivity, m^2/s.
+    pub vertical_diffusivity_m2ps: f64,
+    /// Filament radius at release, m.
+    pub init_radius_m: f64,
+    /// Growth of the squared filament radius, m^2/s.
+    pub growth_rate_m2ps: f64,
+    /// Concentration cut-off, in filament radii.
+    pub cutoff_radii: f64,
+    /// Most live filaments.
+    pub max_filaments: usize,
+    /// Filaments released at each source at t = 0 (pompy releases 10).
+    pub initial_filaments: u64,
+    /// Use pompy's dt-scaled random walk instead of the diffusivities.
+    pub pompy_compatible: bool,
+    /// pompy's `centre_rel_diff_scale`, m/s (with `pompy_compatible`).
+    pub pompy_diff_scale_mps: f64,
+    /// Seabed behaviour.
+    pub seabed: SeabedKind,
+    /// CSV file for "gridded".
+    pub file: Option<PathBuf>,
+}
+
+impl Default for PlumeConfig {
+    fn default() -> Self {
+        let p = plumetrace_env::FilamentParams::default();
+        let (h, v) = match p.dispersion {
+            plumetrace_env::plume::Dispersion::Physical { horizontal_m2ps, vertical_m2ps } => (horizontal_m2ps, vertical_m2ps),
+            plumetrace_env::plume::Dispersion::PompyCompatible { .. } => (0.02, 0.002),
+        };
+        PlumeConfig {
+            model: PlumeKind::Filaments,
+            horizontal_diffusivity_m2ps: h,
+            vertical_diffusivity_m2ps: v,
+            init_radius_m: p.init_radius_m,
+            growth_rate_m2ps: p.growth_rate_m2ps,
+            cutoff_radii: p.cutoff_radii,
+            max_filaments: p.max_filaments,
+            initial_filaments: 0,
+            pompy_compatible: false,
+            pompy_diff_scale_mps: 2.0,
+            seabed: SeabedKind::Reflecting,
+            file: None,
+        }
+    }
+}
+
+/// `[[sources]]`
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SourceConfig {
+    /// East, m.
+    pub x_m: f64,
+    /// North, m.
+    pub y_m: f64,
+    /// Height above the seabed, m (0 = on the bottom).
+    #[serde(default)]
+    pub z_m: f64,
+    /// Chemical released per second.
+    #[serde(default = "one")]
+    pub mass_rate_per_s: f64,
+    /// Filaments released per second.
+    #[serde(default = "five")]
+    pub filament_rate_hz: f64,
+}
+
+fn one() -> f64 {
+    1.0
+}
+fn five() -> f64 {
+    5.0
+}
+
+/// `[[obstacles]]`
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ObstacleConfig {
+    /// Name for logs and plots.
+    #[serde(default)]
+    pub name: String,
+    /// Polygon vertices `[east, north]`, m.
+    pub vertices: Vec<[f64; 2]>,
+}
+
+/// `[output]`: the concentration snapshot and the time average written by `plumetrace run`.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct OutputConfig {
+    /// Snapshot grid points along x.
+    pub nx: usize,
+    /// Snapshot grid points along y.
+    pub ny: usize,
+    /// Height of the snapshot plane above the seabed, m.
+    pub z_m: f64,
+    /// Time between samples of the time average, s.
+    pub average_interval_s: f64,
+    /// Start of the time average, s (lets the plume fill the domain first).
+    pub average_start_s: f64,
+    /// Threshold for the intermittency map (fraction of samples above it).
+    pub threshold: f64,
+}
+
+impl Default for OutputConfig {
+    fn default() -> Self {
+        OutputConfig { nx: 201, ny: 201, z_m: 0.0, average_interval_s: 1.0, average_start_s: 0.0, threshold: 0.1 }
+    }
+}

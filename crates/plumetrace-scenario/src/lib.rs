@@ -1,0 +1,69 @@
+//! Scenario files and built-in presets.
+//!
+//! Configuration is read in two phases. [`config`] mirrors the TOML file with serde
+//! (`deny_unknown_fields`, units in key names) and only checks types; [`build`] turns it into
+//! models and checks values, naming the key path of anything wrong. Built-in scenarios live in
+//! one registry, [`presets::PRESETS`], from which `plumetrace presets` and the docs are made.
+
+pub mod build;
+pub mod config;
+pub mod error;
+pub mod presets;
+
+pub use build::{BuiltScenario, OutputSpec, build};
+pub use config::ScenarioConfig;
+pub use error::ScenarioError;
+pub use presets::{PRESETS, Preset, find_preset};
+
+use std::path::Path;
+
+/// Where a scenario came from, for error messages and relative file paths.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum Origin {
+    /// A file on disk.
+    File(std::path::PathBuf),
+    /// A built-in preset, by name.
+    Preset(String),
+}
+
+impl std::fmt::Display for Origin {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Origin::File(p) => write!(f, "{}", p.display()),
+            Origin::Preset(n) => write!(f, "preset '{n}'"),
+        }
+    }
+}
+
+/// Parses scenario TOML text; errors name the key path and the line.
+pub fn parse(text: &str, origin: &Origin) -> Result<ScenarioConfig, ScenarioError> {
+    let de = toml::Deserializer::parse(text).map_err(|e| ScenarioError::Parse {
+        origin: origin.to_string(),
+        path: String::new(),
+        message: e.to_string(),
+    })?;
+    serde_path_to_error::deserialize(de).map_err(|e| {
+        let path = e.path().to_string();
+        ScenarioError::Parse {
+            origin: origin.to_string(),
+            path: if path == "." { String::new() } else { path },
+            message: e.into_inner().to_string(),
+        }
+    })
+}
+
+/// Reads and parses a scenario file.
+pub fn load_file(path: &Path) -> Result<ScenarioConfig, ScenarioError> {
+    let origin = Origin::File(path.to_path_buf());
+    let text = std::fs::read_to_string(path).map_err(|e| ScenarioError::Io { origin: origin.to_string(), message: e.to_string() })?;
+    parse(&text, &origin)
+}
+
+/// Parses a built-in preset by name.
+pub fn load_preset(name: &str) -> Result<ScenarioConfig, ScenarioError> {
+    let preset = find_preset(name).ok_or_else(|| ScenarioError::UnknownPreset {
+        name: name.to_string(),
+        known: PRESETS.iter().map(|p| p.name).collect::<Vec<_>>().join(", "),
+    })?;
+    parse(preset.toml, &Origin::Preset(name.to_string()))
+}

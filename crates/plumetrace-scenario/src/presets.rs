@@ -1,0 +1,60 @@
+//! Built-in scenarios: the one registry that `plumetrace presets`, the docs and the tests read.
+//!
+//! Each preset is a documented TOML file in `crates/plumetrace-scenario/presets/`, compiled into
+//! the binary; copy one as a starting point for your own scenario.
+
+/// A built-in scenario.
+#[derive(Debug, Clone, Copy)]
+pub struct Preset {
+    /// Name used with `--preset`.
+    pub name: &'static str,
+    /// One line for `plumetrace presets`.
+    pub summary: &'static str,
+    /// The TOML text.
+    pub toml: &'static str,
+}
+
+/// Every built-in scenario.
+pub const PRESETS: &[Preset] = &[
+    Preset {
+        name: "demo",
+        summary: "small meandering plume from a bottom source, 200 m x 100 m, 10 min (seconds to run)",
+        toml: include_str!("../presets/demo.toml"),
+    },
+    Preset {
+        name: "pompy",
+        summary: "pompy's own scenario in pompy-compatible mode (100 m, 1 m/s, dt 0.01 s, 5 puffs/s)",
+        toml: include_str!("../presets/pompy.toml"),
+    },
+    Preset {
+        name: "field-scale",
+        summary: "1.1 km domain, 0.1 m/s, ~50,000 live filaments (a benchmark; minutes to run)",
+        toml: include_str!("../presets/field-scale.toml"),
+    },
+    Preset {
+        name: "freshwater",
+        summary: "steady freshwater plume of the formation-tracing experiment (108 m x 40 m x 4 m)",
+        toml: include_str!("../presets/freshwater.toml"),
+    },
+];
+
+/// The preset called `name`.
+pub fn find_preset(name: &str) -> Option<&'static Preset> {
+    PRESETS.iter().find(|p| p.name == name)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::{Origin, build, load_preset};
+
+    #[test]
+    fn every_preset_parses_builds_and_names_itself() {
+        for p in PRESETS {
+            let cfg = load_preset(p.name).unwrap_or_else(|e| panic!("{e}"));
+            assert_eq!(cfg.name, p.name);
+            let built = build(&cfg, &Origin::Preset(p.name.into()), None).unwrap_or_else(|e| panic!("{e}"));
+            assert!(built.steps > 0);
+        }
+    }
+}
