@@ -133,6 +133,9 @@ pub struct FarrellFlow {
     /// Interior-only row-major `ny x nx` copies for fast interpolation.
     u_int: Vec<f64>,
     v_int: Vec<f64>,
+    /// Per grid cell `(nx - 1) x (ny - 1)`, the corner values `[u00, u10, u01, u11, v00, v10,
+    /// v01, v11]` in one 64-byte record, so an interpolation touches one cache line.
+    cells: Vec<[f64; 8]>,
     noise: ColouredNoise,
     time_s: f64,
     max_stable_dt_s: f64,
@@ -182,11 +185,13 @@ impl FarrellFlow {
             v: vec![v0.y; n_all],
             u_int: vec![v0.x; n_int],
             v_int: vec![v0.y; n_int],
+            cells: vec![[0.0; 8]; (params.nx - 1) * (params.ny - 1)],
             noise,
             time_s: 0.0,
             max_stable_dt_s: 0.0,
             max_speed_mps: v0.norm(),
         };
+        flow.refresh_cells();
         flow.max_stable_dt_s = flow.stable_dt_limit(dt_s);
         if dt_s > flow.max_stable_dt_s {
             return Err(EnvError::invalid(
@@ -305,6 +310,7 @@ impl FarrellFlow {
             self.u[row..row + nx].copy_from_slice(&self.u_int[j * nx..(j + 1) * nx]);
             self.v[row..row + nx].copy_from_slice(&self.v_int[j * nx..(j + 1) * nx]);
         }
+        self.refresh_cells();
         // NaN propagates through max() as the other operand, so check separately.
         self.max_speed_mps = if self.u_int.iter().chain(&self.v_int).all(|x| x.is_finite()) {
             max_sq.sqrt()
@@ -313,18 +319,28 @@ impl FarrellFlow {
         };
     }
 
-    #[inline]
+    /// Rebuilds the per-cell corner records from the interior nodes.
+    fn refresh_cells(&mut self) {
+        let nx = self.params.nx;
+        for j in 0..self.params.ny - 1 {
+            for i in 0..nx - 1 {
+                let k00 = j * nx + i;
+                let (k10, k01, k11) = (k00 + 1, k00 + nx, k00 + nx + 1);
+                let (u, v) = (&self.u_int, &self.v_int);
+                self.cells[j * (nx - 1) + i] = [u[k00], u[k10], u[k01], u[k11], v[k00], v[k10], v[k01], v[k11]];
+            }
+        }
+    }
+
+    #[inline(always)]
     fn interp(&self, x: f64, y: f64) -> (f64, f64) {
         let (nx, ny) = (self.params.nx, self.params.ny);
         let (i, tx) = axis_weight(x, self.region.x_min_m, self.inv_dx, nx);
         let (j, ty) = axis_weight(y, self.region.y_min_m, self.inv_dy, ny);
-        let k00 = j * nx + i;
-        let k10 = k00 + 1;
-        let k01 = k00 + nx;
-        let k11 = k01 + 1;
+        let c = &self.cells[j * (nx - 1) + i];
         let (w00, w10, w01, w11) = ((1.0 - tx) * (1.0 - ty), tx * (1.0 - ty), (1.0 - tx) * ty, tx * ty);
-        let u = w00 * self.u_int[k00] + w10 * self.u_int[k10] + w01 * self.u_int[k01] + w11 * self.u_int[k11];
-        let v = w00 * self.v_int[k00] + w10 * self.v_int[k10] + w01 * self.v_int[k01] + w11 * self.v_int[k11];
+        let u = w00 * c[0] + w10 * c[1] + w01 * c[2] + w11 * c[3];
+        let v = w00 * c[4] + w10 * c[5] + w01 * c[6] + w11 * c[7];
         (u, v)
     }
 }
@@ -458,6 +474,7 @@ mod tests {
                 f.u_int[j * nx + i] = (i as f64 * f.dx_m) / 10.0;
             }
         }
+        f.refresh_cells();
         for x in [0.0_f64, 2.5, 5.0, 33.3, 99.9, 100.0, 120.0, -5.0] {
             let want = x.clamp(0.0, 100.0) / 10.0;
             let got = f.velocity(Vec2::new(x, 7.0)).x;

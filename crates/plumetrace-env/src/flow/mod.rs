@@ -113,18 +113,21 @@ impl FlowField for FlowModel {
 }
 
 /// Bilinear interpolation weights on a regular axis: index of the lower node (clamped to the grid)
-/// and the fraction towards the next node (clamped to [0, 1]). Positions outside the grid take the
-/// value at the nearest edge.
-#[inline]
+/// and the fraction towards the next node (in [0, 1]). Positions outside the grid take the value
+/// at the nearest edge; NaN positions take the first node.
+///
+/// The position is clamped to [0, n - 1] before truncation, so truncation equals `floor` and no
+/// libm call is needed in the filament hot path.
+#[inline(always)]
 pub(crate) fn axis_weight(pos: f64, origin: f64, inv_step: f64, n: usize) -> (usize, f64) {
     if n < 2 {
         return (0, 0.0);
     }
     let f = (pos - origin) * inv_step;
-    let max_lower = (n - 2) as f64;
-    let fl = f.floor().clamp(0.0, max_lower);
-    let t = (f - fl).clamp(0.0, 1.0);
-    // `fl` is clamped to [0, n-2] so the cast cannot overflow; NaN positions clamp to 0.
-    let i = if fl.is_nan() { 0 } else { fl as usize };
-    (i, if t.is_nan() { 0.0 } else { t })
+    // `f > 0.0` is false for NaN, which therefore maps to 0.
+    let f = if f > 0.0 { f } else { 0.0 };
+    let last = (n - 1) as f64;
+    let f = if f < last { f } else { last };
+    let i = (f as usize).min(n - 2);
+    (i, f - i as f64)
 }

@@ -1,0 +1,246 @@
+//! `plumetrace bench plume`: times the plume model and prints one JSON object.
+//!
+//! The pompy case is pompy's own scenario (x 0-100 m, y -50-50 m, 21 x 21 Farrell grid, 1 m/s,
+//! source at (5, 0), dt 0.01 s); the field case is the `field-scale` preset. After a warm-up the
+//! environment is stepped for `--duration` simulated seconds; the CPU time of those steps over the
+//! sum of live filaments gives the cost per filament-step (flow update included, as in pompy's
+//! figure). Point queries are then timed on the final filament set, apart from the one-off index
+//! build, at points drawn around live filaments (inside the plume, the costly case) and uniformly
+//! over the domain. Cross-flow spread statistics at x = 25, 50 and 75 m are gathered every
+//! simulated second for the comparison with pompy.
+
+use anyhow::{Result, bail};
+use cpu_time::ProcessTime;
+use plumetrace_core::Vec3;
+use plumetrace_env::{ConcentrationField, Environment, StreamId, stream_rng};
+use rand::Rng;
+use serde::Serialize;
+use std::collections::BTreeMap;
+use std::time::Instant;
+
+/// Benchmarks.
+#[derive(Debug, clap::Subcommand)]
+pub enum BenchCommand {
+    /// Time the filament plume (stepping and point queries).
+    Plume(PlumeBenchArgs),
+}
+
+/// Which scenario to benchmark.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Case {
+    /// pompy's scenario.
+    Pompy,
+    /// The field-scale preset (1.1 km, ~50,000 filaments).
+    Field,
+}
+
+/// Arguments of `plumetrace bench plume`.
+#[derive(Debug, clap::Args)]
+pub struct PlumeBenchArgs {
+    /// Scenario to time.
+    #[arg(long, value_enum, default_value = "pompy")]
+    case: Case,
+    /// Filament release rate, per second (default: 5, the scenario's).
+    #[arg(long)]
+    release_rate: Option<f64>,
+    /// Simulated seconds timed after the warm-up (default: 20 for pompy, 200 for field).
+    #[arg(long)]
+    duration: Option<f64>,
+    /// Time step, s (default: 0.01 for pompy, 0.1 for field).
+    #[arg(long)]
+    dt: Option<f64>,
+    /// Simulated seconds before timing starts, to fill the domain (default: 100 for pompy,
+    /// 11000 for field).
+    #[arg(long)]
+    warmup: Option<f64>,
+    /// Use pompy's dt-scaled dispersion (the pompy case always does; this switches it on for field).
+    #[arg(long)]
+    pompy_compatible: bool,
+    /// Use physical dispersion in the pompy case instead of pompy's scaling.
+    #[arg(long, conflicts_with = "pompy_compatible")]
+    physical: bool,
+    /// Number of point queries to time.
+    #[arg(long, default_value_t = 200_000)]
+    queries: usize,
+    /// Run seed.
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+}
+
+#[derive(Debug, Serialize)]
+struct PlumeBench {
+    case: Case,
+    pompy_compatible: bool,
+    release_rate_hz: f64,
+    dt_s: f64,
+    warmup_s: f64,
+    duration_s: f64,
+    steps_timed: u64,
+    cpu_s: f64,
+    ns_per_filament_step: f64,
+    ns_per_step: f64,
+    mean_live_filaments: f64,
+    final_live_filaments: usize,
+    sim_s_per_cpu_s: f64,
+    index_build_ns: f64,
+    point_query_ns: f64,
+    point_query_uniform_ns: f64,
+    crossflow_spread_m: BTreeMap<String, f64>,
+    crossflow_samples: BTreeMap<String, u64>,
+    threads: usize,
+}
+
+/// Runs a benchmark and prints its JSON.
+pub fn run(cmd: &BenchCommand) -> Result<()> {
+    match cmd {
+        BenchCommand::Plume(a) => {
+            let r = plume(a)?;
+            println!("{}", serde_json::to_string_pretty(&r)?);
+            Ok(())
+        }
+    }
+}
+
+/// The benchmark's environment: the case's preset with the flags applied to its parsed config.
+fn build_env(a: &PlumeBenchArgs) -> Result<(Environment, bool, f64, f64, f64)> {
+    let (name, dt, duration, warmup) = match a.case {
+        Case::Pompy => ("pompy", 0.01, 20.0, 100.0),
+        Case::Field => ("field-scale", 0.1, 200.0, 11_000.0),
+    };
+    let dt = a.dt.unwrap_or(dt);
+    let duration = a.duration.unwrap_or(duration);
+    let warmup = a.warmup.unwrap_or(warmup);
+    for (what, v) in [("--dt", dt), ("--duration", duration), ("--warmup", warmup)] {
+        if !(v.is_finite() && v >= 0.0) {
+            bail!("{what} must be a finite number >= 0, got {v}");
+        }
+    }
+    if dt <= 0.0 || duration < dt {
+        bail!("--dt must be > 0 and --duration at least one step");
+    }
+    let mut cfg = plumetrace_scenario::load_preset(name)?;
+    cfg.sim.dt_s = dt;
+    cfg.sim.duration_s = warmup + duration;
+    cfg.output.average_start_s = 0.0;
+    cfg.output.average_interval_s = cfg.output.average_interval_s.max(dt);
+    if let Some(rate) = a.release_rate {
+        if !(rate.is_finite() && rate >= 0.0) {
+            bail!("--release-rate must be a finite number >= 0, got {rate}");
+        }
+        for s in &mut cfg.sources {
+            // Keep one mass unit per filament, as in pompy.
+            s.filament_rate_hz = rate;
+            s.mass_rate_per_s = rate;
+        }
+    }
+    if a.pompy_compatible {
+        cfg.plume.pompy_compatible = true;
+    }
+    if a.physical {
+        cfg.plume.pompy_compatible = false;
+    }
+    let origin = plumetrace_scenario::Origin::Preset(name.into());
+    let env = plumetrace_scenario::build(&cfg, &origin, Some(a.seed))?.env;
+    Ok((env, cfg.plume.pompy_compatible, dt, duration, warmup))
+}
+
+fn plume(a: &PlumeBenchArgs) -> Result<PlumeBench> {
+    let (mut env, pompy_compatible, dt, duration, warmup) = build_env(a)?;
+    let warm_steps = (warmup / dt).round() as u64;
+    let timed_steps = ((duration / dt).round() as u64).max(1);
+    let progress = crate::progress::Progress::new(warm_steps + timed_steps, "steps");
+    for k in 0..warm_steps {
+        env.step()?;
+        progress.tick(k);
+    }
+    let slabs = [25.0, 50.0, 75.0];
+    let mut moments = [[0.0f64; 3]; 3];
+    let sample_every = ((1.0 / dt).round() as u64).max(1);
+    let mut live_sum = 0u64;
+    let mut cpu = 0.0;
+    for k in 0..timed_steps {
+        let c0 = ProcessTime::now();
+        env.step()?;
+        cpu += c0.elapsed().as_secs_f64();
+        let f = env.plume().filaments();
+        live_sum += f.map_or(0, |f| f.len() as u64);
+        if k % sample_every == 0 {
+            if let Some(f) = f {
+                for (p, _) in f.filaments() {
+                    for (s, &x) in slabs.iter().enumerate() {
+                        if (p.x - x).abs() <= 2.5 {
+                            moments[s][0] += 1.0;
+                            moments[s][1] += p.y;
+                            moments[s][2] += p.y * p.y;
+                        }
+                    }
+                }
+            }
+        }
+        progress.tick(warm_steps + k);
+    }
+    progress.finish();
+    let Some(f) = env.plume().filaments() else { bail!("the benchmark needs a filament plume") };
+    let t0 = Instant::now();
+    f.prepare_queries();
+    let index_build_ns = t0.elapsed().as_secs_f64() * 1e9;
+    let mut rng = stream_rng(a.seed, StreamId::Custom(77));
+    let centres: Vec<Vec3> = f.filaments().map(|(p, _)| p).collect();
+    let n = a.queries.max(1);
+    let in_plume: Vec<Vec3> = (0..n)
+        .map(|_| {
+            let c = if centres.is_empty() { Vec3::zeros() } else { centres[rng.random_range(0..centres.len())] };
+            Vec3::new(c.x + rng.random_range(-0.5..0.5), c.y + rng.random_range(-0.5..0.5), c.z)
+        })
+        .collect();
+    let d = env.domain();
+    let uniform: Vec<Vec3> = (0..n)
+        .map(|_| Vec3::new(rng.random_range(d.x_min_m..d.x_max_m), rng.random_range(d.y_min_m..d.y_max_m), 0.0))
+        .collect();
+    let time_queries = |pts: &[Vec3]| {
+        let c0 = ProcessTime::now();
+        let mut sink = 0.0;
+        for p in pts {
+            sink += f.concentration(*p);
+        }
+        let ns = c0.elapsed().as_secs_f64() * 1e9 / pts.len() as f64;
+        (ns, sink)
+    };
+    let (point_query_ns, s1) = time_queries(&in_plume);
+    let (point_query_uniform_ns, s2) = time_queries(&uniform);
+    std::hint::black_box(s1 + s2);
+    let mut spread = BTreeMap::new();
+    let mut samples = BTreeMap::new();
+    for (s, x) in slabs.iter().enumerate() {
+        let [n, sy, syy] = moments[s];
+        let key = format!("{x:.0}");
+        samples.insert(key.clone(), n as u64);
+        if n > 1.0 {
+            let m = sy / n;
+            spread.insert(key, (syy / n - m * m).max(0.0).sqrt());
+        }
+    }
+    let mean_live = live_sum as f64 / timed_steps as f64;
+    Ok(PlumeBench {
+        case: a.case,
+        pompy_compatible,
+        release_rate_hz: env.plume().filaments().map_or(0.0, |f| f.sources().iter().map(|s| s.filament_rate_hz).sum()),
+        dt_s: dt,
+        warmup_s: warmup,
+        duration_s: timed_steps as f64 * dt,
+        steps_timed: timed_steps,
+        cpu_s: cpu,
+        ns_per_filament_step: cpu * 1e9 / (live_sum.max(1) as f64),
+        ns_per_step: cpu * 1e9 / timed_steps as f64,
+        mean_live_filaments: mean_live,
+        final_live_filaments: f.len(),
+        sim_s_per_cpu_s: timed_steps as f64 * dt / cpu.max(1e-12),
+        index_build_ns,
+        point_query_ns,
+        point_query_uniform_ns,
+        crossflow_spread_m: spread,
+        crossflow_samples: samples,
+        threads: 1,
+    })
+}

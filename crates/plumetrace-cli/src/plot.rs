@@ -1,0 +1,156 @@
+//! Figures drawn from recorded data (never inside the step loop).
+
+use anyhow::{Result, anyhow};
+use plotters::prelude::*;
+use plumetrace_env::{FlowField, GridSpec, Plume};
+use plumetrace_scenario::BuiltScenario;
+
+/// Colour stops of the light heat map, from the lowest shown value to the highest.
+const STOPS: [(f64, (u8, u8, u8)); 5] = [
+    (0.0, (255, 247, 236)),
+    (0.3, (253, 212, 158)),
+    (0.55, (252, 141, 89)),
+    (0.8, (215, 48, 31)),
+    (1.0, (127, 0, 0)),
+];
+
+/// Concentrations below this fraction of the panel's maximum are left white.
+const FLOOR: f64 = 1e-3;
+
+fn heat(level: f64) -> RGBColor {
+    let l = level.clamp(0.0, 1.0);
+    for w in STOPS.windows(2) {
+        let ((a, ca), (b, cb)) = (w[0], w[1]);
+        if l <= b {
+            let t = (l - a) / (b - a);
+            let mix = |p: u8, q: u8| (f64::from(p) + t * (f64::from(q) - f64::from(p))).round() as u8;
+            return RGBColor(mix(ca.0, cb.0), mix(ca.1, cb.1), mix(ca.2, cb.2));
+        }
+    }
+    RGBColor(127, 0, 0)
+}
+
+/// Level in [0, 1] of a concentration on a square-root scale (it shows both the patchy peaks and
+/// the dilute edges); `None` below `FLOOR` of the maximum.
+fn level(c: f64, max: f64) -> Option<f64> {
+    if max <= 0.0 || c < FLOOR * max {
+        return None;
+    }
+    Some((c / max).sqrt())
+}
+
+/// Two stacked heat maps (instantaneous and time-averaged concentration) with the source,
+/// obstacles and mean flow, as an SVG string.
+pub fn plume_figure(sc: &BuiltScenario, snapshot: &[f64], mean: &[f64], samples: u32) -> Result<String> {
+    let g = sc.output.grid;
+    let d = sc.env.domain();
+    let width = 1000u32;
+    let panel_w = f64::from(width - 140);
+    let panel_h = (panel_w * d.height_m() / d.width_m()).clamp(160.0, 700.0);
+    let height = (2.0 * (panel_h + 90.0)) as u32;
+    let mut svg = String::new();
+    {
+        let root = SVGBackend::with_string(&mut svg, (width, height)).into_drawing_area();
+        root.fill(&WHITE).map_err(|e| anyhow!("{e:?}"))?;
+        let (top, bottom) = root.split_vertically(height / 2);
+        let t = sc.env.time_s();
+        let steady = matches!(sc.env.plume(), Plume::Steady(_));
+        let top_title = if steady {
+            format!("{}: steady concentration at z = {} m", sc.name, g.z_m)
+        } else {
+            format!("{}: concentration at z = {} m, t = {:.0} s", sc.name, g.z_m, t)
+        };
+        let bottom_title = format!("time-averaged concentration ({samples} samples)");
+        panel(&top, sc, &g, snapshot, &top_title)?;
+        panel(&bottom, sc, &g, mean, &bottom_title)?;
+        root.present().map_err(|e| anyhow!("{e:?}"))?;
+    }
+    Ok(svg)
+}
+
+fn panel<DB: DrawingBackend>(area: &DrawingArea<DB, plotters::coord::Shift>, sc: &BuiltScenario, g: &GridSpec, values: &[f64], title: &str) -> Result<()>
+where
+    DB::ErrorType: 'static,
+{
+    let err = |e: DrawingAreaErrorKind<DB::ErrorType>| anyhow!("drawing: {e:?}");
+    let d = sc.env.domain();
+    let mut chart = ChartBuilder::on(area)
+        .caption(title, ("sans-serif", 18))
+        .margin(10)
+        .margin_right(30)
+        .x_label_area_size(40)
+        .y_label_area_size(60)
+        .build_cartesian_2d(d.x_min_m..d.x_max_m, d.y_min_m..d.y_max_m)
+        .map_err(err)?;
+    chart
+        .configure_mesh()
+        .disable_mesh()
+        .x_desc("East (m)")
+        .y_desc("North (m)")
+        .label_style(("sans-serif", 13))
+        .draw()
+        .map_err(err)?;
+    let max = values.iter().copied().fold(0.0, f64::max);
+    // At most ~250 x 250 cells are drawn: coarser grids are subsampled.
+    let stride_x = g.nx.div_ceil(250).max(1);
+    let stride_y = g.ny.div_ceil(250).max(1);
+    let dx = (g.x_max_m - g.x_min_m) / (g.nx - 1) as f64 * stride_x as f64;
+    let dy = (g.y_max_m - g.y_min_m) / (g.ny - 1) as f64 * stride_y as f64;
+    let mut cells = Vec::new();
+    for j in (0..g.ny).step_by(stride_y) {
+        for i in (0..g.nx).step_by(stride_x) {
+            let v = values[j * g.nx + i];
+            if let Some(l) = level(v, max) {
+                let x = g.x_min_m + i as f64 * (g.x_max_m - g.x_min_m) / (g.nx - 1) as f64;
+                let y = g.y_min_m + j as f64 * (g.y_max_m - g.y_min_m) / (g.ny - 1) as f64;
+                cells.push(Rectangle::new([(x - dx / 2.0, y - dy / 2.0), (x + dx / 2.0, y + dy / 2.0)], heat(l).filled()));
+            }
+        }
+    }
+    chart.draw_series(cells).map_err(err)?;
+    for o in sc.env.obstacles().iter() {
+        let pts: Vec<(f64, f64)> = o.polygon.exterior().points().map(|p| (p.x(), p.y())).collect();
+        chart.draw_series(std::iter::once(PathElement::new(pts, GREEN.stroke_width(2)))).map_err(err)?;
+    }
+    if let Some(f) = sc.env.plume().filaments() {
+        chart
+            .draw_series(f.sources().iter().map(|s| TriangleMarker::new((s.pos_m.x, s.pos_m.y), 7, BLACK.filled())))
+            .map_err(err)?
+            .label("source")
+            .legend(|(x, y)| TriangleMarker::new((x + 8, y), 5, BLACK.filled()));
+    }
+    // Mean flow arrow in the upper-left corner, 10 % of the width long.
+    let v = sc.env.flow().velocity(plumetrace_core::Vec2::new(0.5 * (d.x_min_m + d.x_max_m), 0.5 * (d.y_min_m + d.y_max_m)));
+    if v.norm() > 0.0 {
+        let len = 0.1 * d.width_m();
+        let start = (d.x_min_m + 0.06 * d.width_m(), d.y_max_m - 0.15 * d.height_m());
+        let u = v / v.norm() * len;
+        let end = (start.0 + u.x, start.1 + u.y);
+        chart
+            .draw_series(std::iter::once(PathElement::new(vec![start, end], BLUE.stroke_width(2))))
+            .map_err(err)?
+            .label(format!("flow {:.2} m/s", v.norm()))
+            .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], BLUE.stroke_width(2)));
+        chart.draw_series(std::iter::once(Circle::new(end, 3, BLUE.filled()))).map_err(err)?;
+    }
+    // Colour key: swatches at 1 %, 10 %, 50 % and 100 % of the maximum.
+    if max > 0.0 {
+        for (frac, name) in [(0.01, "1 %"), (0.1, "10 %"), (0.5, "50 %"), (1.0, "100 %")] {
+            let c = heat(level(frac * max, max).unwrap_or(0.0));
+            chart
+                .draw_series(std::iter::once(Rectangle::new([(d.x_min_m, d.y_min_m), (d.x_min_m, d.y_min_m)], c.filled())))
+                .map_err(err)?
+                .label(format!("{name} of max {max:.3}"))
+                .legend(move |(x, y)| Rectangle::new([(x, y - 5), (x + 14, y + 5)], c.filled()));
+        }
+    }
+    chart
+        .configure_series_labels()
+        .background_style(WHITE.mix(0.85))
+        .border_style(BLACK)
+        .label_font(("sans-serif", 12))
+        .position(SeriesLabelPosition::UpperRight)
+        .draw()
+        .map_err(err)?;
+    Ok(())
+}
