@@ -50,7 +50,11 @@ fn dispatch(cli: Cli) -> Result<()> {
     match cli.command {
         Command::Run(args) => run::run(&args),
         Command::Presets => {
-            let width = plumetrace_scenario::PRESETS.iter().map(|p| p.name.len()).max().unwrap_or(0);
+            let width = plumetrace_scenario::PRESETS
+                .iter()
+                .map(|p| p.name.len())
+                .max()
+                .unwrap_or(0);
             for p in plumetrace_scenario::PRESETS {
                 println!("{:width$}  {}", p.name, p.summary);
             }
@@ -60,7 +64,12 @@ fn dispatch(cli: Cli) -> Result<()> {
             let cfg = plumetrace_scenario::load_file(&file)?;
             let origin = plumetrace_scenario::Origin::File(file.clone());
             let built = plumetrace_scenario::build(&cfg, &origin, None)?;
-            println!("{}: ok ({} steps of {} s)", file.display(), built.steps, built.env.dt_s());
+            println!(
+                "{}: ok ({} steps of {} s)",
+                file.display(),
+                built.steps,
+                built.env.dt_s()
+            );
             Ok(())
         }
         Command::Bench(b) => bench::run(&b),

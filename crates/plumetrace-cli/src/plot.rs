@@ -23,7 +23,8 @@ fn heat(level: f64) -> RGBColor {
         let ((a, ca), (b, cb)) = (w[0], w[1]);
         if l <= b {
             let t = (l - a) / (b - a);
-            let mix = |p: u8, q: u8| (f64::from(p) + t * (f64::from(q) - f64::from(p))).round() as u8;
+            let mix =
+                |p: u8, q: u8| (f64::from(p) + t * (f64::from(q) - f64::from(p))).round() as u8;
             return RGBColor(mix(ca.0, cb.0), mix(ca.1, cb.1), mix(ca.2, cb.2));
         }
     }
@@ -41,7 +42,12 @@ fn level(c: f64, max: f64) -> Option<f64> {
 
 /// Two stacked heat maps (instantaneous and time-averaged concentration) with the source,
 /// obstacles and mean flow, as an SVG string.
-pub fn plume_figure(sc: &BuiltScenario, snapshot: &[f64], mean: &[f64], samples: u32) -> Result<String> {
+pub fn plume_figure(
+    sc: &BuiltScenario,
+    snapshot: &[f64],
+    mean: &[f64],
+    samples: u32,
+) -> Result<String> {
     let g = sc.output.grid;
     let d = sc.env.domain();
     let width = 1000u32;
@@ -58,7 +64,10 @@ pub fn plume_figure(sc: &BuiltScenario, snapshot: &[f64], mean: &[f64], samples:
         let top_title = if steady {
             format!("{}: steady concentration at z = {} m", sc.name, g.z_m)
         } else {
-            format!("{}: concentration at z = {} m, t = {:.0} s", sc.name, g.z_m, t)
+            format!(
+                "{}: concentration at z = {} m, t = {:.0} s",
+                sc.name, g.z_m, t
+            )
         };
         let bottom_title = format!("time-averaged concentration ({samples} samples)");
         panel(&top, sc, &g, snapshot, &top_title)?;
@@ -68,7 +77,13 @@ pub fn plume_figure(sc: &BuiltScenario, snapshot: &[f64], mean: &[f64], samples:
     Ok(svg)
 }
 
-fn panel<DB: DrawingBackend>(area: &DrawingArea<DB, plotters::coord::Shift>, sc: &BuiltScenario, g: &GridSpec, values: &[f64], title: &str) -> Result<()>
+fn panel<DB: DrawingBackend>(
+    area: &DrawingArea<DB, plotters::coord::Shift>,
+    sc: &BuiltScenario,
+    g: &GridSpec,
+    values: &[f64],
+    title: &str,
+) -> Result<()>
 where
     DB::ErrorType: 'static,
 {
@@ -103,42 +118,73 @@ where
             if let Some(l) = level(v, max) {
                 let x = g.x_min_m + i as f64 * (g.x_max_m - g.x_min_m) / (g.nx - 1) as f64;
                 let y = g.y_min_m + j as f64 * (g.y_max_m - g.y_min_m) / (g.ny - 1) as f64;
-                cells.push(Rectangle::new([(x - dx / 2.0, y - dy / 2.0), (x + dx / 2.0, y + dy / 2.0)], heat(l).filled()));
+                cells.push(Rectangle::new(
+                    [(x - dx / 2.0, y - dy / 2.0), (x + dx / 2.0, y + dy / 2.0)],
+                    heat(l).filled(),
+                ));
             }
         }
     }
     chart.draw_series(cells).map_err(err)?;
     for o in sc.env.obstacles().iter() {
-        let pts: Vec<(f64, f64)> = o.polygon.exterior().points().map(|p| (p.x(), p.y())).collect();
-        chart.draw_series(std::iter::once(PathElement::new(pts, GREEN.stroke_width(2)))).map_err(err)?;
+        let pts: Vec<(f64, f64)> = o
+            .polygon
+            .exterior()
+            .points()
+            .map(|p| (p.x(), p.y()))
+            .collect();
+        chart
+            .draw_series(std::iter::once(PathElement::new(
+                pts,
+                GREEN.stroke_width(2),
+            )))
+            .map_err(err)?;
     }
     if let Some(f) = sc.env.plume().filaments() {
         chart
-            .draw_series(f.sources().iter().map(|s| TriangleMarker::new((s.pos_m.x, s.pos_m.y), 7, BLACK.filled())))
+            .draw_series(
+                f.sources()
+                    .iter()
+                    .map(|s| TriangleMarker::new((s.pos_m.x, s.pos_m.y), 7, BLACK.filled())),
+            )
             .map_err(err)?
             .label("source")
             .legend(|(x, y)| TriangleMarker::new((x + 8, y), 5, BLACK.filled()));
     }
     // Mean flow arrow in the upper-left corner, 10 % of the width long.
-    let v = sc.env.flow().velocity(plumetrace_core::Vec2::new(0.5 * (d.x_min_m + d.x_max_m), 0.5 * (d.y_min_m + d.y_max_m)));
+    let v = sc.env.flow().velocity(plumetrace_core::Vec2::new(
+        0.5 * (d.x_min_m + d.x_max_m),
+        0.5 * (d.y_min_m + d.y_max_m),
+    ));
     if v.norm() > 0.0 {
         let len = 0.1 * d.width_m();
-        let start = (d.x_min_m + 0.06 * d.width_m(), d.y_max_m - 0.15 * d.height_m());
+        let start = (
+            d.x_min_m + 0.06 * d.width_m(),
+            d.y_max_m - 0.15 * d.height_m(),
+        );
         let u = v / v.norm() * len;
         let end = (start.0 + u.x, start.1 + u.y);
         chart
-            .draw_series(std::iter::once(PathElement::new(vec![start, end], BLUE.stroke_width(2))))
+            .draw_series(std::iter::once(PathElement::new(
+                vec![start, end],
+                BLUE.stroke_width(2),
+            )))
             .map_err(err)?
             .label(format!("flow {:.2} m/s", v.norm()))
             .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], BLUE.stroke_width(2)));
-        chart.draw_series(std::iter::once(Circle::new(end, 3, BLUE.filled()))).map_err(err)?;
+        chart
+            .draw_series(std::iter::once(Circle::new(end, 3, BLUE.filled())))
+            .map_err(err)?;
     }
     // Colour key: swatches at 1 %, 10 %, 50 % and 100 % of the maximum.
     if max > 0.0 {
         for (frac, name) in [(0.01, "1 %"), (0.1, "10 %"), (0.5, "50 %"), (1.0, "100 %")] {
             let c = heat(level(frac * max, max).unwrap_or(0.0));
             chart
-                .draw_series(std::iter::once(Rectangle::new([(d.x_min_m, d.y_min_m), (d.x_min_m, d.y_min_m)], c.filled())))
+                .draw_series(std::iter::once(Rectangle::new(
+                    [(d.x_min_m, d.y_min_m), (d.x_min_m, d.y_min_m)],
+                    c.filled(),
+                )))
                 .map_err(err)?
                 .label(format!("{name} of max {max:.3}"))
                 .legend(move |(x, y)| Rectangle::new([(x, y - 5), (x + 14, y + 5)], c.filled()));

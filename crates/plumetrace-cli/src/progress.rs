@@ -16,12 +16,15 @@ impl Progress {
         if let Ok(style) = ProgressStyle::with_template(&template) {
             bar.set_style(style);
         }
-        Progress { bar, every: (total / 1000).max(1) }
+        Progress {
+            bar,
+            every: (total / 1000).max(1),
+        }
     }
 
     /// Records that `done` units are finished (cheap: updates the bar every 0.1 % only).
     pub fn tick(&self, done: u64) {
-        if done % self.every == 0 {
+        if done.is_multiple_of(self.every) {
             self.bar.set_position(done);
         }
     }

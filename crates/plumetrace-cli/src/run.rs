@@ -42,10 +42,20 @@ pub struct StageTimes {
 }
 
 /// Loads a scenario from a file or preset.
-pub fn load(scenario: Option<&Path>, preset: Option<&str>, seed: Option<u64>) -> Result<BuiltScenario> {
+pub fn load(
+    scenario: Option<&Path>,
+    preset: Option<&str>,
+    seed: Option<u64>,
+) -> Result<BuiltScenario> {
     let (cfg, origin) = match (scenario, preset) {
-        (Some(path), None) => (plumetrace_scenario::load_file(path)?, Origin::File(path.to_path_buf())),
-        (None, Some(name)) => (plumetrace_scenario::load_preset(name)?, Origin::Preset(name.to_string())),
+        (Some(path), None) => (
+            plumetrace_scenario::load_file(path)?,
+            Origin::File(path.to_path_buf()),
+        ),
+        (None, Some(name)) => (
+            plumetrace_scenario::load_preset(name)?,
+            Origin::Preset(name.to_string()),
+        ),
         (None, None) => bail!("give a scenario file or --preset NAME (see `plumetrace presets`)"),
         (Some(_), Some(_)) => bail!("give a scenario file or --preset, not both"),
     };
@@ -76,7 +86,8 @@ struct RunStats {
 /// Runs the scenario and writes `stats.json`, `snapshot.csv`, `filaments.csv` and `plume.svg`.
 pub fn run(args: &RunArgs) -> Result<()> {
     let mut sc = load(args.scenario.as_deref(), args.preset.as_deref(), args.seed)?;
-    std::fs::create_dir_all(&args.out).with_context(|| format!("creating {}", args.out.display()))?;
+    std::fs::create_dir_all(&args.out)
+        .with_context(|| format!("creating {}", args.out.display()))?;
     let started = Instant::now();
     let mut times = StageTimes::default();
     let spec = sc.output;
@@ -87,7 +98,10 @@ pub fn run(args: &RunArgs) -> Result<()> {
         let t0 = Instant::now();
         sc.env.step().with_context(|| format!("step {step}"))?;
         let t1 = Instant::now();
-        if step >= spec.average_start_step && step % spec.average_every_steps == 0 && !(steady && mean.samples() > 0) {
+        if step >= spec.average_start_step
+            && step % spec.average_every_steps == 0
+            && !(steady && mean.samples() > 0)
+        {
             mean.accumulate(sc.env.plume());
         }
         let t2 = Instant::now();
@@ -98,7 +112,9 @@ pub fn run(args: &RunArgs) -> Result<()> {
     progress.finish();
     let t_rec = Instant::now();
     let mut snapshot = vec![0.0; spec.grid.nx * spec.grid.ny];
-    sc.env.plume().concentrations(&spec.grid.points(), &mut snapshot);
+    sc.env
+        .plume()
+        .concentrations(&spec.grid.points(), &mut snapshot);
     if mean.samples() == 0 {
         mean.accumulate(sc.env.plume());
     }
@@ -106,7 +122,11 @@ pub fn run(args: &RunArgs) -> Result<()> {
     let inter = mean.intermittency();
     let mut csv = String::from("x_m,y_m,concentration,mean_concentration,intermittency\n");
     for (k, p) in spec.grid.points().iter().enumerate() {
-        let _ = writeln!(csv, "{:.3},{:.3},{:.6e},{:.6e},{:.4}", p.x, p.y, snapshot[k], mean_c[k], inter[k]);
+        let _ = writeln!(
+            csv,
+            "{:.3},{:.3},{:.6e},{:.6e},{:.4}",
+            p.x, p.y, snapshot[k], mean_c[k], inter[k]
+        );
     }
     write_atomic(&args.out.join("snapshot.csv"), csv.as_bytes())?;
     if let Some(f) = sc.env.plume().filaments() {
@@ -146,10 +166,15 @@ pub fn run(args: &RunArgs) -> Result<()> {
     if args.stats {
         eprintln!(
             "stage times: advance environment {:.3} s, sample {:.3} s, record {:.3} s",
-            stats.stage_times.advance_environment_s, stats.stage_times.sample_s, stats.stage_times.record_s
+            stats.stage_times.advance_environment_s,
+            stats.stage_times.sample_s,
+            stats.stage_times.record_s
         );
     }
-    let live = stats.filaments.map(|f| format!(", {} live filaments", f.live)).unwrap_or_default();
+    let live = stats
+        .filaments
+        .map(|f| format!(", {} live filaments", f.live))
+        .unwrap_or_default();
     println!(
         "{}: simulated {:.0} s in {:.2} s ({:.0}x real time){live}; wrote {}",
         stats.scenario,

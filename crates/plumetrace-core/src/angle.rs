@@ -110,23 +110,40 @@ mod tests {
         ];
         for (input, want) in cases {
             let got = wrap_deg_180(input);
-            assert!((got - want).abs() < 1e-9, "wrap_deg_180({input}) = {got}, want {want}");
+            assert!(
+                (got - want).abs() < 1e-9,
+                "wrap_deg_180({input}) = {got}, want {want}"
+            );
         }
     }
 
     #[test]
     fn wrap_360_table() {
-        let cases = [(0.0, 0.0), (360.0, 0.0), (-1.0, 359.0), (725.0, 5.0), (-1e-15, 0.0)];
+        let cases = [
+            (0.0, 0.0),
+            (360.0, 0.0),
+            (-1.0, 359.0),
+            (725.0, 5.0),
+            (-1e-15, 0.0),
+        ];
         for (input, want) in cases {
             let got = wrap_deg_360(input);
-            assert!((got - want).abs() < 1e-9, "wrap_deg_360({input}) = {got}, want {want}");
+            assert!(
+                (got - want).abs() < 1e-9,
+                "wrap_deg_360({input}) = {got}, want {want}"
+            );
             assert!((0.0..360.0).contains(&got));
         }
     }
 
     #[test]
     fn heading_diff_is_wrapped() {
-        let cases = [(10.0, 350.0, 20.0), (350.0, 10.0, -20.0), (180.0, 0.0, 180.0), (90.0, 270.0, 180.0)];
+        let cases = [
+            (10.0, 350.0, 20.0),
+            (350.0, 10.0, -20.0),
+            (180.0, 0.0, 180.0),
+            (90.0, 270.0, 180.0),
+        ];
         for (a, b, want) in cases {
             let got = Heading::from_deg(a).diff_deg(Heading::from_deg(b));
             assert!((got - want).abs() < 1e-9, "{a} - {b} = {got}, want {want}");
@@ -135,11 +152,20 @@ mod tests {
 
     #[test]
     fn heading_of_vector_table() {
-        let cases = [((0.0, 1.0), 0.0), ((1.0, 0.0), 90.0), ((0.0, -1.0), 180.0), ((-1.0, 0.0), 270.0), ((1.0, 1.0), 45.0)];
+        let cases = [
+            ((0.0, 1.0), 0.0),
+            ((1.0, 0.0), 90.0),
+            ((0.0, -1.0), 180.0),
+            ((-1.0, 0.0), 270.0),
+            ((1.0, 1.0), 45.0),
+        ];
         for ((e, n), want) in cases {
             let h = Heading::of_vector(crate::Vec2::new(e, n)).map(Heading::deg);
             let got = h.unwrap_or(f64::NAN);
-            assert!((got - want).abs() < 1e-9, "heading of ({e},{n}) = {got}, want {want}");
+            assert!(
+                (got - want).abs() < 1e-9,
+                "heading of ({e},{n}) = {got}, want {want}"
+            );
         }
         assert!(Heading::of_vector(crate::Vec2::zeros()).is_none());
         assert!(Heading::of_vector(crate::Vec2::new(f64::NAN, 1.0)).is_none());

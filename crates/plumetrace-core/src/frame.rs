@@ -26,10 +26,21 @@ mod tests {
     #[test]
     fn bearing_table() {
         let o = Vec2::new(10.0, 20.0);
-        let cases = [((10.0, 30.0), 0.0), ((20.0, 20.0), 90.0), ((10.0, 10.0), 180.0), ((0.0, 20.0), 270.0), ((0.0, 10.0), 225.0)];
+        let cases = [
+            ((10.0, 30.0), 0.0),
+            ((20.0, 20.0), 90.0),
+            ((10.0, 10.0), 180.0),
+            ((0.0, 20.0), 270.0),
+            ((0.0, 10.0), 225.0),
+        ];
         for ((x, y), want) in cases {
-            let got = bearing_between(o, Vec2::new(x, y)).map(Heading::deg).unwrap_or(f64::NAN);
-            assert!((got - want).abs() < 1e-9, "bearing to ({x},{y}) = {got}, want {want}");
+            let got = bearing_between(o, Vec2::new(x, y))
+                .map(Heading::deg)
+                .unwrap_or(f64::NAN);
+            assert!(
+                (got - want).abs() < 1e-9,
+                "bearing to ({x},{y}) = {got}, want {want}"
+            );
         }
         assert!(bearing_between(o, o).is_none());
     }
@@ -38,8 +49,13 @@ mod tests {
     fn heading_vector_round_trips() {
         for deg in [0.0, 1.0, 89.0, 90.0, 181.0, 270.0, 359.5] {
             let h = Heading::from_deg(deg);
-            let back = Heading::of_vector(heading_vector(h)).map(Heading::deg).unwrap_or(f64::NAN);
-            assert!(Heading::from_deg(back).diff_deg(h).abs() < 1e-9, "{deg} -> {back}");
+            let back = Heading::of_vector(heading_vector(h))
+                .map(Heading::deg)
+                .unwrap_or(f64::NAN);
+            assert!(
+                Heading::from_deg(back).diff_deg(h).abs() < 1e-9,
+                "{deg} -> {back}"
+            );
         }
     }
 }

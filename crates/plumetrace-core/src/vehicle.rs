@@ -129,11 +129,21 @@ mod tests {
 
     #[test]
     fn command_finiteness_check() {
-        let ok = Command { heading: Heading::from_deg(10.0), speed_mps: 2.0, vertical: VerticalCommand::Altitude(2.0) };
+        let ok = Command {
+            heading: Heading::from_deg(10.0),
+            speed_mps: 2.0,
+            vertical: VerticalCommand::Altitude(2.0),
+        };
         assert!(ok.is_finite());
-        let bad_speed = Command { speed_mps: f64::NAN, ..ok };
+        let bad_speed = Command {
+            speed_mps: f64::NAN,
+            ..ok
+        };
         assert!(!bad_speed.is_finite());
-        let bad_alt = Command { vertical: VerticalCommand::Depth(f64::INFINITY), ..ok };
+        let bad_alt = Command {
+            vertical: VerticalCommand::Depth(f64::INFINITY),
+            ..ok
+        };
         assert!(!bad_alt.is_finite());
     }
 }

@@ -20,16 +20,32 @@ pub struct Rect {
 impl Rect {
     /// A rectangle, checked to have a finite, non-zero extent on both axes.
     pub fn new(x_min_m: f64, x_max_m: f64, y_min_m: f64, y_max_m: f64) -> Result<Self, EnvError> {
-        for (k, v) in [("x_min_m", x_min_m), ("x_max_m", x_max_m), ("y_min_m", y_min_m), ("y_max_m", y_max_m)] {
+        for (k, v) in [
+            ("x_min_m", x_min_m),
+            ("x_max_m", x_max_m),
+            ("y_min_m", y_min_m),
+            ("y_max_m", y_max_m),
+        ] {
             require_finite(k, v)?;
         }
         if x_max_m <= x_min_m {
-            return Err(EnvError::invalid("x_max_m", format!("must be > x_min_m ({x_min_m}), got {x_max_m}")));
+            return Err(EnvError::invalid(
+                "x_max_m",
+                format!("must be > x_min_m ({x_min_m}), got {x_max_m}"),
+            ));
         }
         if y_max_m <= y_min_m {
-            return Err(EnvError::invalid("y_max_m", format!("must be > y_min_m ({y_min_m}), got {y_max_m}")));
+            return Err(EnvError::invalid(
+                "y_max_m",
+                format!("must be > y_min_m ({y_min_m}), got {y_max_m}"),
+            ));
         }
-        Ok(Rect { x_min_m, x_max_m, y_min_m, y_max_m })
+        Ok(Rect {
+            x_min_m,
+            x_max_m,
+            y_min_m,
+            y_max_m,
+        })
     }
 
     /// East-West extent, m.

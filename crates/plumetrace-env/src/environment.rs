@@ -27,9 +27,18 @@ impl std::fmt::Debug for Plume {
 impl Plume {
     /// Names and one-line descriptions of the plume models, for `list` commands and docs.
     pub const REGISTRY: &'static [(&'static str, &'static str)] = &[
-        ("filaments", "Farrell et al. 2002 filament (puff) model: Poisson release, meander, intermittency"),
-        ("gaussian", "steady Gaussian plume of a continuous source in a uniform current (freshwater case)"),
-        ("gridded", "steady concentration grid read from a CSV file (x_m,y_m[,z_m],concentration)"),
+        (
+            "filaments",
+            "Farrell et al. 2002 filament (puff) model: Poisson release, meander, intermittency",
+        ),
+        (
+            "gaussian",
+            "steady Gaussian plume of a continuous source in a uniform current (freshwater case)",
+        ),
+        (
+            "gridded",
+            "steady concentration grid read from a CSV file (x_m,y_m[,z_m],concentration)",
+        ),
     ];
 
     /// The filament plume, if this is one.
@@ -74,12 +83,22 @@ pub struct Environment {
 
 impl Environment {
     /// An environment at t = 0 with random streams derived from `seed`.
-    pub fn new(domain: Rect, flow: FlowModel, plume: Plume, obstacles: ObstacleSet, dt_s: f64, seed: u64) -> Result<Self, EnvError> {
+    pub fn new(
+        domain: Rect,
+        flow: FlowModel,
+        plume: Plume,
+        obstacles: ObstacleSet,
+        dt_s: f64,
+        seed: u64,
+    ) -> Result<Self, EnvError> {
         crate::error::require_positive("sim.dt_s", dt_s)?;
-        if let Some(limit) = flow.max_stable_dt_s() {
-            if dt_s > limit {
-                return Err(EnvError::invalid("sim.dt_s", format!("{dt_s} s is above the flow model's stable limit of {limit:.4} s")));
-            }
+        if let Some(limit) = flow.max_stable_dt_s()
+            && dt_s > limit
+        {
+            return Err(EnvError::invalid(
+                "sim.dt_s",
+                format!("{dt_s} s is above the flow model's stable limit of {limit:.4} s"),
+            ));
         }
         Ok(Environment {
             domain,
@@ -98,7 +117,7 @@ impl Environment {
         let t_new = (self.step + 1) as f64 * self.dt_s;
         self.flow.advance(t_new, self.dt_s, &mut self.flow_rng)?;
         if let Plume::Filaments(p) = &mut self.plume {
-            p.step(&self.flow, self.dt_s, &mut self.plume_rng);
+            p.step(&self.flow, t_new, self.dt_s, &mut self.plume_rng);
         }
         self.step += 1;
         Ok(())

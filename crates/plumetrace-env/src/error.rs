@@ -46,7 +46,10 @@ pub fn require_positive(key: &str, value: f64) -> Result<(), EnvError> {
     if value.is_finite() && value > 0.0 {
         Ok(())
     } else {
-        Err(EnvError::invalid(key, format!("must be a finite number > 0, got {value}")))
+        Err(EnvError::invalid(
+            key,
+            format!("must be a finite number > 0, got {value}"),
+        ))
     }
 }
 
@@ -55,7 +58,10 @@ pub fn require_non_negative(key: &str, value: f64) -> Result<(), EnvError> {
     if value.is_finite() && value >= 0.0 {
         Ok(())
     } else {
-        Err(EnvError::invalid(key, format!("must be a finite number >= 0, got {value}")))
+        Err(EnvError::invalid(
+            key,
+            format!("must be a finite number >= 0, got {value}"),
+        ))
     }
 }
 
@@ -64,6 +70,9 @@ pub fn require_finite(key: &str, value: f64) -> Result<(), EnvError> {
     if value.is_finite() {
         Ok(())
     } else {
-        Err(EnvError::invalid(key, format!("must be a finite number, got {value}")))
+        Err(EnvError::invalid(
+            key,
+            format!("must be a finite number, got {value}"),
+        ))
     }
 }

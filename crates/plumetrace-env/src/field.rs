@@ -43,13 +43,28 @@ pub struct GridSpec {
 impl GridSpec {
     /// Checks the grid; `key` prefixes the names in errors.
     pub fn validate(&self, key: &str) -> Result<(), EnvError> {
-        for (k, v) in [("x_min_m", self.x_min_m), ("x_max_m", self.x_max_m), ("y_min_m", self.y_min_m), ("y_max_m", self.y_max_m), ("z_m", self.z_m)] {
+        for (k, v) in [
+            ("x_min_m", self.x_min_m),
+            ("x_max_m", self.x_max_m),
+            ("y_min_m", self.y_min_m),
+            ("y_max_m", self.y_max_m),
+            ("z_m", self.z_m),
+        ] {
             require_finite(&format!("{key}.{k}"), v)?;
         }
-        require_positive(&format!("{key}.x_max_m - x_min_m"), self.x_max_m - self.x_min_m)?;
-        require_positive(&format!("{key}.y_max_m - y_min_m"), self.y_max_m - self.y_min_m)?;
+        require_positive(
+            &format!("{key}.x_max_m - x_min_m"),
+            self.x_max_m - self.x_min_m,
+        )?;
+        require_positive(
+            &format!("{key}.y_max_m - y_min_m"),
+            self.y_max_m - self.y_min_m,
+        )?;
         if self.nx < 2 || self.ny < 2 || self.nx * self.ny > 16_000_000 {
-            return Err(EnvError::invalid(format!("{key}.nx"), "nx and ny must be >= 2 with nx * ny <= 16,000,000"));
+            return Err(EnvError::invalid(
+                format!("{key}.nx"),
+                "nx and ny must be >= 2 with nx * ny <= 16,000,000",
+            ));
         }
         Ok(())
     }
@@ -61,7 +76,11 @@ impl GridSpec {
         let mut pts = Vec::with_capacity(self.nx * self.ny);
         for j in 0..self.ny {
             for i in 0..self.nx {
-                pts.push(Vec3::new(self.x_min_m + i as f64 * dx, self.y_min_m + j as f64 * dy, self.z_m));
+                pts.push(Vec3::new(
+                    self.x_min_m + i as f64 * dx,
+                    self.y_min_m + j as f64 * dy,
+                    self.z_m,
+                ));
             }
         }
         pts
@@ -86,13 +105,26 @@ impl MeanConcentrationGrid {
     pub fn new(spec: GridSpec, threshold: f64) -> Self {
         let points = spec.points();
         let n = points.len();
-        MeanConcentrationGrid { spec, points, scratch: vec![0.0; n], sum: vec![0.0; n], above: vec![0; n], threshold, samples: 0 }
+        MeanConcentrationGrid {
+            spec,
+            points,
+            scratch: vec![0.0; n],
+            sum: vec![0.0; n],
+            above: vec![0; n],
+            threshold,
+            samples: 0,
+        }
     }
 
     /// Adds one sample of `field` at every grid point.
     pub fn accumulate(&mut self, field: &dyn ConcentrationField) {
         field.concentrations(&self.points, &mut self.scratch);
-        for ((s, a), c) in self.sum.iter_mut().zip(self.above.iter_mut()).zip(&self.scratch) {
+        for ((s, a), c) in self
+            .sum
+            .iter_mut()
+            .zip(self.above.iter_mut())
+            .zip(&self.scratch)
+        {
             *s += c;
             if *c > self.threshold {
                 *a += 1;

@@ -17,15 +17,34 @@ pub struct SoftObstacle {
 
 impl SoftObstacle {
     /// An obstacle from its vertices `(east, north)` in order (closed automatically).
-    pub fn new(name: impl Into<String>, vertices: &[[f64; 2]], key: &str) -> Result<Self, EnvError> {
+    pub fn new(
+        name: impl Into<String>,
+        vertices: &[[f64; 2]],
+        key: &str,
+    ) -> Result<Self, EnvError> {
         if vertices.len() < 3 {
-            return Err(EnvError::invalid(format!("{key}.vertices"), format!("needs at least 3 vertices, got {}", vertices.len())));
+            return Err(EnvError::invalid(
+                format!("{key}.vertices"),
+                format!("needs at least 3 vertices, got {}", vertices.len()),
+            ));
         }
-        if let Some(k) = vertices.iter().position(|v| !(v[0].is_finite() && v[1].is_finite())) {
-            return Err(EnvError::invalid(format!("{key}.vertices[{k}]"), "is not finite"));
+        if let Some(k) = vertices
+            .iter()
+            .position(|v| !(v[0].is_finite() && v[1].is_finite()))
+        {
+            return Err(EnvError::invalid(
+                format!("{key}.vertices[{k}]"),
+                "is not finite",
+            ));
         }
-        let ring: Vec<Coord<f64>> = vertices.iter().map(|v| Coord { x: v[0], y: v[1] }).collect();
-        Ok(SoftObstacle { name: name.into(), polygon: Polygon::new(LineString::from(ring), vec![]) })
+        let ring: Vec<Coord<f64>> = vertices
+            .iter()
+            .map(|v| Coord { x: v[0], y: v[1] })
+            .collect();
+        Ok(SoftObstacle {
+            name: name.into(),
+            polygon: Polygon::new(LineString::from(ring), vec![]),
+        })
     }
 }
 
@@ -60,14 +79,23 @@ impl ObstacleSet {
     /// Distance from `p` to the nearest obstacle (0 inside one); `None` without obstacles.
     pub fn distance_m(&self, p: Vec2) -> Option<f64> {
         let pt = Point::new(p.x, p.y);
-        self.obstacles.iter().map(|o| Euclidean.distance(&pt, &o.polygon)).min_by(f64::total_cmp)
+        self.obstacles
+            .iter()
+            .map(|o| Euclidean.distance(&pt, &o.polygon))
+            .min_by(f64::total_cmp)
     }
 
     /// Distance along a ray from `origin` on `heading` to the first obstacle edge within
     /// `max_range_m`, as a range sensor's beam would see it.
     pub fn ray_range_m(&self, origin: Vec2, heading: Heading, max_range_m: f64) -> Option<f64> {
         let end = origin + heading.unit() * max_range_m;
-        let beam = Line::new(Coord { x: origin.x, y: origin.y }, Coord { x: end.x, y: end.y });
+        let beam = Line::new(
+            Coord {
+                x: origin.x,
+                y: origin.y,
+            },
+            Coord { x: end.x, y: end.y },
+        );
         let mut best: Option<f64> = None;
         for o in &self.obstacles {
             for edge in o.polygon.exterior().lines() {
@@ -100,7 +128,14 @@ mod tests {
     use super::*;
 
     fn kelp() -> ObstacleSet {
-        ObstacleSet::new(vec![SoftObstacle::new("kelp", &[[10.0, -5.0], [20.0, -5.0], [20.0, 5.0], [10.0, 5.0]], "obstacles[0]").unwrap()])
+        ObstacleSet::new(vec![
+            SoftObstacle::new(
+                "kelp",
+                &[[10.0, -5.0], [20.0, -5.0], [20.0, 5.0], [10.0, 5.0]],
+                "obstacles[0]",
+            )
+            .unwrap(),
+        ])
     }
 
     #[test]
@@ -116,7 +151,12 @@ mod tests {
     fn ray_ranges_table() {
         let k = kelp();
         let o = Vec2::new(0.0, 0.0);
-        let cases = [(90.0, 30.0, Some(10.0)), (90.0, 8.0, None), (270.0, 30.0, None), (0.0, 30.0, None)];
+        let cases = [
+            (90.0, 30.0, Some(10.0)),
+            (90.0, 8.0, None),
+            (270.0, 30.0, None),
+            (0.0, 30.0, None),
+        ];
         for (hdg, range, want) in cases {
             let got = k.ray_range_m(o, Heading::from_deg(hdg), range);
             match (got, want) {
@@ -129,7 +169,9 @@ mod tests {
 
     #[test]
     fn rejects_degenerate_polygons() {
-        let e = SoftObstacle::new("x", &[[0.0, 0.0], [1.0, 1.0]], "obstacles[2]").unwrap_err().to_string();
+        let e = SoftObstacle::new("x", &[[0.0, 0.0], [1.0, 1.0]], "obstacles[2]")
+            .unwrap_err()
+            .to_string();
         assert!(e.starts_with("obstacles[2].vertices"), "{e}");
     }
 }

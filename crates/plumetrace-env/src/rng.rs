@@ -94,7 +94,11 @@ mod tests {
         let mut sorted = firsts.clone();
         sorted.sort_unstable();
         sorted.dedup();
-        assert_eq!(sorted.len(), firsts.len(), "two streams started with the same number");
+        assert_eq!(
+            sorted.len(),
+            firsts.len(),
+            "two streams started with the same number"
+        );
     }
 
     #[test]

@@ -60,7 +60,10 @@ impl GaussianPlume {
         if let Some(d) = depth_m {
             require_positive("domain.depth_m", d)?;
             if source_m.z > d {
-                return Err(EnvError::invalid("source.z_m", format!("{} m is above the surface ({d} m)", source_m.z)));
+                return Err(EnvError::invalid(
+                    "source.z_m",
+                    format!("{} m is above the surface ({d} m)", source_m.z),
+                ));
             }
         }
         Ok(GaussianPlume {
@@ -106,11 +109,13 @@ impl ConcentrationField for GaussianPlume {
             Some(d) => (-IMAGE_PAIRS..=IMAGE_PAIRS)
                 .map(|n| {
                     let shift = 2.0 * f64::from(n) * d;
-                    (-a * (p.z - (zs + shift)).powi(2)).exp() + (-a * (p.z - (-zs + shift)).powi(2)).exp()
+                    (-a * (p.z - (zs + shift)).powi(2)).exp()
+                        + (-a * (p.z - (-zs + shift)).powi(2)).exp()
                 })
                 .sum(),
         };
-        self.mass_rate_per_s / (4.0 * std::f64::consts::PI * x * (self.k_cross_m2ps * self.k_vert_m2ps).sqrt())
+        self.mass_rate_per_s
+            / (4.0 * std::f64::consts::PI * x * (self.k_cross_m2ps * self.k_vert_m2ps).sqrt())
             * lateral
             * vertical
     }
@@ -137,35 +142,60 @@ impl GriddedConcentration {
         let mut steps = Vec::new();
         for (k, &(lo, hi, n)) in axes.iter().enumerate() {
             let name = ["x", "y", "z"][k];
-            if n < 2 || !(hi > lo) || !lo.is_finite() || !hi.is_finite() {
-                return Err(EnvError::invalid(format!("grid.{name}"), "needs finite min < max and n >= 2"));
+            if n < 2 || hi <= lo || !lo.is_finite() || !hi.is_finite() {
+                return Err(EnvError::invalid(
+                    format!("grid.{name}"),
+                    "needs finite min < max and n >= 2",
+                ));
             }
             steps.push((lo, (hi - lo) / (n - 1) as f64, n));
         }
         let nz = z.map_or(1, |a| a.2);
         let mut points = Vec::with_capacity(x.2 * y.2 * nz);
         for kz in 0..nz {
-            let pz = if steps.len() == 3 { steps[2].0 + kz as f64 * steps[2].1 } else { 0.0 };
+            let pz = if steps.len() == 3 {
+                steps[2].0 + kz as f64 * steps[2].1
+            } else {
+                0.0
+            };
             for j in 0..y.2 {
                 for i in 0..x.2 {
-                    points.push(Vec3::new(steps[0].0 + i as f64 * steps[0].1, steps[1].0 + j as f64 * steps[1].1, pz));
+                    points.push(Vec3::new(
+                        steps[0].0 + i as f64 * steps[0].1,
+                        steps[1].0 + j as f64 * steps[1].1,
+                        pz,
+                    ));
                 }
             }
         }
         let mut values = vec![0.0; points.len()];
         field.concentrations(&points, &mut values);
-        Ok(GriddedConcentration { axes: steps, values })
+        Ok(GriddedConcentration {
+            axes: steps,
+            values,
+        })
     }
 
     /// Reads a grid from CSV with header `x_m,y_m,concentration` or `x_m,y_m,z_m,concentration`;
     /// every combination of the distinct coordinates must appear once.
     pub fn from_csv(path: &Path) -> Result<Self, EnvError> {
-        let file_err = |message: String| EnvError::File { path: path.to_path_buf(), message };
-        let mut reader = csv::ReaderBuilder::new().trim(csv::Trim::All).from_path(path).map_err(|e| file_err(e.to_string()))?;
-        let headers = reader.headers().map_err(|e| file_err(e.to_string()))?.clone();
+        let file_err = |message: String| EnvError::File {
+            path: path.to_path_buf(),
+            message,
+        };
+        let mut reader = csv::ReaderBuilder::new()
+            .trim(csv::Trim::All)
+            .from_path(path)
+            .map_err(|e| file_err(e.to_string()))?;
+        let headers = reader
+            .headers()
+            .map_err(|e| file_err(e.to_string()))?
+            .clone();
         let col = |name: &str| headers.iter().position(|h| h == name);
         let (Some(cx), Some(cy), Some(cc)) = (col("x_m"), col("y_m"), col("concentration")) else {
-            return Err(file_err("header must name x_m, y_m, concentration (and optionally z_m)".into()));
+            return Err(file_err(
+                "header must name x_m, y_m, concentration (and optionally z_m)".into(),
+            ));
         };
         let cz = col("z_m");
         let mut rows: Vec<[f64; 4]> = Vec::new();
@@ -176,7 +206,9 @@ impl GriddedConcentration {
                 let s = rec.get(c).unwrap_or("");
                 match s.parse::<f64>() {
                     Ok(v) if v.is_finite() => Ok(v),
-                    _ => Err(file_err(format!("line {line}: {name} = {s:?} is not a finite number"))),
+                    _ => Err(file_err(format!(
+                        "line {line}: {name} = {s:?} is not a finite number"
+                    ))),
                 }
             };
             let z = match cz {
@@ -185,7 +217,9 @@ impl GriddedConcentration {
             };
             let c = get(cc, "concentration")?;
             if c < 0.0 {
-                return Err(file_err(format!("line {line}: concentration {c} is negative")));
+                return Err(file_err(format!(
+                    "line {line}: concentration {c} is negative"
+                )));
             }
             rows.push([get(cx, "x_m")?, get(cy, "y_m")?, z, c]);
         }
@@ -197,10 +231,15 @@ impl GriddedConcentration {
             v.dedup();
             let name = ["x_m", "y_m", "z_m"][d];
             if v.len() < 2 {
-                return Err(file_err(format!("column {name} needs at least 2 distinct values")));
+                return Err(file_err(format!(
+                    "column {name} needs at least 2 distinct values"
+                )));
             }
             let step = (v[v.len() - 1] - v[0]) / (v.len() - 1) as f64;
-            if v.iter().enumerate().any(|(k, w)| (w - (v[0] + k as f64 * step)).abs() > 1e-6 * step.max(1.0)) {
+            if v.iter()
+                .enumerate()
+                .any(|(k, w)| (w - (v[0] + k as f64 * step)).abs() > 1e-6 * step.max(1.0))
+            {
                 return Err(file_err(format!("column {name} is not evenly spaced")));
             }
             axes.push((v[0], step, v.len()));
@@ -216,12 +255,19 @@ impl GriddedConcentration {
                 stride *= n;
             }
             if !values[k].is_nan() {
-                return Err(file_err(format!("node ({}, {}, {}) appears twice", r[0], r[1], r[2])));
+                return Err(file_err(format!(
+                    "node ({}, {}, {}) appears twice",
+                    r[0], r[1], r[2]
+                )));
             }
             values[k] = r[3];
         }
         if values.iter().any(|v| v.is_nan()) {
-            return Err(file_err(format!("grid is incomplete: {} rows for {} nodes", rows.len(), total)));
+            return Err(file_err(format!(
+                "grid is incomplete: {} rows for {} nodes",
+                rows.len(),
+                total
+            )));
         }
         Ok(GriddedConcentration { axes, values })
     }
@@ -273,7 +319,16 @@ mod tests {
     use super::*;
 
     fn plume(depth: Option<f64>) -> GaussianPlume {
-        GaussianPlume::new(Vec3::new(0.0, 0.0, 3.0), 1.0, 0.05, 90.0, 0.01, 0.002, depth).unwrap()
+        GaussianPlume::new(
+            Vec3::new(0.0, 0.0, 3.0),
+            1.0,
+            0.05,
+            90.0,
+            0.01,
+            0.002,
+            depth,
+        )
+        .unwrap()
     }
 
     /// Mass flux through a cross-flow plane: integral of U c over y and z.
@@ -286,7 +341,8 @@ mod tests {
         let mut total = 0.0;
         for j in 0..ny {
             for k in 0..nz {
-                let w = if j == 0 || j == ny - 1 { 0.5 } else { 1.0 } * if k == 0 || k == nz - 1 { 0.5 } else { 1.0 };
+                let w = if j == 0 || j == ny - 1 { 0.5 } else { 1.0 }
+                    * if k == 0 || k == nz - 1 { 0.5 } else { 1.0 };
                 // Flow towards East: downstream is +x, cross-flow is -y (to the right is South).
                 total += w * p.concentration(Vec3::new(x, y0 + j as f64 * dy, k as f64 * dz));
             }
@@ -314,7 +370,10 @@ mod tests {
             let d2z = (c(x, y, z + hz) - 2.0 * c(x, y, z) + c(x, y, z - hz)) / (hz * hz);
             let lhs = 0.05 * dcdx;
             let rhs = 0.01 * d2y + 0.002 * d2z;
-            assert!((lhs - rhs).abs() <= 1e-3 * lhs.abs().max(rhs.abs()) + 1e-9, "at ({x},{y},{z}): {lhs} vs {rhs}");
+            assert!(
+                (lhs - rhs).abs() <= 1e-3 * lhs.abs().max(rhs.abs()) + 1e-9,
+                "at ({x},{y},{z}): {lhs} vs {rhs}"
+            );
         }
     }
 
@@ -328,7 +387,13 @@ mod tests {
     #[test]
     fn rasterised_grid_matches_field_on_nodes_and_reads_back() {
         let p = plume(Some(4.0));
-        let g = GriddedConcentration::rasterise(&p, (0.0, 50.0, 51), (-10.0, 10.0, 41), Some((0.0, 4.0, 9))).unwrap();
+        let g = GriddedConcentration::rasterise(
+            &p,
+            (0.0, 50.0, 51),
+            (-10.0, 10.0, 41),
+            Some((0.0, 4.0, 9)),
+        )
+        .unwrap();
         for q in [Vec3::new(10.0, 0.0, 3.0), Vec3::new(25.0, -2.5, 1.0)] {
             let (a, b) = (g.concentration(q), p.concentration(q));
             assert!((a - b).abs() <= 1e-9 * b.max(1e-12), "{a} vs {b}");
@@ -347,7 +412,9 @@ mod tests {
         let g = GriddedConcentration::from_csv(&path).unwrap();
         assert!((g.concentration(Vec3::new(3.0, 1.5, 7.0)) - (1.5 + 15.0)).abs() < 1e-12);
         std::fs::write(&path, "x_m,y_m,concentration\n0,0,1\n1,0,2\n0,1,3\n").unwrap();
-        let e = GriddedConcentration::from_csv(&path).unwrap_err().to_string();
+        let e = GriddedConcentration::from_csv(&path)
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("incomplete"), "{e}");
     }
 }

@@ -1,12 +1,15 @@
 //! Statistical tests of the plume physics. Each asserts a number against theory with a tolerance.
 
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
 use plumetrace_core::{Vec2, Vec3};
 use plumetrace_env::flow::{FarrellFlow, FarrellParams, MeanFlow, UniformFlow};
 use plumetrace_env::plume::Dispersion;
 use plumetrace_env::steady::GaussianPlume;
 use plumetrace_env::{
-    ConcentrationField, Environment, FilamentParams, FilamentPlume, FlowModel, GridSpec, MeanConcentrationGrid,
-    ObstacleSet, Plume, Rect, SoftObstacle, Source, StreamId, VerticalBoundary, stream_rng,
+    ConcentrationField, Environment, FilamentParams, FilamentPlume, FlowModel, GridSpec,
+    MeanConcentrationGrid, ObstacleSet, Plume, Rect, SoftObstacle, Source, StreamId,
+    VerticalBoundary, stream_rng,
 };
 
 fn rect(x0: f64, x1: f64, y0: f64, y1: f64) -> Rect {
@@ -14,12 +17,30 @@ fn rect(x0: f64, x1: f64, y0: f64, y1: f64) -> Rect {
 }
 
 fn east(speed: f64) -> MeanFlow {
-    MeanFlow::Steady { speed_mps: speed, toward_deg: 90.0 }
+    MeanFlow::Steady {
+        speed_mps: speed,
+        toward_deg: 90.0,
+    }
 }
 
-fn filament_env(domain: Rect, flow: FlowModel, source: Source, params: FilamentParams, dt: f64, seed: u64) -> Environment {
+fn filament_env(
+    domain: Rect,
+    flow: FlowModel,
+    source: Source,
+    params: FilamentParams,
+    dt: f64,
+    seed: u64,
+) -> Environment {
     let plume = FilamentPlume::new(domain, vec![source], params).unwrap();
-    Environment::new(domain, flow, Plume::Filaments(Box::new(plume)), ObstacleSet::default(), dt, seed).unwrap()
+    Environment::new(
+        domain,
+        flow,
+        Plume::Filaments(Box::new(plume)),
+        ObstacleSet::default(),
+        dt,
+        seed,
+    )
+    .unwrap()
 }
 
 fn filaments(env: &Environment) -> &FilamentPlume {
@@ -36,7 +57,11 @@ fn run(env: &mut Environment, seconds: f64) {
 #[test]
 fn released_mass_matches_rate_times_time() {
     let domain = rect(0.0, 100.0, -50.0, 50.0);
-    let src = Source { pos_m: Vec3::new(5.0, 0.0, 1.0), mass_rate_per_s: 3.0, filament_rate_hz: 20.0 };
+    let src = Source {
+        pos_m: Vec3::new(5.0, 0.0, 1.0),
+        mass_rate_per_s: 3.0,
+        filament_rate_hz: 20.0,
+    };
     let flow = FlowModel::Uniform(UniformFlow::new(east(1.0)).unwrap());
     let mut env = filament_env(domain, flow, src, FilamentParams::default(), 0.05, 1);
     run(&mut env, 200.0);
@@ -44,22 +69,44 @@ fn released_mass_matches_rate_times_time() {
     // Poisson count over 200 s at 20 /s: mean 4000, sd 63.
     let expected = 20.0 * 200.0;
     let z = (s.released as f64 - expected) / expected.sqrt();
-    assert!(z.abs() < 4.0, "released {} filaments, expected {expected} (z = {z:.2})", s.released);
+    assert!(
+        z.abs() < 4.0,
+        "released {} filaments, expected {expected} (z = {z:.2})",
+        s.released
+    );
     let mass_expected = 3.0 * 200.0;
-    assert!((s.released_mass - mass_expected).abs() / mass_expected < 4.0 / expected.sqrt(), "released mass {}", s.released_mass);
+    assert!(
+        (s.released_mass - mass_expected).abs() / mass_expected < 4.0 / expected.sqrt(),
+        "released mass {}",
+        s.released_mass
+    );
     // Every released filament is either alive or has left through the domain edge.
     assert_eq!(s.released, s.live as u64 + s.exited);
     let accounted = filaments(&env).live_mass() + s.exited_mass;
-    assert!((accounted - s.released_mass).abs() < 1e-9 * s.released_mass, "mass not conserved: {accounted} vs {}", s.released_mass);
-    assert!(s.exited > 0, "nothing reached the downflow edge in 200 s at 1 m/s");
+    assert!(
+        (accounted - s.released_mass).abs() < 1e-9 * s.released_mass,
+        "mass not conserved: {accounted} vs {}",
+        s.released_mass
+    );
+    assert!(
+        s.exited > 0,
+        "nothing reached the downflow edge in 200 s at 1 m/s"
+    );
 }
 
 #[test]
 fn filament_cap_suppresses_and_counts() {
     let domain = rect(0.0, 100.0, -50.0, 50.0);
-    let src = Source { pos_m: Vec3::new(5.0, 0.0, 1.0), mass_rate_per_s: 1.0, filament_rate_hz: 50.0 };
+    let src = Source {
+        pos_m: Vec3::new(5.0, 0.0, 1.0),
+        mass_rate_per_s: 1.0,
+        filament_rate_hz: 50.0,
+    };
     let flow = FlowModel::Uniform(UniformFlow::new(east(0.5)).unwrap());
-    let params = FilamentParams { max_filaments: 100, ..FilamentParams::default() };
+    let params = FilamentParams {
+        max_filaments: 100,
+        ..FilamentParams::default()
+    };
     let mut env = filament_env(domain, flow, src, params, 0.1, 2);
     run(&mut env, 20.0);
     let s = filaments(&env).stats();
@@ -71,9 +118,16 @@ fn filament_cap_suppresses_and_counts() {
 fn concentration_integrates_to_live_mass_with_seabed_reflection() {
     // Filaments near the seabed: the image term must return the mass that would leak below z = 0.
     let domain = rect(-20.0, 20.0, -20.0, 20.0);
-    let src = Source { pos_m: Vec3::new(0.0, 0.0, 0.2), mass_rate_per_s: 2.0, filament_rate_hz: 1.0 };
+    let src = Source {
+        pos_m: Vec3::new(0.0, 0.0, 0.2),
+        mass_rate_per_s: 2.0,
+        filament_rate_hz: 1.0,
+    };
     let params = FilamentParams {
-        dispersion: Dispersion::Physical { horizontal_m2ps: 0.0, vertical_m2ps: 0.0 },
+        dispersion: Dispersion::Physical {
+            horizontal_m2ps: 0.0,
+            vertical_m2ps: 0.0,
+        },
         init_radius_m: 0.5,
         growth_rate_m2ps: 0.0,
         cutoff_radii: 5.0,
@@ -87,14 +141,21 @@ fn concentration_integrates_to_live_mass_with_seabed_reflection() {
         for j in -60..=60 {
             for k in 0..=60 {
                 let w = if k == 0 { 0.5 } else { 1.0 };
-                total += w * plume.concentration(Vec3::new(f64::from(i) * h, f64::from(j) * h, f64::from(k) * h));
+                total += w * plume.concentration(Vec3::new(
+                    f64::from(i) * h,
+                    f64::from(j) * h,
+                    f64::from(k) * h,
+                ));
             }
         }
     }
     total *= h * h * h;
     let mass = plume.live_mass();
     assert!((mass - 6.0).abs() < 1e-12);
-    assert!((total - mass).abs() / mass < 0.01, "integral {total}, mass {mass}");
+    assert!(
+        (total - mass).abs() / mass < 0.01,
+        "integral {total}, mass {mass}"
+    );
 }
 
 /// Time-averaged cross-flow profile variance at `x` from a mean-concentration line.
@@ -118,9 +179,16 @@ fn profile_variance(grid: &MeanConcentrationGrid) -> f64 {
 fn mean_crossflow_profile_widens_as_diffusivity_predicts() {
     let (k_h, gamma, u) = (0.05, 0.001, 1.0);
     let domain = rect(0.0, 100.0, -50.0, 50.0);
-    let src = Source { pos_m: Vec3::new(5.0, 0.0, 5.0), mass_rate_per_s: 20.0, filament_rate_hz: 20.0 };
+    let src = Source {
+        pos_m: Vec3::new(5.0, 0.0, 5.0),
+        mass_rate_per_s: 20.0,
+        filament_rate_hz: 20.0,
+    };
     let params = FilamentParams {
-        dispersion: Dispersion::Physical { horizontal_m2ps: k_h, vertical_m2ps: 0.001 },
+        dispersion: Dispersion::Physical {
+            horizontal_m2ps: k_h,
+            vertical_m2ps: 0.001,
+        },
         growth_rate_m2ps: gamma,
         vertical: VerticalBoundary::Unbounded,
         ..FilamentParams::default()
@@ -132,7 +200,15 @@ fn mean_crossflow_profile_widens_as_diffusivity_predicts() {
     let mut grids: Vec<MeanConcentrationGrid> = xs
         .iter()
         .map(|&x| {
-            let spec = GridSpec { x_min_m: x - 0.2, x_max_m: x + 0.2, y_min_m: -15.0, y_max_m: 15.0, nx: 3, ny: 301, z_m: 5.0 };
+            let spec = GridSpec {
+                x_min_m: x - 0.2,
+                x_max_m: x + 0.2,
+                y_min_m: -15.0,
+                y_max_m: 15.0,
+                nx: 3,
+                ny: 301,
+                z_m: 5.0,
+            };
             MeanConcentrationGrid::new(spec, 0.0)
         })
         .collect();
@@ -148,28 +224,54 @@ fn mean_crossflow_profile_widens_as_diffusivity_predicts() {
         let theory = 2.0 * k_h * t + params.init_radius_m.powi(2) + gamma * t;
         let got = profile_variance(g);
         eprintln!("x = {x} m: profile variance {got:.3} m^2, theory {theory:.3} m^2");
-        assert!((got - theory).abs() / theory < 0.10, "x = {x}: variance {got}, theory {theory}");
+        assert!(
+            (got - theory).abs() / theory < 0.10,
+            "x = {x}: variance {got}, theory {theory}"
+        );
         assert!(got > previous);
         previous = got;
     }
 }
 
 fn pompy_farrell(domain: Rect, dt: f64) -> FlowModel {
-    FlowModel::Farrell(Box::new(FarrellFlow::new(domain, east(1.0), FarrellParams::default(), dt).unwrap()))
+    FlowModel::Farrell(Box::new(
+        FarrellFlow::new(domain, east(1.0), FarrellParams::default(), dt).unwrap(),
+    ))
 }
 
 #[test]
 fn intermittency_falls_with_downflow_distance() {
     let domain = rect(0.0, 100.0, -50.0, 50.0);
     // Field-like release (5 /s) and a growth rate that dilutes filaments as they age.
-    let src = Source { pos_m: Vec3::new(5.0, 0.0, 0.0), mass_rate_per_s: 5.0, filament_rate_hz: 5.0 };
-    let params = FilamentParams { vertical: VerticalBoundary::Unbounded, growth_rate_m2ps: 0.02, ..FilamentParams::default() };
+    let src = Source {
+        pos_m: Vec3::new(5.0, 0.0, 0.0),
+        mass_rate_per_s: 5.0,
+        filament_rate_hz: 5.0,
+    };
+    let params = FilamentParams {
+        vertical: VerticalBoundary::Unbounded,
+        growth_rate_m2ps: 0.02,
+        ..FilamentParams::default()
+    };
     // An ocean-like meander: corner noise sd 0.35 m/s against a 1 m/s mean.
-    let fp = FarrellParams { noise_gain: 0.5, ..FarrellParams::default() };
-    let flow = FlowModel::Farrell(Box::new(FarrellFlow::new(domain, east(1.0), fp, 0.05).unwrap()));
+    let fp = FarrellParams {
+        noise_gain: 0.5,
+        ..FarrellParams::default()
+    };
+    let flow = FlowModel::Farrell(Box::new(
+        FarrellFlow::new(domain, east(1.0), fp, 0.05).unwrap(),
+    ));
     let mut env = filament_env(domain, flow, src, params, 0.05, 4);
     run(&mut env, 100.0);
-    let spec = GridSpec { x_min_m: 15.0, x_max_m: 75.0, y_min_m: -2.0, y_max_m: 2.0, nx: 3, ny: 3, z_m: 0.0 };
+    let spec = GridSpec {
+        x_min_m: 15.0,
+        x_max_m: 75.0,
+        y_min_m: -2.0,
+        y_max_m: 2.0,
+        nx: 3,
+        ny: 3,
+        z_m: 0.0,
+    };
     // Threshold 0.5: about an eighth of the near-source ribbon concentration.
     let mut grid = MeanConcentrationGrid::new(spec, 0.5);
     for k in 0..12_000 {
@@ -183,9 +285,15 @@ fn intermittency_falls_with_downflow_distance() {
     let col = |i: usize| (0..3).map(|j| inter[j * 3 + i]).sum::<f64>() / 3.0;
     let (near, mid, far) = (col(0), col(1), col(2));
     eprintln!("fraction above threshold: x=15 m {near:.3}, x=45 m {mid:.3}, x=75 m {far:.3}");
-    assert!(near > mid && mid > far, "not decreasing: {near} {mid} {far}");
+    assert!(
+        near > mid && mid > far,
+        "not decreasing: {near} {mid} {far}"
+    );
     assert!(far < 0.5 * near, "far {far} vs near {near}");
-    assert!(near < 0.9, "near-source points are not intermittent: {near}");
+    assert!(
+        near < 0.9,
+        "near-source points are not intermittent: {near}"
+    );
 }
 
 /// Standard deviation over time of the mean cross-flow position of filaments in a slab.
@@ -193,7 +301,11 @@ fn centroid_wander(env: &mut Environment, x0: f64, x1: f64, samples: usize) -> f
     let mut centroids = Vec::new();
     for _ in 0..samples {
         run(env, 1.0);
-        let ys: Vec<f64> = filaments(env).filaments().filter(|(p, _)| p.x >= x0 && p.x < x1).map(|(p, _)| p.y).collect();
+        let ys: Vec<f64> = filaments(env)
+            .filaments()
+            .filter(|(p, _)| p.x >= x0 && p.x < x1)
+            .map(|(p, _)| p.y)
+            .collect();
         if ys.len() >= 5 {
             centroids.push(ys.iter().sum::<f64>() / ys.len() as f64);
         }
@@ -205,17 +317,31 @@ fn centroid_wander(env: &mut Environment, x0: f64, x1: f64, samples: usize) -> f
 #[test]
 fn centreline_meanders_under_farrell_flow_but_not_uniform_flow() {
     let domain = rect(0.0, 100.0, -50.0, 50.0);
-    let src = Source { pos_m: Vec3::new(5.0, 0.0, 0.0), mass_rate_per_s: 20.0, filament_rate_hz: 20.0 };
+    let src = Source {
+        pos_m: Vec3::new(5.0, 0.0, 0.0),
+        mass_rate_per_s: 20.0,
+        filament_rate_hz: 20.0,
+    };
     let params = FilamentParams::default();
     let mut farrell = filament_env(domain, pompy_farrell(domain, 0.05), src, params, 0.05, 5);
-    let mut uniform = filament_env(domain, FlowModel::Uniform(UniformFlow::new(east(1.0)).unwrap()), src, params, 0.05, 5);
+    let mut uniform = filament_env(
+        domain,
+        FlowModel::Uniform(UniformFlow::new(east(1.0)).unwrap()),
+        src,
+        params,
+        0.05,
+        5,
+    );
     run(&mut farrell, 100.0);
     run(&mut uniform, 100.0);
     let wf = centroid_wander(&mut farrell, 55.0, 65.0, 400);
     let wu = centroid_wander(&mut uniform, 55.0, 65.0, 400);
     eprintln!("centreline wander at 60 m: farrell {wf:.2} m, uniform {wu:.2} m");
     assert!(wu < 0.5, "uniform flow plume wanders {wu} m");
-    assert!(wf > 3.0 && wf > 10.0 * wu, "farrell {wf} m vs uniform {wu} m");
+    assert!(
+        wf > 3.0 && wf > 10.0 * wu,
+        "farrell {wf} m vs uniform {wu} m"
+    );
 }
 
 #[test]
@@ -224,19 +350,41 @@ fn bottom_source_reaches_vehicle_altitude_only_downflow_as_theory_says() {
     // must match the seabed-reflected Gaussian plume with the filament growth folded in.
     let (u, k_h, k_v, gamma) = (0.5, 0.02, 0.005, 0.001);
     let domain = rect(0.0, 150.0, -40.0, 40.0);
-    let src = Source { pos_m: Vec3::new(5.0, 0.0, 0.0), mass_rate_per_s: 10.0, filament_rate_hz: 10.0 };
+    let src = Source {
+        pos_m: Vec3::new(5.0, 0.0, 0.0),
+        mass_rate_per_s: 10.0,
+        filament_rate_hz: 10.0,
+    };
     let params = FilamentParams {
-        dispersion: Dispersion::Physical { horizontal_m2ps: k_h, vertical_m2ps: k_v },
+        dispersion: Dispersion::Physical {
+            horizontal_m2ps: k_h,
+            vertical_m2ps: k_v,
+        },
         growth_rate_m2ps: gamma,
         ..FilamentParams::default()
     };
-    let mut env = filament_env(domain, FlowModel::Uniform(UniformFlow::new(east(u)).unwrap()), src, params, 0.1, 6);
+    let mut env = filament_env(
+        domain,
+        FlowModel::Uniform(UniformFlow::new(east(u)).unwrap()),
+        src,
+        params,
+        0.1,
+        6,
+    );
     run(&mut env, 300.0);
     let xs = [10.0, 30.0, 60.0, 120.0];
     let mut grids: Vec<MeanConcentrationGrid> = xs
         .iter()
         .map(|&x| {
-            let spec = GridSpec { x_min_m: x - 0.5, x_max_m: x + 0.5, y_min_m: -12.0, y_max_m: 12.0, nx: 3, ny: 97, z_m: 2.0 };
+            let spec = GridSpec {
+                x_min_m: x - 0.5,
+                x_max_m: x + 0.5,
+                y_min_m: -12.0,
+                y_max_m: 12.0,
+                nx: 3,
+                ny: 97,
+                z_m: 2.0,
+            };
             MeanConcentrationGrid::new(spec, 0.0)
         })
         .collect();
@@ -247,7 +395,16 @@ fn bottom_source_reaches_vehicle_altitude_only_downflow_as_theory_says() {
         }
     }
     // Equivalent steady plume: the filament's own growth adds gamma / 2 to each diffusivity.
-    let theory = GaussianPlume::new(src.pos_m, 10.0, u, 90.0, k_h + gamma / 2.0, k_v + gamma / 2.0, None).unwrap();
+    let theory = GaussianPlume::new(
+        src.pos_m,
+        10.0,
+        u,
+        90.0,
+        k_h + gamma / 2.0,
+        k_v + gamma / 2.0,
+        None,
+    )
+    .unwrap();
     let mut integrals = Vec::new();
     for (g, x) in grids.iter().zip(xs) {
         // Cross-flow integral of the mean concentration at 2 m, against theory.
@@ -255,14 +412,25 @@ fn bottom_source_reaches_vehicle_altitude_only_downflow_as_theory_says() {
         let dy = (spec.y_max_m - spec.y_min_m) / (spec.ny - 1) as f64;
         let mean = g.mean();
         let got: f64 = (0..spec.ny).map(|j| mean[j * 3 + 1]).sum::<f64>() * dy;
-        let want: f64 = (0..spec.ny).map(|j| theory.concentration(Vec3::new(x, spec.y_min_m + j as f64 * dy, 2.0))).sum::<f64>() * dy;
+        let want: f64 = (0..spec.ny)
+            .map(|j| theory.concentration(Vec3::new(x, spec.y_min_m + j as f64 * dy, 2.0)))
+            .sum::<f64>()
+            * dy;
         eprintln!("x = {x} m: integral at 2 m {got:.4e}, theory {want:.4e}");
         integrals.push((got, want));
     }
     // Within 2 m of... the source the plume has not reached 2 m yet.
-    assert!(integrals[0].0 < 0.05 * integrals[2].0, "near-source {:.3e} vs 60 m {:.3e}", integrals[0].0, integrals[2].0);
+    assert!(
+        integrals[0].0 < 0.05 * integrals[2].0,
+        "near-source {:.3e} vs 60 m {:.3e}",
+        integrals[0].0,
+        integrals[2].0
+    );
     for &(got, want) in &integrals[1..] {
-        assert!((got - want).abs() / want < 0.2, "integral {got} vs theory {want}");
+        assert!(
+            (got - want).abs() / want < 0.2,
+            "integral {got} vs theory {want}"
+        );
     }
 }
 
@@ -271,10 +439,18 @@ fn pompy_scaling_depends_on_dt_and_physical_does_not() {
     // Spread after 20 s with no flow: physical K gives variance 2 K t whatever dt is;
     // pompy's scale * N * dt gives scale^2 dt t, ten times smaller at a ten times smaller dt.
     let domain = rect(-100.0, 100.0, -100.0, 100.0);
-    let src = Source { pos_m: Vec3::new(0.0, 0.0, 10.0), mass_rate_per_s: 1.0, filament_rate_hz: 1.0 };
+    let src = Source {
+        pos_m: Vec3::new(0.0, 0.0, 10.0),
+        mass_rate_per_s: 1.0,
+        filament_rate_hz: 1.0,
+    };
     let still = || FlowModel::Uniform(UniformFlow::new(east(0.0)).unwrap());
     let spread = |dispersion: Dispersion, dt: f64| {
-        let params = FilamentParams { dispersion, vertical: VerticalBoundary::Unbounded, ..FilamentParams::default() };
+        let params = FilamentParams {
+            dispersion,
+            vertical: VerticalBoundary::Unbounded,
+            ..FilamentParams::default()
+        };
         let mut plume = FilamentPlume::new(domain, vec![src], params).unwrap();
         plume.release_at_source(0, 4000);
         let mut rng = stream_rng(9, StreamId::Plume);
@@ -283,36 +459,70 @@ fn pompy_scaling_depends_on_dt_and_physical_does_not() {
         let _ = &mut flow;
         // Release nothing more: the Poisson rate of 1 /s adds a few filaments; keep the first 4000.
         let mut p = plume;
-        for _ in 0..steps {
-            p.step(&flow, dt, &mut rng);
+        for k in 1..=steps {
+            p.step(&flow, k as f64 * dt, dt, &mut rng);
         }
         let xs: Vec<f64> = p.filaments().take(4000).map(|(q, _)| q.x).collect();
         xs.iter().map(|x| x * x).sum::<f64>() / xs.len() as f64
     };
-    let phys = Dispersion::Physical { horizontal_m2ps: 0.1, vertical_m2ps: 0.1 };
+    let phys = Dispersion::Physical {
+        horizontal_m2ps: 0.1,
+        vertical_m2ps: 0.1,
+    };
     let (a, b) = (spread(phys, 0.1), spread(phys, 0.01));
-    assert!((a - 4.0).abs() / 4.0 < 0.1 && (b - 4.0).abs() / 4.0 < 0.1, "physical: {a} and {b}, theory 4.0");
-    let pompy = Dispersion::PompyCompatible { scale_mps: [2.0; 3] };
+    assert!(
+        (a - 4.0).abs() / 4.0 < 0.1 && (b - 4.0).abs() / 4.0 < 0.1,
+        "physical: {a} and {b}, theory 4.0"
+    );
+    let pompy = Dispersion::PompyCompatible {
+        scale_mps: [2.0; 3],
+    };
     let (c, d) = (spread(pompy, 0.1), spread(pompy, 0.01));
     // scale^2 dt t = 4 * 0.1 * 20 = 8 and 0.8.
-    assert!((c - 8.0).abs() / 8.0 < 0.1 && (d - 0.8).abs() / 0.8 < 0.1, "pompy mode: {c} and {d}");
+    assert!(
+        (c - 8.0).abs() / 8.0 < 0.1 && (d - 0.8).abs() / 0.8 < 0.1,
+        "pompy mode: {c} and {d}"
+    );
 }
 
 #[test]
 fn filaments_pass_through_soft_obstacles() {
     let domain = rect(0.0, 100.0, -50.0, 50.0);
-    let src = Source { pos_m: Vec3::new(5.0, 0.0, 0.0), mass_rate_per_s: 5.0, filament_rate_hz: 5.0 };
-    let kelp = SoftObstacle::new("kelp", &[[30.0, -10.0], [40.0, -10.0], [40.0, 10.0], [30.0, 10.0]], "obstacles[0]").unwrap();
+    let src = Source {
+        pos_m: Vec3::new(5.0, 0.0, 0.0),
+        mass_rate_per_s: 5.0,
+        filament_rate_hz: 5.0,
+    };
+    let kelp = SoftObstacle::new(
+        "kelp",
+        &[[30.0, -10.0], [40.0, -10.0], [40.0, 10.0], [30.0, 10.0]],
+        "obstacles[0]",
+    )
+    .unwrap();
     let build = |obstacles: ObstacleSet| {
         let plume = FilamentPlume::new(domain, vec![src], FilamentParams::default()).unwrap();
-        Environment::new(domain, pompy_farrell(domain, 0.05), Plume::Filaments(Box::new(plume)), obstacles, 0.05, 8).unwrap()
+        Environment::new(
+            domain,
+            pompy_farrell(domain, 0.05),
+            Plume::Filaments(Box::new(plume)),
+            obstacles,
+            0.05,
+            8,
+        )
+        .unwrap()
     };
     let mut with = build(ObstacleSet::new(vec![kelp]));
     let mut without = build(ObstacleSet::default());
     run(&mut with, 80.0);
     run(&mut without, 80.0);
-    let inside = filaments(&with).filaments().filter(|(p, _)| with.obstacles().contains(Vec2::new(p.x, p.y))).count();
-    let beyond = filaments(&with).filaments().filter(|(p, _)| p.x > 40.0).count();
+    let inside = filaments(&with)
+        .filaments()
+        .filter(|(p, _)| with.obstacles().contains(Vec2::new(p.x, p.y)))
+        .count();
+    let beyond = filaments(&with)
+        .filaments()
+        .filter(|(p, _)| p.x > 40.0)
+        .count();
     assert!(inside > 0 || beyond > 0, "no filament reached the kelp");
     let a: Vec<_> = filaments(&with).filaments().collect();
     let b: Vec<_> = filaments(&without).filaments().collect();
@@ -322,22 +532,47 @@ fn filaments_pass_through_soft_obstacles() {
 #[test]
 fn same_seed_same_bits_and_thread_count_does_not_matter() {
     let domain = rect(0.0, 100.0, -50.0, 50.0);
-    let src = Source { pos_m: Vec3::new(5.0, 0.0, 0.0), mass_rate_per_s: 5.0, filament_rate_hz: 10.0 };
+    let src = Source {
+        pos_m: Vec3::new(5.0, 0.0, 0.0),
+        mass_rate_per_s: 5.0,
+        filament_rate_hz: 10.0,
+    };
     let make = |seed| {
-        let mut env = filament_env(domain, pompy_farrell(domain, 0.05), src, FilamentParams::default(), 0.05, seed);
+        let mut env = filament_env(
+            domain,
+            pompy_farrell(domain, 0.05),
+            src,
+            FilamentParams::default(),
+            0.05,
+            seed,
+        );
         run(&mut env, 60.0);
         env
     };
     let (a, b, c) = (make(11), make(11), make(12));
     let bits = |e: &Environment| -> Vec<u64> {
-        filaments(e).filaments().flat_map(|(p, r2)| [p.x.to_bits(), p.y.to_bits(), p.z.to_bits(), r2.to_bits()]).collect()
+        filaments(e)
+            .filaments()
+            .flat_map(|(p, r2)| [p.x.to_bits(), p.y.to_bits(), p.z.to_bits(), r2.to_bits()])
+            .collect()
     };
     assert_eq!(bits(&a), bits(&b));
     assert_ne!(bits(&a), bits(&c));
-    let spec = GridSpec { x_min_m: 0.0, x_max_m: 100.0, y_min_m: -20.0, y_max_m: 20.0, nx: 201, ny: 81, z_m: 0.0 };
+    let spec = GridSpec {
+        x_min_m: 0.0,
+        x_max_m: 100.0,
+        y_min_m: -20.0,
+        y_max_m: 20.0,
+        nx: 201,
+        ny: 81,
+        z_m: 0.0,
+    };
     let pts = spec.points();
     let eval = |threads: usize| {
-        let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
         let mut out = vec![0.0; pts.len()];
         pool.install(|| a.plume().concentrations(&pts, &mut out));
         out.iter().map(|c| c.to_bits()).collect::<Vec<_>>()

@@ -8,8 +8,8 @@ use plumetrace_env::flow::{FarrellFlow, FarrellParams, GriddedFlow, MeanFlow, Un
 use plumetrace_env::plume::Dispersion;
 use plumetrace_env::steady::{GaussianPlume, GriddedConcentration};
 use plumetrace_env::{
-    EnvError, Environment, FilamentParams, FilamentPlume, FlowModel, GridSpec, ObstacleSet, Plume, Rect, SoftObstacle,
-    Source, VerticalBoundary,
+    EnvError, Environment, FilamentParams, FilamentPlume, FlowModel, GridSpec, ObstacleSet, Plume,
+    Rect, SoftObstacle, Source, VerticalBoundary,
 };
 use std::path::{Path, PathBuf};
 
@@ -42,11 +42,27 @@ pub struct BuiltScenario {
 }
 
 /// Builds a scenario; `seed` overrides the file's seed.
-pub fn build(cfg: &ScenarioConfig, origin: &Origin, seed: Option<u64>) -> Result<BuiltScenario, ScenarioError> {
-    let invalid = |path: &str, message: String| ScenarioError::Invalid { origin: origin.to_string(), path: path.to_string(), message };
+pub fn build(
+    cfg: &ScenarioConfig,
+    origin: &Origin,
+    seed: Option<u64>,
+) -> Result<BuiltScenario, ScenarioError> {
+    let invalid = |path: &str, message: String| ScenarioError::Invalid {
+        origin: origin.to_string(),
+        path: path.to_string(),
+        message,
+    };
     let env_err = |e: EnvError| match e {
-        EnvError::InvalidParameter { key, message } => ScenarioError::Invalid { origin: origin.to_string(), path: key, message },
-        other => ScenarioError::Invalid { origin: origin.to_string(), path: String::new(), message: other.to_string() },
+        EnvError::InvalidParameter { key, message } => ScenarioError::Invalid {
+            origin: origin.to_string(),
+            path: key,
+            message,
+        },
+        other => ScenarioError::Invalid {
+            origin: origin.to_string(),
+            path: String::new(),
+            message: other.to_string(),
+        },
     };
     let base_dir: PathBuf = match origin {
         Origin::File(p) => p.parent().map(Path::to_path_buf).unwrap_or_default(),
@@ -55,15 +71,24 @@ pub fn build(cfg: &ScenarioConfig, origin: &Origin, seed: Option<u64>) -> Result
 
     let dt_s = cfg.sim.dt_s;
     if !(dt_s.is_finite() && dt_s > 0.0) {
-        return Err(invalid("sim.dt_s", format!("must be a finite number > 0, got {dt_s}")));
+        return Err(invalid(
+            "sim.dt_s",
+            format!("must be a finite number > 0, got {dt_s}"),
+        ));
     }
     let duration = cfg.sim.duration_s;
     if !(duration.is_finite() && duration >= dt_s) {
-        return Err(invalid("sim.duration_s", format!("must be a finite number >= sim.dt_s ({dt_s}), got {duration}")));
+        return Err(invalid(
+            "sim.duration_s",
+            format!("must be a finite number >= sim.dt_s ({dt_s}), got {duration}"),
+        ));
     }
     let steps_f = (duration / dt_s).round();
     if steps_f > 1e10 {
-        return Err(invalid("sim.duration_s", format!("needs {steps_f:.0} steps; at most 1e10")));
+        return Err(invalid(
+            "sim.duration_s",
+            format!("needs {steps_f:.0} steps; at most 1e10"),
+        ));
     }
     let steps = steps_f as u64;
 
@@ -72,23 +97,38 @@ pub fn build(cfg: &ScenarioConfig, origin: &Origin, seed: Option<u64>) -> Result
         EnvError::InvalidParameter { key, message } => invalid(&format!("domain.{key}"), message),
         other => invalid("domain", other.to_string()),
     })?;
-    if let Some(depth) = d.depth_m {
-        if !(depth.is_finite() && depth > 0.0) {
-            return Err(invalid("domain.depth_m", format!("must be a finite number > 0, got {depth}")));
-        }
+    if let Some(depth) = d.depth_m
+        && !(depth.is_finite() && depth > 0.0)
+    {
+        return Err(invalid(
+            "domain.depth_m",
+            format!("must be a finite number > 0, got {depth}"),
+        ));
     }
 
     let mean = |required: bool| -> Result<Option<MeanFlow>, ScenarioError> {
         match &cfg.flow.mean {
-            Some(m) => mean_flow(m).map(Some).map_err(|(k, msg)| invalid(&format!("flow.mean.{k}"), msg)),
-            None if required => Err(invalid("flow.mean", format!("flow model '{:?}' needs a [flow.mean] table", cfg.flow.model).to_lowercase())),
+            Some(m) => mean_flow(m)
+                .map(Some)
+                .map_err(|(k, msg)| invalid(&format!("flow.mean.{k}"), msg)),
+            None if required => Err(invalid(
+                "flow.mean",
+                format!(
+                    "flow model '{:?}' needs a [flow.mean] table",
+                    cfg.flow.model
+                )
+                .to_lowercase(),
+            )),
             None => Ok(None),
         }
     };
     let flow = match cfg.flow.model {
         FlowKind::Uniform => {
             if cfg.flow.farrell.is_some() {
-                return Err(invalid("flow.farrell", "only applies to model = \"farrell\"".into()));
+                return Err(invalid(
+                    "flow.farrell",
+                    "only applies to model = \"farrell\"".into(),
+                ));
             }
             let m = mean(true)?.ok_or_else(|| invalid("flow.mean", "missing".into()))?;
             FlowModel::Uniform(UniformFlow::new(m).map_err(env_err)?)
@@ -106,17 +146,28 @@ pub fn build(cfg: &ScenarioConfig, origin: &Origin, seed: Option<u64>) -> Result
                 noise_bandwidth_radps: f.noise_bandwidth_radps,
                 original_noise_updates: f.original_noise_updates,
             };
-            FlowModel::Farrell(Box::new(FarrellFlow::new(domain, m, params, dt_s).map_err(env_err)?))
+            FlowModel::Farrell(Box::new(
+                FarrellFlow::new(domain, m, params, dt_s).map_err(env_err)?,
+            ))
         }
         FlowKind::Gridded => {
             let Some(file) = &cfg.flow.file else {
-                return Err(invalid("flow.file", "model = \"gridded\" needs a file (CSV: x_m,y_m,u_mps,v_mps[,t_s])".into()));
+                return Err(invalid(
+                    "flow.file",
+                    "model = \"gridded\" needs a file (CSV: x_m,y_m,u_mps,v_mps[,t_s])".into(),
+                ));
             };
-            FlowModel::Gridded(Box::new(GriddedFlow::from_csv(&base_dir.join(file)).map_err(|e| invalid("flow.file", e.to_string()))?))
+            FlowModel::Gridded(Box::new(
+                GriddedFlow::from_csv(&base_dir.join(file))
+                    .map_err(|e| invalid("flow.file", e.to_string()))?,
+            ))
         }
     };
     if cfg.flow.file.is_some() && cfg.flow.model != FlowKind::Gridded {
-        return Err(invalid("flow.file", "only applies to model = \"gridded\"".into()));
+        return Err(invalid(
+            "flow.file",
+            "only applies to model = \"gridded\"".into(),
+        ));
     }
 
     let p = &cfg.plume;
@@ -127,17 +178,29 @@ pub fn build(cfg: &ScenarioConfig, origin: &Origin, seed: Option<u64>) -> Result
     let sources: Vec<Source> = cfg
         .sources
         .iter()
-        .map(|s| Source { pos_m: Vec3::new(s.x_m, s.y_m, s.z_m), mass_rate_per_s: s.mass_rate_per_s, filament_rate_hz: s.filament_rate_hz })
+        .map(|s| Source {
+            pos_m: Vec3::new(s.x_m, s.y_m, s.z_m),
+            mass_rate_per_s: s.mass_rate_per_s,
+            filament_rate_hz: s.filament_rate_hz,
+        })
         .collect();
     if sources.is_empty() && p.model != PlumeKind::Gridded {
-        return Err(invalid("sources", "at least one [[sources]] entry is needed".into()));
+        return Err(invalid(
+            "sources",
+            "at least one [[sources]] entry is needed".into(),
+        ));
     }
     let plume = match p.model {
         PlumeKind::Filaments => {
             let dispersion = if p.pompy_compatible {
-                Dispersion::PompyCompatible { scale_mps: [p.pompy_diff_scale_mps; 3] }
+                Dispersion::PompyCompatible {
+                    scale_mps: [p.pompy_diff_scale_mps; 3],
+                }
             } else {
-                Dispersion::Physical { horizontal_m2ps: p.horizontal_diffusivity_m2ps, vertical_m2ps: p.vertical_diffusivity_m2ps }
+                Dispersion::Physical {
+                    horizontal_m2ps: p.horizontal_diffusivity_m2ps,
+                    vertical_m2ps: p.vertical_diffusivity_m2ps,
+                }
             };
             let params = FilamentParams {
                 dispersion,
@@ -156,10 +219,17 @@ pub fn build(cfg: &ScenarioConfig, origin: &Origin, seed: Option<u64>) -> Result
         PlumeKind::Gaussian => {
             let m = mean(true)?.ok_or_else(|| invalid("flow.mean", "missing".into()))?;
             let v = m.velocity_at(0.0);
-            let toward = plumetrace_core::Heading::of_vector(v)
-                .ok_or_else(|| invalid("flow.mean", "the gaussian plume needs a non-zero current".into()))?;
+            let toward = plumetrace_core::Heading::of_vector(v).ok_or_else(|| {
+                invalid(
+                    "flow.mean",
+                    "the gaussian plume needs a non-zero current".into(),
+                )
+            })?;
             if sources.len() > 1 {
-                return Err(invalid("sources", "the gaussian plume takes exactly one source".into()));
+                return Err(invalid(
+                    "sources",
+                    "the gaussian plume takes exactly one source".into(),
+                ));
             }
             let s = sources[0];
             let g = GaussianPlume::new(
@@ -172,16 +242,24 @@ pub fn build(cfg: &ScenarioConfig, origin: &Origin, seed: Option<u64>) -> Result
                 d.depth_m,
             )
             .map_err(|e| match e {
-                EnvError::InvalidParameter { key, message } => invalid(&key.replace("source.", "sources[0].").replace("flow.", "flow.mean."), message),
+                EnvError::InvalidParameter { key, message } => invalid(
+                    &key.replace("source.", "sources[0].")
+                        .replace("flow.", "flow.mean."),
+                    message,
+                ),
                 other => invalid("plume", other.to_string()),
             })?;
             Plume::Steady(Box::new(g))
         }
         PlumeKind::Gridded => {
             let Some(file) = &p.file else {
-                return Err(invalid("plume.file", "model = \"gridded\" needs a file (CSV: x_m,y_m[,z_m],concentration)".into()));
+                return Err(invalid(
+                    "plume.file",
+                    "model = \"gridded\" needs a file (CSV: x_m,y_m[,z_m],concentration)".into(),
+                ));
             };
-            let g = GriddedConcentration::from_csv(&base_dir.join(file)).map_err(|e| invalid("plume.file", e.to_string()))?;
+            let g = GriddedConcentration::from_csv(&base_dir.join(file))
+                .map_err(|e| invalid("plume.file", e.to_string()))?;
             Plume::Steady(Box::new(g))
         }
     };
@@ -189,24 +267,47 @@ pub fn build(cfg: &ScenarioConfig, origin: &Origin, seed: Option<u64>) -> Result
     let mut obstacles = Vec::new();
     for (k, o) in cfg.obstacles.iter().enumerate() {
         let key = format!("obstacles[{k}]");
-        let name = if o.name.is_empty() { key.clone() } else { o.name.clone() };
+        let name = if o.name.is_empty() {
+            key.clone()
+        } else {
+            o.name.clone()
+        };
         obstacles.push(SoftObstacle::new(name, &o.vertices, &key).map_err(env_err)?);
     }
 
     let seed = seed.unwrap_or(cfg.seed);
-    let env = Environment::new(domain, flow, plume, ObstacleSet::new(obstacles), dt_s, seed).map_err(env_err)?;
+    let env = Environment::new(domain, flow, plume, ObstacleSet::new(obstacles), dt_s, seed)
+        .map_err(env_err)?;
 
     let o = &cfg.output;
-    let grid = GridSpec { x_min_m: d.x_min_m, x_max_m: d.x_max_m, y_min_m: d.y_min_m, y_max_m: d.y_max_m, nx: o.nx, ny: o.ny, z_m: o.z_m };
+    let grid = GridSpec {
+        x_min_m: d.x_min_m,
+        x_max_m: d.x_max_m,
+        y_min_m: d.y_min_m,
+        y_max_m: d.y_max_m,
+        nx: o.nx,
+        ny: o.ny,
+        z_m: o.z_m,
+    };
     grid.validate("output").map_err(env_err)?;
     if !(o.average_interval_s.is_finite() && o.average_interval_s >= dt_s) {
-        return Err(invalid("output.average_interval_s", format!("must be >= sim.dt_s ({dt_s}), got {}", o.average_interval_s)));
+        return Err(invalid(
+            "output.average_interval_s",
+            format!("must be >= sim.dt_s ({dt_s}), got {}", o.average_interval_s),
+        ));
     }
-    if !(o.average_start_s.is_finite() && o.average_start_s >= 0.0 && o.average_start_s < duration) {
-        return Err(invalid("output.average_start_s", format!("must be in [0, sim.duration_s), got {}", o.average_start_s)));
+    if !(o.average_start_s.is_finite() && o.average_start_s >= 0.0 && o.average_start_s < duration)
+    {
+        return Err(invalid(
+            "output.average_start_s",
+            format!("must be in [0, sim.duration_s), got {}", o.average_start_s),
+        ));
     }
     if !(o.threshold.is_finite() && o.threshold >= 0.0) {
-        return Err(invalid("output.threshold", format!("must be a finite number >= 0, got {}", o.threshold)));
+        return Err(invalid(
+            "output.threshold",
+            format!("must be a finite number >= 0, got {}", o.threshold),
+        ));
     }
     let output = OutputSpec {
         grid,
@@ -214,27 +315,52 @@ pub fn build(cfg: &ScenarioConfig, origin: &Origin, seed: Option<u64>) -> Result
         average_start_step: (o.average_start_s / dt_s).round() as u64,
         threshold: o.threshold,
     };
-    Ok(BuiltScenario { name: cfg.name.clone(), seed, env, steps, output })
+    Ok(BuiltScenario {
+        name: cfg.name.clone(),
+        seed,
+        env,
+        steps,
+        output,
+    })
 }
 
 /// Interprets `[flow.mean]`: steady or tidal; on error returns `(key, message)`.
 fn mean_flow(m: &MeanFlowConfig) -> Result<MeanFlow, (String, String)> {
-    let tidal_keys = [m.speed_min_mps, m.speed_max_mps, m.toward_min_deg, m.toward_max_deg, m.period_s, m.phase_deg];
+    let tidal_keys = [
+        m.speed_min_mps,
+        m.speed_max_mps,
+        m.toward_min_deg,
+        m.toward_max_deg,
+        m.period_s,
+        m.phase_deg,
+    ];
     let any_tidal = tidal_keys.iter().any(Option::is_some);
     let any_steady = m.speed_mps.is_some() || m.toward_deg.is_some();
     let mean = match (any_steady, any_tidal) {
         (true, true) => {
-            return Err(("speed_mps".into(), "give either speed_mps and toward_deg (steady) or the tidal keys, not both".into()));
+            return Err((
+                "speed_mps".into(),
+                "give either speed_mps and toward_deg (steady) or the tidal keys, not both".into(),
+            ));
         }
         (false, false) => {
             return Err(("speed_mps".into(), "give speed_mps and toward_deg (steady) or speed_min_mps, speed_max_mps, toward_min_deg, toward_max_deg, period_s (tidal)".into()));
         }
         (true, false) => MeanFlow::Steady {
-            speed_mps: m.speed_mps.ok_or(("speed_mps".to_string(), "missing".to_string()))?,
-            toward_deg: m.toward_deg.ok_or(("toward_deg".to_string(), "missing".to_string()))?,
+            speed_mps: m
+                .speed_mps
+                .ok_or(("speed_mps".to_string(), "missing".to_string()))?,
+            toward_deg: m
+                .toward_deg
+                .ok_or(("toward_deg".to_string(), "missing".to_string()))?,
         },
         (false, true) => {
-            let need = |v: Option<f64>, k: &str| v.ok_or((k.to_string(), "missing (needed for a tidal mean flow)".to_string()));
+            let need = |v: Option<f64>, k: &str| {
+                v.ok_or((
+                    k.to_string(),
+                    "missing (needed for a tidal mean flow)".to_string(),
+                ))
+            };
             MeanFlow::Tidal {
                 speed_min_mps: need(m.speed_min_mps, "speed_min_mps")?,
                 speed_max_mps: need(m.speed_max_mps, "speed_max_mps")?,
@@ -246,7 +372,9 @@ fn mean_flow(m: &MeanFlowConfig) -> Result<MeanFlow, (String, String)> {
         }
     };
     mean.validate("flow.mean").map_err(|e| match e {
-        EnvError::InvalidParameter { key, message } => (key.trim_start_matches("flow.mean.").to_string(), message),
+        EnvError::InvalidParameter { key, message } => {
+            (key.trim_start_matches("flow.mean.").to_string(), message)
+        }
         other => ("speed_mps".into(), other.to_string()),
     })?;
     Ok(mean)

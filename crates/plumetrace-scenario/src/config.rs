@@ -205,7 +205,10 @@ impl Default for PlumeConfig {
     fn default() -> Self {
         let p = plumetrace_env::FilamentParams::default();
         let (h, v) = match p.dispersion {
-            plumetrace_env::plume::Dispersion::Physical { horizontal_m2ps, vertical_m2ps } => (horizontal_m2ps, vertical_m2ps),
+            plumetrace_env::plume::Dispersion::Physical {
+                horizontal_m2ps,
+                vertical_m2ps,
+            } => (horizontal_m2ps, vertical_m2ps),
             plumetrace_env::plume::Dispersion::PompyCompatible { .. } => (0.02, 0.002),
         };
         PlumeConfig {
@@ -282,6 +285,13 @@ pub struct OutputConfig {
 
 impl Default for OutputConfig {
     fn default() -> Self {
-        OutputConfig { nx: 201, ny: 201, z_m: 0.0, average_interval_s: 1.0, average_start_s: 0.0, threshold: 0.1 }
+        OutputConfig {
+            nx: 201,
+            ny: 201,
+            z_m: 0.0,
+            average_interval_s: 1.0,
+            average_start_s: 0.0,
+            threshold: 0.1,
+        }
     }
 }

@@ -45,7 +45,11 @@ impl ScenarioError {
     /// The key path of the error, if it has one.
     pub fn key_path(&self) -> Option<&str> {
         match self {
-            ScenarioError::Parse { path, .. } | ScenarioError::Invalid { path, .. } if !path.is_empty() => Some(path),
+            ScenarioError::Parse { path, .. } | ScenarioError::Invalid { path, .. }
+                if !path.is_empty() =>
+            {
+                Some(path)
+            }
             _ => None,
         }
     }

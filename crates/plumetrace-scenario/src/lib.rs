@@ -55,7 +55,10 @@ pub fn parse(text: &str, origin: &Origin) -> Result<ScenarioConfig, ScenarioErro
 /// Reads and parses a scenario file.
 pub fn load_file(path: &Path) -> Result<ScenarioConfig, ScenarioError> {
     let origin = Origin::File(path.to_path_buf());
-    let text = std::fs::read_to_string(path).map_err(|e| ScenarioError::Io { origin: origin.to_string(), message: e.to_string() })?;
+    let text = std::fs::read_to_string(path).map_err(|e| ScenarioError::Io {
+        origin: origin.to_string(),
+        message: e.to_string(),
+    })?;
     parse(&text, &origin)
 }
 
@@ -63,7 +66,11 @@ pub fn load_file(path: &Path) -> Result<ScenarioConfig, ScenarioError> {
 pub fn load_preset(name: &str) -> Result<ScenarioConfig, ScenarioError> {
     let preset = find_preset(name).ok_or_else(|| ScenarioError::UnknownPreset {
         name: name.to_string(),
-        known: PRESETS.iter().map(|p| p.name).collect::<Vec<_>>().join(", "),
+        known: PRESETS
+            .iter()
+            .map(|p| p.name)
+            .collect::<Vec<_>>()
+            .join(", "),
     })?;
     parse(preset.toml, &Origin::Preset(name.to_string()))
 }

@@ -53,7 +53,8 @@ mod tests {
         for p in PRESETS {
             let cfg = load_preset(p.name).unwrap_or_else(|e| panic!("{e}"));
             assert_eq!(cfg.name, p.name);
-            let built = build(&cfg, &Origin::Preset(p.name.into()), None).unwrap_or_else(|e| panic!("{e}"));
+            let built =
+                build(&cfg, &Origin::Preset(p.name.into()), None).unwrap_or_else(|e| panic!("{e}"));
             assert!(built.steps > 0);
         }
     }

@@ -1,5 +1,7 @@
 //! Bad scenarios are rejected with the key path; nothing panics.
 
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
 use plumetrace_scenario::{Origin, build, find_preset, parse};
 
 fn demo_with(edit: impl Fn(&str) -> String) -> String {
@@ -20,25 +22,48 @@ fn error_of(text: &str) -> String {
 #[test]
 fn bad_values_are_rejected_with_their_key_path() {
     let cases: &[(&str, &str, &str)] = &[
-        ("mass_rate_per_s = 5.0", "mass_rate_per_s = -5.0", "sources[0].mass_rate_per_s"),
-        ("filament_rate_hz = 5.0", "filament_rate_hz = -1.0", "sources[0].filament_rate_hz"),
+        (
+            "mass_rate_per_s = 5.0",
+            "mass_rate_per_s = -5.0",
+            "sources[0].mass_rate_per_s",
+        ),
+        (
+            "filament_rate_hz = 5.0",
+            "filament_rate_hz = -1.0",
+            "sources[0].filament_rate_hz",
+        ),
         ("x_max_m = 200.0", "x_max_m = 0.0", "domain.x_max_m"),
         ("y_max_m = 50.0", "y_max_m = -50.0", "domain.y_max_m"),
         ("dt_s = 0.1", "dt_s = 5.0", "sim.dt_s"),
         ("dt_s = 0.1", "dt_s = -0.1", "sim.dt_s"),
         ("nx = 21", "nx = 1", "flow.farrell.nx"),
-        ("noise_gain = 0.3", "noise_gain = -0.3", "flow.farrell.noise_gain"),
+        (
+            "noise_gain = 0.3",
+            "noise_gain = -0.3",
+            "flow.farrell.noise_gain",
+        ),
         ("speed_mps = 0.5", "speed_mps = -0.5", "flow.mean.speed_mps"),
-        ("growth_rate_m2ps = 0.01", "growth_rate_m2ps = -0.01", "plume.growth_rate_m2ps"),
+        (
+            "growth_rate_m2ps = 0.01",
+            "growth_rate_m2ps = -0.01",
+            "plume.growth_rate_m2ps",
+        ),
         ("x_m = 10.0", "x_m = 500.0", "sources[0].x_m"),
         ("threshold = 0.05", "threshold = -1.0", "output.threshold"),
         ("depth_m = 10.0", "depth_m = 0.0", "domain.depth_m"),
     ];
     for (from, to, key) in cases {
         let text = demo_with(|t| t.replacen(from, to, 1));
-        assert_ne!(text, find_preset("demo").unwrap().toml, "edit {from} -> {to} did not apply");
+        assert_ne!(
+            text,
+            find_preset("demo").unwrap().toml,
+            "edit {from} -> {to} did not apply"
+        );
         let e = error_of(&text);
-        assert!(e.contains(key) && e.starts_with("scenario.toml"), "{from} -> {to}: error {e:?} does not name {key}");
+        assert!(
+            e.contains(key) && e.starts_with("scenario.toml"),
+            "{from} -> {to}: error {e:?} does not name {key}"
+        );
     }
 }
 
@@ -46,7 +71,11 @@ fn bad_values_are_rejected_with_their_key_path() {
 fn unknown_and_mistyped_keys_are_rejected_with_their_path() {
     let cases: &[(&str, &str, &str)] = &[
         ("[sim]\n", "[sim]\ndt = 0.1\n", "sim"),
-        ("[flow.farrell]\n", "[flow.farrell]\nnoise_gian = 1.0\n", "flow.farrell"),
+        (
+            "[flow.farrell]\n",
+            "[flow.farrell]\nnoise_gian = 1.0\n",
+            "flow.farrell",
+        ),
         ("[plume]\n", "[plume]\ngrowth_rate = 0.1\n", "plume"),
         ("model = \"farrell\"", "model = \"farel\"", "flow.model"),
         ("nx = 21", "nx = \"many\"", "flow.farrell.nx"),
@@ -55,19 +84,40 @@ fn unknown_and_mistyped_keys_are_rejected_with_their_path() {
     for (from, to, key) in cases {
         let text = demo_with(|t| t.replacen(from, to, 1));
         let e = error_of(&text);
-        assert!(e.contains(key) && e != "accepted", "{to}: error {e:?} does not name {key}");
+        assert!(
+            e.contains(key) && e != "accepted",
+            "{to}: error {e:?} does not name {key}"
+        );
     }
 }
 
 #[test]
 fn missing_tables_and_files_are_explained() {
-    let no_mean = demo_with(|t| t.replace("[flow.mean]\nspeed_mps = 0.5\ntoward_deg = 90.0          # the water moves East\n", ""));
+    let no_mean = demo_with(|t| {
+        t.replace(
+            "[flow.mean]\nspeed_mps = 0.5\ntoward_deg = 90.0          # the water moves East\n",
+            "",
+        )
+    });
     let e = error_of(&no_mean);
     assert!(e.contains("flow.mean"), "{e}");
-    let gridded = demo_with(|t| t.replacen("model = \"farrell\"", "model = \"gridded\"\nfile = \"nope.csv\"", 1).replace("[flow.farrell]\nnx = 21\nny = 11\n", "[flow.x]\n"));
+    let gridded = demo_with(|t| {
+        t.replacen(
+            "model = \"farrell\"",
+            "model = \"gridded\"\nfile = \"nope.csv\"",
+            1,
+        )
+        .replace("[flow.farrell]\nnx = 21\nny = 11\n", "[flow.x]\n")
+    });
     let e = error_of(&gridded);
     assert!(e.contains("flow"), "{e}");
-    let missing = demo_with(|t| t.replacen("model = \"farrell\"", "model = \"gridded\"\nfile = \"nope.csv\"", 1));
+    let missing = demo_with(|t| {
+        t.replacen(
+            "model = \"farrell\"",
+            "model = \"gridded\"\nfile = \"nope.csv\"",
+            1,
+        )
+    });
     let origin = Origin::File("scenario.toml".into());
     let cfg = parse(&missing, &origin).unwrap();
     let e = build(&cfg, &origin, None).unwrap_err().to_string();

@@ -80,7 +80,13 @@ pub struct ColouredNoise {
 
 impl ColouredNoise {
     /// `channels` independent channels starting at rest.
-    pub fn new(channels: usize, gain: f64, damping: f64, bandwidth_radps: f64, original_updates: bool) -> Self {
+    pub fn new(
+        channels: usize,
+        gain: f64,
+        damping: f64,
+        bandwidth_radps: f64,
+        original_updates: bool,
+    ) -> Self {
         ColouredNoise {
             x0: vec![0.0; channels],
             x1: vec![0.0; channels],
@@ -130,12 +136,10 @@ pub struct FarrellFlow {
     /// Row-major `(ny + 2) x (nx + 2)`: index `j * (nx + 2) + i`, ring included.
     u: Vec<f64>,
     v: Vec<f64>,
-    /// Interior-only row-major `ny x nx` copies for fast interpolation.
-    u_int: Vec<f64>,
-    v_int: Vec<f64>,
-    /// Per grid cell `(nx - 1) x (ny - 1)`, the corner values `[u00, u10, u01, u11, v00, v10,
-    /// v01, v11]` in one 64-byte record, so an interpolation touches one cache line.
-    cells: Vec<[f64; 8]>,
+    /// Buffers the next interior is written to before they are swapped with `u` and `v` (their
+    /// ring is stale until the next boundary update rewrites it).
+    u_next: Vec<f64>,
+    v_next: Vec<f64>,
     noise: ColouredNoise,
     time_s: f64,
     max_stable_dt_s: f64,
@@ -144,22 +148,39 @@ pub struct FarrellFlow {
 
 impl FarrellFlow {
     /// Builds the field over `region`, checking that `dt_s` is within the stable limit.
-    pub fn new(region: Rect, mean: MeanFlow, params: FarrellParams, dt_s: f64) -> Result<Self, EnvError> {
+    pub fn new(
+        region: Rect,
+        mean: MeanFlow,
+        params: FarrellParams,
+        dt_s: f64,
+    ) -> Result<Self, EnvError> {
         mean.validate("flow.mean")?;
         if params.nx < 3 {
-            return Err(EnvError::invalid("flow.farrell.nx", format!("must be >= 3, got {}", params.nx)));
+            return Err(EnvError::invalid(
+                "flow.farrell.nx",
+                format!("must be >= 3, got {}", params.nx),
+            ));
         }
         if params.ny < 3 {
-            return Err(EnvError::invalid("flow.farrell.ny", format!("must be >= 3, got {}", params.ny)));
+            return Err(EnvError::invalid(
+                "flow.farrell.ny",
+                format!("must be >= 3, got {}", params.ny),
+            ));
         }
         if params.nx * params.ny > 4_000_000 {
-            return Err(EnvError::invalid("flow.farrell.nx", "nx * ny must be at most 4,000,000"));
+            return Err(EnvError::invalid(
+                "flow.farrell.nx",
+                "nx * ny must be at most 4,000,000",
+            ));
         }
         require_positive("flow.farrell.diffusivity_x_m2ps", params.diffusivity_x_m2ps)?;
         require_positive("flow.farrell.diffusivity_y_m2ps", params.diffusivity_y_m2ps)?;
         require_non_negative("flow.farrell.noise_gain", params.noise_gain)?;
         require_positive("flow.farrell.noise_damping", params.noise_damping)?;
-        require_positive("flow.farrell.noise_bandwidth_radps", params.noise_bandwidth_radps)?;
+        require_positive(
+            "flow.farrell.noise_bandwidth_radps",
+            params.noise_bandwidth_radps,
+        )?;
         require_positive("sim.dt_s", dt_s)?;
         let dx_m = region.width_m() / (params.nx - 1) as f64;
         let dy_m = region.height_m() / (params.ny - 1) as f64;
@@ -172,7 +193,6 @@ impl FarrellFlow {
         );
         let v0 = mean.velocity_at(0.0);
         let n_all = (params.nx + 2) * (params.ny + 2);
-        let n_int = params.nx * params.ny;
         let mut flow = FarrellFlow {
             params,
             mean,
@@ -183,15 +203,13 @@ impl FarrellFlow {
             inv_dy: 1.0 / dy_m,
             u: vec![v0.x; n_all],
             v: vec![v0.y; n_all],
-            u_int: vec![v0.x; n_int],
-            v_int: vec![v0.y; n_int],
-            cells: vec![[0.0; 8]; (params.nx - 1) * (params.ny - 1)],
+            u_next: vec![v0.x; n_all],
+            v_next: vec![v0.y; n_all],
             noise,
             time_s: 0.0,
             max_stable_dt_s: 0.0,
             max_speed_mps: v0.norm(),
         };
-        flow.refresh_cells();
         flow.max_stable_dt_s = flow.stable_dt_limit(dt_s);
         if dt_s > flow.max_stable_dt_s {
             return Err(EnvError::invalid(
@@ -209,7 +227,8 @@ impl FarrellFlow {
     fn stable_dt_limit(&self, dt_s: f64) -> f64 {
         let dxx = 0.5 * self.params.diffusivity_x_m2ps;
         let dyy = 0.5 * self.params.diffusivity_y_m2ps;
-        let diffusion = 1.0 / (2.0 * (dxx / (self.dx_m * self.dx_m) + dyy / (self.dy_m * self.dy_m)));
+        let diffusion =
+            1.0 / (2.0 * (dxx / (self.dx_m * self.dx_m) + dyy / (self.dy_m * self.dy_m)));
         // Corner noise amplitude; the original update's amplitude scales with sqrt(dt).
         let mut sd = self.noise.stationary_variance().sqrt();
         if self.params.original_noise_updates {
@@ -245,12 +264,12 @@ impl FarrellFlow {
         let mut out = Vec::with_capacity(nx * ny);
         for j in 0..ny {
             for i in 0..nx {
-                let k = j * nx + i;
+                let k = (j + 1) * (nx + 2) + i + 1;
                 out.push([
                     self.region.x_min_m + i as f64 * self.dx_m,
                     self.region.y_min_m + j as f64 * self.dy_m,
-                    self.u_int[k],
-                    self.v_int[k],
+                    self.u[k],
+                    self.v[k],
                 ]);
             }
         }
@@ -281,55 +300,47 @@ impl FarrellFlow {
     fn step_interior(&mut self, dt_s: f64) {
         let (nx, ny) = (self.params.nx, self.params.ny);
         let nx2 = nx + 2;
-        let hx = 0.5 * self.inv_dx;
-        let hy = 0.5 * self.inv_dy;
-        let kx = 0.5 * self.params.diffusivity_x_m2ps * self.inv_dx * self.inv_dx;
-        let ky = 0.5 * self.params.diffusivity_y_m2ps * self.inv_dy * self.inv_dy;
+        let hx = 0.5 * self.inv_dx * dt_s;
+        let hy = 0.5 * self.inv_dy * dt_s;
+        let kx = 0.5 * self.params.diffusivity_x_m2ps * self.inv_dx * self.inv_dx * dt_s;
+        let ky = 0.5 * self.params.diffusivity_y_m2ps * self.inv_dy * self.inv_dy * dt_s;
         let mut max_sq: f64 = 0.0;
-        for j in 0..ny {
-            for i in 0..nx {
-                let c = (j + 1) * nx2 + (i + 1);
-                let (e, w, nn, s) = (c + 1, c - 1, c + nx2, c - nx2);
-                let (u, v) = (self.u[c], self.v[c]);
-                let du_dt = -(u * (self.u[e] - self.u[w]) * hx + v * (self.u[nn] - self.u[s]) * hy)
-                    + kx * (self.u[e] - 2.0 * u + self.u[w])
-                    + ky * (self.u[nn] - 2.0 * u + self.u[s]);
-                let dv_dt = -(u * (self.v[e] - self.v[w]) * hx + v * (self.v[nn] - self.v[s]) * hy)
-                    + kx * (self.v[e] - 2.0 * v + self.v[w])
-                    + ky * (self.v[nn] - 2.0 * v + self.v[s]);
-                let k = j * nx + i;
-                let (un, vn) = (u + du_dt * dt_s, v + dv_dt * dt_s);
-                self.u_int[k] = un;
-                self.v_int[k] = vn;
-                max_sq = max_sq.max(un * un + vn * vn);
+        let mut finite = true;
+        let (u, v) = (&self.u, &self.v);
+        for j in 1..=ny {
+            let row = |r: usize| r * nx2..(r + 1) * nx2;
+            let (us, uc, un) = (&u[row(j - 1)], &u[row(j)], &u[row(j + 1)]);
+            let (vs, vc, vn) = (&v[row(j - 1)], &v[row(j)], &v[row(j + 1)]);
+            let uo = &mut self.u_next[j * nx2 + 1..j * nx2 + 1 + nx];
+            let vo = &mut self.v_next[j * nx2 + 1..j * nx2 + 1 + nx];
+            // Node i of the interior row sits at i + 1 in the ring-padded rows.
+            let cols = uc
+                .windows(3)
+                .zip(vc.windows(3))
+                .zip(us[1..].iter().zip(&un[1..]))
+                .zip(vs[1..].iter().zip(&vn[1..]));
+            for ((((uw, vw), (u_s, u_n)), (v_s, v_n)), (o_u, o_v)) in
+                cols.zip(uo.iter_mut().zip(vo.iter_mut()))
+            {
+                let (uw0, uc0, ue0) = (uw[0], uw[1], uw[2]);
+                let (vw0, vc0, ve0) = (vw[0], vw[1], vw[2]);
+                let du = -(uc0 * (ue0 - uw0) * hx + vc0 * (u_n - u_s) * hy)
+                    + kx * (ue0 - 2.0 * uc0 + uw0)
+                    + ky * (u_n - 2.0 * uc0 + u_s);
+                let dv = -(uc0 * (ve0 - vw0) * hx + vc0 * (v_n - v_s) * hy)
+                    + kx * (ve0 - 2.0 * vc0 + vw0)
+                    + ky * (v_n - 2.0 * vc0 + v_s);
+                let (a, b) = (uc0 + du, vc0 + dv);
+                *o_u = a;
+                *o_v = b;
+                let sq = a * a + b * b;
+                finite &= sq.is_finite();
+                max_sq = max_sq.max(sq);
             }
         }
-        // Write the interior back only after every node used the old values.
-        for j in 0..ny {
-            let row = (j + 1) * nx2 + 1;
-            self.u[row..row + nx].copy_from_slice(&self.u_int[j * nx..(j + 1) * nx]);
-            self.v[row..row + nx].copy_from_slice(&self.v_int[j * nx..(j + 1) * nx]);
-        }
-        self.refresh_cells();
-        // NaN propagates through max() as the other operand, so check separately.
-        self.max_speed_mps = if self.u_int.iter().chain(&self.v_int).all(|x| x.is_finite()) {
-            max_sq.sqrt()
-        } else {
-            f64::NAN
-        };
-    }
-
-    /// Rebuilds the per-cell corner records from the interior nodes.
-    fn refresh_cells(&mut self) {
-        let nx = self.params.nx;
-        for j in 0..self.params.ny - 1 {
-            for i in 0..nx - 1 {
-                let k00 = j * nx + i;
-                let (k10, k01, k11) = (k00 + 1, k00 + nx, k00 + nx + 1);
-                let (u, v) = (&self.u_int, &self.v_int);
-                self.cells[j * (nx - 1) + i] = [u[k00], u[k10], u[k01], u[k11], v[k00], v[k10], v[k01], v[k11]];
-            }
-        }
+        std::mem::swap(&mut self.u, &mut self.u_next);
+        std::mem::swap(&mut self.v, &mut self.v_next);
+        self.max_speed_mps = if finite { max_sq.sqrt() } else { f64::NAN };
     }
 
     #[inline(always)]
@@ -337,11 +348,20 @@ impl FarrellFlow {
         let (nx, ny) = (self.params.nx, self.params.ny);
         let (i, tx) = axis_weight(x, self.region.x_min_m, self.inv_dx, nx);
         let (j, ty) = axis_weight(y, self.region.y_min_m, self.inv_dy, ny);
-        let c = &self.cells[j * (nx - 1) + i];
-        let (w00, w10, w01, w11) = ((1.0 - tx) * (1.0 - ty), tx * (1.0 - ty), (1.0 - tx) * ty, tx * ty);
-        let u = w00 * c[0] + w10 * c[1] + w01 * c[2] + w11 * c[3];
-        let v = w00 * c[4] + w10 * c[5] + w01 * c[6] + w11 * c[7];
-        (u, v)
+        // Interior node (i, j) sits at (i + 1, j + 1) in the ring-padded arrays.
+        let nx2 = nx + 2;
+        let k00 = (j + 1) * nx2 + i + 1;
+        let (k10, k01, k11) = (k00 + 1, k00 + nx2, k00 + nx2 + 1);
+        let (w00, w10, w01, w11) = (
+            (1.0 - tx) * (1.0 - ty),
+            tx * (1.0 - ty),
+            (1.0 - tx) * ty,
+            tx * ty,
+        );
+        let (u, v) = (&self.u, &self.v);
+        let a = w00 * u[k00] + w10 * u[k10] + w01 * u[k01] + w11 * u[k11];
+        let b = w00 * v[k00] + w10 * v[k10] + w01 * v[k01] + w11 * v[k11];
+        (a, b)
     }
 }
 
@@ -373,7 +393,10 @@ impl FlowField for FarrellFlow {
         if !(self.max_speed_mps.is_finite() && self.max_speed_mps < limit) {
             return Err(EnvError::Diverged {
                 time_s: t_new_s,
-                message: format!("largest node speed {} m/s (limit {limit} m/s)", self.max_speed_mps),
+                message: format!(
+                    "largest node speed {} m/s (limit {limit} m/s)",
+                    self.max_speed_mps
+                ),
             });
         }
         Ok(())
@@ -389,11 +412,19 @@ mod tests {
     use crate::{StreamId, stream_rng};
 
     fn pompy_region() -> Rect {
-        Rect { x_min_m: 0.0, x_max_m: 100.0, y_min_m: -50.0, y_max_m: 50.0 }
+        Rect {
+            x_min_m: 0.0,
+            x_max_m: 100.0,
+            y_min_m: -50.0,
+            y_max_m: 50.0,
+        }
     }
 
     fn steady(speed: f64, toward: f64) -> MeanFlow {
-        MeanFlow::Steady { speed_mps: speed, toward_deg: toward }
+        MeanFlow::Steady {
+            speed_mps: speed,
+            toward_deg: toward,
+        }
     }
 
     #[test]
@@ -423,12 +454,18 @@ mod tests {
         let want = noise.stationary_variance();
         assert!((want - 2.0).abs() < 1e-12);
         eprintln!("coloured noise variance {var:.4}, theory {want}");
-        assert!((var - want).abs() / want < 0.06, "variance {var}, theory {want}");
+        assert!(
+            (var - want).abs() / want < 0.06,
+            "variance {var}, theory {want}"
+        );
     }
 
     #[test]
     fn no_noise_keeps_uniform_mean() {
-        let params = FarrellParams { noise_gain: 0.0, ..FarrellParams::default() };
+        let params = FarrellParams {
+            noise_gain: 0.0,
+            ..FarrellParams::default()
+        };
         let mut f = FarrellFlow::new(pompy_region(), steady(1.0, 90.0), params, 0.01).unwrap();
         let mut rng = stream_rng(1, StreamId::Flow);
         for k in 1..=500 {
@@ -440,41 +477,63 @@ mod tests {
 
     #[test]
     fn long_run_stays_finite_and_bounded() {
-        let mut f = FarrellFlow::new(pompy_region(), steady(1.0, 90.0), FarrellParams::default(), 0.05)
-            .unwrap_or_else(|e| panic!("{e}"));
+        let mut f = FarrellFlow::new(
+            pompy_region(),
+            steady(1.0, 90.0),
+            FarrellParams::default(),
+            0.05,
+        )
+        .unwrap_or_else(|e| panic!("{e}"));
         let mut rng = stream_rng(11, StreamId::Flow);
         let mut worst: f64 = 0.0;
         for k in 1..=40_000u32 {
-            f.advance(f64::from(k) * 0.05, 0.05, &mut rng).unwrap_or_else(|e| panic!("{e}"));
+            f.advance(f64::from(k) * 0.05, 0.05, &mut rng)
+                .unwrap_or_else(|e| panic!("{e}"));
             worst = worst.max(f.max_speed_mps());
         }
         // 2000 s: corner noise sd is sqrt(2) m/s, so speeds stay well within 1 + 6 sd.
-        assert!(worst.is_finite() && worst < 1.0 + 6.0 * 2f64.sqrt(), "max speed {worst}");
+        assert!(
+            worst.is_finite() && worst < 1.0 + 6.0 * 2f64.sqrt(),
+            "max speed {worst}"
+        );
         assert!(worst > 1.2, "the field never meandered: max speed {worst}");
     }
 
     #[test]
     fn rejects_unstable_dt() {
         // 101 x 101 nodes over 100 m with k = 20: diffusion limit 1/(2*10*2) = 0.025 s.
-        let params = FarrellParams { nx: 101, ny: 101, ..FarrellParams::default() };
-        let err = FarrellFlow::new(pompy_region(), steady(1.0, 90.0), params, 0.05).err().map(|e| e.to_string());
+        let params = FarrellParams {
+            nx: 101,
+            ny: 101,
+            ..FarrellParams::default()
+        };
+        let err = FarrellFlow::new(pompy_region(), steady(1.0, 90.0), params, 0.05)
+            .err()
+            .map(|e| e.to_string());
         let err = err.unwrap_or_default();
-        assert!(err.starts_with("sim.dt_s") && err.contains("stable limit"), "{err}");
+        assert!(
+            err.starts_with("sim.dt_s") && err.contains("stable limit"),
+            "{err}"
+        );
         assert!(FarrellFlow::new(pompy_region(), steady(1.0, 90.0), params, 0.02).is_ok());
     }
 
     #[test]
     fn bilinear_interpolation_is_exact_on_nodes_and_linear_between() {
-        let mut f = FarrellFlow::new(pompy_region(), steady(0.0, 0.0), FarrellParams::default(), 0.01)
-            .unwrap_or_else(|e| panic!("{e}"));
+        let mut f = FarrellFlow::new(
+            pompy_region(),
+            steady(0.0, 0.0),
+            FarrellParams::default(),
+            0.01,
+        )
+        .unwrap_or_else(|e| panic!("{e}"));
         // Impose u = x / 10 on the interior and check interpolation reproduces the linear field.
         let nx = f.params.nx;
         for j in 0..f.params.ny {
             for i in 0..nx {
-                f.u_int[j * nx + i] = (i as f64 * f.dx_m) / 10.0;
+                f.u[(j + 1) * (nx + 2) + i + 1] = (i as f64 * f.dx_m) / 10.0;
             }
         }
-        f.refresh_cells();
         for x in [0.0_f64, 2.5, 5.0, 33.3, 99.9, 100.0, 120.0, -5.0] {
             let want = x.clamp(0.0, 100.0) / 10.0;
             let got = f.velocity(Vec2::new(x, 7.0)).x;

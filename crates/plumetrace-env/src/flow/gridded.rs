@@ -42,9 +42,15 @@ fn regular_axis(values: &[f64], name: &str, path: &Path) -> Result<(f64, f64, us
     let mut v: Vec<f64> = values.to_vec();
     v.sort_by(f64::total_cmp);
     v.dedup_by(|a, b| (*a - *b).abs() <= 1e-9 * (1.0 + b.abs()));
-    let file_err = |message: String| EnvError::File { path: path.to_path_buf(), message };
+    let file_err = |message: String| EnvError::File {
+        path: path.to_path_buf(),
+        message,
+    };
     if v.len() < 2 {
-        return Err(file_err(format!("column {name} needs at least 2 distinct values, found {}", v.len())));
+        return Err(file_err(format!(
+            "column {name} needs at least 2 distinct values, found {}",
+            v.len()
+        )));
     }
     let step = (v[v.len() - 1] - v[0]) / (v.len() - 1) as f64;
     for (k, w) in v.iter().enumerate() {
@@ -61,14 +67,22 @@ fn regular_axis(values: &[f64], name: &str, path: &Path) -> Result<(f64, f64, us
 impl GriddedFlow {
     /// Reads a gridded flow from a CSV file (see the module docs for the format).
     pub fn from_csv(path: &Path) -> Result<Self, EnvError> {
-        let file_err = |message: String| EnvError::File { path: path.to_path_buf(), message };
+        let file_err = |message: String| EnvError::File {
+            path: path.to_path_buf(),
+            message,
+        };
         let mut reader = csv::ReaderBuilder::new()
             .trim(csv::Trim::All)
             .from_path(path)
             .map_err(|e| file_err(e.to_string()))?;
-        let headers = reader.headers().map_err(|e| file_err(e.to_string()))?.clone();
+        let headers = reader
+            .headers()
+            .map_err(|e| file_err(e.to_string()))?
+            .clone();
         let col = |name: &str| headers.iter().position(|h| h == name);
-        let (Some(cx), Some(cy), Some(cu), Some(cv)) = (col("x_m"), col("y_m"), col("u_mps"), col("v_mps")) else {
+        let (Some(cx), Some(cy), Some(cu), Some(cv)) =
+            (col("x_m"), col("y_m"), col("u_mps"), col("v_mps"))
+        else {
             return Err(file_err(format!(
                 "header must name x_m, y_m, u_mps, v_mps (and optionally t_s); found {:?}",
                 headers.iter().collect::<Vec<_>>()
@@ -81,14 +95,26 @@ impl GriddedFlow {
             let rec = rec.map_err(|e| file_err(format!("line {line}: {e}")))?;
             let get = |c: usize, name: &str| -> Result<f64, EnvError> {
                 let s = rec.get(c).unwrap_or("");
-                let x: f64 = s.parse().map_err(|_| file_err(format!("line {line}: {name} = {s:?} is not a number")))?;
-                if x.is_finite() { Ok(x) } else { Err(file_err(format!("line {line}: {name} = {s} is not finite"))) }
+                let x: f64 = s.parse().map_err(|_| {
+                    file_err(format!("line {line}: {name} = {s:?} is not a number"))
+                })?;
+                if x.is_finite() {
+                    Ok(x)
+                } else {
+                    Err(file_err(format!("line {line}: {name} = {s} is not finite")))
+                }
             };
             let t = match ct {
                 Some(c) => get(c, "t_s")?,
                 None => 0.0,
             };
-            rows.push([t, get(cx, "x_m")?, get(cy, "y_m")?, get(cu, "u_mps")?, get(cv, "v_mps")?]);
+            rows.push([
+                t,
+                get(cx, "x_m")?,
+                get(cy, "y_m")?,
+                get(cu, "u_mps")?,
+                get(cv, "v_mps")?,
+            ]);
         }
         if rows.is_empty() {
             return Err(file_err("no data rows".into()));
@@ -101,7 +127,10 @@ impl GriddedFlow {
         let mut by_time: BTreeMap<i64, Vec<[f64; 5]>> = BTreeMap::new();
         for r in rows {
             // Times are keyed in microseconds so that equal times written differently group together.
-            by_time.entry((r[0] * 1e6).round() as i64).or_default().push(r);
+            by_time
+                .entry((r[0] * 1e6).round() as i64)
+                .or_default()
+                .push(r);
         }
         let mut frames = Vec::with_capacity(by_time.len());
         for (_, rows) in by_time {
@@ -113,7 +142,10 @@ impl GriddedFlow {
                 let j = ((r[2] - y0) / dy).round() as usize;
                 let k = j * nx + i;
                 if !u[k].is_nan() {
-                    return Err(file_err(format!("t_s = {t_s}: node ({}, {}) appears twice", r[1], r[2])));
+                    return Err(file_err(format!(
+                        "t_s = {t_s}: node ({}, {}) appears twice",
+                        r[1], r[2]
+                    )));
                 }
                 u[k] = r[3];
                 v[k] = r[4];
@@ -129,10 +161,20 @@ impl GriddedFlow {
             }
             frames.push(Frame { t_s, u, v });
         }
-        Ok(GriddedFlow::from_frames_unchecked(x0, dx, nx, y0, dy, ny, frames))
+        Ok(GriddedFlow::from_frames_unchecked(
+            x0, dx, nx, y0, dy, ny, frames,
+        ))
     }
 
-    fn from_frames_unchecked(x0: f64, dx: f64, nx: usize, y0: f64, dy: f64, ny: usize, frames: Vec<Frame>) -> Self {
+    fn from_frames_unchecked(
+        x0: f64,
+        dx: f64,
+        nx: usize,
+        y0: f64,
+        dy: f64,
+        ny: usize,
+        frames: Vec<Frame>,
+    ) -> Self {
         let mut f = GriddedFlow {
             x0_m: x0,
             y0_m: y0,
@@ -177,7 +219,12 @@ impl GriddedFlow {
     fn sample(&self, frame: &Frame, i: usize, j: usize, tx: f64, ty: f64) -> (f64, f64) {
         let k00 = j * self.nx + i;
         let (k10, k01, k11) = (k00 + 1, k00 + self.nx, k00 + self.nx + 1);
-        let (w00, w10, w01, w11) = ((1.0 - tx) * (1.0 - ty), tx * (1.0 - ty), (1.0 - tx) * ty, tx * ty);
+        let (w00, w10, w01, w11) = (
+            (1.0 - tx) * (1.0 - ty),
+            tx * (1.0 - ty),
+            (1.0 - tx) * ty,
+            tx * ty,
+        );
         (
             w00 * frame.u[k00] + w10 * frame.u[k10] + w01 * frame.u[k01] + w11 * frame.u[k11],
             w00 * frame.v[k00] + w10 * frame.v[k10] + w01 * frame.v[k01] + w11 * frame.v[k11],
@@ -217,7 +264,8 @@ mod tests {
     use std::io::Write;
 
     fn write_tmp(name: &str, text: &str) -> std::path::PathBuf {
-        let dir = std::env::temp_dir().join(format!("plumetrace-gridded-{}-{name}", std::process::id()));
+        let dir =
+            std::env::temp_dir().join(format!("plumetrace-gridded-{}-{name}", std::process::id()));
         std::fs::create_dir_all(&dir).unwrap();
         let p = dir.join("flow.csv");
         let mut f = std::fs::File::create(&p).unwrap();
@@ -240,7 +288,10 @@ mod tests {
         assert_eq!(f.frame_count(), 2);
         assert_eq!(f.grid_size(), (3, 2));
         let v = f.velocity(Vec2::new(5.0, 5.0));
-        assert!((v.x - 0.5).abs() < 1e-12 && (v.y + 0.5).abs() < 1e-12, "{v:?}");
+        assert!(
+            (v.x - 0.5).abs() < 1e-12 && (v.y + 0.5).abs() < 1e-12,
+            "{v:?}"
+        );
         let mut rng = stream_rng(0, StreamId::Flow);
         f.advance(5.0, 5.0, &mut rng).unwrap();
         let v = f.velocity(Vec2::new(15.0, 0.0));
@@ -252,7 +303,10 @@ mod tests {
 
     #[test]
     fn missing_node_and_bad_numbers_are_located() {
-        let p = write_tmp("missing", "x_m,y_m,u_mps,v_mps\n0,0,1,0\n10,0,1,0\n0,10,1,0\n");
+        let p = write_tmp(
+            "missing",
+            "x_m,y_m,u_mps,v_mps\n0,0,1,0\n10,0,1,0\n0,10,1,0\n",
+        );
         let e = GriddedFlow::from_csv(&p).unwrap_err().to_string();
         assert!(e.contains("missing") && e.contains("flow.csv"), "{e}");
         let p = write_tmp("nan", "x_m,y_m,u_mps,v_mps\n0,0,1,0\n10,0,abc,0\n");

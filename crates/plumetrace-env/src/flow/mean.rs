@@ -41,11 +41,21 @@ impl MeanFlow {
     /// Checks the parameters; `key` prefixes the names in errors.
     pub fn validate(&self, key: &str) -> Result<(), EnvError> {
         match *self {
-            MeanFlow::Steady { speed_mps, toward_deg } => {
+            MeanFlow::Steady {
+                speed_mps,
+                toward_deg,
+            } => {
                 require_non_negative(&format!("{key}.speed_mps"), speed_mps)?;
                 require_finite(&format!("{key}.toward_deg"), toward_deg)
             }
-            MeanFlow::Tidal { speed_min_mps, speed_max_mps, toward_min_deg, toward_max_deg, period_s, phase_deg } => {
+            MeanFlow::Tidal {
+                speed_min_mps,
+                speed_max_mps,
+                toward_min_deg,
+                toward_max_deg,
+                period_s,
+                phase_deg,
+            } => {
                 require_non_negative(&format!("{key}.speed_min_mps"), speed_min_mps)?;
                 require_non_negative(&format!("{key}.speed_max_mps"), speed_max_mps)?;
                 if speed_max_mps < speed_min_mps {
@@ -65,10 +75,21 @@ impl MeanFlow {
     /// Water velocity `(east, north)` at time `t_s`.
     pub fn velocity_at(&self, t_s: f64) -> Vec2 {
         match *self {
-            MeanFlow::Steady { speed_mps, toward_deg } => Heading::from_deg(toward_deg).unit() * speed_mps,
-            MeanFlow::Tidal { speed_min_mps, speed_max_mps, toward_min_deg, toward_max_deg, period_s, phase_deg } => {
+            MeanFlow::Steady {
+                speed_mps,
+                toward_deg,
+            } => Heading::from_deg(toward_deg).unit() * speed_mps,
+            MeanFlow::Tidal {
+                speed_min_mps,
+                speed_max_mps,
+                toward_min_deg,
+                toward_max_deg,
+                period_s,
+                phase_deg,
+            } => {
                 let s = (TAU * t_s / period_s + phase_deg.to_radians()).sin();
-                let speed = 0.5 * (speed_min_mps + speed_max_mps) + 0.5 * (speed_max_mps - speed_min_mps) * s;
+                let speed = 0.5 * (speed_min_mps + speed_max_mps)
+                    + 0.5 * (speed_max_mps - speed_min_mps) * s;
                 let swing = wrap_deg_180(toward_max_deg - toward_min_deg);
                 let dir = toward_min_deg + 0.5 * swing + 0.5 * swing * s;
                 Heading::from_deg(dir).unit() * speed
@@ -110,8 +131,14 @@ mod tests {
             dmin = dmin.min(d);
             dmax = dmax.max(d);
         }
-        assert!((smin - 0.10).abs() < 1e-4 && (smax - 0.15).abs() < 1e-4, "speed range {smin}..{smax}");
-        assert!((dmin - 110.0).abs() < 0.1 && (dmax - 147.0).abs() < 0.1, "direction range {dmin}..{dmax}");
+        assert!(
+            (smin - 0.10).abs() < 1e-4 && (smax - 0.15).abs() < 1e-4,
+            "speed range {smin}..{smax}"
+        );
+        assert!(
+            (dmin - 110.0).abs() < 0.1 && (dmax - 147.0).abs() < 0.1,
+            "direction range {dmin}..{dmax}"
+        );
     }
 
     #[test]
@@ -125,8 +152,13 @@ mod tests {
             phase_deg: 0.0,
         };
         for k in 0..100 {
-            let d = Heading::of_vector(m.velocity_at(f64::from(k))).map(Heading::deg).unwrap_or(f64::NAN);
-            assert!(!(10.01..349.99).contains(&d), "direction {d} left the 350..10 swing");
+            let d = Heading::of_vector(m.velocity_at(f64::from(k)))
+                .map(Heading::deg)
+                .unwrap_or(f64::NAN);
+            assert!(
+                !(10.01..349.99).contains(&d),
+                "direction {d} left the 350..10 swing"
+            );
         }
     }
 
@@ -140,9 +172,16 @@ mod tests {
             period_s: 100.0,
             phase_deg: 0.0,
         };
-        let e = m.validate("flow.mean").err().map(|e| e.to_string()).unwrap_or_default();
+        let e = m
+            .validate("flow.mean")
+            .err()
+            .map(|e| e.to_string())
+            .unwrap_or_default();
         assert!(e.contains("flow.mean.speed_max_mps"), "{e}");
-        let s = MeanFlow::Steady { speed_mps: -1.0, toward_deg: 0.0 };
+        let s = MeanFlow::Steady {
+            speed_mps: -1.0,
+            toward_deg: 0.0,
+        };
         assert!(s.validate("flow").is_err());
     }
 }

@@ -69,9 +69,18 @@ pub enum FlowModel {
 impl FlowModel {
     /// Names and one-line descriptions of the flow models, for `list` commands and docs.
     pub const REGISTRY: &'static [(&'static str, &'static str)] = &[
-        ("uniform", "same velocity everywhere; steady or tidal (speed and direction varying in time)"),
-        ("farrell", "Farrell et al. 2002 meandering field: coloured-noise corners, advection-diffusion interior"),
-        ("gridded", "regular grid read from a CSV file (x_m,y_m,u_mps,v_mps[,t_s]), bilinear in space, linear in time"),
+        (
+            "uniform",
+            "same velocity everywhere; steady or tidal (speed and direction varying in time)",
+        ),
+        (
+            "farrell",
+            "Farrell et al. 2002 meandering field: coloured-noise corners, advection-diffusion interior",
+        ),
+        (
+            "gridded",
+            "regular grid read from a CSV file (x_m,y_m,u_mps,v_mps[,t_s]), bilinear in space, linear in time",
+        ),
     ];
 
     fn inner(&self) -> &dyn FlowField {
@@ -128,6 +137,8 @@ pub(crate) fn axis_weight(pos: f64, origin: f64, inv_step: f64, n: usize) -> (us
     let f = if f > 0.0 { f } else { 0.0 };
     let last = (n - 1) as f64;
     let f = if f < last { f } else { last };
-    let i = (f as usize).min(n - 2);
+    // `f` is in [0, n - 1] with n <= 4e6, so the i32 cast is exact truncation (and cheaper than a
+    // cast to usize, which needs unsigned saturation).
+    let i = (f as i32 as usize).min(n - 2);
     (i, f - i as f64)
 }

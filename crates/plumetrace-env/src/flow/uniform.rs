@@ -16,7 +16,11 @@ impl UniformFlow {
     /// A uniform flow starting at t = 0.
     pub fn new(mean: MeanFlow) -> Result<Self, EnvError> {
         mean.validate("flow.mean")?;
-        Ok(UniformFlow { mean, time_s: 0.0, current_mps: mean.velocity_at(0.0) })
+        Ok(UniformFlow {
+            mean,
+            time_s: 0.0,
+            current_mps: mean.velocity_at(0.0),
+        })
     }
 
     /// The mean-flow description.

@@ -72,7 +72,10 @@ impl Default for FilamentParams {
     /// pompy's defaults for puff size and growth, a physical random walk, a reflecting seabed.
     fn default() -> Self {
         FilamentParams {
-            dispersion: Dispersion::Physical { horizontal_m2ps: 0.02, vertical_m2ps: 0.002 },
+            dispersion: Dispersion::Physical {
+                horizontal_m2ps: 0.02,
+                vertical_m2ps: 0.002,
+            },
             init_radius_m: 0.0316,
             growth_rate_m2ps: 0.001,
             cutoff_radii: 3.0,
@@ -86,7 +89,10 @@ impl FilamentParams {
     /// Checks every parameter; errors name the `plume.*` key.
     pub fn validate(&self) -> Result<(), EnvError> {
         match self.dispersion {
-            Dispersion::Physical { horizontal_m2ps, vertical_m2ps } => {
+            Dispersion::Physical {
+                horizontal_m2ps,
+                vertical_m2ps,
+            } => {
                 require_non_negative("plume.horizontal_diffusivity_m2ps", horizontal_m2ps)?;
                 require_non_negative("plume.vertical_diffusivity_m2ps", vertical_m2ps)?;
             }
@@ -100,7 +106,10 @@ impl FilamentParams {
         require_non_negative("plume.growth_rate_m2ps", self.growth_rate_m2ps)?;
         require_positive("plume.cutoff_radii", self.cutoff_radii)?;
         if self.max_filaments == 0 {
-            return Err(EnvError::invalid("plume.max_filaments", "must be at least 1"));
+            return Err(EnvError::invalid(
+                "plume.max_filaments",
+                "must be at least 1",
+            ));
         }
         if let VerticalBoundary::Reflecting { depth_m: Some(d) } = self.vertical {
             require_positive("domain.depth_m", d)?;
@@ -137,18 +146,24 @@ pub struct FilamentPlume {
     pub(crate) x: Vec<f64>,
     pub(crate) y: Vec<f64>,
     pub(crate) z: Vec<f64>,
-    pub(crate) r2: Vec<f64>,
+    /// Release time of each filament, s: `r^2 = r0^2 + gamma (t - birth)` is computed when
+    /// needed, so stepping never touches it.
+    pub(crate) birth_s: Vec<f64>,
     pub(crate) mass: Vec<f64>,
     pub(crate) source: Vec<u16>,
-    u: Vec<f64>,
-    v: Vec<f64>,
+    /// Plume time, s (the end of the last step).
+    time_s: f64,
     stats: PlumeStats,
     index: OnceLock<CellIndex>,
 }
 
 impl FilamentPlume {
     /// A plume with no filaments yet.
-    pub fn new(domain: Rect, sources: Vec<Source>, params: FilamentParams) -> Result<Self, EnvError> {
+    pub fn new(
+        domain: Rect,
+        sources: Vec<Source>,
+        params: FilamentParams,
+    ) -> Result<Self, EnvError> {
         params.validate()?;
         if sources.len() > usize::from(u16::MAX) {
             return Err(EnvError::invalid("sources", "at most 65535 sources"));
@@ -163,13 +178,19 @@ impl FilamentPlume {
             if !domain.contains_xy(s.pos_m.x, s.pos_m.y) {
                 return Err(EnvError::invalid(
                     key("x_m"),
-                    format!("source at ({}, {}) is outside the domain", s.pos_m.x, s.pos_m.y),
+                    format!(
+                        "source at ({}, {}) is outside the domain",
+                        s.pos_m.x, s.pos_m.y
+                    ),
                 ));
             }
-            if let VerticalBoundary::Reflecting { depth_m: Some(d) } = params.vertical {
-                if s.pos_m.z > d {
-                    return Err(EnvError::invalid(key("z_m"), format!("{} m is above the surface ({d} m)", s.pos_m.z)));
-                }
+            if let VerticalBoundary::Reflecting { depth_m: Some(d) } = params.vertical
+                && s.pos_m.z > d
+            {
+                return Err(EnvError::invalid(
+                    key("z_m"),
+                    format!("{} m is above the surface ({d} m)", s.pos_m.z),
+                ));
             }
         }
         Ok(FilamentPlume {
@@ -181,11 +202,10 @@ impl FilamentPlume {
             x: Vec::new(),
             y: Vec::new(),
             z: Vec::new(),
-            r2: Vec::new(),
+            birth_s: Vec::new(),
             mass: Vec::new(),
             source: Vec::new(),
-            u: Vec::new(),
-            v: Vec::new(),
+            time_s: 0.0,
             stats: PlumeStats::default(),
             index: OnceLock::new(),
         })
@@ -203,7 +223,10 @@ impl FilamentPlume {
 
     /// Running totals.
     pub fn stats(&self) -> PlumeStats {
-        PlumeStats { live: self.x.len(), ..self.stats }
+        PlumeStats {
+            live: self.x.len(),
+            ..self.stats
+        }
     }
 
     /// Number of live filaments.
@@ -223,25 +246,51 @@ impl FilamentPlume {
 
     /// Filament centres `(x, y, z)` and squared radii, for statistics and plots.
     pub fn filaments(&self) -> impl Iterator<Item = (Vec3, f64)> + '_ {
-        (0..self.x.len()).map(|k| (Vec3::new(self.x[k], self.y[k], self.z[k]), self.r2[k]))
+        (0..self.x.len()).map(|k| {
+            (
+                Vec3::new(self.x[k], self.y[k], self.z[k]),
+                self.radius_sq(k),
+            )
+        })
     }
 
-    /// Releases `n` filaments at source `k` (also used to seed a plume at t = 0).
+    /// Squared radius of filament `k` now.
+    #[inline]
+    pub(crate) fn radius_sq(&self, k: usize) -> f64 {
+        let r0 = self.params.init_radius_m;
+        r0 * r0 + self.params.growth_rate_m2ps * (self.time_s - self.birth_s[k]).max(0.0)
+    }
+
+    /// Plume time, s.
+    pub fn time_s(&self) -> f64 {
+        self.time_s
+    }
+
+    /// Releases `n` filaments at source `k` now (also used to seed a plume at t = 0).
     pub fn release_at_source(&mut self, k: usize, n: u64) {
-        let Some(s) = self.sources.get(k).copied() else { return };
+        self.release_at(k, n, self.time_s);
+    }
+
+    fn release_at(&mut self, k: usize, n: u64, birth_s: f64) {
+        let Some(s) = self.sources.get(k).copied() else {
+            return;
+        };
         let room = self.params.max_filaments.saturating_sub(self.x.len()) as u64;
         let take = n.min(room);
         self.stats.suppressed += n - take;
         if take == 0 {
             return;
         }
-        let q = if s.filament_rate_hz > 0.0 { s.mass_rate_per_s / s.filament_rate_hz } else { 0.0 };
-        let r2 = self.params.init_radius_m * self.params.init_radius_m;
+        let q = if s.filament_rate_hz > 0.0 {
+            s.mass_rate_per_s / s.filament_rate_hz
+        } else {
+            0.0
+        };
         for _ in 0..take {
             self.x.push(s.pos_m.x);
             self.y.push(s.pos_m.y);
             self.z.push(s.pos_m.z);
-            self.r2.push(r2);
+            self.birth_s.push(birth_s);
             self.mass.push(q);
             self.source.push(k as u16);
         }
@@ -249,47 +298,85 @@ impl FilamentPlume {
         self.stats.released_mass += q * take as f64;
     }
 
-    /// Advances the plume by `dt_s` in `flow` (already advanced to the new time).
-    pub fn step(&mut self, flow: &dyn FlowField, dt_s: f64, rng: &mut SimRng) {
+    /// Advances the plume by one step of `dt_s` to time `t_new_s`, in `flow` (already advanced to
+    /// the new time). Filaments released in the step are born at its start and move with it, as
+    /// in the reference implementation.
+    pub fn step(&mut self, flow: &dyn FlowField, t_new_s: f64, dt_s: f64, rng: &mut SimRng) {
+        /// Filaments per velocity batch: small enough for the batch to stay in L1 cache.
+        const CHUNK: usize = 256;
         self.index = OnceLock::new();
-        self.release(dt_s, rng);
-        let n = self.x.len();
-        self.u.resize(n, 0.0);
-        self.v.resize(n, 0.0);
-        flow.velocities(&self.x, &self.y, &mut self.u, &mut self.v);
+        self.release(t_new_s - dt_s, dt_s, rng);
+        self.time_s = t_new_s;
         let (sx, sy, sz) = match self.params.dispersion {
-            Dispersion::Physical { horizontal_m2ps, vertical_m2ps } => {
+            Dispersion::Physical {
+                horizontal_m2ps,
+                vertical_m2ps,
+            } => {
                 let h = (2.0 * horizontal_m2ps * dt_s).sqrt();
                 (h, h, (2.0 * vertical_m2ps * dt_s).sqrt())
             }
-            Dispersion::PompyCompatible { scale_mps } => (scale_mps[0] * dt_s, scale_mps[1] * dt_s, scale_mps[2] * dt_s),
+            Dispersion::PompyCompatible { scale_mps } => (
+                scale_mps[0] * dt_s,
+                scale_mps[1] * dt_s,
+                scale_mps[2] * dt_s,
+            ),
         };
-        let dr2 = self.params.growth_rate_m2ps * dt_s;
         let (floor, ceiling) = match self.params.vertical {
             VerticalBoundary::Reflecting { depth_m } => (0.0, depth_m.unwrap_or(f64::INFINITY)),
             VerticalBoundary::Unbounded => (f64::NEG_INFINITY, f64::INFINITY),
         };
         let d = self.domain;
+        let mut left = false;
+        let mut u = [0.0; CHUNK];
+        let mut v = [0.0; CHUNK];
+        let mut noise = [0.0; 3 * CHUNK];
+        for ((xs, ys), zs) in self
+            .x
+            .chunks_mut(CHUNK)
+            .zip(self.y.chunks_mut(CHUNK))
+            .zip(self.z.chunks_mut(CHUNK))
+        {
+            let m = xs.len();
+            flow.velocities(xs, ys, &mut u[..m], &mut v[..m]);
+            for n in &mut noise[..3 * m] {
+                *n = StandardNormal.sample(rng);
+            }
+            let cols = xs
+                .iter_mut()
+                .zip(ys.iter_mut())
+                .zip(zs.iter_mut())
+                .zip(&u[..m])
+                .zip(&v[..m]);
+            for (((((x, y), z), u), v), n) in cols.zip(noise.chunks_exact(3)) {
+                let (nx, ny, nz) = (n[0], n[1], n[2]);
+                *x += u * dt_s + sx * nx;
+                *y += v * dt_s + sy * ny;
+                let mut zn = *z + sz * nz;
+                if zn < floor {
+                    zn = 2.0 * floor - zn;
+                }
+                if zn > ceiling {
+                    zn = (2.0 * ceiling - zn).max(floor);
+                }
+                *z = zn;
+                left |= !d.contains_xy(*x, *y);
+            }
+        }
+        if left {
+            self.remove_outside();
+        }
+    }
+
+    /// Removes the filaments outside the domain, keeping the others in order.
+    fn remove_outside(&mut self) {
+        let d = self.domain;
         let mut keep = 0usize;
-        for k in 0..n {
-            let nx: f64 = StandardNormal.sample(rng);
-            let ny: f64 = StandardNormal.sample(rng);
-            let nz: f64 = StandardNormal.sample(rng);
-            let x = self.x[k] + self.u[k] * dt_s + sx * nx;
-            let y = self.y[k] + self.v[k] * dt_s + sy * ny;
-            let mut z = self.z[k] + sz * nz;
-            if z < floor {
-                z = 2.0 * floor - z;
-            }
-            if z > ceiling {
-                z = (2.0 * ceiling - z).max(floor);
-            }
-            let r2 = self.r2[k] + dr2;
-            if d.contains_xy(x, y) {
-                self.x[keep] = x;
-                self.y[keep] = y;
-                self.z[keep] = z;
-                self.r2[keep] = r2;
+        for k in 0..self.x.len() {
+            if d.contains_xy(self.x[k], self.y[k]) {
+                self.x[keep] = self.x[k];
+                self.y[keep] = self.y[k];
+                self.z[keep] = self.z[k];
+                self.birth_s[keep] = self.birth_s[k];
                 self.mass[keep] = self.mass[k];
                 self.source[keep] = self.source[k];
                 keep += 1;
@@ -298,13 +385,19 @@ impl FilamentPlume {
                 self.stats.exited_mass += self.mass[k];
             }
         }
-        for v in [&mut self.x, &mut self.y, &mut self.z, &mut self.r2, &mut self.mass] {
+        for v in [
+            &mut self.x,
+            &mut self.y,
+            &mut self.z,
+            &mut self.birth_s,
+            &mut self.mass,
+        ] {
             v.truncate(keep);
         }
         self.source.truncate(keep);
     }
 
-    fn release(&mut self, dt_s: f64, rng: &mut SimRng) {
+    fn release(&mut self, t_s: f64, dt_s: f64, rng: &mut SimRng) {
         if dt_s != self.release_dt_s {
             self.release_dt_s = dt_s;
             self.release = self
@@ -319,13 +412,20 @@ impl FilamentPlume {
                 None => 0.0,
             };
             if n > 0.0 {
-                self.release_at_source(k, n as u64);
+                self.release_at(k, n as u64, t_s);
             }
         }
     }
 
     fn index(&self) -> &CellIndex {
-        self.index.get_or_init(|| CellIndex::build(self, self.domain, self.params.cutoff_radii, self.params.vertical))
+        self.index.get_or_init(|| {
+            CellIndex::build(
+                self,
+                self.domain,
+                self.params.cutoff_radii,
+                self.params.vertical,
+            )
+        })
     }
 
     /// Builds the query index now (it is otherwise built by the first query after a step); lets a

@@ -43,9 +43,15 @@ pub(crate) struct CellIndex {
 }
 
 impl CellIndex {
-    pub(crate) fn build(plume: &FilamentPlume, domain: Rect, cutoff_radii: f64, vertical: VerticalBoundary) -> Self {
+    pub(crate) fn build(
+        plume: &FilamentPlume,
+        domain: Rect,
+        cutoff_radii: f64,
+        vertical: VerticalBoundary,
+    ) -> Self {
         let n = plume.x.len();
-        let r2_max = plume.r2.iter().copied().fold(0.0_f64, f64::max);
+        // The oldest filament is the largest (radii only grow).
+        let r2_max = (0..n).map(|k| plume.radius_sq(k)).fold(0.0_f64, f64::max);
         let search_m = cutoff_radii * r2_max.sqrt();
         let (w, h) = (domain.width_m(), domain.height_m());
         let mut cell = search_m.max(w.max(h) / 1024.0);
@@ -71,15 +77,22 @@ impl CellIndex {
             starts[c + 1] += starts[c];
         }
         let mut fill = starts.clone();
-        let blank = Entry { x: 0.0, y: 0.0, z: 0.0, lim2: -1.0, amp: 0.0, neg_inv_2r2: 0.0 };
+        let blank = Entry {
+            x: 0.0,
+            y: 0.0,
+            z: 0.0,
+            lim2: -1.0,
+            amp: 0.0,
+            neg_inv_2r2: 0.0,
+        };
         let mut entries = vec![blank; n];
         let norm = (2.0 * std::f64::consts::PI).powf(1.5);
         let cut2 = cutoff_radii * cutoff_radii;
-        for k in 0..n {
-            let c = cells[k] as usize;
+        for (k, &cell) in cells.iter().enumerate() {
+            let c = cell as usize;
             let slot = fill[c] as usize;
             fill[c] += 1;
-            let r2 = plume.r2[k];
+            let r2 = plume.radius_sq(k);
             entries[slot] = Entry {
                 x: plume.x[k],
                 y: plume.y[k],
@@ -121,8 +134,12 @@ impl CellIndex {
             return 0.0;
         }
         let r = self.search_m;
-        let Some((i0, i1)) = self.cell_range(p.x - r, p.x + r, self.x0, self.ncx) else { return 0.0 };
-        let Some((j0, j1)) = self.cell_range(p.y - r, p.y + r, self.y0, self.ncy) else { return 0.0 };
+        let Some((i0, i1)) = self.cell_range(p.x - r, p.x + r, self.x0, self.ncx) else {
+            return 0.0;
+        };
+        let Some((j0, j1)) = self.cell_range(p.y - r, p.y + r, self.y0, self.ncy) else {
+            return 0.0;
+        };
         let mut c = 0.0;
         for j in j0..=j1 {
             let a = self.starts[j * self.ncx + i0] as usize;

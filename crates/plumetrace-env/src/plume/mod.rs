@@ -29,4 +29,6 @@
 mod filament;
 mod index;
 
-pub use filament::{Dispersion, FilamentParams, FilamentPlume, PlumeStats, Source, VerticalBoundary};
+pub use filament::{
+    Dispersion, FilamentParams, FilamentPlume, PlumeStats, Source, VerticalBoundary,
+};

@@ -1,0 +1,198 @@
+//! Runs the built `plumetrace` binary in temporary directories.
+
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn bin() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_plumetrace"))
+}
+
+fn run_ok(args: &[&str]) -> Output {
+    let out = bin().args(args).output().unwrap();
+    assert!(
+        out.status.success(),
+        "plumetrace {args:?} failed: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    out
+}
+
+/// The demo preset shortened to one simulated minute, written as a scenario file.
+fn short_demo(dir: &Path) -> PathBuf {
+    let text = plumetrace_scenario::find_preset("demo").unwrap().toml;
+    let text = text
+        .replace("duration_s = 600.0", "duration_s = 60.0")
+        .replace("average_start_s = 300.0", "average_start_s = 30.0");
+    let path = dir.join("short.toml");
+    std::fs::write(&path, text).unwrap();
+    path
+}
+
+#[test]
+fn presets_lists_every_registered_preset() {
+    let out = run_ok(&["presets"]);
+    let text = String::from_utf8(out.stdout).unwrap();
+    for p in plumetrace_scenario::PRESETS {
+        assert!(
+            text.lines()
+                .any(|l| l.starts_with(p.name) && l.contains(p.summary)),
+            "{} missing from:\n{text}",
+            p.name
+        );
+    }
+}
+
+#[test]
+fn run_writes_outputs_and_is_reproducible() {
+    let dir = tempfile::tempdir().unwrap();
+    let scenario = short_demo(dir.path());
+    let s = scenario.to_str().unwrap();
+    let (a, b, c) = (
+        dir.path().join("a"),
+        dir.path().join("b"),
+        dir.path().join("c"),
+    );
+    run_ok(&["run", s, "--seed", "5", "--out", a.to_str().unwrap()]);
+    run_ok(&["run", s, "--seed", "5", "--out", b.to_str().unwrap()]);
+    run_ok(&["run", s, "--seed", "6", "--out", c.to_str().unwrap()]);
+    for f in ["stats.json", "snapshot.csv", "filaments.csv", "plume.svg"] {
+        assert!(a.join(f).is_file(), "{f} missing");
+    }
+    let stats: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(a.join("stats.json")).unwrap()).unwrap();
+    assert_eq!(stats["steps"], 600);
+    assert_eq!(stats["seed"], 5);
+    let released = stats["filaments"]["released"].as_u64().unwrap();
+    assert!(
+        (200..400).contains(&released),
+        "released {released} filaments in 60 s at 5 /s"
+    );
+    let read = |d: &Path, f: &str| std::fs::read(d.join(f)).unwrap();
+    assert_eq!(read(&a, "snapshot.csv"), read(&b, "snapshot.csv"));
+    assert_eq!(read(&a, "filaments.csv"), read(&b, "filaments.csv"));
+    assert_ne!(read(&a, "filaments.csv"), read(&c, "filaments.csv"));
+    let snap = String::from_utf8(read(&a, "snapshot.csv")).unwrap();
+    assert!(snap.starts_with("x_m,y_m,concentration,mean_concentration,intermittency\n"));
+    assert_eq!(snap.lines().count(), 1 + 201 * 101);
+    let svg = String::from_utf8(read(&a, "plume.svg")).unwrap();
+    assert!(svg.contains("East (m)") && svg.contains("North (m)") && svg.contains("source"));
+}
+
+#[test]
+fn steady_preset_runs() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("fw");
+    run_ok(&[
+        "run",
+        "--preset",
+        "freshwater",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    let stats: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("stats.json")).unwrap()).unwrap();
+    assert_eq!(stats["plume_model"], "steady");
+    assert!(stats["max_concentration"].as_f64().unwrap() > 0.0);
+}
+
+#[test]
+fn check_accepts_good_files_and_names_the_key_of_bad_ones() {
+    let dir = tempfile::tempdir().unwrap();
+    let good = short_demo(dir.path());
+    let out = run_ok(&["check", good.to_str().unwrap()]);
+    assert!(String::from_utf8_lossy(&out.stdout).contains("ok"));
+    let bad = dir.path().join("bad.toml");
+    let text = std::fs::read_to_string(&good)
+        .unwrap()
+        .replace("mass_rate_per_s = 5.0", "mass_rate_per_s = -5.0");
+    std::fs::write(&bad, text).unwrap();
+    let out = bin()
+        .args(["check", bad.to_str().unwrap()])
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("bad.toml") && err.contains("sources[0].mass_rate_per_s"),
+        "{err}"
+    );
+    let typo = dir.path().join("typo.toml");
+    let text = std::fs::read_to_string(&good)
+        .unwrap()
+        .replace("noise_gain = 0.3", "noise_gane = 0.3");
+    std::fs::write(&typo, text).unwrap();
+    let out = bin()
+        .args(["check", typo.to_str().unwrap()])
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("flow.farrell") && err.contains("noise_gane"),
+        "{err}"
+    );
+    let missing = bin()
+        .args(["check", "/nonexistent/x.toml"])
+        .output()
+        .unwrap();
+    assert_eq!(missing.status.code(), Some(1));
+}
+
+#[test]
+fn bad_flags_are_errors_not_panics() {
+    for args in [
+        vec!["run", "--preset", "nope"],
+        vec!["run"],
+        vec!["bench", "plume", "--dt=-1"],
+        vec![
+            "bench",
+            "plume",
+            "--release-rate=-3",
+            "--warmup",
+            "0",
+            "--duration",
+            "0.1",
+        ],
+    ] {
+        let out = bin().args(&args).output().unwrap();
+        assert_eq!(
+            out.status.code(),
+            Some(1),
+            "{args:?}: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        assert!(String::from_utf8_lossy(&out.stderr).starts_with("error:"));
+    }
+    let out = bin().args(["run", "--seed", "abc"]).output().unwrap();
+    assert_eq!(out.status.code(), Some(2), "clap usage errors exit 2");
+}
+
+#[test]
+fn bench_plume_prints_the_documented_json() {
+    let out = run_ok(&[
+        "bench",
+        "plume",
+        "--warmup",
+        "5",
+        "--duration",
+        "1",
+        "--queries",
+        "1000",
+    ]);
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    for key in [
+        "ns_per_filament_step",
+        "mean_live_filaments",
+        "point_query_ns",
+        "sim_s_per_cpu_s",
+    ] {
+        assert!(
+            v[key].as_f64().is_some_and(|x| x > 0.0),
+            "{key} missing or not positive in {v}"
+        );
+    }
+    assert_eq!(v["pompy_compatible"], true);
+    assert_eq!(v["steps_timed"], 100);
+}

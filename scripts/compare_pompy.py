@@ -1,0 +1,160 @@
+"""Times pompy and plumetrace on pompy's scenario and compares their plume statistics.
+
+Run through compare_pompy.sh, which prepares the environment. Both models use pompy's scenario:
+region x 0-100 m, y -50-50 m, 21 x 21 wind grid, mean flow 1 m/s, source at (5, 0), dt 0.01 s;
+plumetrace runs in pompy-compatible mode (its `pompy` preset).
+"""
+import argparse
+import json
+import subprocess
+import sys
+import time
+from concurrent.futures import ProcessPoolExecutor
+
+import numpy as np
+from pompy import models, processors
+
+SLABS = (25.0, 50.0, 75.0)
+
+
+def make_pompy(rate, seed):
+    rng = np.random.RandomState(seed)
+    region = models.Rectangle(0.0, 100.0, -50.0, 50.0)
+    wind = models.WindModel(region, 21, 21, u_av=1.0, v_av=0.0, rng=rng)
+    plume = models.PlumeModel(region, (5.0, 0.0, 0.0), wind, puff_release_rate=rate,
+                              max_num_puffs=10**6, rng=rng)
+    return wind, plume
+
+
+def pompy_run(rate, seed, dt, warmup, duration, queries):
+    """Steps pompy, timing the timed part; returns costs and slab moments."""
+    wind, plume = make_pompy(rate, seed)
+    for _ in range(int(round(warmup / dt))):
+        wind.update(dt)
+        plume.update(dt)
+    steps = int(round(duration / dt))
+    every = int(round(1.0 / dt))
+    cpu = 0.0
+    live = 0
+    moments = {x: [0.0, 0.0, 0.0] for x in SLABS}
+    for k in range(steps):
+        t0 = time.process_time()
+        wind.update(dt)
+        plume.update(dt)
+        cpu += time.process_time() - t0
+        live += len(plume.puffs)
+        if k % every == 0 and plume.puffs:
+            arr = plume.puff_array
+            for x in SLABS:
+                ys = arr[np.abs(arr[:, 0] - x) <= 2.5, 1]
+                m = moments[x]
+                m[0] += len(ys)
+                m[1] += float(ys.sum())
+                m[2] += float((ys * ys).sum())
+    out = {"cpu_s": cpu, "steps": steps, "live_sum": live, "moments": moments,
+           "final_live": len(plume.puffs)}
+    if queries:
+        arr = plume.puff_array
+        calc = processors.ConcentrationValueCalculator(1.0)
+        qrng = np.random.RandomState(seed + 1)
+        idx = qrng.randint(0, len(arr), size=queries)
+        pts = arr[idx, :2] + qrng.uniform(-0.5, 0.5, size=(queries, 2))
+        t0 = time.process_time()
+        for x, y in pts:
+            calc.calc_conc_point(arr, x, y, 0.0)
+        out["point_query_ns"] = (time.process_time() - t0) / queries * 1e9
+    return out
+
+
+def plumetrace_run(exe, rate, seed, dt, warmup, duration, queries):
+    args = [exe, "bench", "plume", "--release-rate", str(rate), "--seed", str(seed),
+            f"--dt={dt}", f"--warmup={warmup}", f"--duration={duration}", "--queries", str(queries)]
+    return json.loads(subprocess.run(args, check=True, capture_output=True, text=True).stdout)
+
+
+def pooled(parts):
+    """Pools (n, mean, sd) triples into one spread."""
+    n = sum(p[0] for p in parts)
+    if n == 0:
+        return float("nan")
+    s1 = sum(p[0] * p[1] for p in parts)
+    s2 = sum(p[0] * (p[2] ** 2 + p[1] ** 2) for p in parts)
+    m = s1 / n
+    return (s2 / n - m * m) ** 0.5
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--plumetrace", required=True)
+    ap.add_argument("--quick", action="store_true", help="short runs (noisier statistics)")
+    ap.add_argument("--seeds", type=int, default=None, help="pompy seeds for the statistics")
+    ap.add_argument("--stats-duration", type=float, default=None, help="sampled seconds per seed")
+    ap.add_argument("--jobs", type=int, default=2)
+    ap.add_argument("--skip-timing", action="store_true")
+    ap.add_argument("--skip-stats", action="store_true")
+    a = ap.parse_args()
+    dt = 0.01
+    warmup = 30.0 if a.quick else 100.0
+    timed = 5.0 if a.quick else 20.0
+    seeds = a.seeds or (2 if a.quick else 8)
+    stats_duration = a.stats_duration or (60.0 if a.quick else 600.0)
+
+    if not a.skip_timing:
+        timing(a, dt, warmup, timed)
+    if a.skip_stats:
+        return 0
+    return statistics(a, dt, warmup, seeds, stats_duration)
+
+
+def timing(a, dt, warmup, timed):
+    print(f"# Timing: pompy scenario, dt {dt} s, warm-up {warmup} s, timed {timed} s", flush=True)
+    rows = []
+    for rate in (5, 50):
+        p = pompy_run(rate, 1, dt, warmup, timed, 200)
+        r = plumetrace_run(a.plumetrace, rate, 1, dt, warmup, timed, 200000)
+        p_ns = p["cpu_s"] / max(p["live_sum"], 1) * 1e9
+        p_live = p["live_sum"] / p["steps"]
+        p_rt = timed / p["cpu_s"]
+        rows.append((rate, p_live, r["mean_live_filaments"], p_ns, r["ns_per_filament_step"],
+                     p["point_query_ns"], r["point_query_ns"], p_rt, r["sim_s_per_cpu_s"]))
+    print("| release /s | live puffs (pompy / plumetrace) | ns per filament-step (pompy / plumetrace / ratio) "
+          "| point query ns (pompy / plumetrace / ratio) | sim s per CPU s (pompy / plumetrace) |")
+    print("|---|---|---|---|---|")
+    for rate, pl, rl, pn, rn, pq, rq, prt, rrt in rows:
+        print(f"| {rate} | {pl:.0f} / {rl:.0f} | {pn:.0f} / {rn:.1f} / {pn / rn:.0f}x "
+              f"| {pq:.0f} / {rq:.0f} / {pq / rq:.0f}x | {prt:.2f} / {rrt:.0f} |", flush=True)
+
+
+def statistics(a, dt, warmup, seeds, stats_duration):
+    print(f"\n# Statistics: release 5 /s, {seeds} pompy seeds x {stats_duration:.0f} s after {warmup:.0f} s "
+          f"warm-up; plumetrace {4 * seeds} seeds", flush=True)
+    with ProcessPoolExecutor(max_workers=a.jobs) as pool:
+        futs = [pool.submit(pompy_run, 5, 100 + s, dt, warmup, stats_duration, 0) for s in range(seeds)]
+        pres = [f.result() for f in futs]
+    rres = [plumetrace_run(a.plumetrace, 5, 100 + s, dt, warmup, stats_duration, 1000) for s in range(4 * seeds)]
+    p_live = sum(p["live_sum"] for p in pres) / sum(p["steps"] for p in pres)
+    r_live = sum(r["mean_live_filaments"] for r in rres) / len(rres)
+    print("| statistic | pompy | plumetrace | difference |")
+    print("|---|---|---|---|")
+    worst = abs(r_live / p_live - 1)
+    print(f"| mean live puffs | {p_live:.1f} | {r_live:.1f} | {100 * (r_live / p_live - 1):+.1f} % |")
+    for x in SLABS:
+        pp = []
+        for p in pres:
+            n, s1, s2 = p["moments"][x]
+            if n > 0:
+                m = s1 / n
+                pp.append((n, m, max(s2 / n - m * m, 0.0) ** 0.5))
+        key = f"{x:.0f}"
+        rp = [(r["crossflow_samples"][key], r["crossflow_mean_m"][key], r["crossflow_spread_m"][key])
+              for r in rres if key in r["crossflow_spread_m"]]
+        ps, rs = pooled(pp), pooled(rp)
+        worst = max(worst, abs(rs / ps - 1))
+        print(f"| cross-flow spread at x = {x:.0f} m (m) | {ps:.2f} | {rs:.2f} | {100 * (rs / ps - 1):+.1f} % |")
+    verdict = "within" if worst <= 0.10 else "NOT within"
+    print(f"\nlargest difference {100 * worst:.1f} %: {verdict} 10 %")
+    return 0 if worst <= 0.10 else 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())
