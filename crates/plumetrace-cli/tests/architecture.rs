@@ -1,0 +1,70 @@
+//! Enforces the dependency rules of ARCHITECTURE.md on the crates' manifests.
+
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
+use std::collections::BTreeSet;
+use std::path::Path;
+
+/// Which side of the simulator/vehicle boundary a crate is on.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Side {
+    /// Value types both sides share; no randomness.
+    Shared,
+    /// Runs on a vehicle: sees only what a vehicle can know.
+    Onboard,
+    /// The simulated world.
+    Simulator,
+    /// Binaries and tools on top of everything.
+    App,
+}
+
+/// Every crate, its side and the plumetrace crates it may depend on. A new crate must be added
+/// here (and to ARCHITECTURE.md) or this test fails.
+const RULES: &[(&str, Side, &[&str])] = &[
+    ("plumetrace-core", Side::Shared, &[]),
+    ("plumetrace-env", Side::Simulator, &["plumetrace-core"]),
+    ("plumetrace-scenario", Side::Simulator, &["plumetrace-core", "plumetrace-env"]),
+    ("plumetrace-cli", Side::App, &["plumetrace-core", "plumetrace-env", "plumetrace-scenario"]),
+];
+
+fn manifest_deps(path: &Path, table: &str) -> BTreeSet<String> {
+    let text = std::fs::read_to_string(path).unwrap();
+    let value: toml::Value = toml::from_str(&text).unwrap();
+    value.get(table).and_then(|d| d.as_table()).map(|t| t.keys().cloned().collect()).unwrap_or_default()
+}
+
+#[test]
+fn crates_depend_only_on_what_their_side_allows() {
+    let crates_dir = Path::new(env!("CARGO_MANIFEST_DIR")).parent().unwrap();
+    let mut seen = BTreeSet::new();
+    for entry in std::fs::read_dir(crates_dir).unwrap() {
+        let dir = entry.unwrap().path();
+        let manifest = dir.join("Cargo.toml");
+        if !manifest.is_file() {
+            continue;
+        }
+        let name = dir.file_name().unwrap().to_string_lossy().to_string();
+        let Some(&(_, side, allowed)) = RULES.iter().find(|r| r.0 == name) else {
+            panic!("crate {name} is not in the dependency rules (tests/architecture.rs and ARCHITECTURE.md)");
+        };
+        seen.insert(name.clone());
+        let deps = manifest_deps(&manifest, "dependencies");
+        for dep in deps.iter().filter(|d| d.starts_with("plumetrace-")) {
+            assert!(allowed.contains(&dep.as_str()), "{name} may not depend on {dep}");
+            let dep_side = RULES.iter().find(|r| r.0 == dep).map(|r| r.1);
+            if side == Side::Onboard {
+                assert!(
+                    matches!(dep_side, Some(Side::Shared | Side::Onboard)),
+                    "onboard crate {name} depends on {dep}, which is not onboard or shared"
+                );
+            }
+        }
+        if side == Side::Shared || side == Side::Onboard {
+            for banned in ["rand", "rand_pcg", "rand_distr"] {
+                assert!(!deps.contains(banned), "{name} ({side:?}) must not use randomness ({banned})");
+            }
+        }
+    }
+    let expected: BTreeSet<String> = RULES.iter().map(|r| r.0.to_string()).collect();
+    assert_eq!(seen, expected, "a crate in the rules has no directory");
+}
