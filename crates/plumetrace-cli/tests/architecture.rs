@@ -23,14 +23,26 @@ enum Side {
 const RULES: &[(&str, Side, &[&str])] = &[
     ("plumetrace-core", Side::Shared, &[]),
     ("plumetrace-env", Side::Simulator, &["plumetrace-core"]),
-    ("plumetrace-scenario", Side::Simulator, &["plumetrace-core", "plumetrace-env"]),
-    ("plumetrace-cli", Side::App, &["plumetrace-core", "plumetrace-env", "plumetrace-scenario"]),
+    (
+        "plumetrace-scenario",
+        Side::Simulator,
+        &["plumetrace-core", "plumetrace-env"],
+    ),
+    (
+        "plumetrace-cli",
+        Side::App,
+        &["plumetrace-core", "plumetrace-env", "plumetrace-scenario"],
+    ),
 ];
 
 fn manifest_deps(path: &Path, table: &str) -> BTreeSet<String> {
     let text = std::fs::read_to_string(path).unwrap();
     let value: toml::Value = toml::from_str(&text).unwrap();
-    value.get(table).and_then(|d| d.as_table()).map(|t| t.keys().cloned().collect()).unwrap_or_default()
+    value
+        .get(table)
+        .and_then(|d| d.as_table())
+        .map(|t| t.keys().cloned().collect())
+        .unwrap_or_default()
 }
 
 #[test]
@@ -45,12 +57,17 @@ fn crates_depend_only_on_what_their_side_allows() {
         }
         let name = dir.file_name().unwrap().to_string_lossy().to_string();
         let Some(&(_, side, allowed)) = RULES.iter().find(|r| r.0 == name) else {
-            panic!("crate {name} is not in the dependency rules (tests/architecture.rs and ARCHITECTURE.md)");
+            panic!(
+                "crate {name} is not in the dependency rules (tests/architecture.rs and ARCHITECTURE.md)"
+            );
         };
         seen.insert(name.clone());
         let deps = manifest_deps(&manifest, "dependencies");
         for dep in deps.iter().filter(|d| d.starts_with("plumetrace-")) {
-            assert!(allowed.contains(&dep.as_str()), "{name} may not depend on {dep}");
+            assert!(
+                allowed.contains(&dep.as_str()),
+                "{name} may not depend on {dep}"
+            );
             let dep_side = RULES.iter().find(|r| r.0 == dep).map(|r| r.1);
             if side == Side::Onboard {
                 assert!(
@@ -61,7 +78,10 @@ fn crates_depend_only_on_what_their_side_allows() {
         }
         if side == Side::Shared || side == Side::Onboard {
             for banned in ["rand", "rand_pcg", "rand_distr"] {
-                assert!(!deps.contains(banned), "{name} ({side:?}) must not use randomness ({banned})");
+                assert!(
+                    !deps.contains(banned),
+                    "{name} ({side:?}) must not use randomness ({banned})"
+                );
             }
         }
     }

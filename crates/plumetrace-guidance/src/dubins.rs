@@ -1,0 +1,302 @@
+//! Go To Point With Heading: the shortest CSC Dubins path, followed by pursuit.
+//!
+//! The path geometry comes from the `dubins_paths` crate, restricted to the four CSC words (LSL,
+//! LSR, RSL, RSR) as on the field vehicle. That crate measures angles anticlockwise from East;
+//! compass headings are converted at this module's boundary and nowhere else. The frame's axes
+//! are the same (x East, y North), so a left turn is a left turn in both.
+
+use crate::{DoneReason, ModeStatus, Steer};
+use dubins_paths::PathType;
+use dubins_paths::f64::{DubinsPath, PosRot};
+use plumetrace_core::{Heading, Vec2, bearing_between};
+use std::f64::consts::FRAC_PI_2;
+
+/// A position and a compass heading.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Pose {
+    /// `(east, north)`, m.
+    pub pos_m: Vec2,
+    /// Compass heading.
+    pub heading: Heading,
+}
+
+impl Pose {
+    fn to_posrot(self) -> PosRot {
+        PosRot::from_floats(self.pos_m.x, self.pos_m.y, FRAC_PI_2 - self.heading.rad())
+    }
+
+    fn from_posrot(q: PosRot) -> Self {
+        Pose {
+            pos_m: Vec2::new(q.x(), q.y()),
+            heading: Heading::from_rad(FRAC_PI_2 - q.rot()),
+        }
+    }
+}
+
+/// The four turn-straight-turn words.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum CscWord {
+    /// Left, straight, left.
+    Lsl,
+    /// Left, straight, right.
+    Lsr,
+    /// Right, straight, left.
+    Rsl,
+    /// Right, straight, right.
+    Rsr,
+}
+
+impl CscWord {
+    /// All four words.
+    pub const ALL: [CscWord; 4] = [CscWord::Lsl, CscWord::Lsr, CscWord::Rsl, CscWord::Rsr];
+
+    fn path_type(self) -> PathType {
+        match self {
+            CscWord::Lsl => PathType::LSL,
+            CscWord::Lsr => PathType::LSR,
+            CscWord::Rsl => PathType::RSL,
+            CscWord::Rsr => PathType::RSR,
+        }
+    }
+
+    fn from_path_type(t: PathType) -> Option<Self> {
+        match t {
+            PathType::LSL => Some(CscWord::Lsl),
+            PathType::LSR => Some(CscWord::Lsr),
+            PathType::RSL => Some(CscWord::Rsl),
+            PathType::RSR => Some(CscWord::Rsr),
+            PathType::RLR | PathType::LRL => None,
+        }
+    }
+}
+
+/// A CSC path from one pose to another with a minimum turning radius.
+#[derive(Debug, Clone, Copy)]
+pub struct CscPath {
+    inner: DubinsPath,
+    word: CscWord,
+}
+
+impl CscPath {
+    /// The path of one word, if that word connects the poses (LSR and RSL do not always).
+    pub fn new(start: Pose, end: Pose, radius_m: f64, word: CscWord) -> Option<Self> {
+        if !(radius_m.is_finite() && radius_m > 0.0) {
+            return None;
+        }
+        let inner = DubinsPath::new(
+            start.to_posrot(),
+            end.to_posrot(),
+            radius_m,
+            word.path_type(),
+        )
+        .ok()?;
+        inner
+            .length()
+            .is_finite()
+            .then_some(CscPath { inner, word })
+    }
+
+    /// The word.
+    pub fn word(&self) -> CscWord {
+        self.word
+    }
+
+    /// Total length, m.
+    pub fn length_m(&self) -> f64 {
+        self.inner.length()
+    }
+
+    /// Lengths of the turn, straight and turn segments, m.
+    pub fn segment_lengths_m(&self) -> [f64; 3] {
+        [0, 1, 2].map(|i| self.inner.segment_length(i))
+    }
+
+    /// The turning radius, m.
+    pub fn radius_m(&self) -> f64 {
+        self.inner.rho
+    }
+
+    /// The pose `s_m` metres along the path (clamped to the path).
+    pub fn sample(&self, s_m: f64) -> Pose {
+        Pose::from_posrot(self.inner.sample(s_m.clamp(0.0, self.length_m())))
+    }
+}
+
+/// The four CSC candidates that exist between two poses.
+pub fn csc_candidates(start: Pose, end: Pose, radius_m: f64) -> Vec<CscPath> {
+    CscWord::ALL
+        .iter()
+        .filter_map(|&w| CscPath::new(start, end, radius_m, w))
+        .collect()
+}
+
+/// The shortest CSC path between two poses; `None` for a non-positive radius or non-finite poses.
+pub fn shortest_csc(start: Pose, end: Pose, radius_m: f64) -> Option<CscPath> {
+    if !(radius_m.is_finite() && radius_m > 0.0) {
+        return None;
+    }
+    let inner =
+        DubinsPath::shortest_in(start.to_posrot(), end.to_posrot(), radius_m, &PathType::CSC)
+            .ok()?;
+    let word = CscWord::from_path_type(inner.path_type)?;
+    inner
+        .length()
+        .is_finite()
+        .then_some(CscPath { inner, word })
+}
+
+/// Spacing of the points the pursuit follows, m.
+const SAMPLE_STEP_M: f64 = 0.5;
+
+/// Drive to a position with a given heading on arrival, along the shortest CSC path with the
+/// minimum turning radius, followed by pursuit of a point a look-ahead distance along the path.
+/// The path is planned from the vehicle's pose on the first decision and planned again when a
+/// navigation fix puts the vehicle more than `replan_offtrack_m` from it or when the vehicle runs
+/// off its end without arriving.
+#[derive(Debug, Clone)]
+pub struct GoToPointWithHeading {
+    /// Destination pose.
+    pub target: Pose,
+    /// Speed command, m/s.
+    pub speed_mps: f64,
+    /// Arrival radius `R`, m.
+    pub radius_m: f64,
+    /// Arrival heading tolerance, degrees (15 on the field vehicle).
+    pub heading_tolerance_deg: f64,
+    /// Minimum turning radius `R_m`, m.
+    pub min_turn_radius_m: f64,
+    /// Pursuit look-ahead along the path, m.
+    pub lookahead_m: f64,
+    /// Distance from the path beyond which it is planned again, m.
+    pub replan_offtrack_m: f64,
+    plan: Option<CscPath>,
+    /// Distance along the path of the point nearest the vehicle, m.
+    progress_m: f64,
+    plans: u32,
+}
+
+impl GoToPointWithHeading {
+    /// A mode with the look-ahead at half the turning radius and replanning beyond one radius.
+    pub fn new(target: Pose, speed_mps: f64, radius_m: f64, min_turn_radius_m: f64) -> Self {
+        GoToPointWithHeading {
+            target,
+            speed_mps,
+            radius_m,
+            heading_tolerance_deg: 15.0,
+            min_turn_radius_m,
+            lookahead_m: 0.5 * min_turn_radius_m,
+            replan_offtrack_m: min_turn_radius_m.max(radius_m),
+            plan: None,
+            progress_m: 0.0,
+            plans: 0,
+        }
+    }
+
+    /// The path being followed, if planned.
+    pub fn path(&self) -> Option<&CscPath> {
+        self.plan.as_ref()
+    }
+
+    /// How many times a path was planned.
+    pub fn plans(&self) -> u32 {
+        self.plans
+    }
+
+    fn replan(&mut self, pose: Pose) {
+        self.plan = shortest_csc(pose, self.target, self.min_turn_radius_m);
+        self.progress_m = 0.0;
+        self.plans += 1;
+    }
+
+    /// The mode's decision at the vehicle's estimated pose.
+    pub fn update(&mut self, pose: Pose) -> ModeStatus {
+        let to_go = (self.target.pos_m - pose.pos_m).norm();
+        if to_go < self.radius_m
+            && pose.heading.diff_deg(self.target.heading).abs() < self.heading_tolerance_deg
+        {
+            return ModeStatus::Done(DoneReason::ArrivedWithHeading);
+        }
+        let mut need_plan = true;
+        if let Some(path) = &self.plan {
+            // Nearest point within a window ahead of the progress so far (the window keeps it from
+            // jumping to a later part of the path that passes close by); cost is constant.
+            let len = path.length_m();
+            let window = 4.0 * self.min_turn_radius_m.max(self.radius_m);
+            let steps = (window / SAMPLE_STEP_M).ceil() as usize;
+            let (best_s, best_d) = (0..=steps)
+                .map(|k| (self.progress_m + k as f64 * SAMPLE_STEP_M).min(len))
+                .map(|s_m| (s_m, (path.sample(s_m).pos_m - pose.pos_m).norm()))
+                .fold((self.progress_m, f64::INFINITY), |best, c| {
+                    if c.1 < best.1 { c } else { best }
+                });
+            self.progress_m = best_s;
+            need_plan = best_d > self.replan_offtrack_m || best_s >= len - SAMPLE_STEP_M;
+        }
+        if need_plan {
+            self.replan(pose);
+        }
+        let heading = match &self.plan {
+            Some(path) => {
+                let aim = path.sample(self.progress_m + self.lookahead_m);
+                bearing_between(pose.pos_m, aim.pos_m).unwrap_or(aim.heading)
+            }
+            // No path (degenerate input): head straight for the target.
+            None => bearing_between(pose.pos_m, self.target.pos_m).unwrap_or(self.target.heading),
+        };
+        ModeStatus::Running(Steer {
+            heading,
+            speed_mps: self.speed_mps,
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn pose(x: f64, y: f64, h: f64) -> Pose {
+        Pose {
+            pos_m: Vec2::new(x, y),
+            heading: Heading::from_deg(h),
+        }
+    }
+
+    #[test]
+    fn straight_ahead_is_a_straight_path() {
+        let p = shortest_csc(pose(0.0, 0.0, 0.0), pose(0.0, 100.0, 0.0), 10.0).unwrap();
+        assert!((p.length_m() - 100.0).abs() < 1e-6, "{}", p.length_m());
+        let mid = p.sample(50.0);
+        assert!(
+            (mid.pos_m - Vec2::new(0.0, 50.0)).norm() < 1e-6
+                && mid.heading.diff_deg(Heading::NORTH).abs() < 1e-6
+        );
+    }
+
+    #[test]
+    fn u_turn_is_a_half_circle_and_turn_directions_match_compass() {
+        // Heading North, end 20 m East heading South with R = 10: a right (clockwise) half circle.
+        let p = shortest_csc(pose(0.0, 0.0, 0.0), pose(20.0, 0.0, 180.0), 10.0).unwrap();
+        assert!(
+            (p.length_m() - std::f64::consts::PI * 10.0).abs() < 1e-6,
+            "{}",
+            p.length_m()
+        );
+        assert!(
+            matches!(p.word(), CscWord::Rsr | CscWord::Rsl | CscWord::Lsr),
+            "{:?}",
+            p.word()
+        );
+        let q = p.sample(0.5 * p.length_m());
+        assert!(
+            (q.pos_m - Vec2::new(10.0, 10.0)).norm() < 1e-6
+                && q.heading.diff_deg(Heading::from_deg(90.0)).abs() < 1e-6,
+            "{q:?}"
+        );
+    }
+
+    #[test]
+    fn degenerate_radius_gives_no_path() {
+        assert!(shortest_csc(pose(0.0, 0.0, 0.0), pose(5.0, 5.0, 0.0), 0.0).is_none());
+        assert!(shortest_csc(pose(0.0, 0.0, 0.0), pose(5.0, 5.0, 0.0), f64::NAN).is_none());
+    }
+}
