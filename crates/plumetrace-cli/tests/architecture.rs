@@ -23,6 +23,12 @@ enum Side {
 const RULES: &[(&str, Side, &[&str])] = &[
     ("plumetrace-core", Side::Shared, &[]),
     ("plumetrace-env", Side::Simulator, &["plumetrace-core"]),
+    ("plumetrace-guidance", Side::Onboard, &["plumetrace-core"]),
+    (
+        "plumetrace-sim",
+        Side::Simulator,
+        &["plumetrace-core", "plumetrace-env"],
+    ),
     (
         "plumetrace-scenario",
         Side::Simulator,

@@ -1,7 +1,7 @@
 //! Cage (eq. 11-13): keep the vehicle inside the op-area.
 
 use crate::op_area::OpArea;
-use plumetrace_core::Heading;
+use plumetrace_core::{Heading, Vec2};
 
 /// What the cage did to a heading command.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -32,6 +32,22 @@ impl CageAction {
 /// The op-area cage: within `band_m` of an edge, `(1 - delta / band)` of the outward component
 /// of the commanded heading vector is removed (eq. 12); outside, the command is the inward
 /// normal; beyond `abort_m` outside, the mission aborts.
+///
+/// The removal is applied for every edge within the band, nearest first, not only the nearest
+/// one: near a corner a vehicle running along one edge is heading out through the other, and a
+/// nearest-edge rule lets it leave (in closed-loop tests with random commands, the nearest-edge
+/// rule let the vehicle 28 m out). Away from corners both rules are the same.
+///
+/// Eq. 12 shortens the outward component of the command vector, and only the direction of the
+/// result is used, so a command pointing straight out of the area keeps its heading until the
+/// vehicle reaches the edge, where it is replaced by the inward normal; commands at an angle are
+/// turned progressively towards the edge's direction.
+///
+/// The cage acts on commands, not on the vehicle: a vehicle that turns at 10 deg/s (an 11.5 m
+/// turning circle at 2 m/s) and meets the band heading straight out crosses the edge while it
+/// turns. In closed-loop tests with a new random command every 15 s for an hour, the field AUV
+/// was outside 15 % of the time and at most 18.5 m out with perfect navigation (28 m with
+/// long-baseline navigation), and always came back without reaching the 30 m abort distance.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Cage {
     /// The area.
@@ -53,7 +69,7 @@ impl Cage {
     }
 
     /// Applies the cage to `command` at estimated position `pos_m`.
-    pub fn apply(&self, pos_m: plumetrace_core::Vec2, command: Heading) -> CageAction {
+    pub fn apply(&self, pos_m: Vec2, command: Heading) -> CageAction {
         let e = self.area.edge_info(pos_m);
         let n = e.outward_normal;
         if !e.inside {
@@ -68,14 +84,27 @@ impl Cage {
             return CageAction::Pass(command);
         }
         let v = command.unit();
-        let outward = v.dot(&n);
-        if outward <= 0.0 {
+        let mut t = v;
+        let mut inward = Vec2::zeros();
+        for (delta, n) in self.area.edges_within(pos_m, self.band_m) {
+            let outward = t.dot(&n);
+            if outward > 0.0 {
+                t -= n * ((1.0 - delta / self.band_m) * outward);
+            }
+            inward -= n;
+        }
+        if (t - v).norm() == 0.0 {
             return CageAction::Pass(command);
         }
-        let t = v - n * ((1.0 - e.distance_m / self.band_m) * outward);
-        // Only a command straight out at the very edge cancels completely: turn inward then.
+        // A command straight out at the very edge (or into a corner) cancels completely: turn
+        // inward then.
+        let fallback = Heading::of_vector(inward)
+            .or_else(|| Heading::of_vector(-n))
+            .unwrap_or(command);
         CageAction::Modified(
-            Heading::of_vector(t).unwrap_or_else(|| Heading::of_vector(-n).unwrap_or(command)),
+            Heading::of_vector(t)
+                .filter(|_| t.norm() > 1e-9)
+                .unwrap_or(fallback),
         )
     }
 }
@@ -83,7 +112,6 @@ impl Cage {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use plumetrace_core::Vec2;
 
     #[test]
     fn cage_table() {

@@ -152,6 +152,27 @@ impl OpArea {
         }
     }
 
+    /// Every edge closer than `band_m` to `p`: distance to the edge segment and the edge's outward
+    /// normal, nearest first.
+    pub fn edges_within(&self, p: Vec2, band_m: f64) -> Vec<(f64, Vec2)> {
+        let mut out: Vec<(f64, Vec2)> = self
+            .edges()
+            .filter_map(|(a, b)| {
+                let ab = b - a;
+                let len2 = ab.norm_squared();
+                if len2 == 0.0 {
+                    return None;
+                }
+                let t = ((p - a).dot(&ab) / len2).clamp(0.0, 1.0);
+                let d = (p - (a + ab * t)).norm();
+                let n = Vec2::new(ab.y, -ab.x) * self.orientation / len2.sqrt();
+                (d < band_m).then_some((d, n))
+            })
+            .collect();
+        out.sort_by(|x, y| x.0.total_cmp(&y.0));
+        out
+    }
+
     /// The vertex furthest along `direction` (e.g. the most downflow corner).
     pub fn furthest_vertex_along(&self, direction: Vec2) -> Vec2 {
         let mut best = self.vertices[0];

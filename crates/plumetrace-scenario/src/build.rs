@@ -26,6 +26,23 @@ pub struct OutputSpec {
     pub threshold: f64,
 }
 
+/// A vehicle ready to be put in a world: the truth at t = 0 and its navigation and sensors.
+#[derive(Debug, Clone)]
+pub struct VehicleSetup {
+    /// Name for logs and plots.
+    pub name: String,
+    /// Dynamics and true initial state.
+    pub vehicle: plumetrace_sim::Vehicle,
+    /// Navigation.
+    pub nav: plumetrace_sim::NavParams,
+    /// Chemical sensor.
+    pub chem_sensor: plumetrace_sim::ChemSensorParams,
+    /// Flow sensor.
+    pub flow_sensor: plumetrace_sim::FlowSensorParams,
+    /// Obstacle range sensors, if fitted.
+    pub range_sensor: Option<plumetrace_sim::RangeSensorParams>,
+}
+
 /// A scenario ready to run.
 #[derive(Debug)]
 pub struct BuiltScenario {
@@ -39,6 +56,8 @@ pub struct BuiltScenario {
     pub steps: u64,
     /// Output settings.
     pub output: OutputSpec,
+    /// Vehicles, in the order of the file (their index is their `VehicleId`).
+    pub vehicles: Vec<VehicleSetup>,
 }
 
 /// Builds a scenario; `seed` overrides the file's seed.
@@ -275,6 +294,16 @@ pub fn build(
         obstacles.push(SoftObstacle::new(name, &o.vertices, &key).map_err(env_err)?);
     }
 
+    let mut vehicles = Vec::new();
+    for (k, v) in cfg.vehicles.iter().enumerate() {
+        vehicles.push(
+            vehicle_setup(v, k, &domain, d.depth_m).map_err(|e| match e {
+                EnvError::InvalidParameter { key, message } => invalid(&key, message),
+                other => invalid(&format!("vehicles[{k}]"), other.to_string()),
+            })?,
+        );
+    }
+
     let seed = seed.unwrap_or(cfg.seed);
     let env = Environment::new(domain, flow, plume, ObstacleSet::new(obstacles), dt_s, seed)
         .map_err(env_err)?;
@@ -321,6 +350,7 @@ pub fn build(
         env,
         steps,
         output,
+        vehicles,
     })
 }
 
@@ -378,4 +408,172 @@ fn mean_flow(m: &MeanFlowConfig) -> Result<MeanFlow, (String, String)> {
         other => ("speed_mps".into(), other.to_string()),
     })?;
     Ok(mean)
+}
+
+/// Builds one vehicle, filling omitted parameters with its kind's defaults.
+fn vehicle_setup(
+    v: &crate::config::VehicleConfig,
+    k: usize,
+    domain: &Rect,
+    depth_m: Option<f64>,
+) -> Result<VehicleSetup, EnvError> {
+    use plumetrace_core::{Heading, Vec2, VehicleId, VehicleKind};
+    use plumetrace_sim::{
+        ChemSensorParams, FlowFault, FlowSensorParams, NavParams, RangeSensorParams, Vehicle,
+        VehicleParams,
+    };
+    let key = format!("vehicles[{k}]");
+    plumetrace_env::error::require_finite(&format!("{key}.x_m"), v.x_m)?;
+    plumetrace_env::error::require_finite(&format!("{key}.y_m"), v.y_m)?;
+    plumetrace_env::error::require_finite(&format!("{key}.heading_deg"), v.heading_deg)?;
+    if !domain.contains_xy(v.x_m, v.y_m) {
+        return Err(EnvError::invalid(
+            format!("{key}.x_m"),
+            format!("start ({}, {}) is outside the domain", v.x_m, v.y_m),
+        ));
+    }
+    let base = match v.kind {
+        VehicleKind::Auv => VehicleParams::auv(),
+        VehicleKind::Surface => VehicleParams::surface(),
+    };
+    let dy = &v.dynamics;
+    let params = VehicleParams {
+        kind: v.kind,
+        max_speed_mps: dy.max_speed_mps.unwrap_or(base.max_speed_mps),
+        max_turn_rate_deg_s: dy.max_turn_rate_deg_s.unwrap_or(base.max_turn_rate_deg_s),
+        speed_time_constant_s: dy
+            .speed_time_constant_s
+            .unwrap_or(base.speed_time_constant_s),
+        vertical_time_constant_s: dy
+            .vertical_time_constant_s
+            .unwrap_or(base.vertical_time_constant_s),
+        altitude_error_sd_m: dy.altitude_error_sd_m.unwrap_or(base.altitude_error_sd_m),
+        altitude_error_time_s: dy
+            .altitude_error_time_s
+            .unwrap_or(base.altitude_error_time_s),
+    };
+    params.validate(&format!("{key}.dynamics"))?;
+    let z_m = match v.kind {
+        VehicleKind::Auv => {
+            let a = v.altitude_m.unwrap_or(2.0);
+            plumetrace_env::error::require_non_negative(&format!("{key}.altitude_m"), a)?;
+            if let Some(d) = depth_m
+                && a > d
+            {
+                return Err(EnvError::invalid(
+                    format!("{key}.altitude_m"),
+                    format!("{a} m is above the surface ({d} m)"),
+                ));
+            }
+            a
+        }
+        VehicleKind::Surface => {
+            if v.altitude_m.is_some() {
+                return Err(EnvError::invalid(
+                    format!("{key}.altitude_m"),
+                    "surface craft stay at the surface",
+                ));
+            }
+            depth_m.unwrap_or(0.0)
+        }
+    };
+    let nb = match v.kind {
+        VehicleKind::Auv => NavParams::lbl(),
+        VehicleKind::Surface => NavParams::gps(),
+    };
+    let n = &v.nav;
+    let nav = NavParams {
+        fix_interval_s: n.fix_interval_s.unwrap_or(nb.fix_interval_s),
+        fix_sigma_m: n.fix_sigma_m.unwrap_or(nb.fix_sigma_m),
+        velocity_drift_mps_per_sqrt_s: n
+            .velocity_drift_mps_per_sqrt_s
+            .unwrap_or(nb.velocity_drift_mps_per_sqrt_s),
+        velocity_error_max_mps: n
+            .velocity_error_max_mps
+            .unwrap_or(nb.velocity_error_max_mps),
+        heading_sd_deg: n.heading_sd_deg.unwrap_or(nb.heading_sd_deg),
+    };
+    nav.validate(&format!("{key}.nav"))?;
+    let cb = ChemSensorParams::default();
+    let c = &v.chem_sensor;
+    let chem_sensor = ChemSensorParams {
+        rate_hz: c.rate_hz.unwrap_or(cb.rate_hz),
+        volts_per_unit: c.volts_per_unit.unwrap_or(cb.volts_per_unit),
+        full_scale_v: c.full_scale_v.unwrap_or(cb.full_scale_v),
+        noise_sd_v: c.noise_sd_v.unwrap_or(cb.noise_sd_v),
+        lag_time_constant_s: c.lag_time_constant_s.unwrap_or(cb.lag_time_constant_s),
+        threshold_v: c.threshold_v.unwrap_or(cb.threshold_v),
+    };
+    chem_sensor.validate(&format!("{key}.chem_sensor"))?;
+    let fb = FlowSensorParams::default();
+    let f = &v.flow_sensor;
+    let fault = match (f.fault_start_s, f.fault_end_s) {
+        (Some(start_s), Some(end_s)) => Some(FlowFault { start_s, end_s }),
+        (None, None) => None,
+        _ => {
+            return Err(EnvError::invalid(
+                format!("{key}.flow_sensor.fault_end_s"),
+                "give both fault_start_s and fault_end_s",
+            ));
+        }
+    };
+    let flow_sensor = FlowSensorParams {
+        rate_hz: f.rate_hz.unwrap_or(fb.rate_hz),
+        noise_sd_mps: f.noise_sd_mps.unwrap_or(fb.noise_sd_mps),
+        bias_mps: f.bias_mps.unwrap_or(fb.bias_mps),
+        fault,
+    };
+    flow_sensor.validate(&format!("{key}.flow_sensor"))?;
+    let range_sensor = match &v.range_sensor {
+        None => None,
+        Some(r) => {
+            let rb = RangeSensorParams::default();
+            let p = RangeSensorParams {
+                max_range_m: r.max_range_m.unwrap_or(rb.max_range_m),
+                rays_per_group: r.rays_per_group.unwrap_or(rb.rays_per_group),
+                front_half_angle_deg: r.front_half_angle_deg.unwrap_or(rb.front_half_angle_deg),
+                side_outer_angle_deg: r.side_outer_angle_deg.unwrap_or(rb.side_outer_angle_deg),
+            };
+            plumetrace_env::error::require_positive(
+                &format!("{key}.range_sensor.max_range_m"),
+                p.max_range_m,
+            )?;
+            if p.rays_per_group == 0 || p.rays_per_group > 1000 {
+                return Err(EnvError::invalid(
+                    format!("{key}.range_sensor.rays_per_group"),
+                    "must be 1..=1000",
+                ));
+            }
+            if !(p.front_half_angle_deg > 0.0
+                && p.side_outer_angle_deg > p.front_half_angle_deg
+                && p.side_outer_angle_deg <= 180.0)
+            {
+                return Err(EnvError::invalid(
+                    format!("{key}.range_sensor.side_outer_angle_deg"),
+                    "needs 0 < front_half_angle_deg < side_outer_angle_deg <= 180",
+                ));
+            }
+            Some(p)
+        }
+    };
+    let vehicle = Vehicle::new(
+        VehicleId(k as u32),
+        params,
+        Vec2::new(v.x_m, v.y_m),
+        z_m,
+        Heading::from_deg(v.heading_deg),
+    );
+    let name = if v.name.is_empty() {
+        key.clone()
+    } else {
+        v.name.clone()
+    };
+    Ok(VehicleSetup {
+        name,
+        vehicle,
+        nav,
+        chem_sensor,
+        flow_sensor,
+        range_sensor,
+    })
 }

@@ -31,6 +31,9 @@ pub struct ScenarioConfig {
     /// Soft obstacles (kelp).
     #[serde(default)]
     pub obstacles: Vec<ObstacleConfig>,
+    /// Vehicles (AUVs and surface craft) with their navigation and sensors.
+    #[serde(default)]
+    pub vehicles: Vec<VehicleConfig>,
     /// What a plume run writes.
     #[serde(default)]
     pub output: OutputConfig,
@@ -294,4 +297,121 @@ impl Default for OutputConfig {
             threshold: 0.1,
         }
     }
+}
+
+/// `[[vehicles]]`: one vehicle. Every omitted parameter takes the default of its kind (the REMUS
+/// field values for an AUV).
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct VehicleConfig {
+    /// "auv" or "surface".
+    pub kind: plumetrace_core::VehicleKind,
+    /// Name for logs and plots.
+    #[serde(default)]
+    pub name: String,
+    /// Start East, m.
+    pub x_m: f64,
+    /// Start North, m.
+    pub y_m: f64,
+    /// Start heading, compass degrees.
+    #[serde(default)]
+    pub heading_deg: f64,
+    /// Start height above the seabed, m (AUV; default 2). Surface craft start at the surface.
+    pub altitude_m: Option<f64>,
+    /// Dynamics.
+    #[serde(default)]
+    pub dynamics: DynamicsConfig,
+    /// Navigation.
+    #[serde(default)]
+    pub nav: NavConfig,
+    /// Chemical sensor.
+    #[serde(default)]
+    pub chem_sensor: ChemSensorConfig,
+    /// Flow sensor.
+    #[serde(default)]
+    pub flow_sensor: FlowSensorConfig,
+    /// Obstacle range sensors (absent: none).
+    pub range_sensor: Option<RangeSensorConfig>,
+}
+
+/// `[vehicles.dynamics]`
+#[derive(Debug, Clone, Default, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct DynamicsConfig {
+    /// Highest water-relative speed, m/s.
+    pub max_speed_mps: Option<f64>,
+    /// Highest turn rate, deg/s.
+    pub max_turn_rate_deg_s: Option<f64>,
+    /// Speed response time constant, s.
+    pub speed_time_constant_s: Option<f64>,
+    /// Depth/altitude response time constant, s.
+    pub vertical_time_constant_s: Option<f64>,
+    /// Altitude-keeping error (standard deviation), m.
+    pub altitude_error_sd_m: Option<f64>,
+    /// Altitude-keeping error correlation time, s.
+    pub altitude_error_time_s: Option<f64>,
+}
+
+/// `[vehicles.nav]`
+#[derive(Debug, Clone, Default, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct NavConfig {
+    /// Time between fixes, s.
+    pub fix_interval_s: Option<f64>,
+    /// Fix error per axis, m.
+    pub fix_sigma_m: Option<f64>,
+    /// Dead-reckoning velocity error growth, m/s per sqrt(s).
+    pub velocity_drift_mps_per_sqrt_s: Option<f64>,
+    /// Cap on the dead-reckoning velocity error, m/s.
+    pub velocity_error_max_mps: Option<f64>,
+    /// Compass noise, deg.
+    pub heading_sd_deg: Option<f64>,
+}
+
+/// `[vehicles.chem_sensor]`
+#[derive(Debug, Clone, Default, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ChemSensorConfig {
+    /// Sampling rate, Hz.
+    pub rate_hz: Option<f64>,
+    /// Volts per unit of concentration.
+    pub volts_per_unit: Option<f64>,
+    /// Full scale, V.
+    pub full_scale_v: Option<f64>,
+    /// Noise, V.
+    pub noise_sd_v: Option<f64>,
+    /// First-order lag, s.
+    pub lag_time_constant_s: Option<f64>,
+    /// Detection threshold, V.
+    pub threshold_v: Option<f64>,
+}
+
+/// `[vehicles.flow_sensor]`
+#[derive(Debug, Clone, Default, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct FlowSensorConfig {
+    /// Sampling rate, Hz.
+    pub rate_hz: Option<f64>,
+    /// Noise per axis, m/s.
+    pub noise_sd_mps: Option<f64>,
+    /// Bias `[east, north]`, m/s.
+    pub bias_mps: Option<[f64; 2]>,
+    /// Start of a wrong-layer (reversed) fault, s.
+    pub fault_start_s: Option<f64>,
+    /// End of the fault, s.
+    pub fault_end_s: Option<f64>,
+}
+
+/// `[vehicles.range_sensor]`
+#[derive(Debug, Clone, Default, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RangeSensorConfig {
+    /// Detection range, m.
+    pub max_range_m: Option<f64>,
+    /// Rays per group.
+    pub rays_per_group: Option<usize>,
+    /// Front group half-angle, deg.
+    pub front_half_angle_deg: Option<f64>,
+    /// Side groups' outer angle, deg.
+    pub side_outer_angle_deg: Option<f64>,
 }

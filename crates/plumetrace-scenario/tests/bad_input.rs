@@ -125,3 +125,99 @@ fn missing_tables_and_files_are_explained() {
     let not_toml = error_of("this is = = not toml");
     assert!(not_toml.contains("line 1"), "{not_toml}");
 }
+
+const VEHICLES: &str = r#"
+[[vehicles]]
+kind = "auv"
+name = "remus"
+x_m = 150.0
+y_m = 0.0
+heading_deg = 270.0
+
+[[vehicles]]
+kind = "surface"
+x_m = 20.0
+y_m = 10.0
+
+[vehicles.nav]
+fix_sigma_m = 3.0
+"#;
+
+fn demo_with_vehicles(extra: &str) -> String {
+    format!("{}\n{VEHICLES}\n{extra}", find_preset("demo").unwrap().toml)
+}
+
+#[test]
+fn vehicles_take_the_field_defaults_of_their_kind() {
+    let origin = Origin::File("scenario.toml".into());
+    let cfg = parse(&demo_with_vehicles(""), &origin).unwrap();
+    let built = build(&cfg, &origin, None).unwrap();
+    assert_eq!(built.vehicles.len(), 2);
+    let auv = &built.vehicles[0];
+    assert_eq!(auv.name, "remus");
+    assert_eq!(auv.vehicle.params.max_speed_mps, 2.0);
+    assert_eq!(auv.vehicle.params.max_turn_rate_deg_s, 10.0);
+    assert_eq!(auv.vehicle.state.z_m, 2.0);
+    assert_eq!(auv.chem_sensor.rate_hz, 10.0);
+    assert!(
+        (auv.chem_sensor.threshold_v / auv.chem_sensor.full_scale_v - 0.04).abs() < 1e-12,
+        "4 % of full scale"
+    );
+    assert!(auv.range_sensor.is_none());
+    let boat = &built.vehicles[1];
+    assert_eq!(
+        boat.vehicle.state.z_m, 10.0,
+        "at the surface of the 10 m deep demo"
+    );
+    assert_eq!(boat.nav.fix_interval_s, 1.0, "GPS");
+    assert_eq!(boat.nav.fix_sigma_m, 3.0, "overridden");
+}
+
+#[test]
+fn bad_vehicle_settings_are_rejected_with_their_key_path() {
+    let cases: &[(&str, &str)] = &[
+        (
+            "[vehicles.dynamics]\nmax_speed_mps = -2.0",
+            "vehicles[1].dynamics.max_speed_mps",
+        ),
+        (
+            "[vehicles.chem_sensor]\nrate_hz = 0.0",
+            "vehicles[1].chem_sensor.rate_hz",
+        ),
+        (
+            "[vehicles.flow_sensor]\nfault_start_s = 10.0",
+            "vehicles[1].flow_sensor.fault_end_s",
+        ),
+        (
+            "[[vehicles]]\nkind = \"auv\"\nx_m = 9.0\ny_m = 0.0\n[vehicles.nav]\nfix_interval_s = -1.0",
+            "vehicles[2].nav.fix_interval_s",
+        ),
+        (
+            "[vehicles.range_sensor]\nrays_per_group = 0",
+            "vehicles[1].range_sensor.rays_per_group",
+        ),
+        (
+            "[[vehicles]]\nkind = \"auv\"\nx_m = 999.0\ny_m = 0.0",
+            "vehicles[2].x_m",
+        ),
+        (
+            "[[vehicles]]\nkind = \"auv\"\nx_m = 9.0\ny_m = 0.0\naltitude_m = 50.0",
+            "vehicles[2].altitude_m",
+        ),
+        (
+            "[[vehicles]]\nkind = \"glider\"\nx_m = 9.0\ny_m = 0.0",
+            "vehicles[2].kind",
+        ),
+        (
+            "[[vehicles]]\nkind = \"auv\"\nx_m = 9.0\ny_m = 0.0\nspeed = 3",
+            "vehicles[2]",
+        ),
+    ];
+    for (extra, key) in cases {
+        let e = error_of(&demo_with_vehicles(extra));
+        assert!(
+            e.contains(key),
+            "{extra:?}: error {e:?} does not name {key}"
+        );
+    }
+}

@@ -1,1 +1,28 @@
-//! Simulated vehicles.
+//! Simulated vehicles: what really happens to a vehicle and what its sensors report.
+//!
+//! This crate is the simulator's side of a vehicle. It keeps the truth (where the vehicle is,
+//! where it points, how high it flies) and produces what the onboard side may see: a navigation
+//! estimate that drifts and jumps at fixes ([`nav`]), chemical, flow and obstacle-range samples
+//! ([`sensors`]). The onboard side never depends on it.
+//!
+//! - [`vehicle`]: AUV and surface-craft dynamics: water-relative speed and compass heading
+//!   commands, a first-order speed response, a turn-rate limit, drift with the current, and an
+//!   altitude (or depth) hold with a slowly varying error;
+//! - [`nav`]: dead reckoning from measured heading, speed and flow with a slowly drifting error,
+//!   corrected by position fixes (long-baseline for an AUV, GPS for a surface craft);
+//! - [`sensors`]: the 10 Hz chemical sensor used as a threshold detector, an ADCP-like flow sensor
+//!   with bias and a wrong-layer fault, and three-group obstacle range sensors.
+//!
+//! Acoustic ranging between vehicles arrives with formation tracing; its messages already have
+//! a type in `plumetrace_core::MessageBody::RangeReply`.
+
+pub mod nav;
+pub mod sensors;
+pub mod vehicle;
+
+pub use nav::{FixEvent, NavParams, Navigator};
+pub use sensors::{
+    ChemSensor, ChemSensorParams, FlowFault, FlowSensor, FlowSensorParams, RangeSensor,
+    RangeSensorParams,
+};
+pub use vehicle::{Vehicle, VehicleParams, VehicleState};

@@ -1,0 +1,190 @@
+//! Navigation: what the vehicle believes about where it is.
+//!
+//! An AUV dead-reckons: it integrates its measured heading and water-relative speed plus the
+//! measured current, with a slowly drifting velocity error (a random walk), so the estimate wanders
+//! away from the truth. Periodic long-baseline fixes reset it to the truth plus the fix error,
+//! which makes the estimate jump (up to about 10 m in the field). A surface craft works the same
+//! way with frequent, accurate GPS fixes. The planner sees only the estimate.
+
+use crate::vehicle::VehicleState;
+use plumetrace_core::{Heading, NavEstimate, Vec2};
+use plumetrace_env::error::{require_non_negative, require_positive};
+use plumetrace_env::{EnvError, SimRng};
+use rand_distr::{Distribution, StandardNormal};
+use serde::{Deserialize, Serialize};
+
+/// Parameters of a navigation system.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct NavParams {
+    /// Time between position fixes, s.
+    pub fix_interval_s: f64,
+    /// Standard deviation of a fix's error per axis, m.
+    pub fix_sigma_m: f64,
+    /// Growth of the dead-reckoning velocity error: random-walk intensity per axis,
+    /// m/s per sqrt(s).
+    pub velocity_drift_mps_per_sqrt_s: f64,
+    /// Cap on the dead-reckoning velocity error per axis, m/s.
+    pub velocity_error_max_mps: f64,
+    /// Compass noise, degrees (standard deviation).
+    pub heading_sd_deg: f64,
+}
+
+impl NavParams {
+    /// An AUV with long-baseline fixes every 5 minutes, 2 m fix error and a dead-reckoning
+    /// velocity error that drifts by about 1 cm/s in 5 minutes.
+    pub fn lbl() -> Self {
+        NavParams {
+            fix_interval_s: 300.0,
+            fix_sigma_m: 2.0,
+            velocity_drift_mps_per_sqrt_s: 0.0006,
+            velocity_error_max_mps: 0.05,
+            heading_sd_deg: 0.5,
+        }
+    }
+
+    /// A surface craft with 1 Hz GPS fixes of 1.5 m error.
+    pub fn gps() -> Self {
+        NavParams {
+            fix_interval_s: 1.0,
+            fix_sigma_m: 1.5,
+            velocity_drift_mps_per_sqrt_s: 0.0,
+            velocity_error_max_mps: 0.0,
+            heading_sd_deg: 1.0,
+        }
+    }
+
+    /// Checks every parameter; `key` prefixes the names in errors.
+    pub fn validate(&self, key: &str) -> Result<(), EnvError> {
+        require_positive(&format!("{key}.fix_interval_s"), self.fix_interval_s)?;
+        require_non_negative(&format!("{key}.fix_sigma_m"), self.fix_sigma_m)?;
+        require_non_negative(
+            &format!("{key}.velocity_drift_mps_per_sqrt_s"),
+            self.velocity_drift_mps_per_sqrt_s,
+        )?;
+        require_non_negative(
+            &format!("{key}.velocity_error_max_mps"),
+            self.velocity_error_max_mps,
+        )?;
+        require_non_negative(&format!("{key}.heading_sd_deg"), self.heading_sd_deg)
+    }
+}
+
+/// A position fix that moved the estimate.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct FixEvent {
+    /// Time of the fix, s.
+    pub time_s: f64,
+    /// Estimate before the fix.
+    pub before_m: Vec2,
+    /// Estimate after the fix.
+    pub after_m: Vec2,
+}
+
+impl FixEvent {
+    /// How far the estimate jumped, m.
+    pub fn jump_m(&self) -> f64 {
+        (self.after_m - self.before_m).norm()
+    }
+}
+
+/// The navigation estimate of one vehicle.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Navigator {
+    params: NavParams,
+    estimate_m: Vec2,
+    velocity_error_mps: Vec2,
+    next_fix_s: f64,
+    last_fix_s: Option<f64>,
+    heading: Heading,
+    /// Measured water-relative velocity at the previous update (for the trapezoidal step).
+    last_water_velocity: Vec2,
+}
+
+impl Navigator {
+    /// Starts with a perfect estimate at `start`; the first fix comes one interval later.
+    pub fn new(params: NavParams, start: &VehicleState) -> Self {
+        Navigator {
+            params,
+            estimate_m: start.pos_m,
+            velocity_error_mps: Vec2::zeros(),
+            next_fix_s: params.fix_interval_s,
+            last_fix_s: None,
+            heading: start.heading,
+            last_water_velocity: start.heading.unit() * start.speed_mps,
+        }
+    }
+
+    /// The estimated position.
+    pub fn estimate_m(&self) -> Vec2 {
+        self.estimate_m
+    }
+
+    /// Advances the estimate over a step of `dt_s` ending at `t_s`, given the true state and the
+    /// flow the vehicle measured (none: the current is ignored). Returns the fix, if one happened.
+    pub fn update(
+        &mut self,
+        truth: &VehicleState,
+        measured_flow_mps: Option<Vec2>,
+        t_s: f64,
+        dt_s: f64,
+        rng: &mut SimRng,
+    ) -> Option<FixEvent> {
+        let p = self.params;
+        let nh: f64 = StandardNormal.sample(rng);
+        self.heading = truth.heading.turned_deg(p.heading_sd_deg * nh);
+        let flow = measured_flow_mps
+            .filter(|f| f.x.is_finite() && f.y.is_finite())
+            .unwrap_or_else(Vec2::zeros);
+        // Trapezoidal integration of the measured water-relative velocity, as the vehicle moves:
+        // without noise the estimate then follows the truth exactly.
+        let water = self.heading.unit() * truth.speed_mps;
+        let v = (water + self.last_water_velocity) * 0.5 + flow + self.velocity_error_mps;
+        self.last_water_velocity = water;
+        self.estimate_m += v * dt_s;
+        let (ex, ey): (f64, f64) = (StandardNormal.sample(rng), StandardNormal.sample(rng));
+        let kick = p.velocity_drift_mps_per_sqrt_s * dt_s.sqrt();
+        let cap = p.velocity_error_max_mps;
+        self.velocity_error_mps = Vec2::new(
+            (self.velocity_error_mps.x + kick * ex).clamp(-cap, cap),
+            (self.velocity_error_mps.y + kick * ey).clamp(-cap, cap),
+        );
+        if t_s + 1e-9 >= self.next_fix_s {
+            while self.next_fix_s <= t_s + 1e-9 {
+                self.next_fix_s += p.fix_interval_s;
+            }
+            let (fx, fy): (f64, f64) = (StandardNormal.sample(rng), StandardNormal.sample(rng));
+            let before = self.estimate_m;
+            self.estimate_m = truth.pos_m + Vec2::new(fx, fy) * p.fix_sigma_m;
+            self.last_fix_s = Some(t_s);
+            return Some(FixEvent {
+                time_s: t_s,
+                before_m: before,
+                after_m: self.estimate_m,
+            });
+        }
+        None
+    }
+
+    /// Forces a fix now with a given error (tests and scripted scenarios: "a fix that jumps").
+    pub fn force_fix(&mut self, t_s: f64, fix_m: Vec2) -> FixEvent {
+        let before = self.estimate_m;
+        self.estimate_m = fix_m;
+        self.last_fix_s = Some(t_s);
+        FixEvent {
+            time_s: t_s,
+            before_m: before,
+            after_m: fix_m,
+        }
+    }
+
+    /// What the onboard side sees.
+    pub fn estimate(&self, truth: &VehicleState) -> NavEstimate {
+        NavEstimate {
+            pos_m: self.estimate_m,
+            heading: self.heading,
+            speed_mps: truth.speed_mps,
+            altitude_m: truth.z_m,
+            last_fix_s: self.last_fix_s,
+        }
+    }
+}

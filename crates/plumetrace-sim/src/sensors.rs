@@ -1,0 +1,368 @@
+//! Sensors: chemical, flow and obstacle range.
+
+use plumetrace_core::{ChemSample, FlowSample, Heading, RangeReturn, Vec2};
+use plumetrace_env::error::{require_non_negative, require_positive};
+use plumetrace_env::{EnvError, ObstacleSet, SimRng};
+use rand_distr::{Distribution, StandardNormal};
+use serde::{Deserialize, Serialize};
+
+/// A periodic sampling schedule: samples at `k / rate` seconds.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Schedule {
+    period_s: f64,
+    next_k: u64,
+}
+
+impl Schedule {
+    fn new(rate_hz: f64) -> Self {
+        Schedule {
+            period_s: 1.0 / rate_hz,
+            next_k: 0,
+        }
+    }
+
+    /// Whether a sample is due at `t_s` (at most one per call; missed samples are skipped).
+    fn due(&mut self, t_s: f64) -> bool {
+        let next = self.next_k as f64 * self.period_s;
+        if t_s + 1e-9 < next {
+            return false;
+        }
+        self.next_k = ((t_s + 1e-9) / self.period_s).floor() as u64 + 1;
+        true
+    }
+}
+
+/// Parameters of the chemical sensor. Defaults: the field sensor, 10 Hz, 5 V full scale, 0.2 V
+/// (4 %) detection threshold.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct ChemSensorParams {
+    /// Sampling rate, Hz.
+    pub rate_hz: f64,
+    /// Volts per unit of concentration.
+    pub volts_per_unit: f64,
+    /// Full scale, V (readings saturate there).
+    pub full_scale_v: f64,
+    /// Reading noise (standard deviation), V.
+    pub noise_sd_v: f64,
+    /// First-order lag of the sensor, s (0 = none).
+    pub lag_time_constant_s: f64,
+    /// Detection threshold, V.
+    pub threshold_v: f64,
+}
+
+impl Default for ChemSensorParams {
+    fn default() -> Self {
+        ChemSensorParams {
+            rate_hz: 10.0,
+            volts_per_unit: 1.0,
+            full_scale_v: 5.0,
+            noise_sd_v: 0.02,
+            lag_time_constant_s: 0.0,
+            threshold_v: 0.2,
+        }
+    }
+}
+
+impl ChemSensorParams {
+    /// Checks every parameter; `key` prefixes the names in errors.
+    pub fn validate(&self, key: &str) -> Result<(), EnvError> {
+        require_positive(&format!("{key}.rate_hz"), self.rate_hz)?;
+        require_positive(&format!("{key}.volts_per_unit"), self.volts_per_unit)?;
+        require_positive(&format!("{key}.full_scale_v"), self.full_scale_v)?;
+        require_non_negative(&format!("{key}.noise_sd_v"), self.noise_sd_v)?;
+        require_non_negative(
+            &format!("{key}.lag_time_constant_s"),
+            self.lag_time_constant_s,
+        )?;
+        require_non_negative(&format!("{key}.threshold_v"), self.threshold_v)
+    }
+}
+
+/// The chemical sensor: an analog reading and a threshold detection.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ChemSensor {
+    params: ChemSensorParams,
+    schedule: Schedule,
+    lagged_v: f64,
+    last_t_s: Option<f64>,
+}
+
+impl ChemSensor {
+    /// A sensor whose first sample is at t = 0.
+    pub fn new(params: ChemSensorParams) -> Self {
+        ChemSensor {
+            params,
+            schedule: Schedule::new(params.rate_hz),
+            lagged_v: 0.0,
+            last_t_s: None,
+        }
+    }
+
+    /// The parameters.
+    pub fn params(&self) -> &ChemSensorParams {
+        &self.params
+    }
+
+    /// Whether a sample is due at `t_s`; if so the caller must call [`ChemSensor::sample`].
+    pub fn due(&mut self, t_s: f64) -> bool {
+        self.schedule.due(t_s)
+    }
+
+    /// A sample of `concentration` (taken at the sensor's true position) at `t_s`.
+    pub fn sample(&mut self, concentration: f64, t_s: f64, rng: &mut SimRng) -> ChemSample {
+        let p = self.params;
+        let raw = p.volts_per_unit * concentration.max(0.0);
+        self.lagged_v = match (self.last_t_s, p.lag_time_constant_s > 0.0) {
+            (Some(t0), true) => {
+                self.lagged_v
+                    + (raw - self.lagged_v)
+                        * (1.0 - (-(t_s - t0).max(0.0) / p.lag_time_constant_s).exp())
+            }
+            _ => raw,
+        };
+        self.last_t_s = Some(t_s);
+        let n: f64 = StandardNormal.sample(rng);
+        let reading = (self.lagged_v + p.noise_sd_v * n).clamp(0.0, p.full_scale_v);
+        let reading = if reading.is_finite() { reading } else { 0.0 };
+        ChemSample {
+            time_s: t_s,
+            reading,
+            detection: reading > p.threshold_v,
+        }
+    }
+}
+
+/// A window during which the flow sensor measures the wrong layer (the reading is reversed).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct FlowFault {
+    /// Start, s.
+    pub start_s: f64,
+    /// End, s.
+    pub end_s: f64,
+}
+
+/// Parameters of the flow sensor (ADCP-like).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct FlowSensorParams {
+    /// Sampling rate, Hz.
+    pub rate_hz: f64,
+    /// Noise per axis (standard deviation), m/s.
+    pub noise_sd_mps: f64,
+    /// Constant bias `(east, north)`, m/s.
+    pub bias_mps: [f64; 2],
+    /// Wrong-layer fault window, if any.
+    pub fault: Option<FlowFault>,
+}
+
+impl Default for FlowSensorParams {
+    fn default() -> Self {
+        FlowSensorParams {
+            rate_hz: 1.0,
+            noise_sd_mps: 0.02,
+            bias_mps: [0.0, 0.0],
+            fault: None,
+        }
+    }
+}
+
+impl FlowSensorParams {
+    /// Checks every parameter; `key` prefixes the names in errors.
+    pub fn validate(&self, key: &str) -> Result<(), EnvError> {
+        require_positive(&format!("{key}.rate_hz"), self.rate_hz)?;
+        require_non_negative(&format!("{key}.noise_sd_mps"), self.noise_sd_mps)?;
+        if !(self.bias_mps[0].is_finite() && self.bias_mps[1].is_finite()) {
+            return Err(EnvError::invalid(
+                format!("{key}.bias_mps"),
+                "must be finite",
+            ));
+        }
+        if let Some(f) = self.fault
+            && !(f.start_s.is_finite() && f.end_s.is_finite() && f.end_s >= f.start_s)
+        {
+            return Err(EnvError::invalid(
+                format!("{key}.fault"),
+                "needs finite start_s <= end_s",
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// The flow sensor.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FlowSensor {
+    params: FlowSensorParams,
+    schedule: Schedule,
+}
+
+impl FlowSensor {
+    /// A sensor whose first sample is at t = 0.
+    pub fn new(params: FlowSensorParams) -> Self {
+        FlowSensor {
+            params,
+            schedule: Schedule::new(params.rate_hz),
+        }
+    }
+
+    /// Whether a sample is due at `t_s`.
+    pub fn due(&mut self, t_s: f64) -> bool {
+        self.schedule.due(t_s)
+    }
+
+    /// A measurement of the true local flow at `t_s`.
+    pub fn sample(&self, true_flow_mps: Vec2, t_s: f64, rng: &mut SimRng) -> FlowSample {
+        let p = self.params;
+        let (nx, ny): (f64, f64) = (StandardNormal.sample(rng), StandardNormal.sample(rng));
+        let faulty = p.fault.is_some_and(|f| t_s >= f.start_s && t_s < f.end_s);
+        let base = if faulty {
+            -true_flow_mps
+        } else {
+            true_flow_mps + Vec2::new(p.bias_mps[0], p.bias_mps[1])
+        };
+        FlowSample {
+            time_s: t_s,
+            velocity_mps: base + Vec2::new(nx, ny) * p.noise_sd_mps,
+        }
+    }
+}
+
+/// Parameters of the obstacle range sensors: three groups of rays (front, left, right).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct RangeSensorParams {
+    /// Detection range `R`, m.
+    pub max_range_m: f64,
+    /// Rays per group.
+    pub rays_per_group: usize,
+    /// The front group covers +-this angle about the heading, deg (30).
+    pub front_half_angle_deg: f64,
+    /// The side groups reach this far from the heading, deg (90).
+    pub side_outer_angle_deg: f64,
+}
+
+impl Default for RangeSensorParams {
+    fn default() -> Self {
+        RangeSensorParams {
+            max_range_m: 20.0,
+            rays_per_group: 7,
+            front_half_angle_deg: 30.0,
+            side_outer_angle_deg: 90.0,
+        }
+    }
+}
+
+/// The obstacle range sensors: the nearest obstacle distance in each group (seed 001, eq. 8).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RangeSensor {
+    /// Parameters.
+    pub params: RangeSensorParams,
+}
+
+impl RangeSensor {
+    /// Casts every ray from `pos_m` with the vehicle on `heading`.
+    pub fn sample(&self, obstacles: &ObstacleSet, pos_m: Vec2, heading: Heading) -> RangeReturn {
+        let p = self.params;
+        let n = p.rays_per_group.max(1);
+        let spread = |from: f64, to: f64| -> Vec<f64> {
+            if n == 1 {
+                return vec![0.5 * (from + to)];
+            }
+            (0..n)
+                .map(|k| from + (to - from) * k as f64 / (n - 1) as f64)
+                .collect()
+        };
+        let nearest = |angles: Vec<f64>| -> Option<f64> {
+            angles
+                .into_iter()
+                .filter_map(|a| obstacles.ray_range_m(pos_m, heading.turned_deg(a), p.max_range_m))
+                .min_by(f64::total_cmp)
+        };
+        let (f, s) = (p.front_half_angle_deg, p.side_outer_angle_deg);
+        RangeReturn {
+            front_m: nearest(spread(-f, f)),
+            left_m: nearest(spread(-s, -f)),
+            right_m: nearest(spread(f, s)),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use plumetrace_env::{SoftObstacle, StreamId, stream_rng};
+
+    #[test]
+    fn schedule_samples_at_the_rate() {
+        let mut s = ChemSensor::new(ChemSensorParams::default());
+        let due = (0..1000).filter(|k| s.due(f64::from(*k) * 0.01)).count();
+        assert_eq!(due, 100, "10 Hz over 10 s of 100 Hz steps");
+    }
+
+    #[test]
+    fn readings_saturate_and_lag() {
+        let mut rng = stream_rng(1, StreamId::Sensor(0, 0));
+        let mut s = ChemSensor::new(ChemSensorParams {
+            noise_sd_v: 0.0,
+            ..ChemSensorParams::default()
+        });
+        assert_eq!(s.sample(100.0, 0.0, &mut rng).reading, 5.0);
+        let mut lag = ChemSensor::new(ChemSensorParams {
+            noise_sd_v: 0.0,
+            lag_time_constant_s: 1.0,
+            ..ChemSensorParams::default()
+        });
+        lag.sample(0.0, 0.0, &mut rng);
+        let r = lag.sample(1.0, 1.0, &mut rng).reading;
+        assert!((r - (1.0 - (-1.0f64).exp())).abs() < 1e-12, "{r}");
+    }
+
+    #[test]
+    fn flow_fault_reverses_the_reading_in_its_window() {
+        let mut rng = stream_rng(1, StreamId::Sensor(0, 1));
+        let s = FlowSensor::new(FlowSensorParams {
+            noise_sd_mps: 0.0,
+            fault: Some(FlowFault {
+                start_s: 10.0,
+                end_s: 20.0,
+            }),
+            ..FlowSensorParams::default()
+        });
+        let f = Vec2::new(0.1, 0.2);
+        assert_eq!(s.sample(f, 5.0, &mut rng).velocity_mps, f);
+        assert_eq!(s.sample(f, 15.0, &mut rng).velocity_mps, -f);
+        assert_eq!(s.sample(f, 20.0, &mut rng).velocity_mps, f);
+        let biased = FlowSensor::new(FlowSensorParams {
+            noise_sd_mps: 0.0,
+            bias_mps: [0.05, 0.0],
+            ..FlowSensorParams::default()
+        });
+        assert!(
+            (biased.sample(f, 0.0, &mut rng).velocity_mps - Vec2::new(0.15, 0.2)).norm() < 1e-12
+        );
+    }
+
+    #[test]
+    fn range_groups_see_their_sides() {
+        // A wall 10 m East, running North-South; vehicle heading North at the origin.
+        let wall = SoftObstacle::new(
+            "wall",
+            &[[10.0, -50.0], [12.0, -50.0], [12.0, 50.0], [10.0, 50.0]],
+            "obstacles[0]",
+        )
+        .unwrap();
+        let obstacles = ObstacleSet::new(vec![wall]);
+        let r = RangeSensor {
+            params: RangeSensorParams::default(),
+        };
+        let north = r.sample(&obstacles, Vec2::zeros(), Heading::NORTH);
+        assert_eq!(north.left_m, None);
+        assert!((north.right_m.unwrap() - 10.0).abs() < 1e-9, "{north:?}");
+        assert!(
+            north.front_m.is_none(),
+            "30 deg off the heading the wall is 20 m away: out of range"
+        );
+        let east = r.sample(&obstacles, Vec2::zeros(), Heading::from_deg(90.0));
+        assert!((east.front_m.unwrap() - 10.0).abs() < 1e-9);
+        let south = r.sample(&obstacles, Vec2::zeros(), Heading::from_deg(180.0));
+        assert!((south.left_m.unwrap() - 10.0).abs() < 1e-9 && south.right_m.is_none());
+    }
+}

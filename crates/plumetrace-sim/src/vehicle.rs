@@ -1,0 +1,329 @@
+//! Vehicle dynamics: AUVs and surface craft driven by heading, speed and vertical commands.
+
+use plumetrace_core::{Command, Heading, Vec2, VehicleId, VehicleKind, VerticalCommand};
+use plumetrace_env::error::{require_non_negative, require_positive};
+use plumetrace_env::{EnvError, SimRng};
+use rand_distr::{Distribution, StandardNormal};
+use serde::{Deserialize, Serialize};
+
+/// Limits and responses of a vehicle. Defaults are the REMUS field values for an AUV.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct VehicleParams {
+    /// AUV or surface craft.
+    pub kind: VehicleKind,
+    /// Highest water-relative speed, m/s (2 for the field AUV).
+    pub max_speed_mps: f64,
+    /// Highest turn rate, deg/s (10 for the field AUV).
+    pub max_turn_rate_deg_s: f64,
+    /// Time constant of the speed response, s.
+    pub speed_time_constant_s: f64,
+    /// Time constant of the depth/altitude response, s.
+    pub vertical_time_constant_s: f64,
+    /// Standard deviation of the altitude-keeping error, m (the field saw about +-0.7 m).
+    pub altitude_error_sd_m: f64,
+    /// Correlation time of the altitude-keeping error, s.
+    pub altitude_error_time_s: f64,
+}
+
+impl VehicleParams {
+    /// The field AUV: 2 m/s, 10 deg/s, altitude error sd 0.35 m (+-0.7 m at two sd).
+    pub fn auv() -> Self {
+        VehicleParams {
+            kind: VehicleKind::Auv,
+            max_speed_mps: 2.0,
+            max_turn_rate_deg_s: 10.0,
+            speed_time_constant_s: 2.0,
+            vertical_time_constant_s: 5.0,
+            altitude_error_sd_m: 0.35,
+            altitude_error_time_s: 60.0,
+        }
+    }
+
+    /// A small surface craft: 1.5 m/s, 20 deg/s, stays at the surface.
+    pub fn surface() -> Self {
+        VehicleParams {
+            kind: VehicleKind::Surface,
+            max_speed_mps: 1.5,
+            max_turn_rate_deg_s: 20.0,
+            speed_time_constant_s: 2.0,
+            vertical_time_constant_s: 1.0,
+            altitude_error_sd_m: 0.0,
+            altitude_error_time_s: 1.0,
+        }
+    }
+
+    /// Checks every parameter; `key` prefixes the names in errors (e.g. `vehicles[0]`).
+    pub fn validate(&self, key: &str) -> Result<(), EnvError> {
+        require_positive(&format!("{key}.max_speed_mps"), self.max_speed_mps)?;
+        require_positive(
+            &format!("{key}.max_turn_rate_deg_s"),
+            self.max_turn_rate_deg_s,
+        )?;
+        require_positive(
+            &format!("{key}.speed_time_constant_s"),
+            self.speed_time_constant_s,
+        )?;
+        require_positive(
+            &format!("{key}.vertical_time_constant_s"),
+            self.vertical_time_constant_s,
+        )?;
+        require_non_negative(
+            &format!("{key}.altitude_error_sd_m"),
+            self.altitude_error_sd_m,
+        )?;
+        require_positive(
+            &format!("{key}.altitude_error_time_s"),
+            self.altitude_error_time_s,
+        )
+    }
+}
+
+/// The true state of a vehicle.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct VehicleState {
+    /// Position `(east, north)`, m.
+    pub pos_m: Vec2,
+    /// Height above the seabed, m.
+    pub z_m: f64,
+    /// Compass heading.
+    pub heading: Heading,
+    /// Water-relative speed, m/s.
+    pub speed_mps: f64,
+    /// Current altitude-keeping error, m.
+    pub altitude_error_m: f64,
+}
+
+/// A vehicle: its identity, limits and true state.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Vehicle {
+    /// Identity in its world.
+    pub id: VehicleId,
+    /// Limits and responses.
+    pub params: VehicleParams,
+    /// The truth.
+    pub state: VehicleState,
+}
+
+impl Vehicle {
+    /// A vehicle at rest.
+    pub fn new(
+        id: VehicleId,
+        params: VehicleParams,
+        pos_m: Vec2,
+        z_m: f64,
+        heading: Heading,
+    ) -> Self {
+        Vehicle {
+            id,
+            params,
+            state: VehicleState {
+                pos_m,
+                z_m,
+                heading,
+                speed_mps: 0.0,
+                altitude_error_m: 0.0,
+            },
+        }
+    }
+
+    /// Ground velocity: water-relative velocity plus the current, m/s.
+    pub fn ground_velocity(&self, flow_mps: Vec2) -> Vec2 {
+        self.state.heading.unit() * self.state.speed_mps + flow_mps
+    }
+
+    /// Advances the vehicle by `dt_s` under `command` in a current `flow_mps`.
+    ///
+    /// `water_depth_m` converts depth and surface commands to heights above the seabed; without
+    /// it they hold the present height. Non-finite commands are ignored (the vehicle keeps its
+    /// heading and speed): the check is here, at the boundary between planner and vehicle.
+    pub fn step(
+        &mut self,
+        command: &Command,
+        flow_mps: Vec2,
+        water_depth_m: Option<f64>,
+        dt_s: f64,
+        rng: &mut SimRng,
+    ) {
+        let p = self.params;
+        let s = &mut self.state;
+        let (cmd_heading, cmd_speed) = if command.is_finite() {
+            (command.heading, command.speed_mps)
+        } else {
+            (s.heading, s.speed_mps)
+        };
+        let max_turn = p.max_turn_rate_deg_s * dt_s;
+        let turn = cmd_heading.diff_deg(s.heading).clamp(-max_turn, max_turn);
+        let old_heading = s.heading;
+        s.heading = s.heading.turned_deg(turn);
+        let target_speed = cmd_speed.clamp(0.0, p.max_speed_mps);
+        let old_speed = s.speed_mps;
+        s.speed_mps +=
+            (target_speed - s.speed_mps) * (1.0 - (-dt_s / p.speed_time_constant_s).exp());
+        // Trapezoidal step of the water-relative velocity, plus the current.
+        let water = (old_heading.unit() * old_speed + s.heading.unit() * s.speed_mps) * 0.5;
+        s.pos_m += (water + flow_mps) * dt_s;
+
+        let a = (-dt_s / p.altitude_error_time_s).exp();
+        let n: f64 = StandardNormal.sample(rng);
+        s.altitude_error_m =
+            s.altitude_error_m * a + p.altitude_error_sd_m * (1.0 - a * a).sqrt() * n;
+        let target_z = match (p.kind, command.vertical, water_depth_m) {
+            (VehicleKind::Surface, _, Some(d)) | (_, VerticalCommand::Surface, Some(d)) => d,
+            (VehicleKind::Surface, _, None) | (_, VerticalCommand::Surface, None) => s.z_m,
+            (VehicleKind::Auv, VerticalCommand::Altitude(alt), _) if alt.is_finite() => {
+                alt + s.altitude_error_m
+            }
+            (VehicleKind::Auv, VerticalCommand::Depth(dep), Some(d)) if dep.is_finite() => {
+                d - dep + s.altitude_error_m
+            }
+            _ => s.z_m,
+        };
+        let target_z = match water_depth_m {
+            Some(d) => target_z.clamp(0.0, d),
+            None => target_z.max(0.0),
+        };
+        s.z_m += (target_z - s.z_m) * (1.0 - (-dt_s / p.vertical_time_constant_s).exp());
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use plumetrace_env::{StreamId, stream_rng};
+
+    fn cmd(h: f64, v: f64, alt: f64) -> Command {
+        Command {
+            heading: Heading::from_deg(h),
+            speed_mps: v,
+            vertical: VerticalCommand::Altitude(alt),
+        }
+    }
+
+    #[test]
+    fn turn_rate_and_speed_are_limited() {
+        let mut v = Vehicle::new(
+            VehicleId(0),
+            VehicleParams::auv(),
+            Vec2::zeros(),
+            2.0,
+            Heading::NORTH,
+        );
+        let mut rng = stream_rng(1, StreamId::Vehicle(0));
+        v.step(&cmd(90.0, 5.0, 2.0), Vec2::zeros(), None, 1.0, &mut rng);
+        assert!(
+            (v.state.heading.deg() - 10.0).abs() < 1e-9,
+            "{}",
+            v.state.heading.deg()
+        );
+        for _ in 0..60 {
+            v.step(&cmd(90.0, 5.0, 2.0), Vec2::zeros(), None, 1.0, &mut rng);
+        }
+        assert!((v.state.heading.deg() - 90.0).abs() < 1e-9);
+        assert!(
+            v.state.speed_mps <= 2.0 && v.state.speed_mps > 1.99,
+            "{}",
+            v.state.speed_mps
+        );
+    }
+
+    #[test]
+    fn drifts_with_the_current() {
+        let mut v = Vehicle::new(
+            VehicleId(0),
+            VehicleParams::auv(),
+            Vec2::zeros(),
+            2.0,
+            Heading::NORTH,
+        );
+        let mut rng = stream_rng(1, StreamId::Vehicle(0));
+        for _ in 0..100 {
+            v.step(
+                &cmd(0.0, 0.0, 2.0),
+                Vec2::new(0.3, 0.0),
+                None,
+                0.1,
+                &mut rng,
+            );
+        }
+        assert!(
+            (v.state.pos_m - Vec2::new(3.0, 0.0)).norm() < 1e-9,
+            "{:?}",
+            v.state.pos_m
+        );
+    }
+
+    #[test]
+    fn altitude_is_held_with_a_bounded_error() {
+        let mut v = Vehicle::new(
+            VehicleId(0),
+            VehicleParams::auv(),
+            Vec2::zeros(),
+            10.0,
+            Heading::NORTH,
+        );
+        let mut rng = stream_rng(2, StreamId::Vehicle(0));
+        let mut dev = Vec::new();
+        for k in 0..36_000 {
+            v.step(
+                &cmd(0.0, 2.0, 2.0),
+                Vec2::zeros(),
+                Some(20.0),
+                0.1,
+                &mut rng,
+            );
+            if k > 600 {
+                dev.push(v.state.z_m - 2.0);
+            }
+        }
+        let sd = (dev.iter().map(|d| d * d).sum::<f64>() / dev.len() as f64).sqrt();
+        assert!(sd > 0.2 && sd < 0.5, "altitude error sd {sd}");
+        assert!(dev.iter().all(|d| d.abs() < 2.0));
+    }
+
+    #[test]
+    fn non_finite_commands_are_ignored() {
+        let mut v = Vehicle::new(
+            VehicleId(0),
+            VehicleParams::auv(),
+            Vec2::zeros(),
+            2.0,
+            Heading::from_deg(30.0),
+        );
+        let mut rng = stream_rng(1, StreamId::Vehicle(0));
+        v.step(
+            &cmd(90.0, f64::NAN, 2.0),
+            Vec2::zeros(),
+            None,
+            1.0,
+            &mut rng,
+        );
+        assert!((v.state.heading.deg() - 30.0).abs() < 1e-9 && v.state.pos_m.x.is_finite());
+    }
+
+    #[test]
+    fn surface_craft_stay_at_the_surface() {
+        let mut v = Vehicle::new(
+            VehicleId(1),
+            VehicleParams::surface(),
+            Vec2::zeros(),
+            4.0,
+            Heading::NORTH,
+        );
+        let mut rng = stream_rng(1, StreamId::Vehicle(1));
+        for _ in 0..100 {
+            v.step(&cmd(0.0, 1.0, 1.0), Vec2::zeros(), Some(4.0), 0.1, &mut rng);
+        }
+        assert!((v.state.z_m - 4.0).abs() < 1e-12);
+        assert!(VehicleParams::auv().validate("vehicles[0]").is_ok());
+        let bad = VehicleParams {
+            max_speed_mps: -1.0,
+            ..VehicleParams::auv()
+        };
+        assert!(
+            bad.validate("vehicles[0]")
+                .unwrap_err()
+                .to_string()
+                .starts_with("vehicles[0].max_speed_mps")
+        );
+    }
+}

@@ -1,0 +1,108 @@
+//! Statistical tests of the chemical detector and the navigation estimate.
+
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
+use plumetrace_core::{Command, Heading, Vec2, VehicleId, VerticalCommand};
+use plumetrace_env::{StreamId, stream_rng};
+use plumetrace_sim::{ChemSensor, ChemSensorParams, NavParams, Navigator, Vehicle, VehicleParams};
+
+/// Standard normal CDF (Abramowitz and Stegun 7.1.26, error below 1.5e-7).
+fn phi(x: f64) -> f64 {
+    let z = x.abs() / std::f64::consts::SQRT_2;
+    let t = 1.0 / (1.0 + 0.327_591_1 * z);
+    let poly = t
+        * (0.254_829_592
+            + t * (-0.284_496_736
+                + t * (1.421_413_741 + t * (-1.453_152_027 + t * 1.061_405_429))));
+    let erfc = poly * (-z * z).exp();
+    if x >= 0.0 {
+        1.0 - 0.5 * erfc
+    } else {
+        0.5 * erfc
+    }
+}
+
+#[test]
+fn detection_rate_matches_the_threshold_on_known_concentrations() {
+    // Threshold 0.2 V, noise 0.05 V, 1 V per unit: P(detect) = 1 - Phi((0.2 - c) / 0.05).
+    let params = ChemSensorParams {
+        noise_sd_v: 0.05,
+        ..ChemSensorParams::default()
+    };
+    let mut rng = stream_rng(3, StreamId::Sensor(0, 0));
+    for c in [0.0, 0.1, 0.15, 0.2, 0.25, 0.3, 1.0] {
+        let mut s = ChemSensor::new(params);
+        let n = 40_000;
+        let hits = (0..n)
+            .filter(|k| s.sample(c, f64::from(*k) * 0.1, &mut rng).detection)
+            .count();
+        let rate = hits as f64 / f64::from(n);
+        let want = 1.0 - phi((0.2 - c) / 0.05);
+        assert!(
+            (rate - want).abs() < 0.01,
+            "c = {c}: detection rate {rate:.4}, expected {want:.4}"
+        );
+    }
+}
+
+#[test]
+fn navigation_error_grows_between_fixes_and_jumps_back_at_each() {
+    let params = NavParams {
+        fix_interval_s: 200.0,
+        fix_sigma_m: 0.5,
+        velocity_drift_mps_per_sqrt_s: 0.002,
+        velocity_error_max_mps: 0.1,
+        heading_sd_deg: 0.5,
+    };
+    let mut v = Vehicle::new(
+        VehicleId(0),
+        VehicleParams::auv(),
+        Vec2::zeros(),
+        2.0,
+        Heading::from_deg(45.0),
+    );
+    let mut nav = Navigator::new(params, &v.state);
+    let mut rng = stream_rng(4, StreamId::Vehicle(0));
+    let mut nav_rng = stream_rng(4, StreamId::Sensor(0, 9));
+    let cmd = Command {
+        heading: Heading::from_deg(45.0),
+        speed_mps: 2.0,
+        vertical: VerticalCommand::Altitude(2.0),
+    };
+    let dt = 0.1;
+    let mut fixes = Vec::new();
+    let mut error_before_fix = Vec::new();
+    let mut error_after_fix = Vec::new();
+    let mut error_mid = Vec::new();
+    for k in 1..=20_000u32 {
+        let t = f64::from(k) * dt;
+        v.step(&cmd, Vec2::new(0.1, 0.0), None, dt, &mut rng);
+        let before = (nav.estimate_m() - v.state.pos_m).norm();
+        // Measured flow without bias: the error comes from the drifting dead-reckoning velocity.
+        if let Some(fix) = nav.update(&v.state, Some(Vec2::new(0.1, 0.0)), t, dt, &mut nav_rng) {
+            fixes.push(fix);
+            error_before_fix.push(before);
+            error_after_fix.push((nav.estimate_m() - v.state.pos_m).norm());
+        }
+        if (t % 200.0 - 100.0).abs() < dt / 2.0 {
+            error_mid.push((nav.estimate_m() - v.state.pos_m).norm());
+        }
+    }
+    assert_eq!(fixes.len(), 10, "fixes at 200, 400, ..., 2000 s");
+    let mean = |v: &[f64]| v.iter().sum::<f64>() / v.len() as f64;
+    let (b, m, a) = (
+        mean(&error_before_fix),
+        mean(&error_mid),
+        mean(&error_after_fix),
+    );
+    eprintln!("navigation error: mid-interval {m:.2} m, before fix {b:.2} m, after fix {a:.2} m");
+    assert!(
+        b > m && m > a,
+        "error should grow between fixes and drop at them: {a} {m} {b}"
+    );
+    assert!(
+        b > 3.0 * a,
+        "fixes should pull the estimate back: before {b}, after {a}"
+    );
+    assert!(fixes.iter().all(|f| (f.jump_m() - 0.0).abs() > 0.0));
+}
