@@ -32,7 +32,7 @@ const RULES: &[(&str, Side, &[&str])] = &[
     (
         "plumetrace-scenario",
         Side::Simulator,
-        &["plumetrace-core", "plumetrace-env"],
+        &["plumetrace-core", "plumetrace-env", "plumetrace-sim"],
     ),
     (
         "plumetrace-cli",
