@@ -9,6 +9,7 @@
 //! [`FlowField`] trait with its four models, and [`ConcentrationField`], answered by the filament
 //! plume, the steady plume and gridded fields alike.
 
+mod csv_grid;
 pub mod domain;
 pub mod environment;
 pub mod error;

@@ -17,6 +17,7 @@
 //! source the field is zero; closer than `min_downstream_m` it is evaluated at that distance to
 //! avoid the point-source singularity.
 
+use crate::csv_grid::{read_columns, regular_axis};
 use crate::error::{EnvError, require_finite, require_non_negative, require_positive};
 use crate::field::ConcentrationField;
 use plumetrace_core::{Heading, Vec2, Vec3};
@@ -183,66 +184,23 @@ impl GriddedConcentration {
             path: path.to_path_buf(),
             message,
         };
-        let mut reader = csv::ReaderBuilder::new()
-            .trim(csv::Trim::All)
-            .from_path(path)
-            .map_err(|e| file_err(e.to_string()))?;
-        let headers = reader
-            .headers()
-            .map_err(|e| file_err(e.to_string()))?
-            .clone();
-        let col = |name: &str| headers.iter().position(|h| h == name);
-        let (Some(cx), Some(cy), Some(cc)) = (col("x_m"), col("y_m"), col("concentration")) else {
-            return Err(file_err(
-                "header must name x_m, y_m, concentration (and optionally z_m)".into(),
-            ));
-        };
-        let cz = col("z_m");
-        let mut rows: Vec<[f64; 4]> = Vec::new();
-        for (k, rec) in reader.records().enumerate() {
-            let line = k + 2;
-            let rec = rec.map_err(|e| file_err(format!("line {line}: {e}")))?;
-            let get = |c: usize, name: &str| -> Result<f64, EnvError> {
-                let s = rec.get(c).unwrap_or("");
-                match s.parse::<f64>() {
-                    Ok(v) if v.is_finite() => Ok(v),
-                    _ => Err(file_err(format!(
-                        "line {line}: {name} = {s:?} is not a finite number"
-                    ))),
-                }
-            };
-            let z = match cz {
-                Some(c) => get(c, "z_m")?,
-                None => 0.0,
-            };
-            let c = get(cc, "concentration")?;
-            if c < 0.0 {
+        let (table, present) = read_columns(path, &["x_m", "y_m", "concentration"], &["z_m"])?;
+        let has_z = present[0];
+        let mut rows: Vec<[f64; 4]> = Vec::with_capacity(table.len());
+        for (k, r) in table.iter().enumerate() {
+            if r[2] < 0.0 {
                 return Err(file_err(format!(
-                    "line {line}: concentration {c} is negative"
+                    "line {}: concentration {} is negative",
+                    k + 2,
+                    r[2]
                 )));
             }
-            rows.push([get(cx, "x_m")?, get(cy, "y_m")?, z, c]);
+            rows.push([r[0], r[1], if has_z { r[3] } else { 0.0 }, r[2]]);
         }
-        let dims = if cz.is_some() { 3 } else { 2 };
+        let dims = if has_z { 3 } else { 2 };
         let mut axes = Vec::new();
-        for d in 0..dims {
-            let mut v: Vec<f64> = rows.iter().map(|r| r[d]).collect();
-            v.sort_by(f64::total_cmp);
-            v.dedup();
-            let name = ["x_m", "y_m", "z_m"][d];
-            if v.len() < 2 {
-                return Err(file_err(format!(
-                    "column {name} needs at least 2 distinct values"
-                )));
-            }
-            let step = (v[v.len() - 1] - v[0]) / (v.len() - 1) as f64;
-            if v.iter()
-                .enumerate()
-                .any(|(k, w)| (w - (v[0] + k as f64 * step)).abs() > 1e-6 * step.max(1.0))
-            {
-                return Err(file_err(format!("column {name} is not evenly spaced")));
-            }
-            axes.push((v[0], step, v.len()));
+        for (d, name) in ["x_m", "y_m", "z_m"].iter().enumerate().take(dims) {
+            axes.push(regular_axis(rows.iter().map(|r| r[d]), name, path)?);
         }
         let total: usize = axes.iter().map(|a| a.2).product();
         let mut values = vec![f64::NAN; total];

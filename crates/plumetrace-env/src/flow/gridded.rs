@@ -8,6 +8,7 @@
 //! behind [`GriddedFlow::from_csv`] so that other formats (NetCDF) can produce the same grid.
 
 use super::{FlowField, axis_weight};
+use crate::csv_grid::{read_columns, regular_axis};
 use crate::{EnvError, SimRng};
 use plumetrace_core::Vec2;
 use std::collections::BTreeMap;
@@ -37,33 +38,6 @@ pub struct GriddedFlow {
     blend: f64,
 }
 
-/// Distinct values of a coordinate, checked to be evenly spaced.
-fn regular_axis(values: &[f64], name: &str, path: &Path) -> Result<(f64, f64, usize), EnvError> {
-    let mut v: Vec<f64> = values.to_vec();
-    v.sort_by(f64::total_cmp);
-    v.dedup_by(|a, b| (*a - *b).abs() <= 1e-9 * (1.0 + b.abs()));
-    let file_err = |message: String| EnvError::File {
-        path: path.to_path_buf(),
-        message,
-    };
-    if v.len() < 2 {
-        return Err(file_err(format!(
-            "column {name} needs at least 2 distinct values, found {}",
-            v.len()
-        )));
-    }
-    let step = (v[v.len() - 1] - v[0]) / (v.len() - 1) as f64;
-    for (k, w) in v.iter().enumerate() {
-        let expect = v[0] + k as f64 * step;
-        if (w - expect).abs() > 1e-6 * step.abs().max(1.0) {
-            return Err(file_err(format!(
-                "column {name} is not evenly spaced: value {w} where {expect} was expected"
-            )));
-        }
-    }
-    Ok((v[0], step, v.len()))
-}
-
 impl GriddedFlow {
     /// Reads a gridded flow from a CSV file (see the module docs for the format).
     pub fn from_csv(path: &Path) -> Result<Self, EnvError> {
@@ -71,58 +45,22 @@ impl GriddedFlow {
             path: path.to_path_buf(),
             message,
         };
-        let mut reader = csv::ReaderBuilder::new()
-            .trim(csv::Trim::All)
-            .from_path(path)
-            .map_err(|e| file_err(e.to_string()))?;
-        let headers = reader
-            .headers()
-            .map_err(|e| file_err(e.to_string()))?
-            .clone();
-        let col = |name: &str| headers.iter().position(|h| h == name);
-        let (Some(cx), Some(cy), Some(cu), Some(cv)) =
-            (col("x_m"), col("y_m"), col("u_mps"), col("v_mps"))
-        else {
-            return Err(file_err(format!(
-                "header must name x_m, y_m, u_mps, v_mps (and optionally t_s); found {:?}",
-                headers.iter().collect::<Vec<_>>()
-            )));
-        };
-        let ct = col("t_s");
-        let mut rows: Vec<[f64; 5]> = Vec::new();
-        for (k, rec) in reader.records().enumerate() {
-            let line = k + 2;
-            let rec = rec.map_err(|e| file_err(format!("line {line}: {e}")))?;
-            let get = |c: usize, name: &str| -> Result<f64, EnvError> {
-                let s = rec.get(c).unwrap_or("");
-                let x: f64 = s.parse().map_err(|_| {
-                    file_err(format!("line {line}: {name} = {s:?} is not a number"))
-                })?;
-                if x.is_finite() {
-                    Ok(x)
-                } else {
-                    Err(file_err(format!("line {line}: {name} = {s} is not finite")))
-                }
-            };
-            let t = match ct {
-                Some(c) => get(c, "t_s")?,
-                None => 0.0,
-            };
-            rows.push([
-                t,
-                get(cx, "x_m")?,
-                get(cy, "y_m")?,
-                get(cu, "u_mps")?,
-                get(cv, "v_mps")?,
-            ]);
-        }
-        if rows.is_empty() {
-            return Err(file_err("no data rows".into()));
-        }
-        let xs: Vec<f64> = rows.iter().map(|r| r[1]).collect();
-        let ys: Vec<f64> = rows.iter().map(|r| r[2]).collect();
-        let (x0, dx, nx) = regular_axis(&xs, "x_m", path)?;
-        let (y0, dy, ny) = regular_axis(&ys, "y_m", path)?;
+        // Columns: x, y, u, v, then t (NaN when absent: one frame at t = 0).
+        let (table, _) = read_columns(path, &["x_m", "y_m", "u_mps", "v_mps"], &["t_s"])?;
+        let rows: Vec<[f64; 5]> = table
+            .iter()
+            .map(|r| {
+                [
+                    if r[4].is_nan() { 0.0 } else { r[4] },
+                    r[0],
+                    r[1],
+                    r[2],
+                    r[3],
+                ]
+            })
+            .collect();
+        let (x0, dx, nx) = regular_axis(rows.iter().map(|r| r[1]), "x_m", path)?;
+        let (y0, dy, ny) = regular_axis(rows.iter().map(|r| r[2]), "y_m", path)?;
         // Group by time; BTreeMap over the bit pattern of a non-negative-normalised time keeps order.
         let mut by_time: BTreeMap<i64, Vec<[f64; 5]>> = BTreeMap::new();
         for r in rows {
