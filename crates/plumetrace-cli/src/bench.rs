@@ -63,6 +63,10 @@ pub struct PlumeBenchArgs {
     /// Number of point queries to time.
     #[arg(long, default_value_t = 200_000)]
     queries: usize,
+    /// The timed window is split into this many blocks; the reported costs are the medians over
+    /// blocks (the minimum is reported too), which shields them from a noisy machine.
+    #[arg(long, default_value_t = 5)]
+    blocks: usize,
     /// Run seed.
     #[arg(long, default_value_t = 1)]
     seed: u64,
@@ -79,12 +83,15 @@ struct PlumeBench {
     steps_timed: u64,
     cpu_s: f64,
     ns_per_filament_step: f64,
+    ns_per_filament_step_min: f64,
+    ns_per_filament_step_blocks: Vec<f64>,
     ns_per_step: f64,
     mean_live_filaments: f64,
     final_live_filaments: usize,
     sim_s_per_cpu_s: f64,
     index_build_ns: f64,
     point_query_ns: f64,
+    point_query_ns_min: f64,
     point_query_uniform_ns: f64,
     crossflow_spread_m: BTreeMap<String, f64>,
     crossflow_mean_m: BTreeMap<String, f64>,
@@ -160,6 +167,10 @@ fn plume(a: &PlumeBenchArgs) -> Result<PlumeBench> {
     let sample_every = ((1.0 / dt).round() as u64).max(1);
     let mut live_sum = 0u64;
     let mut cpu = 0.0;
+    let blocks = a.blocks.clamp(1, timed_steps as usize) as u64;
+    let block_len = timed_steps.div_ceil(blocks);
+    let (mut block_cpu, mut block_live) = (0.0, 0u64);
+    let mut per_block = Vec::new();
     // CPU time is read once per block of steps between statistics samples, so neither the
     // clock nor the sampling is charged to the model.
     let mut block = ProcessTime::now();
@@ -167,8 +178,17 @@ fn plume(a: &PlumeBenchArgs) -> Result<PlumeBench> {
         env.step()?;
         let f = env.plume().filaments();
         live_sum += f.map_or(0, |f| f.len() as u64);
-        if k.is_multiple_of(sample_every) || k + 1 == timed_steps {
-            cpu += block.elapsed().as_secs_f64();
+        block_live += f.map_or(0, |f| f.len() as u64);
+        let end_of_block = (k + 1).is_multiple_of(block_len) || k + 1 == timed_steps;
+        if k.is_multiple_of(sample_every) || end_of_block {
+            let c = block.elapsed().as_secs_f64();
+            cpu += c;
+            block_cpu += c;
+            block = ProcessTime::now();
+        }
+        if end_of_block {
+            per_block.push(block_cpu * 1e9 / block_live.max(1) as f64);
+            (block_cpu, block_live) = (0.0, 0);
         }
         if k.is_multiple_of(sample_every)
             && let Some(f) = f
@@ -231,9 +251,15 @@ fn plume(a: &PlumeBenchArgs) -> Result<PlumeBench> {
         let ns = c0.elapsed().as_secs_f64() * 1e9 / pts.len() as f64;
         (ns, sink)
     };
-    let (point_query_ns, s1) = time_queries(&in_plume);
-    let (point_query_uniform_ns, s2) = time_queries(&uniform);
-    std::hint::black_box(s1 + s2);
+    let mut in_plume_ns = Vec::new();
+    let mut uniform_ns = Vec::new();
+    for _ in 0..blocks {
+        let (ns, s1) = time_queries(&in_plume);
+        let (ns_u, s2) = time_queries(&uniform);
+        std::hint::black_box(s1 + s2);
+        in_plume_ns.push(ns);
+        uniform_ns.push(ns_u);
+    }
     let mut spread = BTreeMap::new();
     let mut centre = BTreeMap::new();
     let mut samples = BTreeMap::new();
@@ -259,17 +285,31 @@ fn plume(a: &PlumeBenchArgs) -> Result<PlumeBench> {
         duration_s: timed_steps as f64 * dt,
         steps_timed: timed_steps,
         cpu_s: cpu,
-        ns_per_filament_step: cpu * 1e9 / (live_sum.max(1) as f64),
+        ns_per_filament_step: median(&per_block),
+        ns_per_filament_step_min: per_block.iter().copied().fold(f64::INFINITY, f64::min),
+        ns_per_filament_step_blocks: per_block.clone(),
         ns_per_step: cpu * 1e9 / timed_steps as f64,
         mean_live_filaments: mean_live,
         final_live_filaments: f.len(),
         sim_s_per_cpu_s: timed_steps as f64 * dt / cpu.max(1e-12),
         index_build_ns,
-        point_query_ns,
-        point_query_uniform_ns,
+        point_query_ns: median(&in_plume_ns),
+        point_query_ns_min: in_plume_ns.iter().copied().fold(f64::INFINITY, f64::min),
+        point_query_uniform_ns: median(&uniform_ns),
         crossflow_spread_m: spread,
         crossflow_mean_m: centre,
         crossflow_samples: samples,
         threads: 1,
     })
+}
+
+/// The median of a non-empty list (NaN for an empty one).
+fn median(values: &[f64]) -> f64 {
+    let mut v = values.to_vec();
+    v.sort_by(f64::total_cmp);
+    match v.len() {
+        0 => f64::NAN,
+        n if n % 2 == 1 => v[n / 2],
+        n => 0.5 * (v[n / 2 - 1] + v[n / 2]),
+    }
 }

@@ -25,6 +25,11 @@ const RULES: &[(&str, Side, &[&str])] = &[
     ("plumetrace-env", Side::Simulator, &["plumetrace-core"]),
     ("plumetrace-guidance", Side::Onboard, &["plumetrace-core"]),
     (
+        "plumetrace-planner",
+        Side::Onboard,
+        &["plumetrace-core", "plumetrace-guidance"],
+    ),
+    (
         "plumetrace-sim",
         Side::Simulator,
         &["plumetrace-core", "plumetrace-env"],

@@ -15,11 +15,13 @@
 pub mod angle;
 pub mod frame;
 pub mod message;
+pub mod planner;
 pub mod vehicle;
 
 pub use angle::{Heading, wrap_deg_180, wrap_deg_360, wrap_rad_pi};
 pub use frame::{Vec2, Vec3, bearing_between, heading_vector};
 pub use message::{Message, MessageBody, Recipient};
+pub use planner::{Decision, PlanStatus, Planner, PlannerEvent, RegionEvent};
 pub use vehicle::{
     ChemSample, Command, FlowSample, NavEstimate, RangeReturn, SensorSnapshot, VehicleId,
     VehicleKind, VerticalCommand,

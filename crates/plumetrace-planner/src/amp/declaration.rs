@@ -1,0 +1,123 @@
+//! Source declaration: a check run at the end of every Track-Out.
+
+use plumetrace_core::{Heading, Vec2};
+use serde::{Deserialize, Serialize};
+
+/// How the planner decides that the source has been found.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case", tag = "rule")]
+pub enum DeclarationRule {
+    /// The field rule: the three most upflow lost points lie within `along_m` of each other along
+    /// the flow; the most upflow one is declared. Crossflow spread is ignored (the cause of the
+    /// 31 m crossflow error at Duck).
+    AlongFlow {
+        /// Along-flow spread, m (4).
+        along_m: f64,
+    },
+    /// The field rule plus a crossflow bound: the three points must also lie within `cross_m` of
+    /// each other across the flow (the fix proposed after the field tests).
+    AlongAndCrossFlow {
+        /// Along-flow spread, m (4).
+        along_m: f64,
+        /// Crossflow spread, m.
+        cross_m: f64,
+    },
+}
+
+impl DeclarationRule {
+    /// Registry name of the rule (for events and campaign keys).
+    pub fn name(&self) -> &'static str {
+        match self {
+            DeclarationRule::AlongFlow { .. } => "along_flow",
+            DeclarationRule::AlongAndCrossFlow { .. } => "along_and_cross_flow",
+        }
+    }
+
+    /// The declared position, if the lost points satisfy the rule for upflow direction `upflow`.
+    pub fn check(&self, lost_points: &[Vec2], upflow: Heading) -> Option<Vec2> {
+        if lost_points.len() < 3 {
+            return None;
+        }
+        let u = upflow.unit();
+        let c = upflow.turned_deg(90.0).unit();
+        let mut pts: Vec<Vec2> = lost_points.to_vec();
+        // Most upflow first.
+        pts.sort_by(|a, b| b.dot(&u).total_cmp(&a.dot(&u)));
+        let top = &pts[..3];
+        let along = top[0].dot(&u) - top[2].dot(&u);
+        let (along_m, cross_m) = match *self {
+            DeclarationRule::AlongFlow { along_m } => (along_m, f64::INFINITY),
+            DeclarationRule::AlongAndCrossFlow { along_m, cross_m } => (along_m, cross_m),
+        };
+        let cross = top.iter().map(|p| p.dot(&c)).fold(f64::MIN, f64::max)
+            - top.iter().map(|p| p.dot(&c)).fold(f64::MAX, f64::min);
+        (along < along_m && cross < cross_m).then_some(top[0])
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn fires_at_3_9_m_and_not_at_4_1_m() {
+        // Flow towards North: upflow is South; "along" is the southward coordinate.
+        let up = Heading::from_deg(180.0);
+        let rule = DeclarationRule::AlongFlow { along_m: 4.0 };
+        let close = [
+            Vec2::new(0.0, 10.0),
+            Vec2::new(3.0, 8.05),
+            Vec2::new(-2.0, 6.1),
+            Vec2::new(0.0, 60.0),
+        ];
+        assert_eq!(
+            rule.check(&close, up),
+            Some(Vec2::new(-2.0, 6.1)),
+            "3.9 m apart declares the most upflow"
+        );
+        let far = [
+            Vec2::new(0.0, 10.0),
+            Vec2::new(3.0, 8.0),
+            Vec2::new(-2.0, 5.9),
+            Vec2::new(0.0, 60.0),
+        ];
+        assert_eq!(rule.check(&far, up), None, "4.1 m apart does not");
+        assert_eq!(rule.check(&close[..2], up), None, "needs three points");
+    }
+
+    #[test]
+    fn crossflow_variant_also_bounds_the_spread_across() {
+        let up = Heading::from_deg(180.0);
+        let spread = [
+            Vec2::new(0.0, 10.0),
+            Vec2::new(30.0, 9.0),
+            Vec2::new(-2.0, 8.0),
+        ];
+        assert!(
+            DeclarationRule::AlongFlow { along_m: 4.0 }
+                .check(&spread, up)
+                .is_some()
+        );
+        assert!(
+            DeclarationRule::AlongAndCrossFlow {
+                along_m: 4.0,
+                cross_m: 8.0
+            }
+            .check(&spread, up)
+            .is_none()
+        );
+        let tight = [
+            Vec2::new(0.0, 10.0),
+            Vec2::new(3.0, 9.0),
+            Vec2::new(-2.0, 8.0),
+        ];
+        assert_eq!(
+            DeclarationRule::AlongAndCrossFlow {
+                along_m: 4.0,
+                cross_m: 8.0
+            }
+            .check(&tight, up),
+            Some(Vec2::new(-2.0, 8.0))
+        );
+    }
+}
