@@ -1,10 +1,11 @@
 //! The `plumetrace` command.
 //!
-//! Subcommands: `run` (simulate a scenario and write its outputs), `presets` (list the built-in
+//! Subcommands: `run` (fly a mission, or simulate a plume, and write the outputs), `presets` (list the built-in
 //! scenarios), `check` (validate a scenario file), `bench plume` (time the plume model on pompy's
 //! scenario or a field-scale one and print JSON).
 
 mod bench;
+mod mission;
 mod output;
 mod plot;
 mod progress;
@@ -64,11 +65,20 @@ fn dispatch(cli: Cli) -> Result<()> {
             let cfg = plumetrace_scenario::load_file(&file)?;
             let origin = plumetrace_scenario::Origin::File(file.clone());
             let built = plumetrace_scenario::build(&cfg, &origin, None)?;
+            if let Some(pc) = &cfg.planner {
+                plumetrace_mission::amp_params(pc)
+                    .map_err(|e| anyhow::anyhow!("{}: {e}", file.display()))?;
+            }
+            let what = if built.mission.is_some() {
+                "mission"
+            } else {
+                "plume run"
+            };
             println!(
-                "{}: ok ({} steps of {} s)",
+                "{}: ok ({what}, {} steps of {} s)",
                 file.display(),
                 built.steps,
-                built.env.dt_s()
+                built.dt_s
             );
             Ok(())
         }

@@ -83,11 +83,20 @@ struct RunStats {
     stage_times: StageTimes,
 }
 
-/// Runs the scenario and writes `stats.json`, `snapshot.csv`, `filaments.csv` and `plume.svg`.
+/// Runs the scenario: a mission when it has one, otherwise the plume alone.
 pub fn run(args: &RunArgs) -> Result<()> {
-    let mut sc = load(args.scenario.as_deref(), args.preset.as_deref(), args.seed)?;
+    let sc = load(args.scenario.as_deref(), args.preset.as_deref(), args.seed)?;
     std::fs::create_dir_all(&args.out)
         .with_context(|| format!("creating {}", args.out.display()))?;
+    if sc.mission.is_some() {
+        crate::mission::run(sc, &args.out, args.stats)
+    } else {
+        run_plume(sc, args)
+    }
+}
+
+/// Runs the plume alone and writes `stats.json`, `snapshot.csv`, `filaments.csv` and `plume.svg`.
+fn run_plume(mut sc: BuiltScenario, args: &RunArgs) -> Result<()> {
     let started = Instant::now();
     let mut times = StageTimes::default();
     let spec = sc.output;

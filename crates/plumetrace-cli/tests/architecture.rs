@@ -40,9 +40,27 @@ const RULES: &[(&str, Side, &[&str])] = &[
         &["plumetrace-core", "plumetrace-env", "plumetrace-sim"],
     ),
     (
+        "plumetrace-mission",
+        Side::App,
+        &[
+            "plumetrace-core",
+            "plumetrace-env",
+            "plumetrace-sim",
+            "plumetrace-scenario",
+            "plumetrace-guidance",
+            "plumetrace-planner",
+        ],
+    ),
+    (
         "plumetrace-cli",
         Side::App,
-        &["plumetrace-core", "plumetrace-env", "plumetrace-scenario"],
+        &[
+            "plumetrace-core",
+            "plumetrace-env",
+            "plumetrace-sim",
+            "plumetrace-scenario",
+            "plumetrace-mission",
+        ],
     ),
 ];
 

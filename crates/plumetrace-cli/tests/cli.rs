@@ -21,7 +21,7 @@ fn run_ok(args: &[&str]) -> Output {
 
 /// The demo preset shortened to one simulated minute, written as a scenario file.
 fn short_demo(dir: &Path) -> PathBuf {
-    let text = plumetrace_scenario::find_preset("demo").unwrap().toml;
+    let text = plumetrace_scenario::find_preset("plume-demo").unwrap().toml;
     let text = text
         .replace("duration_s = 600.0", "duration_s = 60.0")
         .replace("average_start_s = 300.0", "average_start_s = 30.0");
@@ -195,4 +195,104 @@ fn bench_plume_prints_the_documented_json() {
     }
     assert_eq!(v["pompy_compatible"], true);
     assert_eq!(v["steps_timed"], 100);
+}
+
+#[test]
+fn mission_run_writes_summary_trajectory_events_and_plot() {
+    let dir = tempfile::tempdir().unwrap();
+    let text = plumetrace_scenario::find_preset("demo").unwrap().toml;
+    let text = text
+        .replace("time_limit_s = 1800.0", "time_limit_s = 200.0")
+        .replace("spinup_s = 1500.0", "spinup_s = 600.0");
+    let path = dir.path().join("mission.toml");
+    std::fs::write(&path, text).unwrap();
+    let out = dir.path().join("m");
+    run_ok(&[
+        "run",
+        path.to_str().unwrap(),
+        "--seed",
+        "2",
+        "--out",
+        out.to_str().unwrap(),
+        "--stats",
+    ]);
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    for key in [
+        "outcome",
+        "declared",
+        "declared_x",
+        "declared_y",
+        "source_x",
+        "source_y",
+        "error_m",
+        "error_along_m",
+        "error_cross_m",
+        "first_detection_s",
+        "declaration_s",
+        "path_length_m",
+        "sim_time_s",
+    ] {
+        assert!(summary.get(key).is_some(), "summary.json lacks {key}");
+    }
+    assert_eq!(summary["sim_time_s"], 200.0);
+    let traj = std::fs::read_to_string(out.join("trajectory.csv")).unwrap();
+    assert!(traj.starts_with("t_s,vehicle,true_x_m,true_y_m,true_z_m,est_x_m,est_y_m,heading_deg,speed_mps,behaviour,reading_v,detection\n"));
+    assert_eq!(traj.lines().count(), 1 + 2000);
+    let events = std::fs::read_to_string(out.join("events.jsonl")).unwrap();
+    for line in events.lines() {
+        let v: serde_json::Value = serde_json::from_str(line).unwrap();
+        assert!(v["t_s"].is_number() && v["event"].is_string(), "{line}");
+    }
+    assert!(events.contains("\"behaviour\""));
+    let svg = std::fs::read_to_string(out.join("plot.svg")).unwrap();
+    for label in [
+        "East (m)",
+        "North (m)",
+        "op-area",
+        "detection",
+        "true source",
+        "declared source",
+    ] {
+        assert!(svg.contains(label), "plot lacks {label}");
+    }
+}
+
+#[test]
+fn check_names_bad_planner_and_mission_keys() {
+    let dir = tempfile::tempdir().unwrap();
+    let demo = plumetrace_scenario::find_preset("demo").unwrap().toml;
+    let cases = [
+        (
+            demo.replace("mapping_lines = 3", "mapping_lines = 3\nspeed_mps = -2.0"),
+            "planner.speed_mps",
+        ),
+        (
+            demo.replace("mapping_lines = 3", "mapping_lines = 3\nbeta = 20"),
+            "planner",
+        ),
+        (
+            demo.replace("time_limit_s = 1800.0", "time_limit_s = -1.0"),
+            "mission.time_limit_s",
+        ),
+        (
+            demo.replace("env_dt_s = 0.5", "env_dt_s = 0.25"),
+            "mission.env_dt_s",
+        ),
+    ];
+    for (k, (text, key)) in cases.iter().enumerate() {
+        assert_ne!(text.as_str(), demo, "case {k} did not apply");
+        let path = dir.path().join(format!("bad{k}.toml"));
+        std::fs::write(&path, text).unwrap();
+        let out = bin()
+            .args(["check", path.to_str().unwrap()])
+            .output()
+            .unwrap();
+        assert_eq!(out.status.code(), Some(1), "case {k}");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(
+            err.contains(key) && err.contains(&format!("bad{k}.toml")),
+            "case {k}: {err}"
+        );
+    }
 }

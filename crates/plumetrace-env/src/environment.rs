@@ -77,6 +77,8 @@ pub struct Environment {
     obstacles: ObstacleSet,
     dt_s: f64,
     step: u64,
+    /// Simulated time spent in spin-up before step 0, s.
+    spinup_s: f64,
     flow_rng: SimRng,
     plume_rng: SimRng,
 }
@@ -107,14 +109,57 @@ impl Environment {
             obstacles,
             dt_s,
             step: 0,
+            spinup_s: 0.0,
             flow_rng: stream_rng(seed, StreamId::Flow),
             plume_rng: stream_rng(seed, StreamId::Plume),
         })
     }
 
+    /// Develops the plume before the run starts: `duration_s` of simulated time in steps of
+    /// `dt_s` (coarser than the run's step: the physics does not depend on the step, and a
+    /// kilometre of plume in a 0.1 m/s current needs hours to form). The run's clock then starts
+    /// at 0; [`Environment::elapsed_s`] includes the spin-up.
+    pub fn spin_up(&mut self, duration_s: f64, dt_s: f64) -> Result<(), EnvError> {
+        crate::error::require_non_negative("mission.spinup_s", duration_s)?;
+        crate::error::require_positive("mission.spinup_dt_s", dt_s)?;
+        if let Some(limit) = self.flow.max_stable_dt_s()
+            && dt_s > limit
+        {
+            return Err(EnvError::invalid(
+                "mission.spinup_dt_s",
+                format!("{dt_s} s is above the flow model's stable limit of {limit:.4} s"),
+            ));
+        }
+        let n = (duration_s / dt_s).round() as u64;
+        let start = self.elapsed_s();
+        for k in 1..=n {
+            let t = start + k as f64 * dt_s;
+            self.flow.advance(t, dt_s, &mut self.flow_rng)?;
+            if let Plume::Filaments(p) = &mut self.plume {
+                p.step(&self.flow, t, dt_s, &mut self.plume_rng);
+            }
+        }
+        self.spinup_s += n as f64 * dt_s;
+        Ok(())
+    }
+
+    /// Simulated time including any spin-up, s (the flow and plume clocks).
+    pub fn elapsed_s(&self) -> f64 {
+        self.spinup_s + self.step as f64 * self.dt_s
+    }
+
+    /// Concentration at one point; cheaper than the query index when only a few points are
+    /// sampled between steps (a vehicle's sensor), since it needs no index build.
+    pub fn sample_concentration(&self, p: Vec3) -> f64 {
+        match &self.plume {
+            Plume::Filaments(f) => f.concentration_scan(p),
+            Plume::Steady(s) => s.concentration(p),
+        }
+    }
+
     /// Advances the flow, then the plume, by one step.
     pub fn step(&mut self) -> Result<(), EnvError> {
-        let t_new = (self.step + 1) as f64 * self.dt_s;
+        let t_new = self.spinup_s + (self.step + 1) as f64 * self.dt_s;
         self.flow.advance(t_new, self.dt_s, &mut self.flow_rng)?;
         if let Plume::Filaments(p) = &mut self.plume {
             p.step(&self.flow, t_new, self.dt_s, &mut self.plume_rng);

@@ -581,3 +581,42 @@ fn same_seed_same_bits_and_thread_count_does_not_matter() {
     assert_eq!(one, eval(2));
     assert!(one.iter().any(|&c| f64::from_bits(c) > 0.0));
 }
+
+#[test]
+fn scanned_and_indexed_queries_agree() {
+    let domain = rect(0.0, 100.0, -50.0, 50.0);
+    let src = Source {
+        pos_m: Vec3::new(5.0, 0.0, 0.5),
+        mass_rate_per_s: 5.0,
+        filament_rate_hz: 10.0,
+    };
+    let params = FilamentParams {
+        vertical: VerticalBoundary::Reflecting { depth_m: Some(6.0) },
+        growth_rate_m2ps: 0.01,
+        ..FilamentParams::default()
+    };
+    let mut env = filament_env(domain, pompy_farrell(domain, 0.05), src, params, 0.05, 21);
+    env.spin_up(60.0, 0.5).unwrap();
+    run(&mut env, 10.0);
+    assert!((env.elapsed_s() - 70.0).abs() < 1e-9 && (env.time_s() - 10.0).abs() < 1e-9);
+    let f = filaments(&env);
+    assert!(f.len() > 300);
+    let mut nonzero = 0;
+    for (k, (c, _)) in f.filaments().enumerate().step_by(7) {
+        for q in [
+            Vec3::new(c.x + 0.1, c.y - 0.05, 0.3),
+            Vec3::new(c.x, c.y, 5.9),
+            Vec3::new(f64::from(k as u32 % 90), 3.0, 1.0),
+        ] {
+            let (a, b) = (f.concentration(q), env.sample_concentration(q));
+            assert!(
+                (a - b).abs() <= 1e-12 * a.abs().max(1e-300),
+                "{a} vs {b} at {q:?}"
+            );
+            if a > 0.0 {
+                nonzero += 1;
+            }
+        }
+    }
+    assert!(nonzero > 50);
+}

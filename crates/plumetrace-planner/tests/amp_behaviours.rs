@@ -219,7 +219,7 @@ fn does_not_declare_when_the_points_are_spread_along_the_flow() {
 }
 
 #[test]
-fn keeps_at_most_six_lost_points_dropping_the_most_downflow() {
+fn keeps_at_most_six_lost_points_dropping_the_oldest() {
     let mut a = amp();
     a.decide(&snap(0.0, (200.0, 500.0), 0.0, false));
     let pts: Vec<(f64, f64)> = (0..8)

@@ -43,6 +43,23 @@ pub struct VehicleSetup {
     pub range_sensor: Option<plumetrace_sim::RangeSensorParams>,
 }
 
+/// The mission part of a scenario (present when it has vehicles to fly).
+#[derive(Debug, Clone, PartialEq)]
+pub struct MissionSpec {
+    /// Op-area polygon.
+    pub op_area: Vec<plumetrace_core::Vec2>,
+    /// Subregions searched in turn (empty: the whole op-area).
+    pub subregions: Vec<Vec<plumetrace_core::Vec2>>,
+    /// Time limit, s.
+    pub time_limit_s: f64,
+    /// Plume spin-up, s.
+    pub spinup_s: f64,
+    /// Spin-up step, s.
+    pub spinup_dt_s: f64,
+    /// Flow direction the planner assumes before measuring it, deg.
+    pub prior_flow_toward_deg: f64,
+}
+
 /// A scenario ready to run.
 #[derive(Debug)]
 pub struct BuiltScenario {
@@ -58,6 +75,14 @@ pub struct BuiltScenario {
     pub output: OutputSpec,
     /// Vehicles, in the order of the file (their index is their `VehicleId`).
     pub vehicles: Vec<VehicleSetup>,
+    /// The mission, if the scenario flies vehicles.
+    pub mission: Option<MissionSpec>,
+    /// The planner table as written (its values are checked when the planner is made).
+    pub planner: Option<crate::config::PlannerConfig>,
+    /// The vehicles' step, s (`sim.dt_s`; the environment may step more coarsely).
+    pub dt_s: f64,
+    /// Water depth, m.
+    pub depth_m: Option<f64>,
 }
 
 /// Builds a scenario; `seed` overrides the file's seed.
@@ -101,6 +126,22 @@ pub fn build(
             "sim.duration_s",
             format!("must be a finite number >= sim.dt_s ({dt_s}), got {duration}"),
         ));
+    }
+    let env_dt_s = cfg
+        .mission
+        .as_ref()
+        .and_then(|m| m.env_dt_s)
+        .unwrap_or(dt_s);
+    if let Some(m) = &cfg.mission
+        && m.env_dt_s.is_some()
+    {
+        let ratio = env_dt_s / dt_s;
+        if !(env_dt_s.is_finite() && ratio >= 1.0 - 1e-9 && (ratio - ratio.round()).abs() < 1e-9) {
+            return Err(invalid(
+                "mission.env_dt_s",
+                format!("must be a whole multiple of sim.dt_s ({dt_s}), got {env_dt_s}"),
+            ));
+        }
     }
     let steps_f = (duration / dt_s).round();
     if steps_f > 1e10 {
@@ -166,7 +207,14 @@ pub fn build(
                 original_noise_updates: f.original_noise_updates,
             };
             FlowModel::Farrell(Box::new(
-                FarrellFlow::new(domain, m, params, dt_s).map_err(env_err)?,
+                FarrellFlow::new(domain, m, params, env_dt_s).map_err(|e| match e {
+                    EnvError::InvalidParameter { key, message }
+                        if key == "sim.dt_s" && env_dt_s != dt_s =>
+                    {
+                        invalid("mission.env_dt_s", message)
+                    }
+                    other => env_err(other),
+                })?,
             ))
         }
         FlowKind::Gridded => {
@@ -305,8 +353,47 @@ pub fn build(
     }
 
     let seed = seed.unwrap_or(cfg.seed);
-    let env = Environment::new(domain, flow, plume, ObstacleSet::new(obstacles), dt_s, seed)
-        .map_err(env_err)?;
+    let env = Environment::new(
+        domain,
+        flow,
+        plume,
+        ObstacleSet::new(obstacles),
+        env_dt_s,
+        seed,
+    )
+    .map_err(env_err)?;
+
+    let mission = match &cfg.mission {
+        None => {
+            if !vehicles.is_empty() && cfg.planner.is_some() {
+                return Err(invalid(
+                    "mission",
+                    "a scenario with vehicles and a planner needs a [mission] table".into(),
+                ));
+            }
+            None
+        }
+        Some(m) => Some(mission_spec(m, &domain, env_dt_s).map_err(|e| match e {
+            EnvError::InvalidParameter { key, message } => invalid(&key, message),
+            other => invalid("mission", other.to_string()),
+        })?),
+    };
+    if mission.is_some() && cfg.planner.is_none() {
+        return Err(invalid(
+            "planner",
+            "a [mission] needs a [planner] table".into(),
+        ));
+    }
+    if mission.is_some()
+        && !vehicles
+            .iter()
+            .any(|v| v.vehicle.params.kind == plumetrace_core::VehicleKind::Auv)
+    {
+        return Err(invalid(
+            "vehicles",
+            "a [mission] needs at least one vehicle with kind = \"auv\"".into(),
+        ));
+    }
 
     let o = &cfg.output;
     let grid = GridSpec {
@@ -351,6 +438,10 @@ pub fn build(
         steps,
         output,
         vehicles,
+        mission,
+        planner: cfg.planner.clone(),
+        dt_s,
+        depth_m: d.depth_m,
     })
 }
 
@@ -575,5 +666,79 @@ fn vehicle_setup(
         chem_sensor,
         flow_sensor,
         range_sensor,
+    })
+}
+
+fn polygon(vertices: &[[f64; 2]], key: &str) -> Result<Vec<plumetrace_core::Vec2>, EnvError> {
+    if vertices.len() < 3 {
+        return Err(EnvError::invalid(
+            key,
+            format!("needs at least 3 vertices, got {}", vertices.len()),
+        ));
+    }
+    if let Some(k) = vertices
+        .iter()
+        .position(|v| !(v[0].is_finite() && v[1].is_finite()))
+    {
+        return Err(EnvError::invalid(format!("{key}[{k}]"), "is not finite"));
+    }
+    let area2: f64 = (0..vertices.len())
+        .map(|i| {
+            let (a, b) = (vertices[i], vertices[(i + 1) % vertices.len()]);
+            a[0] * b[1] - b[0] * a[1]
+        })
+        .sum();
+    if area2.abs() < 1e-9 {
+        return Err(EnvError::invalid(key, "has zero area"));
+    }
+    Ok(vertices
+        .iter()
+        .map(|v| plumetrace_core::Vec2::new(v[0], v[1]))
+        .collect())
+}
+
+fn mission_spec(
+    m: &crate::config::MissionConfig,
+    domain: &Rect,
+    env_dt_s: f64,
+) -> Result<MissionSpec, EnvError> {
+    let op_area = match &m.op_area {
+        Some(v) => polygon(v, "mission.op_area")?,
+        None => {
+            let inset = 50.0f64.min(0.25 * domain.width_m().min(domain.height_m()));
+            let r = Rect::new(
+                domain.x_min_m + inset,
+                domain.x_max_m - inset,
+                domain.y_min_m + inset,
+                domain.y_max_m - inset,
+            )?;
+            r.corners().to_vec()
+        }
+    };
+    if let Some(k) = op_area.iter().position(|p| !domain.contains(*p)) {
+        return Err(EnvError::invalid(
+            format!("mission.op_area[{k}]"),
+            "lies outside the domain",
+        ));
+    }
+    let mut subregions = Vec::new();
+    for (k, r) in m.subregions.iter().enumerate() {
+        subregions.push(polygon(r, &format!("mission.subregions[{k}]"))?);
+    }
+    plumetrace_env::error::require_positive("mission.time_limit_s", m.time_limit_s)?;
+    plumetrace_env::error::require_non_negative("mission.spinup_s", m.spinup_s)?;
+    let spinup_dt_s = m.spinup_dt_s.unwrap_or(10.0 * env_dt_s);
+    plumetrace_env::error::require_positive("mission.spinup_dt_s", spinup_dt_s)?;
+    plumetrace_env::error::require_finite(
+        "mission.prior_flow_toward_deg",
+        m.prior_flow_toward_deg,
+    )?;
+    Ok(MissionSpec {
+        op_area,
+        subregions,
+        time_limit_s: m.time_limit_s,
+        spinup_s: m.spinup_s,
+        spinup_dt_s,
+        prior_flow_toward_deg: m.prior_flow_toward_deg,
     })
 }

@@ -34,6 +34,10 @@ pub struct ScenarioConfig {
     /// Vehicles (AUVs and surface craft) with their navigation and sensors.
     #[serde(default)]
     pub vehicles: Vec<VehicleConfig>,
+    /// The mission: op-area, subregions, time limit, plume spin-up (needed with vehicles).
+    pub mission: Option<MissionConfig>,
+    /// The planner flown by every AUV.
+    pub planner: Option<PlannerConfig>,
     /// What a plume run writes.
     #[serde(default)]
     pub output: OutputConfig,
@@ -414,4 +418,96 @@ pub struct RangeSensorConfig {
     pub front_half_angle_deg: Option<f64>,
     /// Side groups' outer angle, deg.
     pub side_outer_angle_deg: Option<f64>,
+}
+
+/// `[mission]`
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MissionConfig {
+    /// Op-area polygon `[[east, north], ...]`, m (default: the domain shrunk by 50 m).
+    pub op_area: Option<Vec<[f64; 2]>>,
+    /// Subregions searched in turn (a multi-source mission), each a polygon.
+    #[serde(default)]
+    pub subregions: Vec<Vec<[f64; 2]>>,
+    /// Mission time limit, s.
+    pub time_limit_s: f64,
+    /// Plume development before the vehicles start, s.
+    #[serde(default)]
+    pub spinup_s: f64,
+    /// Step of the spin-up, s (default: 10 x `env_dt_s`, within the flow's stable limit).
+    pub spinup_dt_s: Option<f64>,
+    /// Step of the flow and plume during the mission, s (a whole multiple of `sim.dt_s`;
+    /// default `sim.dt_s`).
+    pub env_dt_s: Option<f64>,
+    /// Flow direction the planner assumes before its first flow measurement, deg.
+    #[serde(default)]
+    pub prior_flow_toward_deg: f64,
+}
+
+/// Which planner.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum PlannerKind {
+    /// The REMUS Adaptive Mission Planner.
+    Amp,
+}
+
+/// Which declaration rule.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum DeclarationKind {
+    /// Three most upflow lost points within `declaration_along_m` along the flow.
+    AlongFlow,
+    /// The same and within `declaration_cross_m` across the flow.
+    AlongAndCrossFlow,
+}
+
+/// `[planner]`: every key is optional; defaults are the field values (Table 4).
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PlannerConfig {
+    /// Planner name ("amp").
+    pub strategy: PlannerKind,
+    /// Speed command, m/s.
+    pub speed_mps: Option<f64>,
+    /// Altitude command, m.
+    pub altitude_m: Option<f64>,
+    /// lambda, s.
+    pub lambda_s: Option<f64>,
+    /// beta, deg.
+    pub beta_deg: Option<f64>,
+    /// L_u, m.
+    pub l_u_m: Option<f64>,
+    /// L_c, m.
+    pub l_c_m: Option<f64>,
+    /// N_re.
+    pub n_re: Option<usize>,
+    /// K, deg/m.
+    pub k_deg_per_m: Option<f64>,
+    /// R, m.
+    pub r_m: Option<f64>,
+    /// Minimum turning radius, m.
+    pub min_turn_radius_m: Option<f64>,
+    /// Most lost points kept.
+    pub max_lost_points: Option<usize>,
+    /// Declaration rule.
+    pub declaration: Option<DeclarationKind>,
+    /// Along-flow spread of the rule, m.
+    pub declaration_along_m: Option<f64>,
+    /// Crossflow spread of the crossflow-aware rule, m.
+    pub declaration_cross_m: Option<f64>,
+    /// Fly the post-declaration mapping pattern.
+    pub mapping: Option<bool>,
+    /// Mapping lines.
+    pub mapping_lines: Option<usize>,
+    /// Mapping line length, m.
+    pub mapping_length_m: Option<f64>,
+    /// Mapping line spacing, m.
+    pub mapping_spacing_m: Option<f64>,
+    /// Search time per subregion, s.
+    pub region_timeout_s: Option<f64>,
+    /// Flow estimate time constant, s.
+    pub flow_average_s: Option<f64>,
+    /// Compensate for the measured flow.
+    pub flow_compensation: Option<bool>,
 }

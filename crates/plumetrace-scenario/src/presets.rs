@@ -18,8 +18,23 @@ pub struct Preset {
 pub const PRESETS: &[Preset] = &[
     Preset {
         name: "demo",
-        summary: "small meandering plume from a bottom source, 200 m x 100 m, 10 min (seconds to run)",
+        summary: "small plume-tracing mission: the AMP flies an AUV up a 400 m plume (seconds to run)",
         toml: include_str!("../presets/demo.toml"),
+    },
+    Preset {
+        name: "duck-2003-st",
+        summary: "Duck 2003 single-source mission: 1094 m x 367 m op-area, 0.10-0.15 m/s, about 1 km of plume",
+        toml: include_str!("../presets/duck-2003-st.toml"),
+    },
+    Preset {
+        name: "duck-2003-mt",
+        summary: "Duck 2003 multi-source mission: 4 subregions, 2 sources, 0.20-0.30 m/s",
+        toml: include_str!("../presets/duck-2003-mt.toml"),
+    },
+    Preset {
+        name: "plume-demo",
+        summary: "plume only: small meandering plume from a bottom source, 200 m x 100 m, 10 min",
+        toml: include_str!("../presets/plume-demo.toml"),
     },
     Preset {
         name: "pompy",

@@ -5,7 +5,7 @@
 use plumetrace_scenario::{Origin, build, find_preset, parse};
 
 fn demo_with(edit: impl Fn(&str) -> String) -> String {
-    edit(find_preset("demo").unwrap().toml)
+    edit(find_preset("plume-demo").unwrap().toml)
 }
 
 fn error_of(text: &str) -> String {
@@ -56,7 +56,7 @@ fn bad_values_are_rejected_with_their_key_path() {
         let text = demo_with(|t| t.replacen(from, to, 1));
         assert_ne!(
             text,
-            find_preset("demo").unwrap().toml,
+            find_preset("plume-demo").unwrap().toml,
             "edit {from} -> {to} did not apply"
         );
         let e = error_of(&text);
@@ -144,7 +144,10 @@ fix_sigma_m = 3.0
 "#;
 
 fn demo_with_vehicles(extra: &str) -> String {
-    format!("{}\n{VEHICLES}\n{extra}", find_preset("demo").unwrap().toml)
+    format!(
+        "{}\n{VEHICLES}\n{extra}",
+        find_preset("plume-demo").unwrap().toml
+    )
 }
 
 #[test]

@@ -10,6 +10,8 @@
 //!   altitude (or depth) hold with a slowly varying error;
 //! - [`nav`]: dead reckoning from measured heading, speed and flow with a slowly drifting error,
 //!   corrected by position fixes (long-baseline for an AUV, GPS for a surface craft);
+//! - [`world`]: an environment and several vehicles stepped together in named, timed stages,
+//!   with planners plugged in through `plumetrace_core::Planner`;
 //! - [`sensors`]: the 10 Hz chemical sensor used as a threshold detector, an ADCP-like flow sensor
 //!   with bias and a wrong-layer fault, and three-group obstacle range sensors.
 //!
@@ -19,6 +21,7 @@
 pub mod nav;
 pub mod sensors;
 pub mod vehicle;
+pub mod world;
 
 pub use nav::{FixEvent, NavParams, Navigator};
 pub use sensors::{
@@ -26,3 +29,4 @@ pub use sensors::{
     RangeSensorParams,
 };
 pub use vehicle::{Vehicle, VehicleParams, VehicleState};
+pub use world::{Incident, SimVehicle, StageTimes, StepReport, World};

@@ -17,7 +17,9 @@
 //! gives the limit (the smaller of the diffusion limit `1 / (2 (Dx/dx^2 + Dy/dy^2))` with
 //! `D = k/2`, the centred-advection limit `2 min(D) / U^2` and the Courant limit
 //! `min(dx, dy) / U`, where `U` bounds the speed at the corners: mean speed plus four standard
-//! deviations of the corner noise). Building the field with a larger step is an error.
+//! deviations of the corner noise, and the corner oscillator's own limit `2 z / w`: explicit Euler
+//! on a lightly damped oscillator grows without bound beyond it, 1 s for pompy's parameters).
+//! Building the field with a larger step is an error.
 
 use super::{FlowField, MeanFlow, axis_weight};
 use crate::error::{EnvError, require_non_negative, require_positive};
@@ -236,11 +238,20 @@ impl FarrellFlow {
         }
         let u_bound = self.mean.max_speed_mps() + 4.0 * sd * std::f64::consts::SQRT_2;
         if u_bound <= 0.0 {
-            return diffusion;
+            return diffusion.min(self.noise_limit());
         }
         let advection = 2.0 * dxx.min(dyy) / (u_bound * u_bound);
         let courant = self.dx_m.min(self.dy_m) / u_bound;
-        diffusion.min(advection).min(courant)
+        diffusion
+            .min(advection)
+            .min(courant)
+            .min(self.noise_limit())
+    }
+
+    /// Explicit Euler on the corner oscillator (eigenvalues `w (-z +- i sqrt(1 - z^2))`) is stable
+    /// only while `|1 + lambda dt| < 1`, i.e. `dt < 2 z / w`.
+    fn noise_limit(&self) -> f64 {
+        2.0 * self.params.noise_damping / self.params.noise_bandwidth_radps
     }
 
     /// The model parameters.
@@ -497,6 +508,29 @@ mod tests {
             "max speed {worst}"
         );
         assert!(worst > 1.2, "the field never meandered: max speed {worst}");
+    }
+
+    #[test]
+    fn the_corner_oscillator_limits_the_step() {
+        // Damping 0.1, bandwidth 0.2 rad/s: dt < 2 z / w = 1 s. A small gain keeps the other
+        // limits (advection, diffusion, Courant) far above it.
+        let region = Rect { x_min_m: 0.0, x_max_m: 1000.0, y_min_m: 0.0, y_max_m: 1000.0 };
+        let params = FarrellParams { noise_gain: 0.1, ..FarrellParams::default() };
+        let err = FarrellFlow::new(region, steady(0.1, 90.0), params, 2.0).err().map(|e| e.to_string()).unwrap_or_default();
+        assert!(err.contains("sim.dt_s") && err.contains("1.0000"), "{err}");
+        let f = FarrellFlow::new(region, steady(0.1, 90.0), params, 0.5).unwrap();
+        assert!((f.max_stable_dt_s().unwrap() - 1.0).abs() < 1e-12);
+        // A run at 2 s (what the check forbids) does blow up.
+        let mut g = FarrellFlow::new(region, steady(0.1, 90.0), params, 0.5).unwrap();
+        let mut rng = stream_rng(1, StreamId::Flow);
+        let mut diverged = false;
+        for k in 1..=5_000u32 {
+            if g.advance(f64::from(k) * 2.0, 2.0, &mut rng).is_err() {
+                diverged = true;
+                break;
+            }
+        }
+        assert!(diverged, "explicit Euler beyond 2 z / w should diverge");
     }
 
     #[test]

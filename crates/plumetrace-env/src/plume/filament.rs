@@ -428,6 +428,48 @@ impl FilamentPlume {
         })
     }
 
+    /// Concentration at `p` by scanning every filament (no index): for a few points per step this
+    /// is cheaper than building the index. Same result as the indexed query.
+    pub fn concentration_scan(&self, p: Vec3) -> f64 {
+        let r0 = self.params.init_radius_m;
+        let (r0sq, gamma, t) = (r0 * r0, self.params.growth_rate_m2ps, self.time_s);
+        let cut2 = self.params.cutoff_radii * self.params.cutoff_radii;
+        let norm = (2.0 * std::f64::consts::PI).powf(1.5);
+        let (floor, ceiling) = match self.params.vertical {
+            VerticalBoundary::Reflecting { depth_m } => (Some(0.0), depth_m),
+            VerticalBoundary::Unbounded => (None, None),
+        };
+        let mut c = 0.0;
+        for k in 0..self.x.len() {
+            let dx = p.x - self.x[k];
+            let dy = p.y - self.y[k];
+            let dxy2 = dx * dx + dy * dy;
+            let r2 = r0sq + gamma * (t - self.birth_s[k]).max(0.0);
+            let lim2 = cut2 * r2;
+            if dxy2 > lim2 {
+                continue;
+            }
+            let amp = self.mass[k] / (norm * r2 * r2.sqrt());
+            let k2 = -0.5 / r2;
+            let z = self.z[k];
+            for zc in [
+                Some(z),
+                floor.map(|f| 2.0 * f - z),
+                ceiling.map(|s| 2.0 * s - z),
+            ]
+            .into_iter()
+            .flatten()
+            {
+                let dz = p.z - zc;
+                let d2 = dxy2 + dz * dz;
+                if d2 < lim2 {
+                    c += amp * (d2 * k2).exp();
+                }
+            }
+        }
+        c
+    }
+
     /// Builds the query index now (it is otherwise built by the first query after a step); lets a
     /// benchmark time the build apart from the queries.
     pub fn prepare_queries(&self) {

@@ -67,7 +67,7 @@ pub struct AmpParams {
     pub min_turn_radius_m: f64,
     /// Heading-rate limit of the commands, deg/s.
     pub max_turn_rate_deg_s: f64,
-    /// Most lost points kept (the most downflow is dropped beyond it).
+    /// Most lost points kept (the oldest is dropped beyond it).
     pub max_lost_points: usize,
     /// Find offset from across-flow, deg.
     pub find_offset_deg: f64,
@@ -377,20 +377,14 @@ impl Amp {
         }
     }
 
-    /// Saves a lost point, keeping at most `max_lost_points` (the most downflow is dropped).
+    /// Saves a lost point, keeping at most `max_lost_points`: the oldest is dropped, so the list
+    /// follows the plume as it is now and a single early outlier cannot block the declaration
+    /// forever.
     fn save_lost_point(&mut self, p: Vec2) {
         self.lost.push(p);
         self.events.push(PlannerEvent::LostPoint { pos_m: p });
         if self.lost.len() > self.p.max_lost_points {
-            let u = self.flow.upflow().unit();
-            if let Some((k, _)) = self
-                .lost
-                .iter()
-                .enumerate()
-                .min_by(|a, b| a.1.dot(&u).total_cmp(&b.1.dot(&u)))
-            {
-                self.lost.remove(k);
-            }
+            self.lost.remove(0);
         }
     }
 

@@ -1,0 +1,216 @@
+//! The mission figure, drawn from the recorded run (like the field-test figures): op-area and
+//! subregions dashed, the estimated track as the vehicle logged it (the true track thin and grey),
+//! detections as x, lost points as open circles, declared sources as filled dots, true sources as
+//! triangles, and the time-averaged plume at the vehicle's altitude as a light heat map.
+
+use crate::run::{EventKind, MissionRun};
+use plotters::prelude::*;
+use plumetrace_core::{PlannerEvent, Vec2};
+
+fn err<E: std::fmt::Debug>(e: E) -> String {
+    format!("drawing the figure: {e:?}")
+}
+
+fn dashed(points: &[Vec2], colour: RGBColor, width: u32) -> Vec<PathElement<(f64, f64)>> {
+    // Closed polygon as short dashes of 8 m with 6 m gaps.
+    let mut out = Vec::new();
+    let n = points.len();
+    for i in 0..n {
+        let (a, b) = (points[i], points[(i + 1) % n]);
+        let len = (b - a).norm();
+        let dir = if len > 0.0 {
+            (b - a) / len
+        } else {
+            Vec2::zeros()
+        };
+        let dash = (len / 60.0).clamp(4.0, 12.0);
+        let mut s = 0.0;
+        while s < len {
+            let e = (s + dash).min(len);
+            let p = a + dir * s;
+            let q = a + dir * e;
+            out.push(PathElement::new(
+                vec![(p.x, p.y), (q.x, q.y)],
+                colour.stroke_width(width),
+            ));
+            s += 1.75 * dash;
+        }
+    }
+    out
+}
+
+/// The figure as an SVG string.
+pub fn mission_figure(run: &MissionRun, title: &str) -> Result<String, String> {
+    let g = *run.mean_plume.spec();
+    let (x0, x1, y0, y1) = (g.x_min_m, g.x_max_m, g.y_min_m, g.y_max_m);
+    let width = 900u32;
+    let plot_w = f64::from(width - 90);
+    let height = ((plot_w * (y1 - y0) / (x1 - x0)).clamp(300.0, 1400.0) + 120.0) as u32;
+    let mut svg = String::new();
+    {
+        let root = SVGBackend::with_string(&mut svg, (width, height)).into_drawing_area();
+        root.fill(&WHITE).map_err(err)?;
+        let mut chart = ChartBuilder::on(&root)
+            .caption(title, ("sans-serif", 18))
+            .margin(12)
+            .margin_right(20)
+            .x_label_area_size(40)
+            .y_label_area_size(60)
+            .build_cartesian_2d(x0..x1, y0..y1)
+            .map_err(err)?;
+        chart
+            .configure_mesh()
+            .disable_mesh()
+            .x_desc("East (m)")
+            .y_desc("North (m)")
+            .label_style(("sans-serif", 13))
+            .draw()
+            .map_err(err)?;
+
+        // Plume: square-root scale of the time-averaged concentration, light.
+        let mean = run.mean_plume.mean();
+        let max = mean.iter().copied().fold(0.0, f64::max);
+        let (dx, dy) = ((x1 - x0) / (g.nx - 1) as f64, (y1 - y0) / (g.ny - 1) as f64);
+        if max > 0.0 {
+            let mut cells = Vec::new();
+            for j in 0..g.ny {
+                for i in 0..g.nx {
+                    let c = mean[j * g.nx + i] / max;
+                    if c > 1e-3 {
+                        let l = c.sqrt();
+                        let col =
+                            RGBColor(255, (246.0 - 120.0 * l) as u8, (236.0 - 190.0 * l) as u8);
+                        let (x, y) = (x0 + i as f64 * dx, y0 + j as f64 * dy);
+                        cells.push(Rectangle::new(
+                            [(x - dx / 2.0, y - dy / 2.0), (x + dx / 2.0, y + dy / 2.0)],
+                            col.filled(),
+                        ));
+                    }
+                }
+            }
+            chart
+                .draw_series(cells)
+                .map_err(err)?
+                .label("mean plume at vehicle altitude")
+                .legend(|(x, y)| {
+                    Rectangle::new(
+                        [(x, y - 5), (x + 14, y + 5)],
+                        RGBColor(255, 170, 100).filled(),
+                    )
+                });
+        }
+        chart
+            .draw_series(dashed(&run.op_area, BLACK, 2))
+            .map_err(err)?
+            .label("op-area")
+            .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 6, y)], BLACK.stroke_width(2)));
+        for r in &run.subregions {
+            chart
+                .draw_series(dashed(r, RGBColor(120, 120, 120), 1))
+                .map_err(err)?;
+        }
+
+        let vehicles: Vec<u32> = {
+            let mut v: Vec<u32> = run.trajectory.iter().map(|r| r.vehicle).collect();
+            v.sort_unstable();
+            v.dedup();
+            v
+        };
+        for &vid in &vehicles {
+            let rows: Vec<_> = run.trajectory.iter().filter(|r| r.vehicle == vid).collect();
+            let step = (rows.len() / 20_000).max(1);
+            let truth: Vec<(f64, f64)> = rows
+                .iter()
+                .step_by(step)
+                .map(|r| (r.true_x_m, r.true_y_m))
+                .collect();
+            let est: Vec<(f64, f64)> = rows
+                .iter()
+                .step_by(step)
+                .map(|r| (r.est_x_m, r.est_y_m))
+                .collect();
+            chart
+                .draw_series(std::iter::once(PathElement::new(
+                    truth,
+                    RGBColor(150, 150, 150).stroke_width(1),
+                )))
+                .map_err(err)?
+                .label("true track")
+                .legend(|(x, y)| {
+                    PathElement::new(
+                        vec![(x, y), (x + 16, y)],
+                        RGBColor(150, 150, 150).stroke_width(1),
+                    )
+                });
+            chart
+                .draw_series(std::iter::once(PathElement::new(
+                    est,
+                    RGBColor(20, 60, 160).stroke_width(2),
+                )))
+                .map_err(err)?
+                .label("track (navigation estimate)")
+                .legend(|(x, y)| {
+                    PathElement::new(
+                        vec![(x, y), (x + 16, y)],
+                        RGBColor(20, 60, 160).stroke_width(2),
+                    )
+                });
+            let hits: Vec<(f64, f64)> = rows
+                .iter()
+                .filter(|r| r.detection)
+                .map(|r| (r.est_x_m, r.est_y_m))
+                .collect();
+            chart
+                .draw_series(hits.iter().map(|&p| Cross::new(p, 3, RED.stroke_width(1))))
+                .map_err(err)?
+                .label("detection")
+                .legend(|(x, y)| Cross::new((x + 8, y), 4, RED.stroke_width(2)));
+        }
+        let lost: Vec<(f64, f64)> = run
+            .events
+            .iter()
+            .filter_map(|e| match &e.event {
+                EventKind::Planner(PlannerEvent::LostPoint { pos_m }) => Some((pos_m.x, pos_m.y)),
+                _ => None,
+            })
+            .collect();
+        chart
+            .draw_series(
+                lost.iter()
+                    .map(|&p| Circle::new(p, 5, RGBColor(230, 120, 0).stroke_width(2))),
+            )
+            .map_err(err)?
+            .label("lost point")
+            .legend(|(x, y)| Circle::new((x + 8, y), 5, RGBColor(230, 120, 0).stroke_width(2)));
+        chart
+            .draw_series(
+                run.sources
+                    .iter()
+                    .map(|s| TriangleMarker::new((s.x, s.y), 9, RGBColor(0, 140, 60).filled())),
+            )
+            .map_err(err)?
+            .label("true source")
+            .legend(|(x, y)| TriangleMarker::new((x + 8, y), 6, RGBColor(0, 140, 60).filled()));
+        let declared: Vec<(f64, f64)> = run
+            .summary
+            .declarations
+            .iter()
+            .map(|d| (d.x_m, d.y_m))
+            .collect();
+        chart
+            .draw_series(declared.iter().map(|&p| Circle::new(p, 7, BLACK.filled())))
+            .map_err(err)?
+            .label("declared source")
+            .legend(|(x, y)| Circle::new((x + 8, y), 5, BLACK.filled()));
+        chart
+            .configure_series_labels()
+            .background_style(WHITE.mix(0.9))
+            .border_style(BLACK)
+            .label_font(("sans-serif", 12))
+            .position(SeriesLabelPosition::LowerRight)
+            .draw()
+            .map_err(err)?;
+        root.present().map_err(err)?;
+    }
+    Ok(svg)
+}
