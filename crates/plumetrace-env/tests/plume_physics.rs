@@ -596,7 +596,7 @@ fn scanned_and_indexed_queries_agree() {
         ..FilamentParams::default()
     };
     let mut env = filament_env(domain, pompy_farrell(domain, 0.05), src, params, 0.05, 21);
-    env.spin_up(60.0, 0.5).unwrap();
+    env.spin_up(60.0, 0.2).unwrap();
     run(&mut env, 10.0);
     assert!((env.elapsed_s() - 70.0).abs() < 1e-9 && (env.time_s() - 10.0).abs() < 1e-9);
     let f = filaments(&env);
