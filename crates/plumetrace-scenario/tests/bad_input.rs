@@ -79,7 +79,11 @@ fn unknown_and_mistyped_keys_are_rejected_with_their_path() {
         ("[plume]\n", "[plume]\ngrowth_rate = 0.1\n", "plume"),
         ("model = \"farrell\"", "model = \"farel\"", "flow.model"),
         ("nx = 21", "nx = \"many\"", "flow.farrell.nx"),
-        ("name = \"demo\"", "name = \"demo\"\ncolour = 3", "colour"),
+        (
+            "name = \"plume-demo\"",
+            "name = \"plume-demo\"\ncolour = 3",
+            "colour",
+        ),
     ];
     for (from, to, key) in cases {
         let text = demo_with(|t| t.replacen(from, to, 1));

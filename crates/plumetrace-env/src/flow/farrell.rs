@@ -514,9 +514,20 @@ mod tests {
     fn the_corner_oscillator_limits_the_step() {
         // Damping 0.1, bandwidth 0.2 rad/s: dt < 2 z / w = 1 s. A small gain keeps the other
         // limits (advection, diffusion, Courant) far above it.
-        let region = Rect { x_min_m: 0.0, x_max_m: 1000.0, y_min_m: 0.0, y_max_m: 1000.0 };
-        let params = FarrellParams { noise_gain: 0.1, ..FarrellParams::default() };
-        let err = FarrellFlow::new(region, steady(0.1, 90.0), params, 2.0).err().map(|e| e.to_string()).unwrap_or_default();
+        let region = Rect {
+            x_min_m: 0.0,
+            x_max_m: 1000.0,
+            y_min_m: 0.0,
+            y_max_m: 1000.0,
+        };
+        let params = FarrellParams {
+            noise_gain: 0.1,
+            ..FarrellParams::default()
+        };
+        let err = FarrellFlow::new(region, steady(0.1, 90.0), params, 2.0)
+            .err()
+            .map(|e| e.to_string())
+            .unwrap_or_default();
         assert!(err.contains("sim.dt_s") && err.contains("1.0000"), "{err}");
         let f = FarrellFlow::new(region, steady(0.1, 90.0), params, 0.5).unwrap();
         assert!((f.max_stable_dt_s().unwrap() - 1.0).abs() < 1e-12);
