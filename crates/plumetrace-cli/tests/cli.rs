@@ -202,8 +202,8 @@ fn mission_run_writes_summary_trajectory_events_and_plot() {
     let dir = tempfile::tempdir().unwrap();
     let text = plumetrace_scenario::find_preset("demo").unwrap().toml;
     let text = text
-        .replace("time_limit_s = 1800.0", "time_limit_s = 200.0")
-        .replace("spinup_s = 1500.0", "spinup_s = 600.0");
+        .replace("time_limit_s = 2400.0", "time_limit_s = 200.0")
+        .replace("spinup_s = 3500.0", "spinup_s = 600.0");
     let path = dir.path().join("mission.toml");
     std::fs::write(&path, text).unwrap();
     let out = dir.path().join("m");
@@ -272,7 +272,7 @@ fn check_names_bad_planner_and_mission_keys() {
             "planner",
         ),
         (
-            demo.replace("time_limit_s = 1800.0", "time_limit_s = -1.0"),
+            demo.replace("time_limit_s = 2400.0", "time_limit_s = -1.0"),
             "mission.time_limit_s",
         ),
         (

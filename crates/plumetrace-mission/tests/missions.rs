@@ -77,7 +77,7 @@ fn same_seed_same_summary_and_trajectory() {
 
 #[test]
 fn the_demo_finds_the_plume_and_traces_it_towards_the_source() {
-    let run = run_mission(shortened("demo", 1500.0, 900.0, 1), &mut |_, _| {}).unwrap();
+    let run = run_mission(shortened("demo", 3500.0, 900.0, 1), &mut |_, _| {}).unwrap();
     let s = &run.summary;
     assert!(
         s.first_detection_s.is_finite() && s.first_detection_s < 300.0,
