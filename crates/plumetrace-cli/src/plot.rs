@@ -89,22 +89,13 @@ where
 {
     let err = |e: DrawingAreaErrorKind<DB::ErrorType>| anyhow!("drawing: {e:?}");
     let d = sc.env.domain();
-    let mut chart = ChartBuilder::on(area)
-        .caption(title, ("sans-serif", 18))
-        .margin(10)
-        .margin_right(30)
-        .x_label_area_size(40)
-        .y_label_area_size(60)
-        .build_cartesian_2d(d.x_min_m..d.x_max_m, d.y_min_m..d.y_max_m)
-        .map_err(err)?;
-    chart
-        .configure_mesh()
-        .disable_mesh()
-        .x_desc("East (m)")
-        .y_desc("North (m)")
-        .label_style(("sans-serif", 13))
-        .draw()
-        .map_err(err)?;
+    let mut chart = plumetrace_mission::plot::map_chart(
+        area,
+        title,
+        d.x_min_m..d.x_max_m,
+        d.y_min_m..d.y_max_m,
+    )
+    .map_err(anyhow::Error::msg)?;
     let max = values.iter().copied().fold(0.0, f64::max);
     // At most ~250 x 250 cells are drawn: coarser grids are subsampled.
     let stride_x = g.nx.div_ceil(250).max(1);

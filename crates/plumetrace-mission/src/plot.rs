@@ -4,11 +4,42 @@
 //! triangles, and the time-averaged plume at the vehicle's altitude as a light heat map.
 
 use crate::run::{EventKind, MissionRun};
+use plotters::coord::types::RangedCoordf64;
 use plotters::prelude::*;
 use plumetrace_core::{PlannerEvent, Vec2};
 
 fn err<E: std::fmt::Debug>(e: E) -> String {
     format!("drawing the figure: {e:?}")
+}
+
+/// A map panel: `title` above, East/North axes in metres over `x` and `y`, no grid lines. Shared
+/// by every figure so that maps look the same.
+pub fn map_chart<'a, DB: DrawingBackend + 'a>(
+    area: &'a DrawingArea<DB, plotters::coord::Shift>,
+    title: &str,
+    x: std::ops::Range<f64>,
+    y: std::ops::Range<f64>,
+) -> Result<ChartContext<'a, DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>, String>
+where
+    DB::ErrorType: 'static,
+{
+    let mut chart = ChartBuilder::on(area)
+        .caption(title, ("sans-serif", 18))
+        .margin(12)
+        .margin_right(25)
+        .x_label_area_size(40)
+        .y_label_area_size(60)
+        .build_cartesian_2d(x, y)
+        .map_err(err)?;
+    chart
+        .configure_mesh()
+        .disable_mesh()
+        .x_desc("East (m)")
+        .y_desc("North (m)")
+        .label_style(("sans-serif", 13))
+        .draw()
+        .map_err(err)?;
+    Ok(chart)
 }
 
 fn dashed(points: &[Vec2], colour: RGBColor, width: u32) -> Vec<PathElement<(f64, f64)>> {
@@ -50,22 +81,7 @@ pub fn mission_figure(run: &MissionRun, title: &str) -> Result<String, String> {
     {
         let root = SVGBackend::with_string(&mut svg, (width, height)).into_drawing_area();
         root.fill(&WHITE).map_err(err)?;
-        let mut chart = ChartBuilder::on(&root)
-            .caption(title, ("sans-serif", 18))
-            .margin(12)
-            .margin_right(20)
-            .x_label_area_size(40)
-            .y_label_area_size(60)
-            .build_cartesian_2d(x0..x1, y0..y1)
-            .map_err(err)?;
-        chart
-            .configure_mesh()
-            .disable_mesh()
-            .x_desc("East (m)")
-            .y_desc("North (m)")
-            .label_style(("sans-serif", 13))
-            .draw()
-            .map_err(err)?;
+        let mut chart = map_chart(&root, title, x0..x1, y0..y1)?;
 
         // Plume: square-root scale of the time-averaged concentration, light.
         let mean = run.mean_plume.mean();
