@@ -120,6 +120,21 @@ impl Default for AmpParams {
     }
 }
 
+impl AmpParams {
+    /// A Follow Line leg from `a` to `b` with the planner's speed, radius, gain and turning radius
+    /// (approaching the start with the line's heading).
+    fn line(&self, a: Vec2, b: Vec2) -> FollowLine {
+        FollowLine::new(
+            a,
+            b,
+            self.speed_mps,
+            self.r_m,
+            self.k_deg_per_m,
+            self.min_turn_radius_m,
+        )
+    }
+}
+
 /// The AMP behaviours, by their registry names.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
@@ -417,14 +432,7 @@ impl Amp {
             self.next_region(t);
         } else if let Some(m) = self.p.mapping {
             let legs = m.legs(at, self.flow.toward());
-            let line = FollowLine::new(
-                legs[0].0,
-                legs[0].1,
-                self.p.speed_mps,
-                self.p.r_m,
-                self.p.k_deg_per_m,
-                self.p.min_turn_radius_m,
-            );
+            let line = self.p.line(legs[0].0, legs[0].1);
             self.set_mode(Mode::Mapping {
                 legs,
                 k: 0,
@@ -476,14 +484,7 @@ impl Amp {
             self.p.bowtie_angle_deg,
             self.p.bowtie_half_width_m,
         );
-        let line = FollowLine::new(
-            b.first.0,
-            b.first.1,
-            self.p.speed_mps,
-            self.p.r_m,
-            self.p.k_deg_per_m,
-            self.p.min_turn_radius_m,
-        );
+        let line = self.p.line(b.first.0, b.first.1);
         (b, line)
     }
 
@@ -594,8 +595,7 @@ impl Amp {
                 ModeStatus::Running(s) => Some(Some(s)),
                 ModeStatus::Done(_) => {
                     r.leg += 1;
-                    let (speed, radius, k, turn) =
-                        (p.speed_mps, p.r_m, p.k_deg_per_m, p.min_turn_radius_m);
+                    let (speed, radius, k) = (p.speed_mps, p.r_m, p.k_deg_per_m);
                     match r.leg {
                         // The side of the Bowtie: from the end of the first line, downflow, to the start of the second.
                         1 => {
@@ -607,16 +607,7 @@ impl Amp {
                                 k,
                             )
                         }
-                        2 => {
-                            r.line = FollowLine::new(
-                                r.bowtie.second.0,
-                                r.bowtie.second.1,
-                                speed,
-                                radius,
-                                k,
-                                turn,
-                            )
-                        }
+                        2 => r.line = p.line(r.bowtie.second.0, r.bowtie.second.1),
                         _ => {
                             let (point, n) = (r.point, r.n + 1);
                             if n < p.n_re.max(1) {
@@ -643,14 +634,7 @@ impl Amp {
                     *k += 1;
                     if *k < legs.len() {
                         let (a, b) = legs[*k];
-                        **line = FollowLine::new(
-                            a,
-                            b,
-                            p.speed_mps,
-                            p.r_m,
-                            p.k_deg_per_m,
-                            p.min_turn_radius_m,
-                        );
+                        **line = p.line(a, b);
                     } else {
                         self.set_mode(Mode::Done);
                     }
