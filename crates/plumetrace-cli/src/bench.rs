@@ -1,4 +1,5 @@
-//! `plumetrace bench plume`: times the plume model and prints one JSON object.
+//! `plumetrace bench plume` times the plume model; `plumetrace bench missions` times whole
+//! missions on several thread counts. Each prints one JSON object.
 //!
 //! The pompy case is pompy's own scenario (x 0-100 m, y -50-50 m, 21 x 21 Farrell grid, 1 m/s,
 //! source at (5, 0), dt 0.01 s); the field case is the `field-scale` preset. After a warm-up the
@@ -23,6 +24,98 @@ use std::time::Instant;
 pub enum BenchCommand {
     /// Time the filament plume (stepping and point queries).
     Plume(PlumeBenchArgs),
+    /// Missions per second of a mission preset on 1, 2, ... threads (as a campaign runs them).
+    Missions(MissionBenchArgs),
+}
+
+/// Arguments of `plumetrace bench missions`.
+#[derive(Debug, clap::Args)]
+pub struct MissionBenchArgs {
+    /// Mission preset to fly.
+    #[arg(long, default_value = "duck-2003-st")]
+    preset: String,
+    /// Missions per thread count (the same missions, seeds derived from `--seed`, each time).
+    #[arg(long, default_value_t = 8)]
+    runs: u64,
+    /// Thread counts to time, comma-separated.
+    #[arg(long, value_delimiter = ',', default_value = "1,2")]
+    threads: Vec<usize>,
+    /// Base seed.
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+}
+
+#[derive(Debug, Serialize)]
+struct MissionBench {
+    preset: String,
+    runs: u64,
+    mean_mission_s: f64,
+    results: Vec<MissionBenchRow>,
+    /// missions/s on the largest thread count over missions/s on the smallest.
+    scaling: f64,
+}
+
+#[derive(Debug, Serialize)]
+struct MissionBenchRow {
+    threads: usize,
+    wall_s: f64,
+    missions_per_s: f64,
+    real_time_factor: f64,
+}
+
+/// Flies `runs` missions of the preset on each thread count, as a campaign does (no mean-plume
+/// grid, no trajectory kept).
+fn missions(a: &MissionBenchArgs) -> Result<MissionBench> {
+    use rayon::prelude::*;
+    if a.runs == 0 || a.threads.is_empty() || a.threads.contains(&0) {
+        bail!("--runs and every --threads value must be at least 1");
+    }
+    let cfg = plumetrace_scenario::load_preset(&a.preset)?;
+    let origin = plumetrace_scenario::Origin::Preset(a.preset.clone());
+    if plumetrace_scenario::build(&cfg, &origin, None)?
+        .mission
+        .is_none()
+    {
+        bail!("preset '{}' is not a mission", a.preset);
+    }
+    let options = plumetrace_mission::MissionOptions {
+        mean_plume: false,
+        trajectory: false,
+    };
+    let mut results = Vec::new();
+    let mut sim_s = 0.0;
+    for &t in &a.threads {
+        let pool = rayon::ThreadPoolBuilder::new().num_threads(t).build()?;
+        let started = Instant::now();
+        let times: Vec<Result<f64>> = pool.install(|| {
+            (0..a.runs)
+                .into_par_iter()
+                .map(|i| {
+                    let seed = plumetrace_env::derive_seed(a.seed, i);
+                    let sc = plumetrace_scenario::build(&cfg, &origin, Some(seed))?;
+                    let run = plumetrace_mission::run_mission_with(sc, options, &mut |_, _| {})?;
+                    Ok(run.summary.sim_time_s)
+                })
+                .collect()
+        });
+        let wall = started.elapsed().as_secs_f64();
+        sim_s = times.into_iter().sum::<Result<f64>>()?;
+        results.push(MissionBenchRow {
+            threads: t,
+            wall_s: wall,
+            missions_per_s: a.runs as f64 / wall,
+            real_time_factor: sim_s / wall,
+        });
+    }
+    let first = results.first().map_or(f64::NAN, |r| r.missions_per_s);
+    let last = results.last().map_or(f64::NAN, |r| r.missions_per_s);
+    Ok(MissionBench {
+        preset: a.preset.clone(),
+        runs: a.runs,
+        mean_mission_s: sim_s / a.runs as f64,
+        results,
+        scaling: last / first,
+    })
 }
 
 /// Which scenario to benchmark.
@@ -104,6 +197,11 @@ pub fn run(cmd: &BenchCommand) -> Result<()> {
     match cmd {
         BenchCommand::Plume(a) => {
             let r = plume(a)?;
+            println!("{}", serde_json::to_string_pretty(&r)?);
+            Ok(())
+        }
+        BenchCommand::Missions(a) => {
+            let r = missions(a)?;
             println!("{}", serde_json::to_string_pretty(&r)?);
             Ok(())
         }

@@ -1,10 +1,12 @@
 //! The `plumetrace` command.
 //!
-//! Subcommands: `run` (fly a mission, or simulate a plume, and write the outputs), `presets` (list the built-in
-//! scenarios), `check` (validate a scenario file), `bench plume` (time the plume model on pompy's
-//! scenario or a field-scale one and print JSON).
+//! Subcommands: `run` (fly a mission, or simulate a plume, and write the outputs), `presets` (list
+//! the built-in scenarios), `check` (validate a scenario file), `campaign` and `merge` (Monte
+//! Carlo campaigns), `bench plume` (time the plume model on pompy's scenario or a field-scale one)
+//! and `bench missions` (missions per second on 1 and more threads); benchmarks print JSON.
 
 mod bench;
+mod campaign;
 mod mission;
 mod output;
 mod plot;
@@ -34,6 +36,10 @@ enum Command {
         /// The scenario file (TOML).
         file: PathBuf,
     },
+    /// Run a Monte Carlo campaign (resumable, parallel, shardable) and summarise it.
+    Campaign(campaign::CampaignArgs),
+    /// Merge the output directories of a campaign's shards.
+    Merge(campaign::MergeArgs),
     /// Benchmarks; print one JSON object.
     #[command(subcommand)]
     Bench(bench::BenchCommand),
@@ -82,6 +88,8 @@ fn dispatch(cli: Cli) -> Result<()> {
             );
             Ok(())
         }
+        Command::Campaign(args) => campaign::run(&args),
+        Command::Merge(args) => campaign::run_merge(&args),
         Command::Bench(b) => bench::run(&b),
     }
 }

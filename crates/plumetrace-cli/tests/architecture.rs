@@ -52,6 +52,16 @@ const RULES: &[(&str, Side, &[&str])] = &[
         ],
     ),
     (
+        "plumetrace-campaign",
+        Side::App,
+        &[
+            "plumetrace-core",
+            "plumetrace-env",
+            "plumetrace-scenario",
+            "plumetrace-mission",
+        ],
+    ),
+    (
         "plumetrace-cli",
         Side::App,
         &[
@@ -60,6 +70,7 @@ const RULES: &[(&str, Side, &[&str])] = &[
             "plumetrace-sim",
             "plumetrace-scenario",
             "plumetrace-mission",
+            "plumetrace-campaign",
         ],
     ),
 ];

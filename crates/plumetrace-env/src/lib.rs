@@ -27,4 +27,4 @@ pub use field::{ConcentrationField, GridSpec, MeanConcentrationGrid};
 pub use flow::{FlowField, FlowModel};
 pub use obstacle::{ObstacleSet, SoftObstacle};
 pub use plume::{FilamentParams, FilamentPlume, PlumeStats, Source, VerticalBoundary};
-pub use rng::{SimRng, StreamId, stream_rng};
+pub use rng::{SimRng, StreamId, derive_seed, stream_rng};

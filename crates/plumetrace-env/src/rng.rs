@@ -48,6 +48,13 @@ fn splitmix64(state: &mut u64) -> u64 {
     z ^ (z >> 31)
 }
 
+/// The seed of run `index` of a family of runs seeded with `seed` (a campaign): well spread, so
+/// neighbouring indices give unrelated runs, and fixed, so run `index` always meets the same plume.
+pub fn derive_seed(seed: u64, index: u64) -> u64 {
+    let mut s = seed ^ index.wrapping_mul(0xd1b5_4a32_d192_ed03);
+    splitmix64(&mut s)
+}
+
 /// The random stream of subsystem `stream` in the run seeded with `seed`.
 pub fn stream_rng(seed: u64, stream: StreamId) -> SimRng {
     let mut s = seed;

@@ -6,9 +6,13 @@
 //! time limit, and records what happened: the trajectory, the event stream, a summary with the
 //! declaration errors, and a figure.
 
+pub mod output;
 pub mod planner_config;
 pub mod plot;
 pub mod run;
 
 pub use planner_config::{PlannerError, amp_params};
-pub use run::{MissionError, MissionRun, Outcome, Summary, TrajectoryRow, run_mission};
+pub use run::{
+    MissionError, MissionOptions, MissionRun, Outcome, Summary, TrajectoryRow, run_mission,
+    run_mission_with,
+};

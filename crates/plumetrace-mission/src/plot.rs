@@ -31,9 +31,15 @@ where
         .y_label_area_size(60)
         .build_cartesian_2d(x, y)
         .map_err(err)?;
+    // Whole metres, and about one label per 90 pixels so that narrow panels stay readable.
+    let (w, h) = area.dim_in_pixel();
     chart
         .configure_mesh()
         .disable_mesh()
+        .x_labels((w / 90).clamp(3, 10) as usize)
+        .y_labels((h / 60).clamp(3, 12) as usize)
+        .x_label_formatter(&|v| format!("{v:.0}"))
+        .y_label_formatter(&|v| format!("{v:.0}"))
         .x_desc("East (m)")
         .y_desc("North (m)")
         .label_style(("sans-serif", 13))
@@ -42,8 +48,8 @@ where
     Ok(chart)
 }
 
-fn dashed(points: &[Vec2], colour: RGBColor, width: u32) -> Vec<PathElement<(f64, f64)>> {
-    // Closed polygon as short dashes of 8 m with 6 m gaps.
+/// A closed polygon drawn dashed (dash length scaled to the edge, gaps 3/4 of a dash).
+pub fn dashed(points: &[Vec2], colour: RGBColor, width: u32) -> Vec<PathElement<(f64, f64)>> {
     let mut out = Vec::new();
     let n = points.len();
     for i in 0..n {

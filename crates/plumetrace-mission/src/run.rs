@@ -173,6 +173,9 @@ pub struct Summary {
     pub declaration_s: f64,
     /// Distance travelled over ground by the first AUV, m.
     pub path_length_m: f64,
+    /// Distance it travelled from its first detection to the first declaration, m (NaN if none
+    /// declared).
+    pub trace_length_m: f64,
     /// Straight-line distance from the first detection to the source, m (NaN without detection).
     pub detection_to_source_m: f64,
     /// Mission time, s.
@@ -206,9 +209,38 @@ pub struct MissionRun {
     pub mean_flow_mps: Vec2,
 }
 
-/// Runs a scenario's mission; `progress` is called with the mission time now and then.
+/// What a mission records besides its summary and events.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct MissionOptions {
+    /// Accumulate the time-averaged plume over the op-area for the figure (costs a grid of
+    /// concentration queries every 20 s).
+    pub mean_plume: bool,
+    /// Keep every step of the trajectory (otherwise `trajectory` stays empty).
+    pub trajectory: bool,
+}
+
+impl Default for MissionOptions {
+    fn default() -> Self {
+        MissionOptions {
+            mean_plume: true,
+            trajectory: true,
+        }
+    }
+}
+
+/// Runs a scenario's mission recording everything; `progress` is called with the mission time
+/// now and then.
 pub fn run_mission(
     sc: BuiltScenario,
+    progress: &mut dyn FnMut(f64, f64),
+) -> Result<MissionRun, MissionError> {
+    run_mission_with(sc, MissionOptions::default(), progress)
+}
+
+/// Runs a scenario's mission recording what `options` asks for.
+pub fn run_mission_with(
+    sc: BuiltScenario,
+    options: MissionOptions,
     progress: &mut dyn FnMut(f64, f64),
 ) -> Result<MissionRun, MissionError> {
     let BuiltScenario {
@@ -297,6 +329,15 @@ pub fn run_mission(
     let mut first_detection = f64::NAN;
     let mut first_detection_pos = None;
     let mut declarations: Vec<(f64, Vec2)> = Vec::new();
+    // Distance over ground of the first AUV, in total and from its first detection to its first
+    // declaration (the traced path).
+    let tracer = setups
+        .iter()
+        .position(|v| v.vehicle.params.kind == VehicleKind::Auv)
+        .unwrap_or(0);
+    let mut path_length_m = 0.0;
+    let mut trace_length_m = 0.0;
+    let mut last_pos: Option<Vec2> = None;
     let steps = (spec.time_limit_s / dt_s).round() as u64;
     for k in 0..steps {
         let t = world.time_s();
@@ -353,7 +394,18 @@ pub fn run_mission(
                 Incident::Collided => Outcome::Collided,
             });
         }
-        for v in world.vehicles() {
+        if let Some(v) = world.vehicles().get(tracer) {
+            let p = v.vehicle.state.pos_m;
+            if let Some(q) = last_pos {
+                let step = (p - q).norm();
+                path_length_m += step;
+                if !first_detection.is_nan() && declarations.is_empty() {
+                    trace_length_m += step;
+                }
+            }
+            last_pos = Some(p);
+        }
+        for v in world.vehicles().iter().filter(|_| options.trajectory) {
             let s = v.vehicle.state;
             let est = v.nav.estimate_m();
             let chem = v.last_chem;
@@ -373,7 +425,9 @@ pub fn run_mission(
             });
         }
         if k.is_multiple_of(sample_every) {
-            mean_plume.accumulate(world.env().plume());
+            if options.mean_plume {
+                mean_plume.accumulate(world.env().plume());
+            }
             if let Some(s) = sources.first() {
                 flow_sum += world.env().flow().velocity(s.xy());
                 flow_n += 1.0;
@@ -414,7 +468,6 @@ pub fn run_mission(
         .map(|(t, p)| declaration_record(*t, *p, &sources, mean_flow))
         .collect();
     let first = records.first();
-    let path_length_m = path_length(&trajectory, 0);
     let src0 = first
         .map(|r| Vec2::new(r.source_x_m, r.source_y_m))
         .or_else(|| sources.first().map(|s| s.xy()))
@@ -434,6 +487,11 @@ pub fn run_mission(
         first_detection_s: first_detection,
         declaration_s: first.map_or(f64::NAN, |r| r.t_s),
         path_length_m,
+        trace_length_m: if first.is_some() {
+            trace_length_m
+        } else {
+            f64::NAN
+        },
         detection_to_source_m: first_detection_pos.map_or(f64::NAN, |p| (p - src0).norm()),
         sim_time_s: sim_time,
         declarations: records,
@@ -472,17 +530,4 @@ fn declaration_record(t: f64, p: Vec2, sources: &[Vec3], mean_flow: Vec2) -> Dec
         error_along_m: d.dot(&u),
         error_cross_m: d.dot(&right),
     }
-}
-
-fn path_length(rows: &[TrajectoryRow], vehicle: u32) -> f64 {
-    let mut len = 0.0;
-    let mut last: Option<Vec2> = None;
-    for r in rows.iter().filter(|r| r.vehicle == vehicle) {
-        let p = Vec2::new(r.true_x_m, r.true_y_m);
-        if let Some(q) = last {
-            len += (p - q).norm();
-        }
-        last = Some(p);
-    }
-    len
 }

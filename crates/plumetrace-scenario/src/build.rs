@@ -576,12 +576,8 @@ fn vehicle_setup(
     let nav = NavParams {
         fix_interval_s: n.fix_interval_s.unwrap_or(nb.fix_interval_s),
         fix_sigma_m: n.fix_sigma_m.unwrap_or(nb.fix_sigma_m),
-        velocity_drift_mps_per_sqrt_s: n
-            .velocity_drift_mps_per_sqrt_s
-            .unwrap_or(nb.velocity_drift_mps_per_sqrt_s),
-        velocity_error_max_mps: n
-            .velocity_error_max_mps
-            .unwrap_or(nb.velocity_error_max_mps),
+        velocity_error_sd_mps: n.velocity_error_sd_mps.unwrap_or(nb.velocity_error_sd_mps),
+        velocity_error_tau_s: n.velocity_error_tau_s.unwrap_or(nb.velocity_error_tau_s),
         heading_sd_deg: n.heading_sd_deg.unwrap_or(nb.heading_sd_deg),
     };
     nav.validate(&format!("{key}.nav"))?;

@@ -364,10 +364,10 @@ pub struct NavConfig {
     pub fix_interval_s: Option<f64>,
     /// Fix error per axis, m.
     pub fix_sigma_m: Option<f64>,
-    /// Dead-reckoning velocity error growth, m/s per sqrt(s).
-    pub velocity_drift_mps_per_sqrt_s: Option<f64>,
-    /// Cap on the dead-reckoning velocity error, m/s.
-    pub velocity_error_max_mps: Option<f64>,
+    /// Dead-reckoning velocity error, standard deviation per axis, m/s.
+    pub velocity_error_sd_mps: Option<f64>,
+    /// Its correlation time, s.
+    pub velocity_error_tau_s: Option<f64>,
     /// Compass noise, deg.
     pub heading_sd_deg: Option<f64>,
 }

@@ -52,6 +52,19 @@ pub fn parse(text: &str, origin: &Origin) -> Result<ScenarioConfig, ScenarioErro
     })
 }
 
+/// Reads a scenario from an already parsed TOML table (e.g. a scenario with overrides applied);
+/// errors name the key path.
+pub fn from_table(table: toml::Table, origin: &Origin) -> Result<ScenarioConfig, ScenarioError> {
+    serde_path_to_error::deserialize(toml::Value::Table(table)).map_err(|e| {
+        let path = e.path().to_string();
+        ScenarioError::Parse {
+            origin: origin.to_string(),
+            path: if path == "." { String::new() } else { path },
+            message: e.into_inner().to_string(),
+        }
+    })
+}
+
 /// Reads and parses a scenario file.
 pub fn load_file(path: &Path) -> Result<ScenarioConfig, ScenarioError> {
     let origin = Origin::File(path.to_path_buf());

@@ -1,8 +1,9 @@
 //! Navigation: what the vehicle believes about where it is.
 //!
 //! An AUV dead-reckons: it integrates its measured heading and water-relative speed plus the
-//! measured current, with a slowly drifting velocity error (a random walk), so the estimate wanders
-//! away from the truth. Periodic long-baseline fixes reset it to the truth plus the fix error,
+//! measured current, with a slowly varying velocity error (a first-order Gauss-Markov process:
+//! stationary, so the navigation is as good late in a long mission as early on), so the estimate
+//! wanders away from the truth. Periodic long-baseline fixes reset it to the truth plus the fix error,
 //! which makes the estimate jump (up to about 10 m in the field). A surface craft works the same
 //! way with frequent, accurate GPS fixes. The planner sees only the estimate.
 
@@ -20,24 +21,25 @@ pub struct NavParams {
     pub fix_interval_s: f64,
     /// Standard deviation of a fix's error per axis, m.
     pub fix_sigma_m: f64,
-    /// Growth of the dead-reckoning velocity error: random-walk intensity per axis,
-    /// m/s per sqrt(s).
-    pub velocity_drift_mps_per_sqrt_s: f64,
-    /// Cap on the dead-reckoning velocity error per axis, m/s.
-    pub velocity_error_max_mps: f64,
+    /// Standard deviation of the dead-reckoning velocity error per axis, m/s (its stationary
+    /// value: the error starts at zero, as after a calibration, and settles there).
+    pub velocity_error_sd_mps: f64,
+    /// Correlation time of the dead-reckoning velocity error, s.
+    pub velocity_error_tau_s: f64,
     /// Compass noise, degrees (standard deviation).
     pub heading_sd_deg: f64,
 }
 
 impl NavParams {
     /// An AUV with long-baseline fixes every 5 minutes, 2 m fix error and a dead-reckoning
-    /// velocity error that drifts by about 1 cm/s in 5 minutes.
+    /// velocity error of 1 cm/s per axis (half a percent of 2 m/s) correlated over 20 minutes:
+    /// about 3 m of drift per axis between fixes, so fixes jump the estimate by up to about 10 m.
     pub fn lbl() -> Self {
         NavParams {
             fix_interval_s: 300.0,
             fix_sigma_m: 2.0,
-            velocity_drift_mps_per_sqrt_s: 0.0006,
-            velocity_error_max_mps: 0.05,
+            velocity_error_sd_mps: 0.01,
+            velocity_error_tau_s: 1200.0,
             heading_sd_deg: 0.5,
         }
     }
@@ -47,8 +49,8 @@ impl NavParams {
         NavParams {
             fix_interval_s: 1.0,
             fix_sigma_m: 1.5,
-            velocity_drift_mps_per_sqrt_s: 0.0,
-            velocity_error_max_mps: 0.0,
+            velocity_error_sd_mps: 0.0,
+            velocity_error_tau_s: 1200.0,
             heading_sd_deg: 1.0,
         }
     }
@@ -58,12 +60,12 @@ impl NavParams {
         require_positive(&format!("{key}.fix_interval_s"), self.fix_interval_s)?;
         require_non_negative(&format!("{key}.fix_sigma_m"), self.fix_sigma_m)?;
         require_non_negative(
-            &format!("{key}.velocity_drift_mps_per_sqrt_s"),
-            self.velocity_drift_mps_per_sqrt_s,
+            &format!("{key}.velocity_error_sd_mps"),
+            self.velocity_error_sd_mps,
         )?;
-        require_non_negative(
-            &format!("{key}.velocity_error_max_mps"),
-            self.velocity_error_max_mps,
+        require_positive(
+            &format!("{key}.velocity_error_tau_s"),
+            self.velocity_error_tau_s,
         )?;
         require_non_negative(&format!("{key}.heading_sd_deg"), self.heading_sd_deg)
     }
@@ -142,12 +144,10 @@ impl Navigator {
         self.last_water_velocity = water;
         self.estimate_m += v * dt_s;
         let (ex, ey): (f64, f64) = (StandardNormal.sample(rng), StandardNormal.sample(rng));
-        let kick = p.velocity_drift_mps_per_sqrt_s * dt_s.sqrt();
-        let cap = p.velocity_error_max_mps;
-        self.velocity_error_mps = Vec2::new(
-            (self.velocity_error_mps.x + kick * ex).clamp(-cap, cap),
-            (self.velocity_error_mps.y + kick * ey).clamp(-cap, cap),
-        );
+        // Exact discretisation of dv = -v / tau dt + sd sqrt(2 / tau) dW.
+        let a = (-dt_s / p.velocity_error_tau_s).exp();
+        let kick = p.velocity_error_sd_mps * (1.0 - a * a).sqrt();
+        self.velocity_error_mps = self.velocity_error_mps * a + Vec2::new(ex, ey) * kick;
         if t_s + 1e-9 >= self.next_fix_s {
             while self.next_fix_s <= t_s + 1e-9 {
                 self.next_fix_s += p.fix_interval_s;

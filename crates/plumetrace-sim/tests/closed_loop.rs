@@ -82,8 +82,8 @@ fn perfect_nav() -> NavParams {
     NavParams {
         fix_interval_s: 1e9,
         fix_sigma_m: 0.0,
-        velocity_drift_mps_per_sqrt_s: 0.0,
-        velocity_error_max_mps: 0.0,
+        velocity_error_sd_mps: 0.0,
+        velocity_error_tau_s: 1200.0,
         heading_sd_deg: 0.0,
     }
 }

@@ -50,8 +50,8 @@ fn navigation_error_grows_between_fixes_and_jumps_back_at_each() {
     let params = NavParams {
         fix_interval_s: 200.0,
         fix_sigma_m: 0.5,
-        velocity_drift_mps_per_sqrt_s: 0.002,
-        velocity_error_max_mps: 0.1,
+        velocity_error_sd_mps: 0.03,
+        velocity_error_tau_s: 600.0,
         heading_sd_deg: 0.5,
     };
     let mut v = Vehicle::new(
@@ -105,4 +105,50 @@ fn navigation_error_grows_between_fixes_and_jumps_back_at_each() {
         "fixes should pull the estimate back: before {b}, after {a}"
     );
     assert!(fixes.iter().all(|f| (f.jump_m() - 0.0).abs() > 0.0));
+}
+
+#[test]
+fn dead_reckoning_drift_is_stationary_and_matches_the_gauss_markov_variance() {
+    // A vehicle at rest: every metre the estimate moves between fixes is velocity error.
+    let params = NavParams {
+        fix_interval_s: 300.0,
+        fix_sigma_m: 0.0,
+        velocity_error_sd_mps: 0.01,
+        velocity_error_tau_s: 1200.0,
+        heading_sd_deg: 0.0,
+    };
+    let v = Vehicle::new(
+        VehicleId(0),
+        VehicleParams::auv(),
+        Vec2::zeros(),
+        0.0,
+        Heading::NORTH,
+    );
+    let mut nav = Navigator::new(params, &v.state);
+    let mut rng = stream_rng(11, StreamId::Sensor(0, 9));
+    let dt = 0.5;
+    let mut drifts = Vec::new();
+    for k in 1..=(1_200_000 / 5) as u32 {
+        let t = f64::from(k) * dt;
+        if let Some(fix) = nav.update(&v.state, None, t, dt, &mut rng) {
+            drifts.push(fix.before_m - fix.after_m);
+        }
+    }
+    // Skip the first two correlation times (the error starts at zero).
+    let drifts = &drifts[8..];
+    let sd = |d: &[Vec2]| {
+        (d.iter().map(|p| p.x * p.x + p.y * p.y).sum::<f64>() / (2.0 * d.len() as f64)).sqrt()
+    };
+    // Variance of the integral of a stationary Gauss-Markov process over T:
+    // 2 s^2 tau^2 (T / tau - 1 + exp(-T / tau)).
+    let (s, tau, t) = (0.01_f64, 1200.0_f64, 300.0_f64);
+    let want = (2.0 * s * s * tau * tau * (t / tau - 1.0 + (-t / tau).exp())).sqrt();
+    let (first, second) = drifts.split_at(drifts.len() / 2);
+    let (all, a, b) = (sd(drifts), sd(first), sd(second));
+    eprintln!("drift per axis over 300 s: {all:.2} m (theory {want:.2}); halves {a:.2}, {b:.2}");
+    assert!((all / want - 1.0).abs() < 0.15, "{all} vs {want}");
+    assert!(
+        (a / b - 1.0).abs() < 0.3,
+        "drift should not grow with mission time: {a} then {b}"
+    );
 }

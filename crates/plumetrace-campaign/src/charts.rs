@@ -1,0 +1,575 @@
+//! Campaign charts (SVG): success rates with Wilson intervals, error distributions, and one
+//! example track per group.
+
+use crate::error::CampaignError;
+use crate::example::ExampleRun;
+use crate::runs::RunRow;
+use crate::spec::{Campaign, RunKey};
+use crate::stats::{GroupSummary, quantile};
+use plotters::coord::types::RangedCoordf64;
+use plotters::prelude::*;
+use plotters::style::text_anchor;
+use plumetrace_core::Vec2;
+use std::path::Path;
+
+fn err<E: std::fmt::Debug>(what: &str) -> impl Fn(E) -> CampaignError + '_ {
+    move |e| CampaignError::Chart {
+        what: what.to_string(),
+        message: format!("{e:?}"),
+    }
+}
+
+/// Distinct colours for series (colour-blind-safe set by Okabe and Ito).
+const PALETTE: [RGBColor; 8] = [
+    RGBColor(0, 114, 178),
+    RGBColor(213, 94, 0),
+    RGBColor(0, 158, 115),
+    RGBColor(204, 121, 167),
+    RGBColor(230, 159, 0),
+    RGBColor(86, 180, 233),
+    RGBColor(120, 120, 120),
+    RGBColor(0, 0, 0),
+];
+
+/// The label of a group in charts: the configuration, then the sweep point, then the scenario
+/// when the campaign has several.
+fn group_label(c: &Campaign, g: &GroupSummary) -> String {
+    let mut s = g.config.clone();
+    if !g.point.is_empty() {
+        s = format!("{s} · {}", g.point.replace(';', ", "));
+    }
+    if c.scenarios.len() > 1 {
+        s = format!("{} · {s}", g.scenario);
+    }
+    s
+}
+
+fn label_width(labels: &[String]) -> u32 {
+    let longest = labels.iter().map(|l| l.chars().count()).max().unwrap_or(4) as u32;
+    (longest * 7 + 16).clamp(60, 420)
+}
+
+/// The sweep key and numeric values when the campaign sweeps exactly one numeric key.
+fn numeric_sweep(c: &Campaign) -> Option<(String, Vec<f64>)> {
+    if c.file.sweep.len() != 1 || c.points.len() < 2 {
+        return None;
+    }
+    let (key, _) = c.file.sweep.iter().next()?;
+    let values: Option<Vec<f64>> = c
+        .points
+        .iter()
+        .map(|p| match &p.values[0].1 {
+            toml::Value::Float(f) => Some(*f),
+            toml::Value::Integer(i) => Some(*i as f64),
+            _ => None,
+        })
+        .collect();
+    Some((key.clone(), values?))
+}
+
+/// `success.svg`.
+pub fn success_chart(c: &Campaign, groups: &[GroupSummary]) -> Result<String, CampaignError> {
+    if let Some((key, values)) = numeric_sweep(c) {
+        return success_vs_sweep(c, groups, &key, &values);
+    }
+    let e = err("success.svg");
+    let labels: Vec<String> = groups.iter().map(|g| group_label(c, g)).collect();
+    let n = groups.len().max(1);
+    let lw = label_width(&labels);
+    let (width, height) = (lw + 620, (n as u32 * 34 + 130).max(220));
+    let mut svg = String::new();
+    {
+        let root = SVGBackend::with_string(&mut svg, (width, height)).into_drawing_area();
+        root.fill(&WHITE).map_err(&e)?;
+        let mut chart = ChartBuilder::on(&root)
+            .caption(
+                format!("{}: success rate with Wilson 95 % intervals", c.file.name),
+                ("sans-serif", 17),
+            )
+            .margin(12)
+            .margin_right(30)
+            .x_label_area_size(40)
+            .y_label_area_size(lw)
+            .build_cartesian_2d(0.0..1.0, -0.6..(n as f64 - 0.4))
+            .map_err(&e)?;
+        chart
+            .configure_mesh()
+            .disable_y_mesh()
+            .y_labels(0)
+            .x_desc(success_desc(c))
+            .label_style(("sans-serif", 13))
+            .draw()
+            .map_err(&e)?;
+        for (i, g) in groups.iter().enumerate() {
+            let y = (n - 1 - i) as f64;
+            let col = PALETTE[i % PALETTE.len()];
+            chart
+                .draw_series([
+                    PathElement::new(
+                        vec![(g.success_ci_low, y), (g.success_ci_high, y)],
+                        col.stroke_width(2),
+                    ),
+                    PathElement::new(
+                        vec![(g.success_ci_low, y - 0.15), (g.success_ci_low, y + 0.15)],
+                        col.stroke_width(2),
+                    ),
+                    PathElement::new(
+                        vec![(g.success_ci_high, y - 0.15), (g.success_ci_high, y + 0.15)],
+                        col.stroke_width(2),
+                    ),
+                ])
+                .map_err(&e)?;
+            if g.success_rate.is_finite() {
+                chart
+                    .draw_series([Circle::new((g.success_rate, y), 6, col.filled())])
+                    .map_err(&e)?;
+                let (px, py) = chart.backend_coord(&(g.success_ci_high, y));
+                root.draw(&Text::new(
+                    format!(
+                        "{}/{} = {:.2} ({:.2}–{:.2})",
+                        g.successes, g.runs, g.success_rate, g.success_ci_low, g.success_ci_high
+                    ),
+                    (px.min(width as i32 - 190) + 8, py - 20),
+                    ("sans-serif", 12).into_font().color(&BLACK),
+                ))
+                .map_err(&e)?;
+            }
+        }
+        row_labels(&root, &chart, &labels).map_err(&e)?;
+        root.present().map_err(&e)?;
+    }
+    Ok(svg)
+}
+
+fn success_desc(c: &Campaign) -> String {
+    match c.success_radius_m() {
+        Some(r) => format!("fraction of runs declaring within {r} m of a source"),
+        None => "fraction of runs declaring a source".into(),
+    }
+}
+
+/// Writes `labels[i]` right-aligned left of row `n - 1 - i`.
+fn row_labels<DB: DrawingBackend>(
+    root: &DrawingArea<DB, plotters::coord::Shift>,
+    chart: &ChartContext<'_, DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>,
+    labels: &[String],
+) -> Result<(), DrawingAreaErrorKind<DB::ErrorType>> {
+    let n = labels.len();
+    let x0 = chart.x_range().start;
+    for (i, l) in labels.iter().enumerate() {
+        let (px, py) = chart.backend_coord(&(x0, (n - 1 - i) as f64));
+        let style = ("sans-serif", 13)
+            .into_font()
+            .color(&BLACK)
+            .pos(text_anchor::Pos::new(
+                text_anchor::HPos::Right,
+                text_anchor::VPos::Center,
+            ));
+        root.draw(&Text::new(l.clone(), (px - 8, py), style))?;
+    }
+    Ok(())
+}
+
+fn success_vs_sweep(
+    c: &Campaign,
+    groups: &[GroupSummary],
+    key: &str,
+    values: &[f64],
+) -> Result<String, CampaignError> {
+    let e = err("success.svg");
+    let (lo, hi) = values
+        .iter()
+        .fold((f64::MAX, f64::MIN), |(a, b), v| (a.min(*v), b.max(*v)));
+    let pad = ((hi - lo) * 0.08).max(1e-9);
+    let mut svg = String::new();
+    {
+        let root = SVGBackend::with_string(&mut svg, (900, 560)).into_drawing_area();
+        root.fill(&WHITE).map_err(&e)?;
+        let mut chart = ChartBuilder::on(&root)
+            .caption(
+                format!(
+                    "{}: success rate against {key} (Wilson 95 % intervals)",
+                    c.file.name
+                ),
+                ("sans-serif", 17),
+            )
+            .margin(12)
+            .margin_right(30)
+            .x_label_area_size(40)
+            .y_label_area_size(55)
+            .build_cartesian_2d((lo - pad)..(hi + pad), 0.0..1.0)
+            .map_err(&e)?;
+        chart
+            .configure_mesh()
+            .x_desc(key)
+            .y_desc(success_desc(c))
+            .label_style(("sans-serif", 13))
+            .draw()
+            .map_err(&e)?;
+        let series: Vec<(String, String)> = {
+            let mut s: Vec<(String, String)> = groups
+                .iter()
+                .map(|g| (g.scenario.clone(), g.config.clone()))
+                .collect();
+            s.dedup();
+            s
+        };
+        let offset = (hi - lo).max(1e-9) * 0.006;
+        for (k, (scenario, config)) in series.iter().enumerate() {
+            let col = PALETTE[k % PALETTE.len()];
+            let dx = (k as f64 - (series.len() as f64 - 1.0) / 2.0) * offset;
+            let pts: Vec<(f64, &GroupSummary)> = groups
+                .iter()
+                .filter(|g| &g.scenario == scenario && &g.config == config)
+                .filter_map(|g| {
+                    let i = c.points.iter().position(|p| p.label() == g.point)?;
+                    Some((values[i] + dx, g))
+                })
+                .collect();
+            let name = if c.scenarios.len() > 1 {
+                format!("{scenario} · {config}")
+            } else {
+                config.clone()
+            };
+            chart
+                .draw_series(LineSeries::new(
+                    pts.iter().map(|(x, g)| (*x, g.success_rate)),
+                    col.stroke_width(2),
+                ))
+                .map_err(&e)?
+                .label(name)
+                .legend(move |(x, y)| {
+                    PathElement::new(vec![(x, y), (x + 16, y)], col.stroke_width(2))
+                });
+            chart
+                .draw_series(pts.iter().map(|(x, g)| {
+                    ErrorBar::new_vertical(
+                        *x,
+                        g.success_ci_low,
+                        g.success_rate,
+                        g.success_ci_high,
+                        col.stroke_width(2),
+                        10,
+                    )
+                }))
+                .map_err(&e)?;
+            chart
+                .draw_series(
+                    pts.iter()
+                        .map(|(x, g)| Circle::new((*x, g.success_rate), 5, col.filled())),
+                )
+                .map_err(&e)?;
+        }
+        chart
+            .configure_series_labels()
+            .background_style(WHITE.mix(0.9))
+            .border_style(BLACK)
+            .label_font(("sans-serif", 13))
+            .position(SeriesLabelPosition::LowerRight)
+            .draw()
+            .map_err(&e)?;
+        root.present().map_err(&e)?;
+    }
+    Ok(svg)
+}
+
+/// `errors.svg`: per group, the total, along-flow and crossflow errors of the declaring runs as
+/// boxes (quartiles, median line, whiskers from the 5th to the 95th percentile) over every run
+/// as a dot.
+pub fn error_chart(
+    c: &Campaign,
+    groups: &[GroupSummary],
+    rows: &[(RunKey, RunRow)],
+) -> Result<String, CampaignError> {
+    let e = err("errors.svg");
+    let labels: Vec<String> = groups.iter().map(|g| group_label(c, g)).collect();
+    let n = groups.len().max(1);
+    let lw = label_width(&labels);
+    let panel_w = 330u32;
+    let (width, height) = (lw + 3 * panel_w + 20, (n as u32 * 46 + 140).max(240));
+    let values = |g: &GroupSummary, f: &dyn Fn(&RunRow) -> Option<f64>| -> Vec<(u64, f64)> {
+        rows.iter()
+            .map(|(_, r)| r)
+            .filter(|r| {
+                r.declared && r.scenario == g.scenario && r.config == g.config && r.point == g.point
+            })
+            .filter_map(|r| f(r).map(|v| (r.seed_index, v)))
+            .collect()
+    };
+    type Metric<'a> = (&'a str, &'a dyn Fn(&RunRow) -> Option<f64>);
+    let metrics: [Metric; 3] = [
+        ("declaration error (m)", &|r: &RunRow| r.error_m),
+        ("along-flow error (m, + downflow)", &|r: &RunRow| {
+            r.error_along_m
+        }),
+        ("crossflow error (m, + right of flow)", &|r: &RunRow| {
+            r.error_cross_m
+        }),
+    ];
+    let mut svg = String::new();
+    {
+        let root = SVGBackend::with_string(&mut svg, (width, height)).into_drawing_area();
+        root.fill(&WHITE).map_err(&e)?;
+        let (title, body) = root.split_vertically(36);
+        title
+            .draw(&Text::new(
+                format!(
+                    "{}: declaration errors of declaring runs (box: quartiles and median; \
+                     whiskers: 5th–95th percentile; dots: runs)",
+                    c.file.name
+                ),
+                (12, 10),
+                ("sans-serif", 16).into_font().color(&BLACK),
+            ))
+            .map_err(&e)?;
+        let (left, rest) = body.split_horizontally(lw + panel_w);
+        let (mid, right) = rest.split_horizontally(panel_w);
+        let panels = [&left, &mid, &right];
+        for (m, (name, f)) in metrics.iter().enumerate() {
+            let per_group: Vec<Vec<(u64, f64)>> = groups.iter().map(|g| values(g, *f)).collect();
+            let mut all: Vec<f64> = per_group.iter().flatten().map(|(_, v)| *v).collect();
+            all.sort_by(f64::total_cmp);
+            // The axis covers the bulk: at most 2.5 times the 95th percentile of |value| (and at
+            // least 5 m); runs beyond it are drawn at its edge as triangles and counted.
+            let mut abs: Vec<f64> = all.iter().map(|v| v.abs()).collect();
+            abs.sort_by(f64::total_cmp);
+            let limit = (2.5 * quantile(&abs, 0.95)).max(5.0);
+            let (mut lo, mut hi) = all
+                .iter()
+                .map(|v| v.clamp(-limit, limit))
+                .fold((f64::MAX, f64::MIN), |(a, b), v| (a.min(v), b.max(v)));
+            if all.is_empty() {
+                (lo, hi) = (0.0, 1.0);
+            }
+            if m == 0 {
+                lo = 0.0;
+            }
+            let beyond = all.iter().filter(|v| v.abs() > limit).count();
+            let desc = if beyond > 0 {
+                format!("{name}; {beyond} beyond the axis: ▷ ◁ at its edge")
+            } else {
+                name.to_string()
+            };
+            let pad = ((hi - lo) * 0.05).max(0.5);
+            let area = panels[m];
+            let mut chart = ChartBuilder::on(area)
+                .margin(8)
+                .margin_right(14)
+                .x_label_area_size(40)
+                .y_label_area_size(if m == 0 { lw } else { 4 })
+                .build_cartesian_2d((lo - pad)..(hi + pad), -0.6..(n as f64 - 0.4))
+                .map_err(&e)?;
+            chart
+                .configure_mesh()
+                .disable_y_mesh()
+                .y_labels(0)
+                .x_labels(6)
+                .x_desc(desc)
+                .label_style(("sans-serif", 12))
+                .draw()
+                .map_err(&e)?;
+            if m > 0 && lo < 0.0 && hi > 0.0 {
+                chart
+                    .draw_series([PathElement::new(
+                        vec![(0.0, -0.6), (0.0, n as f64 - 0.4)],
+                        RGBColor(190, 190, 190).stroke_width(1),
+                    )])
+                    .map_err(&e)?;
+            }
+            for (i, vals) in per_group.iter().enumerate() {
+                let y = (n - 1 - i) as f64;
+                let col = PALETTE[i % PALETTE.len()];
+                let mut sorted: Vec<f64> = vals.iter().map(|(_, v)| *v).collect();
+                sorted.sort_by(f64::total_cmp);
+                if sorted.is_empty() {
+                    continue;
+                }
+                let q = |p| quantile(&sorted, p);
+                let (p5, q1, q2, q3, p95) = (q(0.05), q(0.25), q(0.5), q(0.75), q(0.95));
+                chart
+                    .draw_series([
+                        PathElement::new(vec![(p5, y), (q1, y)], col.stroke_width(1)),
+                        PathElement::new(vec![(q3, y), (p95, y)], col.stroke_width(1)),
+                        PathElement::new(vec![(p5, y - 0.1), (p5, y + 0.1)], col.stroke_width(1)),
+                        PathElement::new(vec![(p95, y - 0.1), (p95, y + 0.1)], col.stroke_width(1)),
+                    ])
+                    .map_err(&e)?;
+                chart
+                    .draw_series([Rectangle::new(
+                        [(q1, y - 0.28), (q3, y + 0.28)],
+                        col.mix(0.18).filled(),
+                    )])
+                    .map_err(&e)?;
+                chart
+                    .draw_series([
+                        Rectangle::new([(q1, y - 0.28), (q3, y + 0.28)], col.stroke_width(1)),
+                        Rectangle::new([(q2, y - 0.28), (q2, y + 0.28)], col.stroke_width(3)),
+                    ])
+                    .map_err(&e)?;
+                // Dots jittered by seed index (deterministic), inside the box's height; values
+                // beyond the axis as triangles at its edge.
+                let jitter =
+                    |s: u64| ((s.wrapping_mul(2_654_435_761) % 1000) as f64 / 1000.0 - 0.5) * 0.4;
+                chart
+                    .draw_series(
+                        vals.iter().filter(|(_, v)| v.abs() <= limit).map(|(s, v)| {
+                            Circle::new((*v, y + jitter(*s)), 2, col.mix(0.7).filled())
+                        }),
+                    )
+                    .map_err(&e)?;
+                chart
+                    .draw_series(vals.iter().filter(|(_, v)| v.abs() > limit).map(|(s, v)| {
+                        let x = v.clamp(-limit, limit);
+                        let tip = if *v > 0.0 { 7 } else { -7 };
+                        EmptyElement::at((x, y + jitter(*s)))
+                            + Polygon::new(vec![(0, -5), (0, 5), (tip, 0)], col.filled())
+                    }))
+                    .map_err(&e)?;
+            }
+            if m == 0 {
+                row_labels(&root, &chart, &labels).map_err(&e)?;
+            }
+        }
+        root.present().map_err(&e)?;
+    }
+    Ok(svg)
+}
+
+/// `trajectories.svg`: each group's example run (seed index 0) on a small map.
+pub fn trajectory_chart(c: &Campaign, examples: &[ExampleRun]) -> Result<String, CampaignError> {
+    let e = err("trajectories.svg");
+    let shown = &examples[..examples.len().min(12)];
+    let cols = shown.len().clamp(1, 3);
+    let rows = shown.len().div_ceil(cols).max(1);
+    // Common extent: every op-area, source and track point.
+    let (mut x0, mut x1, mut y0, mut y1) = (f64::MAX, f64::MIN, f64::MAX, f64::MIN);
+    for ex in shown {
+        for p in ex.op_area.iter().chain(&ex.sources).chain(&ex.track) {
+            (x0, x1, y0, y1) = (x0.min(p[0]), x1.max(p[0]), y0.min(p[1]), y1.max(p[1]));
+        }
+    }
+    if x0 > x1 {
+        (x0, x1, y0, y1) = (0.0, 1.0, 0.0, 1.0);
+    }
+    let pad = 0.04 * (x1 - x0).max(y1 - y0);
+    let (x0, x1, y0, y1) = (x0 - pad, x1 + pad, y0 - pad, y1 + pad);
+    let panel_w = 430u32;
+    let panel_h =
+        ((f64::from(panel_w) - 80.0) * (y1 - y0) / (x1 - x0) + 110.0).clamp(260.0, 900.0) as u32;
+    let (width, height) = (panel_w * cols as u32, panel_h * rows as u32 + 40);
+    let mut svg = String::new();
+    {
+        let root = SVGBackend::with_string(&mut svg, (width, height)).into_drawing_area();
+        root.fill(&WHITE).map_err(&e)?;
+        let (title, body) = root.split_vertically(40);
+        let more = if examples.len() > shown.len() {
+            format!(" (first {} of {} groups)", shown.len(), examples.len())
+        } else {
+            String::new()
+        };
+        title
+            .draw(&Text::new(
+                format!(
+                    "{}: one example run per group (seed index 0){more}; track as logged, \
+                     ○ lost points, ● declared, ▲ true source",
+                    c.file.name
+                ),
+                (12, 12),
+                ("sans-serif", 15).into_font().color(&BLACK),
+            ))
+            .map_err(&e)?;
+        let panels = body.split_evenly((rows, cols));
+        for (ex, area) in shown.iter().zip(panels.iter()) {
+            let mut name = ex.config.clone();
+            if !ex.point.is_empty() {
+                name = format!("{name} · {}", ex.point.replace(';', ", "));
+            }
+            if c.scenarios.len() > 1 {
+                name = format!("{} · {name}", ex.scenario);
+            }
+            let result = match ex.error_m {
+                Some(d) => format!("{}, {d:.1} m", ex.outcome),
+                None => ex.outcome.clone(),
+            };
+            let mut chart = plumetrace_mission::plot::map_chart(
+                area,
+                &format!("{name}: {result}"),
+                x0..x1,
+                y0..y1,
+            )
+            .map_err(|m| CampaignError::Chart {
+                what: "trajectories.svg".into(),
+                message: m,
+            })?;
+            let poly = |pts: &[[f64; 2]]| -> Vec<Vec2> {
+                pts.iter().map(|p| Vec2::new(p[0], p[1])).collect()
+            };
+            chart
+                .draw_series(plumetrace_mission::plot::dashed(
+                    &poly(&ex.op_area),
+                    BLACK,
+                    1,
+                ))
+                .map_err(&e)?;
+            for r in &ex.subregions {
+                chart
+                    .draw_series(plumetrace_mission::plot::dashed(
+                        &poly(r),
+                        RGBColor(150, 150, 150),
+                        1,
+                    ))
+                    .map_err(&e)?;
+            }
+            chart
+                .draw_series([PathElement::new(
+                    ex.track.iter().map(|p| (p[0], p[1])).collect::<Vec<_>>(),
+                    RGBColor(20, 60, 160).stroke_width(1),
+                )])
+                .map_err(&e)?;
+            chart
+                .draw_series(
+                    ex.lost_points.iter().map(|p| {
+                        Circle::new((p[0], p[1]), 4, RGBColor(230, 120, 0).stroke_width(1))
+                    }),
+                )
+                .map_err(&e)?;
+            chart
+                .draw_series(
+                    ex.sources.iter().map(|p| {
+                        TriangleMarker::new((p[0], p[1]), 7, RGBColor(0, 140, 60).filled())
+                    }),
+                )
+                .map_err(&e)?;
+            chart
+                .draw_series(
+                    ex.declared
+                        .iter()
+                        .map(|p| Circle::new((p[0], p[1]), 5, BLACK.filled())),
+                )
+                .map_err(&e)?;
+        }
+        root.present().map_err(&e)?;
+    }
+    Ok(svg)
+}
+
+/// Writes the three charts into `out`.
+pub fn write_charts(
+    c: &Campaign,
+    out: &Path,
+    groups: &[GroupSummary],
+    rows: &[(RunKey, RunRow)],
+) -> Result<(), CampaignError> {
+    let write = |name: &str, svg: String| {
+        let p = out.join(name);
+        plumetrace_mission::output::write_atomic(&p, svg.as_bytes())
+            .map_err(|e| CampaignError::io(&p, e))
+    };
+    write("success.svg", success_chart(c, groups)?)?;
+    write("errors.svg", error_chart(c, groups, rows)?)?;
+    let examples: Vec<ExampleRun> = groups
+        .iter()
+        .filter_map(|g| ExampleRun::read(out, &g.scenario, &g.config, &g.point))
+        .collect();
+    write("trajectories.svg", trajectory_chart(c, &examples)?)
+}

@@ -1,0 +1,61 @@
+//! What can go wrong with a campaign, with the file, key or line it concerns.
+
+/// A campaign error.
+#[derive(Debug, thiserror::Error)]
+pub enum CampaignError {
+    /// A file could not be read or written.
+    #[error("{path}: {message}")]
+    Io {
+        /// The file.
+        path: String,
+        /// What failed.
+        message: String,
+    },
+    /// The campaign file is malformed or has a bad value.
+    #[error("{file}: {}{message}", if key.is_empty() { String::new() } else { format!("{key}: ") })]
+    Invalid {
+        /// The campaign file.
+        file: String,
+        /// Key path in it (empty for syntax errors, which name their line).
+        key: String,
+        /// What is wrong.
+        message: String,
+    },
+    /// A scenario with a configuration and sweep point does not build.
+    #[error("{file}: {group}: {message}")]
+    Group {
+        /// The campaign file.
+        file: String,
+        /// Scenario, configuration and sweep point.
+        group: String,
+        /// The scenario or planner error (with its key path).
+        message: String,
+    },
+    /// A results file is damaged or belongs to another campaign.
+    #[error("{path}{}: {message}", line.map(|l| format!(" line {l}")).unwrap_or_default())]
+    Results {
+        /// The file.
+        path: String,
+        /// Line number, 1-based.
+        line: Option<u64>,
+        /// What is wrong.
+        message: String,
+    },
+    /// A chart could not be drawn.
+    #[error("drawing {what}: {message}")]
+    Chart {
+        /// Which chart.
+        what: String,
+        /// Why.
+        message: String,
+    },
+}
+
+impl CampaignError {
+    pub(crate) fn io(path: &std::path::Path, e: impl std::fmt::Display) -> Self {
+        CampaignError::Io {
+            path: path.display().to_string(),
+            message: e.to_string(),
+        }
+    }
+}

@@ -1,0 +1,132 @@
+//! One example track per group (its seed index 0), kept for the trajectory chart.
+
+use crate::spec::{Campaign, RunKey};
+use plumetrace_core::PlannerEvent;
+use plumetrace_mission::MissionRun;
+use plumetrace_mission::run::EventKind;
+use serde::{Deserialize, Serialize};
+use std::path::{Path, PathBuf};
+
+/// Directory of the example files inside a campaign directory.
+pub const EXAMPLES_DIR: &str = "examples";
+
+/// Longest track kept, in points.
+const MAX_TRACK_POINTS: usize = 3000;
+
+/// What the chart needs of one run.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ExampleRun {
+    /// Scenario label.
+    pub scenario: String,
+    /// Configuration name.
+    pub config: String,
+    /// Sweep point label.
+    pub point: String,
+    /// Run seed.
+    pub seed: u64,
+    /// Outcome name.
+    pub outcome: String,
+    /// Declaration error, m.
+    pub error_m: Option<f64>,
+    /// Op-area corners.
+    pub op_area: Vec<[f64; 2]>,
+    /// Subregions.
+    pub subregions: Vec<Vec<[f64; 2]>>,
+    /// True sources.
+    pub sources: Vec<[f64; 2]>,
+    /// Declared positions.
+    pub declared: Vec<[f64; 2]>,
+    /// Lost points.
+    pub lost_points: Vec<[f64; 2]>,
+    /// The first AUV's track as it logged it (navigation estimate), thinned.
+    pub track: Vec<[f64; 2]>,
+}
+
+impl ExampleRun {
+    /// Extracts the example from a finished run.
+    pub fn from_run(c: &Campaign, key: &RunKey, run: &MissionRun) -> Self {
+        let xy = |p: &plumetrace_core::Vec2| [p.x, p.y];
+        let rows: Vec<_> = run.trajectory.iter().filter(|r| r.vehicle == 0).collect();
+        let step = rows.len().div_ceil(MAX_TRACK_POINTS).max(1);
+        ExampleRun {
+            scenario: c.scenarios[key.scenario].label.clone(),
+            config: c.configs[key.config].name.clone(),
+            point: c.points[key.point].label(),
+            seed: c.run_seed(key),
+            outcome: run.outcome.name().to_string(),
+            error_m: run
+                .summary
+                .error_m
+                .is_finite()
+                .then_some(run.summary.error_m),
+            op_area: run.op_area.iter().map(xy).collect(),
+            subregions: run
+                .subregions
+                .iter()
+                .map(|r| r.iter().map(xy).collect())
+                .collect(),
+            sources: run.sources.iter().map(|s| [s.x, s.y]).collect(),
+            declared: run
+                .summary
+                .declarations
+                .iter()
+                .map(|d| [d.x_m, d.y_m])
+                .collect(),
+            lost_points: run
+                .events
+                .iter()
+                .filter_map(|e| match &e.event {
+                    EventKind::Planner(PlannerEvent::LostPoint { pos_m }) => Some(xy(pos_m)),
+                    _ => None,
+                })
+                .collect(),
+            track: rows
+                .iter()
+                .step_by(step)
+                .map(|r| [r.est_x_m, r.est_y_m])
+                .collect(),
+        }
+    }
+
+    /// Writes it into a campaign directory (atomically).
+    pub fn write(&self, dir: &Path) -> std::io::Result<()> {
+        let json = serde_json::to_string(self).map_err(std::io::Error::other)?;
+        plumetrace_mission::output::write_atomic(&self.path_in(dir), json.as_bytes())
+    }
+
+    fn path_in(&self, dir: &Path) -> PathBuf {
+        dir.join(EXAMPLES_DIR).join(format!(
+            "{}.json",
+            slug(&[&self.scenario, &self.config, &self.point])
+        ))
+    }
+
+    /// Reads a group's example from a campaign directory, if it is there.
+    pub fn read(dir: &Path, scenario: &str, config: &str, point: &str) -> Option<Self> {
+        let p = dir
+            .join(EXAMPLES_DIR)
+            .join(format!("{}.json", slug(&[scenario, config, point])));
+        let text = std::fs::read_to_string(p).ok()?;
+        serde_json::from_str(&text).ok()
+    }
+}
+
+/// A file name from labels: letters, digits, `-`, `.` and `_` kept, the rest `_`, parts joined
+/// by `__`.
+fn slug(parts: &[&str]) -> String {
+    parts
+        .iter()
+        .map(|p| {
+            p.chars()
+                .map(|ch| {
+                    if ch.is_ascii_alphanumeric() || matches!(ch, '-' | '.' | '_') {
+                        ch
+                    } else {
+                        '_'
+                    }
+                })
+                .collect::<String>()
+        })
+        .collect::<Vec<_>>()
+        .join("__")
+}

@@ -1,0 +1,208 @@
+//! Running a campaign: parallel over runs, appending each result as it finishes, resuming from
+//! what a directory already holds, and writing the summary, charts and example tracks at the end.
+
+use crate::error::CampaignError;
+use crate::example::{EXAMPLES_DIR, ExampleRun};
+use crate::runs::{Appender, RUNS_FILE, RunRow, row_key};
+use crate::spec::{Campaign, RunKey, Shard};
+use plumetrace_mission::{MissionOptions, run_mission_with};
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+use std::collections::BTreeSet;
+use std::path::Path;
+use std::sync::Mutex;
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
+
+/// The name of the file that ties a directory to its campaign.
+pub const META_FILE: &str = "campaign.json";
+/// The copy of the campaign file kept in the directory (for `merge`).
+pub const CAMPAIGN_COPY: &str = "campaign.toml";
+
+/// What a directory records about the campaign it holds.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Meta {
+    /// Campaign name.
+    pub name: String,
+    /// [`Campaign::fingerprint`].
+    pub fingerprint: String,
+    /// Seeds per group of the latest call (`--seeds` may change it; results stay valid).
+    pub seeds: u64,
+}
+
+/// How to run.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct RunOptions {
+    /// Worker threads (None: one per core).
+    pub jobs: Option<usize>,
+    /// Only this shard's runs.
+    pub shard: Option<Shard>,
+}
+
+/// What a campaign call did.
+#[derive(Debug, Clone, Default)]
+pub struct CampaignReport {
+    /// Runs in this shard's list.
+    pub planned: u64,
+    /// Found already recorded and skipped.
+    pub skipped: u64,
+    /// Run now.
+    pub ran: u64,
+    /// Of those, runs that failed (outcome `error`).
+    pub failed: u64,
+    /// A partial row left by a killed process was cut off.
+    pub cut_partial_line: bool,
+}
+
+/// Checks or records that `out` belongs to this campaign.
+pub fn claim_dir(c: &Campaign, out: &Path) -> Result<(), CampaignError> {
+    std::fs::create_dir_all(out).map_err(|e| CampaignError::io(out, e))?;
+    let meta_path = out.join(META_FILE);
+    let meta = Meta {
+        name: c.file.name.clone(),
+        fingerprint: c.fingerprint(),
+        seeds: c.file.seeds,
+    };
+    if meta_path.exists() {
+        let text =
+            std::fs::read_to_string(&meta_path).map_err(|e| CampaignError::io(&meta_path, e))?;
+        let old: Meta = serde_json::from_str(&text).map_err(|e| CampaignError::Results {
+            path: meta_path.display().to_string(),
+            line: Some(e.line() as u64),
+            message: e.to_string(),
+        })?;
+        if old.fingerprint != meta.fingerprint {
+            return Err(CampaignError::Results {
+                path: meta_path.display().to_string(),
+                line: None,
+                message: format!(
+                    "{} holds results of a different campaign ('{}', fingerprint {}; this one is \
+                     '{}', {}): the campaign file or one of its scenarios changed. Use a new \
+                     --out directory.",
+                    out.display(),
+                    old.name,
+                    old.fingerprint,
+                    meta.name,
+                    meta.fingerprint
+                ),
+            });
+        }
+    }
+    let json = serde_json::to_string_pretty(&meta).unwrap_or_default();
+    plumetrace_mission::output::write_atomic(&meta_path, json.as_bytes())
+        .map_err(|e| CampaignError::io(&meta_path, e))?;
+    let copy = out.join(CAMPAIGN_COPY);
+    plumetrace_mission::output::write_atomic(&copy, c.text.as_bytes())
+        .map_err(|e| CampaignError::io(&copy, e))
+}
+
+/// Runs (the rest of) a campaign into `out`, calling `progress(done, total)` after each run, then
+/// writes the sorted `runs.csv`, summaries and charts.
+pub fn run_campaign(
+    c: &Campaign,
+    out: &Path,
+    opts: RunOptions,
+    progress: &(dyn Fn(u64, u64) + Sync),
+) -> Result<CampaignReport, CampaignError> {
+    claim_dir(c, out)?;
+    let runs_path = out.join(RUNS_FILE);
+    let (appender, existing) = Appender::open(&runs_path)?;
+    let mut done = BTreeSet::new();
+    for row in &existing.rows {
+        done.insert(row_key(c, row, &runs_path)?);
+    }
+    let planned = c.shard_runs(opts.shard);
+    let todo: Vec<RunKey> = planned
+        .iter()
+        .filter(|k| !done.contains(k))
+        .copied()
+        .collect();
+    let mut report = CampaignReport {
+        planned: planned.len() as u64,
+        skipped: (planned.len() - todo.len()) as u64,
+        cut_partial_line: existing.cut_partial_line,
+        ..CampaignReport::default()
+    };
+    std::fs::create_dir_all(out.join(EXAMPLES_DIR))
+        .map_err(|e| CampaignError::io(&out.join(EXAMPLES_DIR), e))?;
+
+    let appender = Mutex::new(appender);
+    let first_error: Mutex<Option<CampaignError>> = Mutex::new(None);
+    let stop = AtomicBool::new(false);
+    let finished = AtomicU64::new(0);
+    let failed = AtomicU64::new(0);
+    let total = todo.len() as u64;
+    let work = || {
+        todo.par_iter().for_each(|key| {
+            if stop.load(Ordering::Relaxed) {
+                return;
+            }
+            let row = run_one(c, key, out);
+            if row.outcome == crate::runs::ERROR_OUTCOME {
+                failed.fetch_add(1, Ordering::Relaxed);
+            }
+            let written = appender
+                .lock()
+                .map_err(|_| CampaignError::io(&runs_path, "a worker panicked while writing"))
+                .and_then(|mut a| a.append(&row));
+            if let Err(e) = written {
+                stop.store(true, Ordering::Relaxed);
+                if let Ok(mut slot) = first_error.lock() {
+                    slot.get_or_insert(e);
+                }
+                return;
+            }
+            progress(finished.fetch_add(1, Ordering::Relaxed) + 1, total);
+        });
+    };
+    match opts.jobs {
+        Some(n) => rayon::ThreadPoolBuilder::new()
+            .num_threads(n.max(1))
+            .build()
+            .map_err(|e| CampaignError::io(out, e))?
+            .install(work),
+        None => work(),
+    }
+    if let Some(e) = first_error.into_inner().ok().flatten() {
+        return Err(e);
+    }
+    report.ran = finished.load(Ordering::Relaxed);
+    report.failed = failed.load(Ordering::Relaxed);
+    drop(appender);
+    crate::finish::finish_dir(c, out)?;
+    Ok(report)
+}
+
+/// Flies one run and makes its row; never panics (a panic inside becomes outcome `error`).
+fn run_one(c: &Campaign, key: &RunKey, out: &Path) -> RunRow {
+    let attempt = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+        let sc = c.build(key).map_err(|e| e.to_string())?;
+        let example = key.seed_index == 0;
+        let options = MissionOptions {
+            mean_plume: false,
+            trajectory: example,
+        };
+        let run = run_mission_with(sc, options, &mut |_, _| {}).map_err(|e| e.to_string())?;
+        if example {
+            let ex = ExampleRun::from_run(c, key, &run);
+            ex.write(out).map_err(|e| e.to_string())?;
+        }
+        Ok::<RunRow, String>(RunRow::from_summary(
+            c,
+            key,
+            run.outcome.name(),
+            &run.summary,
+        ))
+    }));
+    match attempt {
+        Ok(Ok(row)) => row,
+        Ok(Err(message)) => RunRow::failed(c, key, message),
+        Err(panic) => {
+            let what = panic
+                .downcast_ref::<String>()
+                .cloned()
+                .or_else(|| panic.downcast_ref::<&str>().map(|s| s.to_string()))
+                .unwrap_or_else(|| "unknown panic".into());
+            RunRow::failed(c, key, format!("internal error (panic): {what}"))
+        }
+    }
+}

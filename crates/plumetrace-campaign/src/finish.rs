@@ -1,0 +1,37 @@
+//! The end of a campaign call: `runs.csv` sorted into the canonical order, then `summary.csv`,
+//! `summary.md`, the charts and (with the `parquet` feature) `runs.parquet`.
+
+use crate::error::CampaignError;
+use crate::runs::{RUNS_FILE, RunRow, read_rows, rows_text, sorted_unique};
+use crate::spec::{Campaign, RunKey};
+use crate::stats::{GroupSummary, summarise, summary_csv, summary_md};
+use std::path::Path;
+
+/// Sorts `runs.csv` in place (atomically) and writes every derived file from it.
+pub fn finish_dir(c: &Campaign, out: &Path) -> Result<Vec<GroupSummary>, CampaignError> {
+    let path = out.join(RUNS_FILE);
+    let existing = read_rows(&path)?;
+    let rows = sorted_unique(c, existing.rows, &path)?;
+    write_results(c, out, &rows)
+}
+
+/// Writes `runs.csv` (sorted) and everything derived from the rows.
+pub fn write_results(
+    c: &Campaign,
+    out: &Path,
+    rows: &[(RunKey, RunRow)],
+) -> Result<Vec<GroupSummary>, CampaignError> {
+    let write = |name: &str, bytes: &[u8]| {
+        let p = out.join(name);
+        plumetrace_mission::output::write_atomic(&p, bytes).map_err(|e| CampaignError::io(&p, e))
+    };
+    write(RUNS_FILE, rows_text(rows)?.as_bytes())?;
+    let groups = summarise(c, rows);
+    write("summary.csv", summary_csv(&groups).as_bytes())?;
+    let expected = c.runs().len() as u64;
+    write("summary.md", summary_md(c, &groups, expected).as_bytes())?;
+    crate::charts::write_charts(c, out, &groups, rows)?;
+    #[cfg(feature = "parquet")]
+    crate::parquet_out::write_parquet(&out.join("runs.parquet"), rows)?;
+    Ok(groups)
+}

@@ -1,0 +1,365 @@
+//! `runs.csv`: one row per finished run, appended as runs finish, sorted when the campaign ends.
+//!
+//! Each row is written with a single `write` of a complete line to a file opened for appending,
+//! so a process killed at any moment leaves every finished run on disk and at most one partial
+//! last line, which the next start cuts off (that run is simply run again).
+
+use crate::error::CampaignError;
+use crate::spec::{Campaign, RunKey};
+use plumetrace_mission::Summary;
+use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
+use std::io::{Read, Seek, Write};
+use std::path::{Path, PathBuf};
+
+/// The name of the results file in a campaign directory.
+pub const RUNS_FILE: &str = "runs.csv";
+
+/// Outcome name of a run that failed to run (a diverging flow, an internal error).
+pub const ERROR_OUTCOME: &str = "error";
+
+/// One run's keys and results. Missing numbers (no declaration, no detection) are empty fields.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct RunRow {
+    /// Scenario label.
+    pub scenario: String,
+    /// Configuration name.
+    pub config: String,
+    /// Sweep point (`key=value;...`, empty without a sweep).
+    pub point: String,
+    /// Seed index within the group.
+    pub seed_index: u64,
+    /// Run seed (the same for every group at this seed index).
+    pub seed: u64,
+    /// Outcome name (`declared`, `no_declaration`, `timed_out`, ..., or `error`).
+    pub outcome: String,
+    /// Declared (within the success radius, if the campaign sets one).
+    pub success: bool,
+    /// Declared at all.
+    pub declared: bool,
+    /// Number of declarations (several on multi-source missions).
+    pub declarations: u32,
+    /// First declared position, m.
+    pub declared_x: Option<f64>,
+    /// First declared position, m.
+    pub declared_y: Option<f64>,
+    /// Nearest true source, m.
+    pub source_x: Option<f64>,
+    /// Nearest true source, m.
+    pub source_y: Option<f64>,
+    /// Declaration error, m.
+    pub error_m: Option<f64>,
+    /// Along-flow error (positive downflow), m.
+    pub error_along_m: Option<f64>,
+    /// Crossflow error (positive to the right looking downflow), m.
+    pub error_cross_m: Option<f64>,
+    /// Time of the first detection, s.
+    pub first_detection_s: Option<f64>,
+    /// Time of the first declaration, s.
+    pub declaration_s: Option<f64>,
+    /// Distance over ground, m.
+    pub path_length_m: Option<f64>,
+    /// Distance over ground from the first detection to the first declaration, m.
+    pub trace_length_m: Option<f64>,
+    /// Straight line from the first detection to the source, m.
+    pub detection_to_source_m: Option<f64>,
+    /// `trace_length_m / detection_to_source_m`.
+    pub path_ratio: Option<f64>,
+    /// Mission time, s.
+    pub sim_time_s: Option<f64>,
+    /// Why a run failed (outcome `error`), else empty.
+    pub message: String,
+}
+
+fn finite(v: f64) -> Option<f64> {
+    v.is_finite().then_some(v)
+}
+
+impl RunRow {
+    /// The row of a finished mission.
+    pub fn from_summary(c: &Campaign, key: &RunKey, outcome: &str, s: &Summary) -> Self {
+        let declared = s.declared;
+        let success = declared
+            && c.success_radius_m()
+                .is_none_or(|r| s.error_m.is_finite() && s.error_m <= r);
+        let ratio = if s.trace_length_m.is_finite()
+            && s.detection_to_source_m.is_finite()
+            && s.detection_to_source_m > 0.0
+        {
+            Some(s.trace_length_m / s.detection_to_source_m)
+        } else {
+            None
+        };
+        RunRow {
+            outcome: outcome.to_string(),
+            success,
+            declared,
+            declarations: u32::try_from(s.declarations.len()).unwrap_or(u32::MAX),
+            declared_x: finite(s.declared_x),
+            declared_y: finite(s.declared_y),
+            source_x: finite(s.source_x),
+            source_y: finite(s.source_y),
+            error_m: finite(s.error_m),
+            error_along_m: finite(s.error_along_m),
+            error_cross_m: finite(s.error_cross_m),
+            first_detection_s: finite(s.first_detection_s),
+            declaration_s: finite(s.declaration_s),
+            path_length_m: finite(s.path_length_m),
+            trace_length_m: finite(s.trace_length_m),
+            detection_to_source_m: finite(s.detection_to_source_m),
+            path_ratio: ratio,
+            sim_time_s: finite(s.sim_time_s),
+            ..RunRow::empty(c, key)
+        }
+    }
+
+    /// The row of a run that could not run.
+    pub fn failed(c: &Campaign, key: &RunKey, message: String) -> Self {
+        RunRow {
+            outcome: ERROR_OUTCOME.to_string(),
+            message,
+            ..RunRow::empty(c, key)
+        }
+    }
+
+    fn empty(c: &Campaign, key: &RunKey) -> Self {
+        RunRow {
+            scenario: c.scenarios[key.scenario].label.clone(),
+            config: c.configs[key.config].name.clone(),
+            point: c.points[key.point].label(),
+            seed_index: key.seed_index,
+            seed: c.run_seed(key),
+            ..RunRow::default()
+        }
+    }
+
+    /// The row as one CSV line (with its newline).
+    pub fn to_line(&self) -> Result<Vec<u8>, String> {
+        let mut w = csv::WriterBuilder::new()
+            .has_headers(false)
+            .from_writer(Vec::new());
+        w.serialize(self).map_err(|e| e.to_string())?;
+        w.into_inner().map_err(|e| e.to_string())
+    }
+}
+
+/// The header line of `runs.csv` (without its newline).
+pub fn header() -> String {
+    let mut w = csv::Writer::from_writer(Vec::new());
+    let probe = RunRow::default();
+    let _ = w.serialize(&probe);
+    let bytes = w.into_inner().unwrap_or_default();
+    String::from_utf8_lossy(&bytes)
+        .lines()
+        .next()
+        .unwrap_or_default()
+        .to_string()
+}
+
+/// What was found in an existing results file.
+#[derive(Debug, Default)]
+pub struct Existing {
+    /// Complete rows.
+    pub rows: Vec<RunRow>,
+    /// A partial last line was cut off (a run killed while its row was being written).
+    pub cut_partial_line: bool,
+}
+
+/// Parses the complete lines of a results file; `text` must start with the header.
+pub fn parse_rows(path: &Path, text: &str) -> Result<Vec<RunRow>, CampaignError> {
+    let want = header();
+    let first = text.lines().next().unwrap_or_default();
+    if first != want {
+        return Err(CampaignError::Results {
+            path: path.display().to_string(),
+            line: Some(1),
+            message: format!("unexpected header (is it a plumetrace runs file?): '{first}'"),
+        });
+    }
+    let mut rd = csv::ReaderBuilder::new()
+        .has_headers(true)
+        .from_reader(text.as_bytes());
+    let mut rows = Vec::new();
+    for r in rd.deserialize::<RunRow>() {
+        let row = r.map_err(|e| CampaignError::Results {
+            path: path.display().to_string(),
+            line: e.position().map(|p| p.line()),
+            message: e.to_string(),
+        })?;
+        rows.push(row);
+    }
+    Ok(rows)
+}
+
+/// Reads a results file, ignoring a partial last line (reported in [`Existing`]).
+pub fn read_rows(path: &Path) -> Result<Existing, CampaignError> {
+    let text = std::fs::read_to_string(path).map_err(|e| CampaignError::io(path, e))?;
+    let complete = match text.rfind('\n') {
+        Some(i) => &text[..=i],
+        None => "",
+    };
+    if complete.is_empty() {
+        return Err(CampaignError::Results {
+            path: path.display().to_string(),
+            line: Some(1),
+            message: "no header line".into(),
+        });
+    }
+    Ok(Existing {
+        rows: parse_rows(path, complete)?,
+        cut_partial_line: complete.len() < text.len(),
+    })
+}
+
+/// Appends rows to `runs.csv`, one `write` per row.
+#[derive(Debug)]
+pub struct Appender {
+    file: std::fs::File,
+    path: PathBuf,
+}
+
+impl Appender {
+    /// Opens (or creates) `path` for appending: checks the header, cuts off a partial last line,
+    /// and returns the rows already there.
+    pub fn open(path: &Path) -> Result<(Appender, Existing), CampaignError> {
+        let io = |e: std::io::Error| CampaignError::io(path, e);
+        let mut file = std::fs::OpenOptions::new()
+            .read(true)
+            .append(true)
+            .create(true)
+            .open(path)
+            .map_err(io)?;
+        let mut text = String::new();
+        file.read_to_string(&mut text).map_err(io)?;
+        let existing = if text.is_empty() {
+            file.write_all(format!("{}\n", header()).as_bytes())
+                .map_err(io)?;
+            Existing::default()
+        } else {
+            let complete = text.rfind('\n').map_or(0, |i| i + 1);
+            if complete == 0 {
+                // Not even a full header: nothing was recorded yet.
+                file.set_len(0).map_err(io)?;
+                file.write_all(format!("{}\n", header()).as_bytes())
+                    .map_err(io)?;
+                Existing {
+                    rows: Vec::new(),
+                    cut_partial_line: true,
+                }
+            } else {
+                let rows = parse_rows(path, &text[..complete])?;
+                let cut = complete < text.len();
+                if cut {
+                    file.set_len(complete as u64).map_err(io)?;
+                    file.seek(std::io::SeekFrom::End(0)).map_err(io)?;
+                }
+                Existing {
+                    rows,
+                    cut_partial_line: cut,
+                }
+            }
+        };
+        Ok((
+            Appender {
+                file,
+                path: path.to_path_buf(),
+            },
+            existing,
+        ))
+    }
+
+    /// Appends one row as one write and hands it to the operating system (which keeps it even
+    /// if this process is killed).
+    pub fn append(&mut self, row: &RunRow) -> Result<(), CampaignError> {
+        let line = row
+            .to_line()
+            .map_err(|e| CampaignError::io(&self.path, e))?;
+        self.file
+            .write_all(&line)
+            .and_then(|()| self.file.flush())
+            .map_err(|e| CampaignError::io(&self.path, e))
+    }
+}
+
+/// The canonical position of a row in its campaign, or an error naming the row.
+pub fn row_key(c: &Campaign, row: &RunRow, path: &Path) -> Result<RunKey, CampaignError> {
+    let not_ours = |what: String| CampaignError::Results {
+        path: path.display().to_string(),
+        line: None,
+        message: format!("a row of another campaign: {what}; use a new output directory"),
+    };
+    let scenario = c
+        .scenarios
+        .iter()
+        .position(|s| s.label == row.scenario)
+        .ok_or_else(|| not_ours(format!("unknown scenario '{}'", row.scenario)))?;
+    let config = c
+        .configs
+        .iter()
+        .position(|s| s.name == row.config)
+        .ok_or_else(|| not_ours(format!("unknown config '{}'", row.config)))?;
+    let point = c
+        .points
+        .iter()
+        .position(|p| p.label() == row.point)
+        .ok_or_else(|| not_ours(format!("unknown sweep point '{}'", row.point)))?;
+    let key = RunKey {
+        scenario,
+        config,
+        point,
+        seed_index: row.seed_index,
+    };
+    if c.run_seed(&key) != row.seed {
+        return Err(not_ours(format!(
+            "seed {} at seed index {} (expected {})",
+            row.seed,
+            row.seed_index,
+            c.run_seed(&key)
+        )));
+    }
+    Ok(key)
+}
+
+/// Rows in canonical order, one per run. Exact duplicates (the same run recorded twice) collapse;
+/// two different results for one run are an error.
+pub fn sorted_unique(
+    c: &Campaign,
+    rows: Vec<RunRow>,
+    path: &Path,
+) -> Result<Vec<(RunKey, RunRow)>, CampaignError> {
+    let mut by_key: BTreeMap<RunKey, RunRow> = BTreeMap::new();
+    for row in rows {
+        let key = row_key(c, &row, path)?;
+        if let Some(old) = by_key.get(&key) {
+            if *old != row {
+                return Err(CampaignError::Results {
+                    path: path.display().to_string(),
+                    line: None,
+                    message: format!(
+                        "two different results for {} seed index {}",
+                        c.group_name(key.scenario, key.config, key.point),
+                        key.seed_index
+                    ),
+                });
+            }
+            continue;
+        }
+        by_key.insert(key, row);
+    }
+    Ok(by_key.into_iter().collect())
+}
+
+/// The text of a sorted results file.
+pub fn rows_text(rows: &[(RunKey, RunRow)]) -> Result<String, CampaignError> {
+    let mut out = header();
+    out.push('\n');
+    for (_, r) in rows {
+        let line = r.to_line().map_err(|e| CampaignError::Results {
+            path: RUNS_FILE.into(),
+            line: None,
+            message: e,
+        })?;
+        out.push_str(&String::from_utf8_lossy(&line));
+    }
+    Ok(out)
+}

@@ -1,0 +1,595 @@
+//! The campaign file and the run list it expands to.
+//!
+//! A campaign names scenarios (preset names or `.toml` files next to the campaign file), planner
+//! configurations (a name and keys to set), an optional sweep (a grid over keys) and a number of
+//! seeds. Every (scenario, configuration, sweep point) group runs the same seeds, derived from the
+//! campaign seed and the seed index, so every configuration meets the same plume realisations.
+
+use crate::error::CampaignError;
+use plumetrace_scenario::{Origin, PRESETS, find_preset};
+use serde::{Deserialize, Serialize};
+use std::path::{Path, PathBuf};
+
+/// The campaign file as written (`deny_unknown_fields`).
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CampaignFile {
+    /// Campaign name (used in titles).
+    pub name: String,
+    /// One line about it.
+    #[serde(default)]
+    pub description: String,
+    /// Campaign seed: run seeds derive from it and the seed index.
+    pub seed: u64,
+    /// Seeds per group (`--seeds` overrides).
+    pub seeds: u64,
+    /// Preset names, or paths ending in `.toml` relative to the campaign file.
+    pub scenarios: Vec<String>,
+    /// A run succeeds when it declares; with this set, only when it also declares within this
+    /// distance of a true source, m.
+    #[serde(default)]
+    pub success_radius_m: Option<f64>,
+    /// Planner configurations (none: one configuration, "default", as the scenario has it).
+    #[serde(default)]
+    pub configs: Vec<ConfigFile>,
+    /// Grid of values per key (every combination is a sweep point).
+    #[serde(default)]
+    pub sweep: toml::Table,
+}
+
+/// One planner configuration.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ConfigFile {
+    /// Its name in tables and charts.
+    pub name: String,
+    /// Keys to set in the scenario: bare names are `[planner]` keys (`beta_deg`, `declaration`),
+    /// dotted paths reach any table (`plume.vertical_diffusivity_m2ps`, `sources.0.z_m`).
+    #[serde(default)]
+    pub set: toml::Table,
+}
+
+/// A scenario of the campaign with its TOML, ready for overrides.
+#[derive(Debug, Clone)]
+pub struct ScenarioEntry {
+    /// As written in the campaign (preset name or path).
+    pub label: String,
+    /// Where it came from.
+    pub origin: Origin,
+    /// Its TOML.
+    pub table: toml::Table,
+}
+
+/// One sweep point: the value of each swept key.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SweepPoint {
+    /// `(key, value)` in the sweep's key order.
+    pub values: Vec<(String, toml::Value)>,
+}
+
+impl SweepPoint {
+    /// `key=value` pairs joined by `;` (empty without a sweep).
+    pub fn label(&self) -> String {
+        self.values
+            .iter()
+            .map(|(k, v)| format!("{k}={}", value_text(v)))
+            .collect::<Vec<_>>()
+            .join(";")
+    }
+}
+
+/// A value as short text (strings without quotes).
+pub fn value_text(v: &toml::Value) -> String {
+    match v {
+        toml::Value::String(s) => s.clone(),
+        other => other.to_string(),
+    }
+}
+
+/// A loaded, checked campaign.
+#[derive(Debug, Clone)]
+pub struct Campaign {
+    /// The file as written.
+    pub file: CampaignFile,
+    /// Where it was read from.
+    pub path: PathBuf,
+    /// Its text, copied into the output directory.
+    pub text: String,
+    /// Scenarios with their TOML.
+    pub scenarios: Vec<ScenarioEntry>,
+    /// Configurations (at least one).
+    pub configs: Vec<ConfigFile>,
+    /// Sweep points (one empty point without a sweep).
+    pub points: Vec<SweepPoint>,
+}
+
+/// One run of the list.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub struct RunKey {
+    /// Scenario index.
+    pub scenario: usize,
+    /// Configuration index.
+    pub config: usize,
+    /// Sweep point index.
+    pub point: usize,
+    /// Seed index (0-based).
+    pub seed_index: u64,
+}
+
+/// A shard: `index` of `count`, 1-based as written (`--shard 2/4`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Shard {
+    /// 1..=count.
+    pub index: u64,
+    /// Number of shards.
+    pub count: u64,
+}
+
+impl std::str::FromStr for Shard {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        let (k, n) = s
+            .split_once('/')
+            .ok_or_else(|| format!("shard '{s}' is not K/N (e.g. 2/4)"))?;
+        let k: u64 = k
+            .trim()
+            .parse()
+            .map_err(|_| format!("shard '{s}': K is not a whole number"))?;
+        let n: u64 = n
+            .trim()
+            .parse()
+            .map_err(|_| format!("shard '{s}': N is not a whole number"))?;
+        if n == 0 || k == 0 || k > n {
+            return Err(format!("shard '{s}': need 1 <= K <= N"));
+        }
+        Ok(Shard { index: k, count: n })
+    }
+}
+
+impl std::fmt::Display for Shard {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{}/{}", self.index, self.count)
+    }
+}
+
+/// Parses campaign text; errors name the key path.
+pub fn parse_campaign(text: &str, path: &Path) -> Result<CampaignFile, CampaignError> {
+    let file = path.display().to_string();
+    let de = toml::Deserializer::parse(text).map_err(|e| CampaignError::Invalid {
+        file: file.clone(),
+        key: String::new(),
+        message: e.to_string(),
+    })?;
+    serde_path_to_error::deserialize(de).map_err(|e| {
+        let key = e.path().to_string();
+        CampaignError::Invalid {
+            file,
+            key: if key == "." { String::new() } else { key },
+            message: e.into_inner().to_string(),
+        }
+    })
+}
+
+impl Campaign {
+    /// Reads a campaign file, loads its scenarios and checks every group builds.
+    pub fn load(path: &Path, seeds: Option<u64>) -> Result<Self, CampaignError> {
+        let text = std::fs::read_to_string(path).map_err(|e| CampaignError::Io {
+            path: path.display().to_string(),
+            message: e.to_string(),
+        })?;
+        let mut file = parse_campaign(&text, path)?;
+        if let Some(n) = seeds {
+            file.seeds = n;
+        }
+        let c = Campaign::resolve(file, path, text, true)?;
+        c.check_groups()?;
+        Ok(c)
+    }
+
+    /// Expands a parsed file; `read_scenarios` false skips loading scenario files (merging needs
+    /// only names and the sweep).
+    pub fn resolve(
+        file: CampaignFile,
+        path: &Path,
+        text: String,
+        read_scenarios: bool,
+    ) -> Result<Self, CampaignError> {
+        let fname = path.display().to_string();
+        let invalid = |key: String, message: String| CampaignError::Invalid {
+            file: fname.clone(),
+            key,
+            message,
+        };
+        if file.seeds == 0 {
+            return Err(invalid("seeds".into(), "must be at least 1".into()));
+        }
+        if file.scenarios.is_empty() {
+            return Err(invalid(
+                "scenarios".into(),
+                "name at least one scenario".into(),
+            ));
+        }
+        if let Some(r) = file.success_radius_m
+            && !(r.is_finite() && r > 0.0)
+        {
+            return Err(invalid(
+                "success_radius_m".into(),
+                format!("must be a finite number > 0, got {r}"),
+            ));
+        }
+        let base = path.parent().map(Path::to_path_buf).unwrap_or_default();
+        let mut scenarios = Vec::new();
+        for (i, s) in file.scenarios.iter().enumerate() {
+            if scenarios.iter().any(|e: &ScenarioEntry| &e.label == s) {
+                return Err(invalid(
+                    format!("scenarios[{i}]"),
+                    format!("'{s}' is listed twice"),
+                ));
+            }
+            let (origin, text) = if s.ends_with(".toml") {
+                let p = base.join(s);
+                let text = if read_scenarios {
+                    std::fs::read_to_string(&p).map_err(|e| {
+                        invalid(format!("scenarios[{i}]"), format!("{}: {e}", p.display()))
+                    })?
+                } else {
+                    String::new()
+                };
+                (Origin::File(p), text)
+            } else if let Some(p) = find_preset(s) {
+                (Origin::Preset(s.clone()), p.toml.to_string())
+            } else {
+                let known: Vec<&str> = PRESETS.iter().map(|p| p.name).collect();
+                return Err(invalid(
+                    format!("scenarios[{i}]"),
+                    format!(
+                        "'{s}' is neither a preset ({}) nor a path ending in .toml",
+                        known.join(", ")
+                    ),
+                ));
+            };
+            let table: toml::Table = text.parse().map_err(|e: toml::de::Error| {
+                invalid(format!("scenarios[{i}]"), format!("{origin}: {e}"))
+            })?;
+            scenarios.push(ScenarioEntry {
+                label: s.clone(),
+                origin,
+                table,
+            });
+        }
+        let configs = if file.configs.is_empty() {
+            vec![ConfigFile {
+                name: "default".into(),
+                set: toml::Table::new(),
+            }]
+        } else {
+            file.configs.clone()
+        };
+        for (i, c) in configs.iter().enumerate() {
+            if c.name.trim().is_empty() {
+                return Err(invalid(
+                    format!("configs[{i}].name"),
+                    "must not be empty".into(),
+                ));
+            }
+            if configs[..i].iter().any(|d| d.name == c.name) {
+                return Err(invalid(
+                    format!("configs[{i}].name"),
+                    format!("'{}' is used twice", c.name),
+                ));
+            }
+        }
+        let mut points = vec![SweepPoint { values: Vec::new() }];
+        for (key, values) in &file.sweep {
+            let toml::Value::Array(values) = values else {
+                return Err(invalid(
+                    format!("sweep.{key}"),
+                    "must be an array of values".into(),
+                ));
+            };
+            if values.is_empty() {
+                return Err(invalid(format!("sweep.{key}"), "must not be empty".into()));
+            }
+            let mut next = Vec::new();
+            for p in &points {
+                for v in values {
+                    let mut q = p.clone();
+                    q.values.push((key.clone(), v.clone()));
+                    next.push(q);
+                }
+            }
+            points = next;
+        }
+        Ok(Campaign {
+            file,
+            path: path.to_path_buf(),
+            text,
+            scenarios,
+            configs,
+            points,
+        })
+    }
+
+    /// The success radius, if any.
+    pub fn success_radius_m(&self) -> Option<f64> {
+        self.file.success_radius_m
+    }
+
+    /// Every run, in the canonical order: scenario, configuration, sweep point, seed index.
+    pub fn runs(&self) -> Vec<RunKey> {
+        let mut out = Vec::new();
+        for scenario in 0..self.scenarios.len() {
+            for config in 0..self.configs.len() {
+                for point in 0..self.points.len() {
+                    for seed_index in 0..self.file.seeds {
+                        out.push(RunKey {
+                            scenario,
+                            config,
+                            point,
+                            seed_index,
+                        });
+                    }
+                }
+            }
+        }
+        out
+    }
+
+    /// The runs of one shard: every `count`-th run of the canonical list.
+    pub fn shard_runs(&self, shard: Option<Shard>) -> Vec<RunKey> {
+        let all = self.runs();
+        match shard {
+            None => all,
+            Some(s) => all
+                .into_iter()
+                .enumerate()
+                .filter(|(j, _)| (*j as u64) % s.count == s.index - 1)
+                .map(|(_, k)| k)
+                .collect(),
+        }
+    }
+
+    /// The seed of a run: the same for every group at the same seed index.
+    pub fn run_seed(&self, key: &RunKey) -> u64 {
+        plumetrace_env::derive_seed(self.file.seed, key.seed_index)
+    }
+
+    /// The scenario TOML of a group, with the configuration's and the sweep point's keys set.
+    pub fn group_table(
+        &self,
+        scenario: usize,
+        config: usize,
+        point: usize,
+    ) -> Result<toml::Table, CampaignError> {
+        let mut t = self.scenarios[scenario].table.clone();
+        let c = &self.configs[config];
+        for (k, v) in &c.set {
+            set_key(&mut t, k, v.clone()).map_err(|m| CampaignError::Invalid {
+                file: self.path.display().to_string(),
+                key: format!("configs.{}.set.{k}", c.name),
+                message: m,
+            })?;
+        }
+        for (k, v) in &self.points[point].values {
+            set_key(&mut t, k, v.clone()).map_err(|m| CampaignError::Invalid {
+                file: self.path.display().to_string(),
+                key: format!("sweep.{k}"),
+                message: m,
+            })?;
+        }
+        Ok(t)
+    }
+
+    /// Builds the scenario of a run.
+    pub fn build(&self, key: &RunKey) -> Result<plumetrace_scenario::BuiltScenario, CampaignError> {
+        let cfg = self.group_config(key.scenario, key.config, key.point)?;
+        let origin = &self.scenarios[key.scenario].origin;
+        plumetrace_scenario::build(&cfg, origin, Some(self.run_seed(key)))
+            .map_err(|e| self.group_error(key.scenario, key.config, key.point, e.to_string()))
+    }
+
+    fn group_config(
+        &self,
+        scenario: usize,
+        config: usize,
+        point: usize,
+    ) -> Result<plumetrace_scenario::ScenarioConfig, CampaignError> {
+        let t = self.group_table(scenario, config, point)?;
+        let origin = &self.scenarios[scenario].origin;
+        plumetrace_scenario::from_table(t, origin)
+            .map_err(|e| self.group_error(scenario, config, point, e.to_string()))
+    }
+
+    /// A readable name of a group for errors and tables.
+    pub fn group_name(&self, scenario: usize, config: usize, point: usize) -> String {
+        let p = self.points[point].label();
+        let mut s = format!(
+            "scenario '{}', config '{}'",
+            self.scenarios[scenario].label, self.configs[config].name
+        );
+        if !p.is_empty() {
+            s.push_str(&format!(", sweep {p}"));
+        }
+        s
+    }
+
+    fn group_error(
+        &self,
+        scenario: usize,
+        config: usize,
+        point: usize,
+        message: String,
+    ) -> CampaignError {
+        CampaignError::Group {
+            file: self.path.display().to_string(),
+            group: self.group_name(scenario, config, point),
+            message,
+        }
+    }
+
+    /// Builds every group once (scenario and planner settings), so a bad key fails before any run.
+    pub fn check_groups(&self) -> Result<(), CampaignError> {
+        for s in 0..self.scenarios.len() {
+            for c in 0..self.configs.len() {
+                for p in 0..self.points.len() {
+                    let cfg = self.group_config(s, c, p)?;
+                    let origin = &self.scenarios[s].origin;
+                    let built = plumetrace_scenario::build(&cfg, origin, None)
+                        .map_err(|e| self.group_error(s, c, p, e.to_string()))?;
+                    if built.mission.is_none() {
+                        return Err(self.group_error(
+                            s,
+                            c,
+                            p,
+                            "the scenario has no [mission] table: campaigns run missions".into(),
+                        ));
+                    }
+                    let pc = cfg.planner.as_ref().ok_or_else(|| {
+                        self.group_error(s, c, p, "the scenario has no [planner] table".into())
+                    })?;
+                    plumetrace_mission::amp_params(pc)
+                        .map_err(|e| self.group_error(s, c, p, e.to_string()))?;
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// A digest of everything that decides the runs' results except the number of seeds: seed,
+    /// scenarios' TOML, configurations, sweep, success radius. Resuming or merging requires equal
+    /// fingerprints.
+    pub fn fingerprint(&self) -> String {
+        #[derive(Serialize)]
+        struct Canon<'a> {
+            seed: u64,
+            scenarios: Vec<(&'a str, &'a toml::Table)>,
+            configs: &'a [ConfigFile],
+            sweep: &'a toml::Table,
+            success_radius_m: Option<f64>,
+        }
+        let canon = Canon {
+            seed: self.file.seed,
+            scenarios: self
+                .scenarios
+                .iter()
+                .map(|s| (s.label.as_str(), &s.table))
+                .collect(),
+            configs: &self.configs,
+            sweep: &self.file.sweep,
+            success_radius_m: self.file.success_radius_m,
+        };
+        let text = serde_json::to_string(&canon).unwrap_or_default();
+        format!("{:016x}", fnv1a(text.as_bytes()))
+    }
+}
+
+/// FNV-1a, 64 bits: a stable digest (std's hasher may change between releases).
+fn fnv1a(bytes: &[u8]) -> u64 {
+    let mut h: u64 = 0xcbf2_9ce4_8422_2325;
+    for b in bytes {
+        h ^= u64::from(*b);
+        h = h.wrapping_mul(0x0000_0100_0000_01b3);
+    }
+    h
+}
+
+/// Sets `key` in a scenario table: a bare name means `planner.NAME`; a dotted path walks tables,
+/// and whole-number segments index arrays (`sources.0.mass_rate_per_s`).
+pub fn set_key(table: &mut toml::Table, key: &str, value: toml::Value) -> Result<(), String> {
+    let path: Vec<&str> = if key.contains('.') {
+        key.split('.').collect()
+    } else {
+        vec!["planner", key]
+    };
+    if path.iter().any(|s| s.is_empty()) {
+        return Err(format!("'{key}' is not a key path"));
+    }
+    let (last, walk) = path.split_last().ok_or_else(|| "empty key".to_string())?;
+    let mut here = TableOrArray::Table(table);
+    let mut walked = String::new();
+    for seg in walk {
+        if !walked.is_empty() {
+            walked.push('.');
+        }
+        walked.push_str(seg);
+        here = match here {
+            TableOrArray::Table(t) => {
+                let next = t
+                    .entry(seg.to_string())
+                    .or_insert_with(|| toml::Value::Table(toml::Table::new()));
+                TableOrArray::from_value(next, &walked)?
+            }
+            TableOrArray::Array(a) => {
+                let len = a.len();
+                let i: usize = seg
+                    .parse()
+                    .map_err(|_| format!("'{walked}': '{seg}' is not an index of an array"))?;
+                let next = a
+                    .get_mut(i)
+                    .ok_or_else(|| format!("'{walked}': index {i} past the {len} entries"))?;
+                TableOrArray::from_value(next, &walked)?
+            }
+        };
+    }
+    match here {
+        TableOrArray::Table(t) => {
+            t.insert(last.to_string(), value);
+        }
+        TableOrArray::Array(a) => {
+            let len = a.len();
+            let i: usize = last
+                .parse()
+                .map_err(|_| format!("'{key}': '{last}' is not an index of an array"))?;
+            *a.get_mut(i)
+                .ok_or_else(|| format!("'{key}': index {i} past the {len} entries"))? = value;
+        }
+    }
+    Ok(())
+}
+
+enum TableOrArray<'a> {
+    Table(&'a mut toml::Table),
+    Array(&'a mut Vec<toml::Value>),
+}
+
+impl<'a> TableOrArray<'a> {
+    fn from_value(v: &'a mut toml::Value, at: &str) -> Result<Self, String> {
+        match v {
+            toml::Value::Table(t) => Ok(TableOrArray::Table(t)),
+            toml::Value::Array(a) => Ok(TableOrArray::Array(a)),
+            other => Err(format!("'{at}' is a {}, not a table", other.type_str())),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn table(s: &str) -> toml::Table {
+        s.parse().unwrap_or_default()
+    }
+
+    #[test]
+    fn bare_keys_go_to_the_planner_and_paths_walk_tables_and_arrays() {
+        let mut t = table("[planner]\nstrategy = \"amp\"\n[[sources]]\nx_m = 1.0\n");
+        assert!(set_key(&mut t, "beta_deg", toml::Value::Float(30.0)).is_ok());
+        assert!(set_key(&mut t, "sources.0.x_m", toml::Value::Float(5.0)).is_ok());
+        assert!(set_key(&mut t, "plume.growth_rate_m2ps", toml::Value::Float(0.01)).is_ok());
+        assert_eq!(t["planner"]["beta_deg"].as_float(), Some(30.0));
+        assert_eq!(t["sources"][0]["x_m"].as_float(), Some(5.0));
+        assert_eq!(t["plume"]["growth_rate_m2ps"].as_float(), Some(0.01));
+        let e = set_key(&mut t, "sources.3.x_m", toml::Value::Float(5.0));
+        assert!(e.is_err_and(|m| m.contains("index 3")));
+        let e = set_key(&mut t, "planner.strategy.x", toml::Value::Float(5.0));
+        assert!(e.is_err_and(|m| m.contains("not a table")));
+    }
+
+    #[test]
+    fn shards_parse_and_reject_nonsense() {
+        assert_eq!("2/4".parse::<Shard>(), Ok(Shard { index: 2, count: 4 }));
+        for bad in ["0/4", "5/4", "2", "a/b", "1/0"] {
+            assert!(bad.parse::<Shard>().is_err(), "{bad}");
+        }
+    }
+}

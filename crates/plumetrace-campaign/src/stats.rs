@@ -1,0 +1,362 @@
+//! Per-group statistics: success rate with a Wilson interval, error quantiles, times and path.
+
+use crate::runs::{ERROR_OUTCOME, RunRow};
+use crate::spec::{Campaign, RunKey};
+use serde::Serialize;
+use std::fmt::Write as _;
+
+/// z of a two-sided 95 % interval.
+pub const Z95: f64 = 1.959_963_984_540_054;
+
+/// Wilson score interval for `k` successes in `n` trials at normal quantile `z`;
+/// `(0, 1)` when `n` is 0.
+pub fn wilson(k: u64, n: u64, z: f64) -> (f64, f64) {
+    if n == 0 {
+        return (0.0, 1.0);
+    }
+    let n_f = n as f64;
+    let p = k as f64 / n_f;
+    let z2 = z * z;
+    let denom = 1.0 + z2 / n_f;
+    let centre = (p + z2 / (2.0 * n_f)) / denom;
+    let half = z / denom * (p * (1.0 - p) / n_f + z2 / (4.0 * n_f * n_f)).sqrt();
+    ((centre - half).max(0.0), (centre + half).min(1.0))
+}
+
+/// Quantile `q` of sorted values by linear interpolation between order statistics (NumPy's
+/// default); NaN for no values.
+pub fn quantile(sorted: &[f64], q: f64) -> f64 {
+    match sorted.len() {
+        0 => f64::NAN,
+        1 => sorted[0],
+        n => {
+            let h = q.clamp(0.0, 1.0) * (n - 1) as f64;
+            let lo = h.floor() as usize;
+            let hi = (lo + 1).min(n - 1);
+            sorted[lo] + (h - lo as f64) * (sorted[hi] - sorted[lo])
+        }
+    }
+}
+
+fn sorted(values: impl Iterator<Item = f64>) -> Vec<f64> {
+    let mut v: Vec<f64> = values.filter(|x| x.is_finite()).collect();
+    v.sort_by(f64::total_cmp);
+    v
+}
+
+/// Every outcome name, in table order.
+pub const OUTCOMES: [&str; 7] = [
+    "declared",
+    "no_declaration",
+    "timed_out",
+    "aborted_by_cage",
+    "left_domain",
+    "collided",
+    ERROR_OUTCOME,
+];
+
+/// The statistics of one (scenario, configuration, sweep point) group.
+#[derive(Debug, Clone, Serialize)]
+pub struct GroupSummary {
+    /// Scenario label.
+    pub scenario: String,
+    /// Configuration name.
+    pub config: String,
+    /// Sweep point label.
+    pub point: String,
+    /// Runs recorded.
+    pub runs: u64,
+    /// Successful runs.
+    pub successes: u64,
+    /// successes / runs.
+    pub success_rate: f64,
+    /// Wilson 95 % interval, low end.
+    pub success_ci_low: f64,
+    /// Wilson 95 % interval, high end.
+    pub success_ci_high: f64,
+    /// Declaration error of declaring runs: median, m.
+    pub error_median_m: f64,
+    /// 90th percentile, m.
+    pub error_p90_m: f64,
+    /// |along-flow error|: median, m.
+    pub along_median_m: f64,
+    /// |along-flow error|: 90th percentile, m.
+    pub along_p90_m: f64,
+    /// Signed along-flow error: median (positive: declared downflow), m.
+    pub along_signed_median_m: f64,
+    /// |crossflow error|: median, m.
+    pub cross_median_m: f64,
+    /// |crossflow error|: 90th percentile, m.
+    pub cross_p90_m: f64,
+    /// Time to first detection (runs that detected): median, s.
+    pub first_detection_median_s: f64,
+    /// Time to declaration (declaring runs): median, s.
+    pub declaration_median_s: f64,
+    /// Path length over ground: median, m.
+    pub path_length_median_m: f64,
+    /// Traced path over the straight line from the first detection to the source: median.
+    pub path_ratio_median: f64,
+    /// Count of each outcome, in [`OUTCOMES`] order.
+    pub outcomes: Vec<u64>,
+}
+
+/// Summarises sorted rows group by group, in campaign order; groups without rows are left out.
+pub fn summarise(c: &Campaign, rows: &[(RunKey, RunRow)]) -> Vec<GroupSummary> {
+    let mut out = Vec::new();
+    let mut i = 0;
+    while i < rows.len() {
+        let (k0, _) = &rows[i];
+        let j = rows[i..]
+            .iter()
+            .position(|(k, _)| {
+                (k.scenario, k.config, k.point) != (k0.scenario, k0.config, k0.point)
+            })
+            .map_or(rows.len(), |d| i + d);
+        let group: Vec<&RunRow> = rows[i..j].iter().map(|(_, r)| r).collect();
+        out.push(summarise_group(c, k0, &group));
+        i = j;
+    }
+    out
+}
+
+fn summarise_group(c: &Campaign, key: &RunKey, rows: &[&RunRow]) -> GroupSummary {
+    let n = rows.len() as u64;
+    let k = rows.iter().filter(|r| r.success).count() as u64;
+    let (lo, hi) = wilson(k, n, Z95);
+    let dec: Vec<&&RunRow> = rows.iter().filter(|r| r.declared).collect();
+    let err = sorted(dec.iter().filter_map(|r| r.error_m));
+    let along = sorted(dec.iter().filter_map(|r| r.error_along_m.map(f64::abs)));
+    let along_signed = sorted(dec.iter().filter_map(|r| r.error_along_m));
+    let cross = sorted(dec.iter().filter_map(|r| r.error_cross_m.map(f64::abs)));
+    let det = sorted(rows.iter().filter_map(|r| r.first_detection_s));
+    let decl = sorted(dec.iter().filter_map(|r| r.declaration_s));
+    let path = sorted(rows.iter().filter_map(|r| r.path_length_m));
+    let ratio = sorted(dec.iter().filter_map(|r| r.path_ratio));
+    GroupSummary {
+        scenario: c.scenarios[key.scenario].label.clone(),
+        config: c.configs[key.config].name.clone(),
+        point: c.points[key.point].label(),
+        runs: n,
+        successes: k,
+        success_rate: if n > 0 { k as f64 / n as f64 } else { f64::NAN },
+        success_ci_low: lo,
+        success_ci_high: hi,
+        error_median_m: quantile(&err, 0.5),
+        error_p90_m: quantile(&err, 0.9),
+        along_median_m: quantile(&along, 0.5),
+        along_p90_m: quantile(&along, 0.9),
+        along_signed_median_m: quantile(&along_signed, 0.5),
+        cross_median_m: quantile(&cross, 0.5),
+        cross_p90_m: quantile(&cross, 0.9),
+        first_detection_median_s: quantile(&det, 0.5),
+        declaration_median_s: quantile(&decl, 0.5),
+        path_length_median_m: quantile(&path, 0.5),
+        path_ratio_median: quantile(&ratio, 0.5),
+        outcomes: OUTCOMES
+            .iter()
+            .map(|o| rows.iter().filter(|r| r.outcome == *o).count() as u64)
+            .collect(),
+    }
+}
+
+fn num(v: f64, digits: usize) -> String {
+    if v.is_finite() {
+        format!("{v:.digits$}")
+    } else {
+        String::new()
+    }
+}
+
+/// `summary.csv`: one row per group, numbers rounded for reading (the raw runs are in runs.csv).
+pub fn summary_csv(groups: &[GroupSummary]) -> String {
+    let mut w = csv::Writer::from_writer(Vec::new());
+    let mut head: Vec<String> = [
+        "scenario",
+        "config",
+        "point",
+        "runs",
+        "successes",
+        "success_rate",
+        "success_ci_low",
+        "success_ci_high",
+        "error_median_m",
+        "error_p90_m",
+        "along_median_m",
+        "along_p90_m",
+        "along_signed_median_m",
+        "cross_median_m",
+        "cross_p90_m",
+        "first_detection_median_s",
+        "declaration_median_s",
+        "path_length_median_m",
+        "path_ratio_median",
+    ]
+    .iter()
+    .map(|s| s.to_string())
+    .collect();
+    head.extend(OUTCOMES.iter().map(|o| format!("n_{o}")));
+    let _ = w.write_record(&head);
+    for g in groups {
+        let mut rec = vec![
+            g.scenario.clone(),
+            g.config.clone(),
+            g.point.clone(),
+            g.runs.to_string(),
+            g.successes.to_string(),
+            num(g.success_rate, 4),
+            num(g.success_ci_low, 4),
+            num(g.success_ci_high, 4),
+            num(g.error_median_m, 2),
+            num(g.error_p90_m, 2),
+            num(g.along_median_m, 2),
+            num(g.along_p90_m, 2),
+            num(g.along_signed_median_m, 2),
+            num(g.cross_median_m, 2),
+            num(g.cross_p90_m, 2),
+            num(g.first_detection_median_s, 1),
+            num(g.declaration_median_s, 1),
+            num(g.path_length_median_m, 1),
+            num(g.path_ratio_median, 3),
+        ];
+        rec.extend(g.outcomes.iter().map(u64::to_string));
+        let _ = w.write_record(&rec);
+    }
+    String::from_utf8(w.into_inner().unwrap_or_default()).unwrap_or_default()
+}
+
+fn cell(v: f64, digits: usize) -> String {
+    if v.is_finite() {
+        format!("{v:.digits$}")
+    } else {
+        "–".to_string()
+    }
+}
+
+/// `summary.md`: a Markdown table per campaign.
+pub fn summary_md(c: &Campaign, groups: &[GroupSummary], expected_runs: u64) -> String {
+    let mut s = String::new();
+    let _ = writeln!(s, "# Campaign `{}`\n", c.file.name);
+    if !c.file.description.is_empty() {
+        let _ = writeln!(s, "{}\n", c.file.description);
+    }
+    let recorded: u64 = groups.iter().map(|g| g.runs).sum();
+    let _ = writeln!(
+        s,
+        "{recorded} of {expected_runs} runs recorded; campaign seed {}, {} seeds per group. \
+         Success: {}. Errors are of the first declaration, in metres, over the declaring runs; \
+         along/across are absolute values along and across the mean flow at the source \
+         (signed along median: positive = declared downflow). Times are medians in seconds. \
+         Path ratio: path flown from the first detection to the declaration over the straight \
+         line from the first detection to the source.\n",
+        c.file.seed,
+        c.file.seeds,
+        match c.success_radius_m() {
+            Some(r) => format!("a declaration within {r} m of a true source"),
+            None => "a declaration".to_string(),
+        }
+    );
+    let multi_scenario = c.scenarios.len() > 1;
+    let sweep = c.points.len() > 1;
+    let mut head = Vec::new();
+    if multi_scenario {
+        head.push("scenario");
+    }
+    head.push("config");
+    if sweep {
+        head.push("sweep");
+    }
+    head.extend([
+        "runs",
+        "success (95 % CI)",
+        "error median / p90",
+        "along median / p90",
+        "signed along median",
+        "across median / p90",
+        "first detection",
+        "declaration",
+        "path (m)",
+        "path ratio",
+        "outcomes",
+    ]);
+    let _ = writeln!(s, "| {} |", head.join(" | "));
+    let _ = writeln!(
+        s,
+        "|{}|",
+        head.iter().map(|_| " --- ").collect::<Vec<_>>().join("|")
+    );
+    for g in groups {
+        let mut row = Vec::new();
+        if multi_scenario {
+            row.push(g.scenario.clone());
+        }
+        row.push(g.config.clone());
+        if sweep {
+            row.push(g.point.clone());
+        }
+        let outcomes: Vec<String> = OUTCOMES
+            .iter()
+            .zip(&g.outcomes)
+            .filter(|(_, n)| **n > 0)
+            .map(|(o, n)| format!("{o} {n}"))
+            .collect();
+        row.extend([
+            g.runs.to_string(),
+            format!(
+                "{}/{} = {} ({} – {})",
+                g.successes,
+                g.runs,
+                cell(g.success_rate, 2),
+                cell(g.success_ci_low, 2),
+                cell(g.success_ci_high, 2)
+            ),
+            format!("{} / {}", cell(g.error_median_m, 1), cell(g.error_p90_m, 1)),
+            format!("{} / {}", cell(g.along_median_m, 1), cell(g.along_p90_m, 1)),
+            cell(g.along_signed_median_m, 1),
+            format!("{} / {}", cell(g.cross_median_m, 1), cell(g.cross_p90_m, 1)),
+            cell(g.first_detection_median_s, 0),
+            cell(g.declaration_median_s, 0),
+            cell(g.path_length_median_m, 0),
+            cell(g.path_ratio_median, 2),
+            outcomes.join(", "),
+        ]);
+        let _ = writeln!(s, "| {} |", row.join(" | "));
+    }
+    s
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn wilson_matches_published_values() {
+        // Reference values (z = 1.96): Newcombe (1998), Table I, and direct evaluation.
+        let cases = [
+            (81, 263, 0.2553, 0.3662),
+            (15, 148, 0.0624, 0.1605),
+            (0, 20, 0.0, 0.1611),
+            (1, 29, 0.0061, 0.1718),
+            (10, 10, 0.7225, 1.0),
+            (8, 10, 0.4902, 0.9433),
+        ];
+        for (k, n, lo, hi) in cases {
+            let (a, b) = wilson(k, n, 1.96);
+            assert!(
+                (a - lo).abs() < 5e-4 && (b - hi).abs() < 5e-4,
+                "{k}/{n}: ({a:.4}, {b:.4}), expected ({lo}, {hi})"
+            );
+        }
+        assert_eq!(wilson(0, 0, Z95), (0.0, 1.0));
+    }
+
+    #[test]
+    fn quantiles_interpolate_like_numpy() {
+        let v = [1.0, 2.0, 3.0, 4.0, 10.0];
+        assert_eq!(quantile(&v, 0.5), 3.0);
+        assert!((quantile(&v, 0.9) - 7.6).abs() < 1e-12);
+        assert_eq!(quantile(&v, 0.0), 1.0);
+        assert_eq!(quantile(&v, 1.0), 10.0);
+        assert!(quantile(&[], 0.5).is_nan());
+        assert!((quantile(&[1.0, 2.0], 0.5) - 1.5).abs() < 1e-12);
+    }
+}

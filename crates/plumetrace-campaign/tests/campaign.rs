@@ -1,0 +1,247 @@
+//! Campaigns end to end on a shortened demo mission: determinism across calls, thread counts and
+//! shards; resuming; damaged and foreign results; malformed campaign files.
+
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
+use plumetrace_campaign::{Campaign, CampaignError, RunOptions, Shard, merge, run_campaign};
+use std::path::{Path, PathBuf};
+
+/// Two configurations x two sweep values x 2 seeds of a 1,500 s demo mission.
+const CAMPAIGN: &str = r#"
+name = "test"
+seed = 11
+seeds = 2
+scenarios = ["demo"]
+
+[[configs]]
+name = "paper"
+[configs.set]
+declaration = "along_flow"
+mapping = false
+"mission.time_limit_s" = 1500.0
+"mission.spinup_s" = 1500.0
+
+[[configs]]
+name = "cross"
+[configs.set]
+declaration = "along_and_cross_flow"
+mapping = false
+"mission.time_limit_s" = 1500.0
+"mission.spinup_s" = 1500.0
+
+[sweep]
+beta_deg = [20.0, 30.0]
+"#;
+
+fn campaign_file(dir: &Path, text: &str) -> PathBuf {
+    let p = dir.join("campaign.toml");
+    std::fs::write(&p, text).unwrap();
+    p
+}
+
+fn run(file: &Path, out: &Path, opts: RunOptions, seeds: Option<u64>) {
+    let c = Campaign::load(file, seeds).unwrap();
+    run_campaign(&c, out, opts, &|_, _| {}).unwrap();
+}
+
+fn read(p: &Path) -> String {
+    std::fs::read_to_string(p).unwrap()
+}
+
+#[test]
+fn same_campaign_same_results_whatever_the_threads_and_shards() {
+    let tmp = tempfile::tempdir().unwrap();
+    let file = campaign_file(tmp.path(), CAMPAIGN);
+    let (a, b) = (tmp.path().join("a"), tmp.path().join("b"));
+    run(
+        &file,
+        &a,
+        RunOptions {
+            jobs: Some(1),
+            shard: None,
+        },
+        None,
+    );
+    run(
+        &file,
+        &b,
+        RunOptions {
+            jobs: Some(2),
+            shard: None,
+        },
+        None,
+    );
+    let runs = read(&a.join("runs.csv"));
+    assert_eq!(runs.lines().count(), 1 + 2 * 2 * 2, "{runs}");
+    assert_eq!(
+        runs,
+        read(&b.join("runs.csv")),
+        "--jobs 1 and --jobs 2 differ"
+    );
+    assert_eq!(read(&a.join("summary.csv")), read(&b.join("summary.csv")));
+
+    // Common random numbers: every group at seed index k has the same seed.
+    let rows: Vec<Vec<String>> = runs
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').map(str::to_string).collect())
+        .collect();
+    for r in &rows {
+        let twin = rows.iter().find(|s| s[3] == r[3]).unwrap();
+        assert_eq!(r[4], twin[4], "seed of seed index {}", r[3]);
+    }
+    let outcomes: Vec<&str> = rows.iter().map(|r| r[5].as_str()).collect();
+    assert!(outcomes.contains(&"declared"), "{outcomes:?}");
+
+    // Three shards, merged, equal the single run byte for byte.
+    let shards: Vec<PathBuf> = (1..=3).map(|k| tmp.path().join(format!("s{k}"))).collect();
+    for (k, dir) in shards.iter().enumerate() {
+        let shard = Some(Shard {
+            index: k as u64 + 1,
+            count: 3,
+        });
+        run(
+            &file,
+            dir,
+            RunOptions {
+                jobs: Some(2),
+                shard,
+            },
+            None,
+        );
+    }
+    let shard_rows: usize = shards
+        .iter()
+        .map(|d| read(&d.join("runs.csv")).lines().count() - 1)
+        .sum();
+    assert_eq!(shard_rows, 8, "every run in exactly one shard");
+    let merged = tmp.path().join("merged");
+    let report = merge(&shards, &merged).unwrap();
+    assert_eq!((report.runs, report.expected), (8, 8));
+    assert_eq!(read(&merged.join("runs.csv")), runs);
+    assert_eq!(
+        read(&merged.join("summary.csv")),
+        read(&a.join("summary.csv"))
+    );
+    assert_eq!(
+        read(&merged.join("summary.md")),
+        read(&a.join("summary.md"))
+    );
+    for f in ["success.svg", "errors.svg", "trajectories.svg"] {
+        assert!(read(&merged.join(f)).contains("<svg"), "{f}");
+    }
+    // An example per group (4 groups), whichever shard flew it.
+    assert_eq!(
+        std::fs::read_dir(merged.join("examples")).unwrap().count(),
+        4
+    );
+}
+
+#[test]
+fn resuming_skips_recorded_runs_cuts_a_partial_row_and_extends_seeds() {
+    let tmp = tempfile::tempdir().unwrap();
+    let text = CAMPAIGN.replace("[sweep]\nbeta_deg = [20.0, 30.0]\n", "");
+    let file = campaign_file(tmp.path(), &text);
+    let full = tmp.path().join("full");
+    run(&file, &full, RunOptions::default(), Some(3));
+    let want = read(&full.join("runs.csv"));
+    assert_eq!(want.lines().count(), 1 + 2 * 3);
+
+    // A directory where a killed campaign left two rows and half of a third.
+    let dir = tmp.path().join("resumed");
+    run(&file, &dir, RunOptions::default(), Some(1));
+    let partial = read(&dir.join("runs.csv"));
+    assert_eq!(partial.lines().count(), 3);
+    let next_row = want.lines().nth(2).unwrap();
+    std::fs::write(
+        dir.join("runs.csv"),
+        format!("{partial}{}", &next_row[..next_row.len() / 2]),
+    )
+    .unwrap();
+    let c = Campaign::load(&file, Some(3)).unwrap();
+    let report = run_campaign(&c, &dir, RunOptions::default(), &|_, _| {}).unwrap();
+    assert!(report.cut_partial_line);
+    assert_eq!((report.planned, report.skipped, report.ran), (6, 2, 4));
+    assert_eq!(read(&dir.join("runs.csv")), want);
+
+    // Nothing left to do: a third call runs nothing and changes nothing.
+    let report = run_campaign(&c, &dir, RunOptions::default(), &|_, _| {}).unwrap();
+    assert_eq!((report.skipped, report.ran), (6, 0));
+    assert_eq!(read(&dir.join("runs.csv")), want);
+}
+
+#[test]
+fn a_directory_of_another_campaign_or_a_damaged_file_is_refused_without_touching_it() {
+    let tmp = tempfile::tempdir().unwrap();
+    let text = CAMPAIGN.replace("[sweep]\nbeta_deg = [20.0, 30.0]\n", "");
+    let file = campaign_file(tmp.path(), &text);
+    let dir = tmp.path().join("out");
+    run(&file, &dir, RunOptions::default(), Some(1));
+    let before = read(&dir.join("runs.csv"));
+
+    let other = tmp.path().join("other");
+    std::fs::create_dir_all(&other).unwrap();
+    let other_file = campaign_file(&other, &text.replace("seed = 11", "seed = 12"));
+    let c = Campaign::load(&other_file, Some(1)).unwrap();
+    let e = run_campaign(&c, &dir, RunOptions::default(), &|_, _| {}).unwrap_err();
+    assert!(e.to_string().contains("different campaign"), "{e}");
+    assert_eq!(read(&dir.join("runs.csv")), before);
+
+    // A row damaged in the middle: an error naming the file and line, and the file is kept.
+    let mut lines: Vec<String> = before.lines().map(str::to_string).collect();
+    let mut fields: Vec<&str> = lines[1].split(',').collect();
+    fields[4] = "not-a-seed";
+    lines[1] = fields.join(",");
+    let damaged = lines.join("\n") + "\n";
+    std::fs::write(dir.join("runs.csv"), &damaged).unwrap();
+    let c = Campaign::load(&file, Some(1)).unwrap();
+    let e = run_campaign(&c, &dir, RunOptions::default(), &|_, _| {}).unwrap_err();
+    let msg = e.to_string();
+    assert!(msg.contains("runs.csv line 2"), "{msg}");
+    assert_eq!(read(&dir.join("runs.csv")), damaged);
+}
+
+fn load_err(text: &str) -> CampaignError {
+    let tmp = tempfile::tempdir().unwrap();
+    let file = campaign_file(tmp.path(), text);
+    Campaign::load(&file, None).unwrap_err()
+}
+
+#[test]
+fn malformed_campaigns_are_rejected_with_their_key_path() {
+    let cases: [(&str, &str); 7] = [
+        (
+            "name = \"x\"\nseed = 1\nseeds = 2\nscenarios = [\"demo\"]\ntypo = 3\n",
+            "unknown field `typo`",
+        ),
+        (
+            "name = \"x\"\nseed = 1\nseeds = \"many\"\nscenarios = [\"demo\"]\n",
+            "seeds",
+        ),
+        (
+            "name = \"x\"\nseed = 1\nseeds = 2\nscenarios = [\"no-such-preset\"]\n",
+            "scenarios[0]",
+        ),
+        (
+            "name = \"x\"\nseed = 1\nseeds = 2\nscenarios = [\"demo\"]\n[[configs]]\nname = \"a\"\n[configs.set]\nbeta_deg = 95.0\n",
+            "planner.beta_deg",
+        ),
+        (
+            "name = \"x\"\nseed = 1\nseeds = 2\nscenarios = [\"demo\"]\n[[configs]]\nname = \"a\"\n[configs.set]\nbeta_dge = 25.0\n",
+            "planner.beta_dge",
+        ),
+        (
+            "name = \"x\"\nseed = 1\nseeds = 2\nscenarios = [\"demo\"]\n[sweep]\nlambda_s = 5.0\n",
+            "sweep.lambda_s",
+        ),
+        (
+            "name = \"x\"\nseed = 1\nseeds = 2\nscenarios = [\"demo\"]\n[[configs]]\nname = \"a\"\n[[configs]]\nname = \"a\"\n",
+            "configs[1].name",
+        ),
+    ];
+    for (text, key) in cases {
+        let msg = load_err(text).to_string();
+        assert!(msg.contains(key), "expected '{key}' in: {msg}");
+        assert!(msg.contains("campaign.toml"), "no file in: {msg}");
+    }
+}

@@ -1,0 +1,109 @@
+//! `plumetrace campaign` and `plumetrace merge`.
+
+use anyhow::{Context, Result};
+use plumetrace_campaign::{Campaign, RunOptions, Shard, merge, run_campaign};
+use std::path::PathBuf;
+use std::time::Instant;
+
+/// Arguments of `plumetrace campaign`.
+#[derive(Debug, clap::Args)]
+pub struct CampaignArgs {
+    /// The campaign file (TOML).
+    pub file: PathBuf,
+    /// Output directory; running again into it resumes (finished runs are skipped).
+    #[arg(long)]
+    pub out: PathBuf,
+    /// Worker threads (default: one per core). Results do not depend on it.
+    #[arg(long)]
+    pub jobs: Option<usize>,
+    /// Run only shard K of N (1-based, e.g. `--shard 2/4`): every N-th run of the list.
+    #[arg(long)]
+    pub shard: Option<Shard>,
+    /// Seeds per group (overrides the file's `seeds`).
+    #[arg(long)]
+    pub seeds: Option<u64>,
+}
+
+/// Runs (or resumes) a campaign and prints where the results are.
+pub fn run(args: &CampaignArgs) -> Result<()> {
+    if args.jobs == Some(0) {
+        anyhow::bail!("--jobs: must be at least 1");
+    }
+    if args.seeds == Some(0) {
+        anyhow::bail!("--seeds: must be at least 1");
+    }
+    let c = Campaign::load(&args.file, args.seeds)?;
+    let started = Instant::now();
+    let planned = c.shard_runs(args.shard).len() as u64;
+    let progress = crate::progress::Progress::new(planned, "runs");
+    let report = run_campaign(
+        &c,
+        &args.out,
+        RunOptions {
+            jobs: args.jobs,
+            shard: args.shard,
+        },
+        &|done, _| progress.tick(done),
+    )
+    .with_context(|| format!("campaign {}", args.file.display()))?;
+    progress.finish();
+    let wall = started.elapsed().as_secs_f64();
+    if report.cut_partial_line {
+        eprintln!("note: cut off a partial last row left by an interrupted run (it was run again)");
+    }
+    let shard = args
+        .shard
+        .map(|s| format!(" (shard {s})"))
+        .unwrap_or_default();
+    println!(
+        "{}{shard}: {} runs planned, {} already recorded, {} run now ({} failed) in {wall:.1} s{}; wrote {}",
+        c.file.name,
+        report.planned,
+        report.skipped,
+        report.ran,
+        report.failed,
+        if report.ran > 0 && wall > 0.0 {
+            format!(" ({:.2} runs/s)", report.ran as f64 / wall)
+        } else {
+            String::new()
+        },
+        args.out.display()
+    );
+    Ok(())
+}
+
+/// Arguments of `plumetrace merge`.
+#[derive(Debug, clap::Args)]
+pub struct MergeArgs {
+    /// Shard output directories of one campaign.
+    #[arg(required = true)]
+    pub dirs: Vec<PathBuf>,
+    /// Where to write the merged results.
+    #[arg(long)]
+    pub out: PathBuf,
+}
+
+/// Merges shard directories.
+pub fn run_merge(args: &MergeArgs) -> Result<()> {
+    let report = merge(&args.dirs, &args.out)?;
+    for d in &report.cut_partial_lines {
+        eprintln!(
+            "note: {} ends with a partial row (an interrupted shard); resume it to complete it",
+            d.display()
+        );
+    }
+    let missing = report.expected.saturating_sub(report.runs);
+    println!(
+        "merged {} directories: {} of {} runs{}; wrote {}",
+        args.dirs.len(),
+        report.runs,
+        report.expected,
+        if missing > 0 {
+            format!(" ({missing} missing: resume the shards that lack them)")
+        } else {
+            String::new()
+        },
+        args.out.display()
+    );
+    Ok(())
+}
