@@ -91,24 +91,21 @@ impl ExampleRun {
     /// Writes it into a campaign directory (atomically).
     pub fn write(&self, dir: &Path) -> std::io::Result<()> {
         let json = serde_json::to_string(self).map_err(std::io::Error::other)?;
-        plumetrace_mission::output::write_atomic(&self.path_in(dir), json.as_bytes())
-    }
-
-    fn path_in(&self, dir: &Path) -> PathBuf {
-        dir.join(EXAMPLES_DIR).join(format!(
-            "{}.json",
-            slug(&[&self.scenario, &self.config, &self.point])
-        ))
+        let path = example_file(dir, &self.scenario, &self.config, &self.point);
+        plumetrace_mission::output::write_atomic(&path, json.as_bytes())
     }
 
     /// Reads a group's example from a campaign directory, if it is there.
     pub fn read(dir: &Path, scenario: &str, config: &str, point: &str) -> Option<Self> {
-        let p = dir
-            .join(EXAMPLES_DIR)
-            .join(format!("{}.json", slug(&[scenario, config, point])));
-        let text = std::fs::read_to_string(p).ok()?;
+        let text = std::fs::read_to_string(example_file(dir, scenario, config, point)).ok()?;
         serde_json::from_str(&text).ok()
     }
+}
+
+/// The example file of a group: `examples/<scenario>__<config>__<point>.json`.
+fn example_file(dir: &Path, scenario: &str, config: &str, point: &str) -> PathBuf {
+    dir.join(EXAMPLES_DIR)
+        .join(format!("{}.json", slug(&[scenario, config, point])))
 }
 
 /// A file name from labels: letters, digits, `-`, `.` and `_` kept, the rest `_`, parts joined

@@ -87,12 +87,21 @@ pub fn claim_dir(c: &Campaign, out: &Path) -> Result<(), CampaignError> {
             });
         }
     }
-    let json = serde_json::to_string_pretty(&meta).unwrap_or_default();
-    plumetrace_mission::output::write_atomic(&meta_path, json.as_bytes())
-        .map_err(|e| CampaignError::io(&meta_path, e))?;
-    let copy = out.join(CAMPAIGN_COPY);
-    plumetrace_mission::output::write_atomic(&copy, c.text.as_bytes())
-        .map_err(|e| CampaignError::io(&copy, e))
+    write_meta(out, &meta, &c.text)
+}
+
+/// Writes `campaign.json` and the copy of the campaign file into `out`.
+pub fn write_meta(out: &Path, meta: &Meta, campaign_text: &str) -> Result<(), CampaignError> {
+    let json = serde_json::to_string_pretty(meta).unwrap_or_default();
+    for (name, bytes) in [
+        (META_FILE, json.as_bytes()),
+        (CAMPAIGN_COPY, campaign_text.as_bytes()),
+    ] {
+        let p = out.join(name);
+        plumetrace_mission::output::write_atomic(&p, bytes)
+            .map_err(|e| CampaignError::io(&p, e))?;
+    }
+    Ok(())
 }
 
 /// Runs (the rest of) a campaign into `out`, calling `progress(done, total)` after each run, then

@@ -2,7 +2,7 @@
 
 use crate::error::CampaignError;
 use crate::example::EXAMPLES_DIR;
-use crate::execute::{CAMPAIGN_COPY, META_FILE, Meta};
+use crate::execute::{CAMPAIGN_COPY, META_FILE, Meta, write_meta};
 use crate::finish::write_results;
 use crate::runs::{RUNS_FILE, read_rows, sorted_unique};
 use crate::spec::{Campaign, parse_campaign};
@@ -94,12 +94,7 @@ pub fn merge(dirs: &[PathBuf], out: &Path) -> Result<MergeReport, CampaignError>
     c.file.seeds = seeds.max(1);
     std::fs::create_dir_all(out.join(EXAMPLES_DIR))
         .map_err(|e| CampaignError::io(&out.join(EXAMPLES_DIR), e))?;
-    let meta_out = Meta { seeds, ..meta };
-    let json = serde_json::to_string_pretty(&meta_out).unwrap_or_default();
-    plumetrace_mission::output::write_atomic(&out.join(META_FILE), json.as_bytes())
-        .map_err(|e| CampaignError::io(&out.join(META_FILE), e))?;
-    plumetrace_mission::output::write_atomic(&out.join(CAMPAIGN_COPY), c.text.as_bytes())
-        .map_err(|e| CampaignError::io(&out.join(CAMPAIGN_COPY), e))?;
+    write_meta(out, &Meta { seeds, ..meta }, &c.text)?;
     for d in dirs {
         let Ok(entries) = std::fs::read_dir(d.join(EXAMPLES_DIR)) else {
             continue;

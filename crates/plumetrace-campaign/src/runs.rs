@@ -191,13 +191,15 @@ pub fn parse_rows(path: &Path, text: &str) -> Result<Vec<RunRow>, CampaignError>
     Ok(rows)
 }
 
+/// The complete lines of a results file (up to and including the last newline).
+fn complete_lines(text: &str) -> &str {
+    text.rfind('\n').map_or("", |i| &text[..=i])
+}
+
 /// Reads a results file, ignoring a partial last line (reported in [`Existing`]).
 pub fn read_rows(path: &Path) -> Result<Existing, CampaignError> {
     let text = std::fs::read_to_string(path).map_err(|e| CampaignError::io(path, e))?;
-    let complete = match text.rfind('\n') {
-        Some(i) => &text[..=i],
-        None => "",
-    };
+    let complete = complete_lines(&text);
     if complete.is_empty() {
         return Err(CampaignError::Results {
             path: path.display().to_string(),
@@ -231,33 +233,26 @@ impl Appender {
             .map_err(io)?;
         let mut text = String::new();
         file.read_to_string(&mut text).map_err(io)?;
-        let existing = if text.is_empty() {
+        let complete = complete_lines(&text);
+        // Check what is there before changing anything: a damaged file is left as it is.
+        let rows = if complete.is_empty() {
+            Vec::new()
+        } else {
+            parse_rows(path, complete)?
+        };
+        let cut_partial_line = complete.len() < text.len();
+        if cut_partial_line {
+            file.set_len(complete.len() as u64).map_err(io)?;
+            file.seek(std::io::SeekFrom::End(0)).map_err(io)?;
+        }
+        if complete.is_empty() {
+            // A new file, or not even a full header: nothing was recorded yet.
             file.write_all(format!("{}\n", header()).as_bytes())
                 .map_err(io)?;
-            Existing::default()
-        } else {
-            let complete = text.rfind('\n').map_or(0, |i| i + 1);
-            if complete == 0 {
-                // Not even a full header: nothing was recorded yet.
-                file.set_len(0).map_err(io)?;
-                file.write_all(format!("{}\n", header()).as_bytes())
-                    .map_err(io)?;
-                Existing {
-                    rows: Vec::new(),
-                    cut_partial_line: true,
-                }
-            } else {
-                let rows = parse_rows(path, &text[..complete])?;
-                let cut = complete < text.len();
-                if cut {
-                    file.set_len(complete as u64).map_err(io)?;
-                    file.seek(std::io::SeekFrom::End(0)).map_err(io)?;
-                }
-                Existing {
-                    rows,
-                    cut_partial_line: cut,
-                }
-            }
+        }
+        let existing = Existing {
+            rows,
+            cut_partial_line,
         };
         Ok((
             Appender {

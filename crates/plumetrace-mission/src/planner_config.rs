@@ -13,25 +13,31 @@ pub struct PlannerError {
     pub message: String,
 }
 
+/// `v` if finite and > 0 (the environment's check, with the planner's key path).
 fn positive(key: &str, v: f64) -> Result<f64, PlannerError> {
-    if v.is_finite() && v > 0.0 {
-        Ok(v)
-    } else {
-        Err(PlannerError {
-            key: format!("planner.{key}"),
-            message: format!("must be a finite number > 0, got {v}"),
-        })
-    }
+    plumetrace_env::error::require_positive(&format!("planner.{key}"), v)
+        .map(|()| v)
+        .map_err(PlannerError::from_env)
 }
 
+/// `v` if finite and >= 0.
 fn non_negative(key: &str, v: f64) -> Result<f64, PlannerError> {
-    if v.is_finite() && v >= 0.0 {
-        Ok(v)
-    } else {
-        Err(PlannerError {
-            key: format!("planner.{key}"),
-            message: format!("must be a finite number >= 0, got {v}"),
-        })
+    plumetrace_env::error::require_non_negative(&format!("planner.{key}"), v)
+        .map(|()| v)
+        .map_err(PlannerError::from_env)
+}
+
+impl PlannerError {
+    fn from_env(e: plumetrace_env::EnvError) -> Self {
+        match e {
+            plumetrace_env::EnvError::InvalidParameter { key, message } => {
+                PlannerError { key, message }
+            }
+            other => PlannerError {
+                key: "planner".into(),
+                message: other.to_string(),
+            },
+        }
     }
 }
 

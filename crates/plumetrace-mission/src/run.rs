@@ -405,7 +405,12 @@ pub fn run_mission_with(
             }
             last_pos = Some(p);
         }
-        for v in world.vehicles().iter().filter(|_| options.trajectory) {
+        let recorded: &[SimVehicle] = if options.trajectory {
+            world.vehicles()
+        } else {
+            &[]
+        };
+        for v in recorded {
             let s = v.vehicle.state;
             let est = v.nav.estimate_m();
             let chem = v.last_chem;

@@ -4,7 +4,7 @@
 use crate::config::{FlowKind, MeanFlowConfig, PlumeKind, ScenarioConfig, SeabedKind};
 use crate::{Origin, ScenarioError};
 use plumetrace_core::Vec3;
-use plumetrace_env::flow::{FarrellFlow, FarrellParams, GriddedFlow, MeanFlow, UniformFlow};
+use plumetrace_env::flow::{FarrellFlow, GriddedFlow, MeanFlow, UniformFlow};
 use plumetrace_env::plume::Dispersion;
 use plumetrace_env::steady::{GaussianPlume, GriddedConcentration};
 use plumetrace_env::{
@@ -195,17 +195,7 @@ pub fn build(
         }
         FlowKind::Farrell => {
             let m = mean(true)?.ok_or_else(|| invalid("flow.mean", "missing".into()))?;
-            let f = cfg.flow.farrell.clone().unwrap_or_default();
-            let params = FarrellParams {
-                nx: f.nx,
-                ny: f.ny,
-                diffusivity_x_m2ps: f.diffusivity_x_m2ps,
-                diffusivity_y_m2ps: f.diffusivity_y_m2ps,
-                noise_gain: f.noise_gain,
-                noise_damping: f.noise_damping,
-                noise_bandwidth_radps: f.noise_bandwidth_radps,
-                original_noise_updates: f.original_noise_updates,
-            };
+            let params = cfg.flow.farrell.unwrap_or_default();
             FlowModel::Farrell(Box::new(
                 FarrellFlow::new(domain, m, params, env_dt_s).map_err(|e| match e {
                     EnvError::InvalidParameter { key, message }

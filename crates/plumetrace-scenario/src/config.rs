@@ -90,7 +90,7 @@ pub struct FlowConfig {
     /// Mean flow (uniform and farrell).
     pub mean: Option<MeanFlowConfig>,
     /// Farrell grid and noise parameters.
-    pub farrell: Option<FarrellConfig>,
+    pub farrell: Option<plumetrace_env::flow::FarrellParams>,
     /// CSV file for "gridded" (relative to the scenario file).
     pub file: Option<PathBuf>,
 }
@@ -116,44 +116,6 @@ pub struct MeanFlowConfig {
     pub period_s: Option<f64>,
     /// Tidal: phase at t = 0, degrees.
     pub phase_deg: Option<f64>,
-}
-
-/// `[flow.farrell]`: defaults are pompy's.
-#[derive(Debug, Clone, Serialize, Deserialize)]
-#[serde(deny_unknown_fields, default)]
-pub struct FarrellConfig {
-    /// Grid nodes along x.
-    pub nx: usize,
-    /// Grid nodes along y.
-    pub ny: usize,
-    /// Diffusivity along x, m^2/s.
-    pub diffusivity_x_m2ps: f64,
-    /// Diffusivity along y, m^2/s.
-    pub diffusivity_y_m2ps: f64,
-    /// Corner noise gain.
-    pub noise_gain: f64,
-    /// Corner noise damping ratio.
-    pub noise_damping: f64,
-    /// Corner noise bandwidth, rad/s.
-    pub noise_bandwidth_radps: f64,
-    /// Original Farrell noise scaling (dt instead of sqrt(dt)).
-    pub original_noise_updates: bool,
-}
-
-impl Default for FarrellConfig {
-    fn default() -> Self {
-        let p = plumetrace_env::flow::FarrellParams::default();
-        FarrellConfig {
-            nx: p.nx,
-            ny: p.ny,
-            diffusivity_x_m2ps: p.diffusivity_x_m2ps,
-            diffusivity_y_m2ps: p.diffusivity_y_m2ps,
-            noise_gain: p.noise_gain,
-            noise_damping: p.noise_damping,
-            noise_bandwidth_radps: p.noise_bandwidth_radps,
-            original_noise_updates: p.original_noise_updates,
-        }
-    }
 }
 
 /// Which plume model.

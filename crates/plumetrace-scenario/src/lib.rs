@@ -42,20 +42,21 @@ pub fn parse(text: &str, origin: &Origin) -> Result<ScenarioConfig, ScenarioErro
         path: String::new(),
         message: e.to_string(),
     })?;
-    serde_path_to_error::deserialize(de).map_err(|e| {
-        let path = e.path().to_string();
-        ScenarioError::Parse {
-            origin: origin.to_string(),
-            path: if path == "." { String::new() } else { path },
-            message: e.into_inner().to_string(),
-        }
-    })
+    deserialize(de, origin)
 }
 
 /// Reads a scenario from an already parsed TOML table (e.g. a scenario with overrides applied);
 /// errors name the key path.
 pub fn from_table(table: toml::Table, origin: &Origin) -> Result<ScenarioConfig, ScenarioError> {
-    serde_path_to_error::deserialize(toml::Value::Table(table)).map_err(|e| {
+    deserialize(toml::Value::Table(table), origin)
+}
+
+/// Deserializes the scenario, turning serde's error into one that names the key path.
+fn deserialize<'de, D: serde::Deserializer<'de>>(
+    de: D,
+    origin: &Origin,
+) -> Result<ScenarioConfig, ScenarioError> {
+    serde_path_to_error::deserialize(de).map_err(|e| {
         let path = e.path().to_string();
         ScenarioError::Parse {
             origin: origin.to_string(),

@@ -28,8 +28,10 @@ use plumetrace_core::Vec2;
 use rand_distr::{Distribution, StandardNormal};
 use serde::{Deserialize, Serialize};
 
-/// Parameters of the Farrell flow field (defaults: pompy's `WindModel`).
+/// Parameters of the Farrell flow field (defaults: pompy's `WindModel`). Read as is from a
+/// scenario's `[flow.farrell]` table: unknown keys are errors, omitted ones take the defaults.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
 pub struct FarrellParams {
     /// Grid nodes along x (East), >= 3.
     pub nx: usize,
