@@ -13,8 +13,16 @@ use std::path::Path;
 use std::sync::Arc;
 
 type Getter = fn(&RunRow) -> Option<f64>;
+type CountGetter = fn(&RunRow) -> u32;
 
-/// The optional numeric columns, in `runs.csv` order after `declarations`.
+/// The count columns, in `runs.csv` order after `declared`.
+const COUNTS: [(&str, CountGetter); 3] = [
+    ("declarations", |r| r.declarations),
+    ("sources", |r| r.sources),
+    ("sources_located", |r| r.sources_located),
+];
+
+/// The optional numeric columns, in `runs.csv` order after the counts.
 const NUMBERS: [(&str, Getter); 14] = [
     ("declared_x", |r| r.declared_x),
     ("declared_y", |r| r.declared_y),
@@ -43,12 +51,15 @@ fn schema() -> String {
   REQUIRED BYTE_ARRAY outcome (UTF8);
   REQUIRED BOOLEAN success;
   REQUIRED BOOLEAN declared;
-  REQUIRED INT32 declarations (INTEGER(32,false));
 ",
     );
+    for (name, _) in COUNTS {
+        s.push_str(&format!("  REQUIRED INT32 {name} (INTEGER(32,false));\n"));
+    }
     for (name, _) in NUMBERS {
         s.push_str(&format!("  OPTIONAL DOUBLE {name};\n"));
     }
+    s.push_str("  REQUIRED BYTE_ARRAY source_errors_m (UTF8);\n");
     s.push_str("  REQUIRED BYTE_ARRAY message (UTF8);\n}\n");
     s
 }
@@ -106,20 +117,24 @@ pub fn write_parquet(path: &Path, rows: &[(RunKey, RunRow)]) -> Result<(), Campa
                 None,
                 None,
             ),
-            8 => col.typed::<Int32Type>().write_batch(
-                &rows
-                    .iter()
-                    .map(|r| r.declarations as i32)
-                    .collect::<Vec<_>>(),
-                None,
-                None,
-            ),
-            i if i < 9 + NUMBERS.len() => {
-                let get = NUMBERS[i - 9].1;
+            i if i < 8 + COUNTS.len() => {
+                let get = COUNTS[i - 8].1;
+                col.typed::<Int32Type>().write_batch(
+                    &rows.iter().map(|r| get(r) as i32).collect::<Vec<_>>(),
+                    None,
+                    None,
+                )
+            }
+            i if i < 8 + COUNTS.len() + NUMBERS.len() => {
+                let get = NUMBERS[i - 8 - COUNTS.len()].1;
                 let values: Vec<f64> = rows.iter().filter_map(|r| get(r)).collect();
                 let levels: Vec<i16> = rows.iter().map(|r| i16::from(get(r).is_some())).collect();
                 col.typed::<DoubleType>()
                     .write_batch(&values, Some(&levels), None)
+            }
+            i if i == 8 + COUNTS.len() + NUMBERS.len() => {
+                col.typed::<ByteArrayType>()
+                    .write_batch(&text(|r| &r.source_errors_m), None, None)
             }
             _ => col
                 .typed::<ByteArrayType>()
@@ -163,6 +178,8 @@ mod tests {
             success: error.is_some(),
             declared: error.is_some(),
             declarations: u32::from(error.is_some()),
+            sources: 1,
+            sources_located: u32::from(error.is_some()),
             declared_x: error,
             declared_y: error,
             source_x: Some(1.0),
@@ -177,6 +194,7 @@ mod tests {
             detection_to_source_m: Some(50.0),
             path_ratio: error,
             sim_time_s: Some(7200.0),
+            source_errors_m: error.map_or(String::new(), |e| format!("{e:.3}")),
             message: String::new(),
         };
         (key, r)
@@ -205,6 +223,14 @@ mod tests {
         assert_eq!(field(&read[2], "error_m"), Field::Double(3.25));
         assert_eq!(field(&read[1], "outcome"), Field::Str("timed_out".into()));
         assert_eq!(field(&read[2], "seed"), Field::ULong(u64::MAX - 2));
+        assert_eq!(field(&read[0], "sources_located"), Field::UInt(1));
+        assert_eq!(field(&read[1], "sources_located"), Field::UInt(0));
+        let names: Vec<String> = read[0].get_column_iter().map(|(n, _)| n.clone()).collect();
+        assert_eq!(
+            names.join(","),
+            crate::runs::header(),
+            "the same columns as runs.csv, in order"
+        );
         std::fs::remove_file(&tmp).unwrap();
     }
 }

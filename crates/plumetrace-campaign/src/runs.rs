@@ -33,12 +33,17 @@ pub struct RunRow {
     pub seed: u64,
     /// Outcome name (`declared`, `no_declaration`, `timed_out`, ..., or `error`).
     pub outcome: String,
-    /// Declared (within the success radius, if the campaign sets one).
+    /// Single source: declared (within the success radius, if the campaign sets one). Several
+    /// sources: every source located (`sources_located == sources`).
     pub success: bool,
     /// Declared at all.
     pub declared: bool,
     /// Number of declarations (several on multi-source missions).
     pub declarations: u32,
+    /// Number of true sources.
+    pub sources: u32,
+    /// Sources with a declaration within the success radius (the mission's 50 m without one).
+    pub sources_located: u32,
     /// First declared position, m.
     pub declared_x: Option<f64>,
     /// First declared position, m.
@@ -67,6 +72,9 @@ pub struct RunRow {
     pub path_ratio: Option<f64>,
     /// Mission time, s.
     pub sim_time_s: Option<f64>,
+    /// Distance from each true source to its nearest declaration, m, `;`-separated in the
+    /// scenario's source order (empty entries for sources without one).
+    pub source_errors_m: String,
     /// Why a run failed (outcome `error`), else empty.
     pub message: String,
 }
@@ -79,9 +87,21 @@ impl RunRow {
     /// The row of a finished mission.
     pub fn from_summary(c: &Campaign, key: &RunKey, outcome: &str, s: &Summary) -> Self {
         let declared = s.declared;
-        let success = declared
-            && c.success_radius_m()
-                .is_none_or(|r| s.error_m.is_finite() && s.error_m <= r);
+        let radius = c
+            .success_radius_m()
+            .unwrap_or(plumetrace_mission::LOCATED_RADIUS_M);
+        let located = s
+            .sources
+            .iter()
+            .filter(|src| src.nearest_error_m <= radius)
+            .count();
+        let success = if s.sources.len() > 1 {
+            located == s.sources.len()
+        } else {
+            declared
+                && c.success_radius_m()
+                    .is_none_or(|r| s.error_m.is_finite() && s.error_m <= r)
+        };
         let ratio = if s.trace_length_m.is_finite()
             && s.detection_to_source_m.is_finite()
             && s.detection_to_source_m > 0.0
@@ -95,6 +115,8 @@ impl RunRow {
             success,
             declared,
             declarations: u32::try_from(s.declarations.len()).unwrap_or(u32::MAX),
+            sources: u32::try_from(s.sources.len()).unwrap_or(u32::MAX),
+            sources_located: u32::try_from(located).unwrap_or(u32::MAX),
             declared_x: finite(s.declared_x),
             declared_y: finite(s.declared_y),
             source_x: finite(s.source_x),
@@ -109,6 +131,12 @@ impl RunRow {
             detection_to_source_m: finite(s.detection_to_source_m),
             path_ratio: ratio,
             sim_time_s: finite(s.sim_time_s),
+            source_errors_m: s
+                .sources
+                .iter()
+                .map(|src| finite(src.nearest_error_m).map_or(String::new(), |e| format!("{e:.3}")))
+                .collect::<Vec<_>>()
+                .join(";"),
             ..RunRow::empty(c, key)
         }
     }

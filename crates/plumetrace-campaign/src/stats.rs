@@ -74,6 +74,14 @@ pub struct GroupSummary {
     pub success_ci_low: f64,
     /// Wilson 95 % interval, high end.
     pub success_ci_high: f64,
+    /// True sources over all runs.
+    pub sources: u64,
+    /// Of them, located.
+    pub sources_located: u64,
+    /// Distance from each located source to its nearest declaration: median, m.
+    pub located_error_median_m: f64,
+    /// 90th percentile, m.
+    pub located_error_p90_m: f64,
     /// Declaration error of declaring runs: median, m.
     pub error_median_m: f64,
     /// 90th percentile, m.
@@ -132,6 +140,15 @@ fn summarise_group(c: &Campaign, key: &RunKey, rows: &[&RunRow]) -> GroupSummary
     let decl = sorted(dec.iter().filter_map(|r| r.declaration_s));
     let path = sorted(rows.iter().filter_map(|r| r.path_length_m));
     let ratio = sorted(dec.iter().filter_map(|r| r.path_ratio));
+    let radius = c
+        .success_radius_m()
+        .unwrap_or(plumetrace_mission::LOCATED_RADIUS_M);
+    let located = sorted(
+        rows.iter()
+            .flat_map(|r| r.source_errors_m.split(';'))
+            .filter_map(|e| e.parse::<f64>().ok())
+            .filter(|e| *e <= radius),
+    );
     GroupSummary {
         scenario: c.scenarios[key.scenario].label.clone(),
         config: c.configs[key.config].name.clone(),
@@ -141,6 +158,10 @@ fn summarise_group(c: &Campaign, key: &RunKey, rows: &[&RunRow]) -> GroupSummary
         success_rate: if n > 0 { k as f64 / n as f64 } else { f64::NAN },
         success_ci_low: lo,
         success_ci_high: hi,
+        sources: rows.iter().map(|r| u64::from(r.sources)).sum(),
+        sources_located: rows.iter().map(|r| u64::from(r.sources_located)).sum(),
+        located_error_median_m: quantile(&located, 0.5),
+        located_error_p90_m: quantile(&located, 0.9),
         error_median_m: quantile(&err, 0.5),
         error_p90_m: quantile(&err, 0.9),
         along_median_m: quantile(&along, 0.5),
@@ -179,6 +200,10 @@ pub fn summary_csv(groups: &[GroupSummary]) -> String {
         "success_rate",
         "success_ci_low",
         "success_ci_high",
+        "sources",
+        "sources_located",
+        "located_error_median_m",
+        "located_error_p90_m",
         "error_median_m",
         "error_p90_m",
         "along_median_m",
@@ -206,6 +231,10 @@ pub fn summary_csv(groups: &[GroupSummary]) -> String {
             num(g.success_rate, 4),
             num(g.success_ci_low, 4),
             num(g.success_ci_high, 4),
+            g.sources.to_string(),
+            g.sources_located.to_string(),
+            num(g.located_error_median_m, 2),
+            num(g.located_error_p90_m, 2),
             num(g.error_median_m, 2),
             num(g.error_p90_m, 2),
             num(g.along_median_m, 2),
@@ -240,6 +269,11 @@ pub fn summary_md(c: &Campaign, groups: &[GroupSummary], expected_runs: u64) -> 
         let _ = writeln!(s, "{}\n", c.file.description);
     }
     let recorded: u64 = groups.iter().map(|g| g.runs).sum();
+    // Several sources per run somewhere: success means every source located.
+    let multi_source = groups.iter().any(|g| g.sources > g.runs);
+    let radius = c
+        .success_radius_m()
+        .unwrap_or(plumetrace_mission::LOCATED_RADIUS_M);
     let _ = writeln!(
         s,
         "{recorded} of {expected_runs} runs recorded; campaign seed {}, {} seeds per group. \
@@ -250,11 +284,27 @@ pub fn summary_md(c: &Campaign, groups: &[GroupSummary], expected_runs: u64) -> 
          line from the first detection to the source.\n",
         c.file.seed,
         c.file.seeds,
-        match c.success_radius_m() {
-            Some(r) => format!("a declaration within {r} m of a true source"),
-            None => "a declaration".to_string(),
+        match (c.success_radius_m(), multi_source) {
+            (Some(r), false) => format!("a declaration within {r} m of a true source"),
+            (None, false) => "a declaration".to_string(),
+            (_, true) => format!(
+                "with one source, a declaration{}; with several, every source located \
+                 (a declaration within {radius} m of it; edge declarations of subregions \
+                 count for the source they are nearest to)",
+                c.success_radius_m()
+                    .map_or(String::new(), |r| format!(" within {r} m"))
+            ),
         }
     );
+    if multi_source {
+        let _ = writeln!(
+            s,
+            "Several sources: the first declaration is often at the edge of a subregion, so \
+             its error says little; `sources located` counts sources with a declaration within \
+             {radius} m, and `located error` is the distance from each located source to its \
+             nearest declaration (all runs' sources pooled).\n"
+        );
+    }
     let multi_scenario = c.scenarios.len() > 1;
     let sweep = c.points.len() > 1;
     let mut head = Vec::new();
@@ -265,9 +315,12 @@ pub fn summary_md(c: &Campaign, groups: &[GroupSummary], expected_runs: u64) -> 
     if sweep {
         head.push("sweep");
     }
+    head.extend(["runs", "success (95 % CI)"]);
+    if multi_source {
+        head.push("sources located");
+        head.push("located error median / p90");
+    }
     head.extend([
-        "runs",
-        "success (95 % CI)",
         "error median / p90",
         "along median / p90",
         "signed along median",
@@ -309,6 +362,16 @@ pub fn summary_md(c: &Campaign, groups: &[GroupSummary], expected_runs: u64) -> 
                 cell(g.success_ci_low, 2),
                 cell(g.success_ci_high, 2)
             ),
+        ]);
+        if multi_source {
+            row.push(format!("{}/{}", g.sources_located, g.sources));
+            row.push(format!(
+                "{} / {}",
+                cell(g.located_error_median_m, 1),
+                cell(g.located_error_p90_m, 1)
+            ));
+        }
+        row.extend([
             format!("{} / {}", cell(g.error_median_m, 1), cell(g.error_p90_m, 1)),
             format!("{} / {}", cell(g.along_median_m, 1), cell(g.along_p90_m, 1)),
             cell(g.along_signed_median_m, 1),
@@ -326,7 +389,47 @@ pub fn summary_md(c: &Campaign, groups: &[GroupSummary], expected_runs: u64) -> 
 
 #[cfg(test)]
 mod tests {
+    #![allow(clippy::unwrap_used)]
     use super::*;
+
+    #[test]
+    fn multi_source_groups_count_located_sources_and_pool_their_errors() {
+        let path = std::path::Path::new("mt.toml");
+        let text = "name = \"mt\"\nseed = 1\nseeds = 2\nscenarios = [\"duck-2003-mt\"]\n";
+        let file = crate::spec::parse_campaign(text, path).unwrap();
+        let c = Campaign::resolve(file, path, text.to_string(), true).unwrap();
+        let row = |seed_index: u64, located: u32, errors: &str| {
+            let key = RunKey {
+                scenario: 0,
+                config: 0,
+                point: 0,
+                seed_index,
+            };
+            let r = RunRow {
+                outcome: "declared".into(),
+                declared: true,
+                success: located == 2,
+                sources: 2,
+                sources_located: located,
+                source_errors_m: errors.into(),
+                error_m: Some(313.0),
+                ..RunRow::default()
+            };
+            (key, r)
+        };
+        // The second run's other source has only a far (edge) declaration: not located.
+        let rows = vec![row(0, 2, "4.000;6.000"), row(1, 1, "3.000;290.000")];
+        let g = summarise(&c, &rows);
+        assert_eq!(
+            (g[0].sources, g[0].sources_located, g[0].successes),
+            (4, 3, 1)
+        );
+        assert_eq!(g[0].located_error_median_m, 4.0);
+        let md = summary_md(&c, &g, 2);
+        assert!(md.contains("| sources located |"), "{md}");
+        assert!(md.contains("| 3/4 | 4.0 / 5.6 |"), "{md}");
+        assert!(md.contains("every source located"), "{md}");
+    }
 
     #[test]
     fn wilson_matches_published_values() {

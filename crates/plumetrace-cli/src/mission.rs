@@ -49,7 +49,27 @@ pub fn run(sc: BuiltScenario, out: &Path, stats: bool) -> Result<()> {
             spinup_wall.unwrap_or(0.0)
         );
     }
-    let result = if s.declared {
+    let result = if s.sources.len() > 1 || s.declarations.len() > 1 {
+        let nearest: Vec<String> = s
+            .sources
+            .iter()
+            .map(|r| {
+                if r.nearest_error_m.is_finite() {
+                    format!("{:.1} m", r.nearest_error_m)
+                } else {
+                    "none".to_string()
+                }
+            })
+            .collect();
+        format!(
+            "{} declarations; {} of {} sources located within {:.0} m (nearest declaration per source: {})",
+            s.declarations.len(),
+            s.sources_located,
+            s.sources.len(),
+            plumetrace_mission::LOCATED_RADIUS_M,
+            nearest.join(", ")
+        )
+    } else if s.declared {
         format!(
             "declared at ({:.1}, {:.1}), {:.1} m from the source ({:+.1} m along, {:+.1} m across the flow)",
             s.declared_x, s.declared_y, s.error_m, s.error_along_m, s.error_cross_m
@@ -114,10 +134,20 @@ fn write_outputs(
     )?;
     let svg = plumetrace_mission::plot::mission_figure(
         run,
-        &format!(
-            "{name}: {} (seed {})",
-            run.summary.outcome, run.summary.seed
-        ),
+        &if run.summary.sources.len() > 1 {
+            format!(
+                "{name}: {}, {} of {} sources located (seed {})",
+                run.summary.outcome,
+                run.summary.sources_located,
+                run.summary.sources.len(),
+                run.summary.seed
+            )
+        } else {
+            format!(
+                "{name}: {} (seed {})",
+                run.summary.outcome, run.summary.seed
+            )
+        },
     )
     .map_err(anyhow::Error::msg)?;
     write_atomic(&out.join("plot.svg"), svg.as_bytes())?;

@@ -224,6 +224,13 @@ fn mission_run_writes_summary_trajectory_events_and_plot() {
         assert!(summary.get(key).is_some(), "summary.json lacks {key}");
     }
     assert_eq!(summary["sim_time_s"], 200.0);
+    let sources = summary["sources"].as_array().unwrap();
+    assert_eq!(sources.len(), 1);
+    assert_eq!(sources[0]["x_m"], summary["source_x"]);
+    assert_eq!(
+        summary["sources_located"].as_u64().unwrap(),
+        u64::from(sources[0]["located"].as_bool().unwrap())
+    );
     let traj = std::fs::read_to_string(out.join("trajectory.csv")).unwrap();
     assert!(traj.starts_with("t_s,vehicle,true_x_m,true_y_m,true_z_m,est_x_m,est_y_m,heading_deg,speed_mps,behaviour,reading_v,detection\n"));
     assert_eq!(traj.lines().count(), 1 + 2000);

@@ -13,6 +13,6 @@ pub mod run;
 
 pub use planner_config::{PlannerError, amp_params};
 pub use run::{
-    MissionError, MissionOptions, MissionRun, Outcome, Summary, TrajectoryRow, run_mission,
-    run_mission_with,
+    DeclarationRecord, LOCATED_RADIUS_M, MissionError, MissionOptions, MissionRun, Outcome,
+    SourceRecord, Summary, TrajectoryRow, run_mission, run_mission_with,
 };

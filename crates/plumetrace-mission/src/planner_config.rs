@@ -1,7 +1,7 @@
 //! From the scenario's `[planner]` table to planner parameters, with key paths in errors.
 
-use plumetrace_planner::{AmpParams, DeclarationRule, MappingParams};
-use plumetrace_scenario::config::{DeclarationKind, PlannerConfig};
+use plumetrace_planner::{AmpParams, DeclarationRule, LostPointEviction, MappingParams};
+use plumetrace_scenario::config::{DeclarationKind, EvictionKind, PlannerConfig};
 
 /// A bad planner setting.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -112,6 +112,11 @@ pub fn amp_params(c: &PlannerConfig) -> Result<AmpParams, PlannerError> {
             c.min_turn_radius_m.unwrap_or(d.min_turn_radius_m),
         )?,
         max_lost_points: max_lost,
+        lost_point_eviction: match c.lost_point_eviction {
+            None => d.lost_point_eviction,
+            Some(EvictionKind::MostDownflow) => LostPointEviction::MostDownflow,
+            Some(EvictionKind::Oldest) => LostPointEviction::Oldest,
+        },
         declaration,
         mapping,
         region_timeout_s: positive(

@@ -140,6 +140,29 @@ pub struct DeclarationRecord {
     pub error_along_m: f64,
     /// Across the flow (positive: to the right looking downflow), m.
     pub error_cross_m: f64,
+    /// The rule that declared it (`along_flow`, `along_and_cross_flow`, `upflow_edge`, ...).
+    pub rule: &'static str,
+}
+
+/// A source counts as located when a declaration lies within this distance of it, m. The field
+/// declarations were within 31 m of the sonar positions, and the plume of a bottom source reaches
+/// a vehicle 1.5-2 m up only some tens of metres downflow.
+pub const LOCATED_RADIUS_M: f64 = 50.0;
+
+/// A true source and how well the declarations found it.
+#[derive(Debug, Clone, Serialize)]
+pub struct SourceRecord {
+    /// Position, m.
+    pub x_m: f64,
+    /// Position, m.
+    pub y_m: f64,
+    /// Declarations nearer to this source than to any other (edge declarations of a
+    /// multi-source mission included).
+    pub declarations: usize,
+    /// Distance of the nearest declaration, m (NaN if none).
+    pub nearest_error_m: f64,
+    /// A declaration lies within [`LOCATED_RADIUS_M`].
+    pub located: bool,
 }
 
 /// The mission's key numbers (written as `summary.json`).
@@ -182,6 +205,10 @@ pub struct Summary {
     pub sim_time_s: f64,
     /// Every declaration.
     pub declarations: Vec<DeclarationRecord>,
+    /// Sources with a declaration within [`LOCATED_RADIUS_M`].
+    pub sources_located: usize,
+    /// Every true source, with its nearest declaration.
+    pub sources: Vec<SourceRecord>,
 }
 
 /// Everything a mission produced.
@@ -328,7 +355,7 @@ pub fn run_mission_with(
     let mut outcome = None;
     let mut first_detection = f64::NAN;
     let mut first_detection_pos = None;
-    let mut declarations: Vec<(f64, Vec2)> = Vec::new();
+    let mut declarations: Vec<(f64, Vec2, &'static str)> = Vec::new();
     // Distance over ground of the first AUV, in total and from its first detection to its first
     // declaration (the traced path).
     let tracer = setups
@@ -351,7 +378,9 @@ pub fn run_mission_with(
                         first_detection = t;
                         first_detection_pos = Some(*pos_m);
                     }
-                    PlannerEvent::Declared { pos_m, .. } => declarations.push((t, *pos_m)),
+                    PlannerEvent::Declared { pos_m, rule } => {
+                        declarations.push((t, *pos_m, rule));
+                    }
                     _ => {}
                 }
                 events.push(EventRecord {
@@ -470,8 +499,9 @@ pub fn run_mission_with(
     };
     let records: Vec<DeclarationRecord> = declarations
         .iter()
-        .map(|(t, p)| declaration_record(*t, *p, &sources, mean_flow))
+        .map(|(t, p, rule)| declaration_record(*t, *p, rule, &sources, mean_flow))
         .collect();
+    let source_records = source_records(&sources, &records);
     let first = records.first();
     let src0 = first
         .map(|r| Vec2::new(r.source_x_m, r.source_y_m))
@@ -500,6 +530,8 @@ pub fn run_mission_with(
         detection_to_source_m: first_detection_pos.map_or(f64::NAN, |p| (p - src0).norm()),
         sim_time_s: sim_time,
         declarations: records,
+        sources_located: source_records.iter().filter(|s| s.located).count(),
+        sources: source_records,
     };
     Ok(MissionRun {
         outcome,
@@ -515,7 +547,13 @@ pub fn run_mission_with(
     })
 }
 
-fn declaration_record(t: f64, p: Vec2, sources: &[Vec3], mean_flow: Vec2) -> DeclarationRecord {
+fn declaration_record(
+    t: f64,
+    p: Vec2,
+    rule: &'static str,
+    sources: &[Vec3],
+    mean_flow: Vec2,
+) -> DeclarationRecord {
     let src = sources
         .iter()
         .map(|s| s.xy())
@@ -534,5 +572,59 @@ fn declaration_record(t: f64, p: Vec2, sources: &[Vec3], mean_flow: Vec2) -> Dec
         error_m: d.norm(),
         error_along_m: d.dot(&u),
         error_cross_m: d.dot(&right),
+        rule,
+    }
+}
+
+/// Each true source with the declarations attributed to it (those nearest to it).
+fn source_records(sources: &[Vec3], declarations: &[DeclarationRecord]) -> Vec<SourceRecord> {
+    sources
+        .iter()
+        .map(|s| {
+            let mine: Vec<f64> = declarations
+                .iter()
+                .filter(|d| d.source_x_m == s.x && d.source_y_m == s.y)
+                .map(|d| d.error_m)
+                .collect();
+            let nearest = mine.iter().copied().fold(f64::NAN, f64::min);
+            SourceRecord {
+                x_m: s.x,
+                y_m: s.y,
+                declarations: mine.len(),
+                nearest_error_m: nearest,
+                located: nearest <= LOCATED_RADIUS_M,
+            }
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn declarations_are_attributed_to_their_nearest_source() {
+        let sources = [Vec3::new(300.0, 860.0, 0.0), Vec3::new(700.0, 820.0, 0.0)];
+        let flow = Vec2::new(0.05, -0.25);
+        let decl: Vec<DeclarationRecord> = [
+            (100.0, Vec2::new(340.0, 550.0), "upflow_edge"),
+            (900.0, Vec2::new(298.0, 852.0), "along_flow"),
+            (1500.0, Vec2::new(305.0, 845.0), "along_flow"),
+        ]
+        .iter()
+        .map(|(t, p, rule)| declaration_record(*t, *p, rule, &sources, flow))
+        .collect();
+        let recs = source_records(&sources, &decl);
+        assert_eq!(recs[0].declarations, 3, "the edge declaration counts too");
+        assert!((recs[0].nearest_error_m - 68f64.sqrt()).abs() < 1e-12);
+        assert!(recs[0].located);
+        assert_eq!(recs[1].declarations, 0);
+        assert!(recs[1].nearest_error_m.is_nan());
+        assert!(!recs[1].located);
+        // Only the edge declaration: attributed, but 300 m away is not located.
+        let recs = source_records(&sources, &decl[..1]);
+        assert_eq!(recs[0].declarations, 1);
+        assert!(recs[0].nearest_error_m > LOCATED_RADIUS_M && !recs[0].located);
+        assert_eq!(decl[0].rule, "upflow_edge");
     }
 }

@@ -1,25 +1,23 @@
-//! The Duck 2003 single-source mission over 20 seeds (the acceptance check of the AMP). Slow in a
+//! The Duck 2003 missions over several seeds (the acceptance checks of the AMP). Slow in a
 //! debug build: run with `cargo test --release -p plumetrace-mission --test duck_campaign --
 //! --ignored` (CI does).
 
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
-use plumetrace_mission::run_mission;
+use plumetrace_mission::{Summary, run_mission};
 use plumetrace_scenario::{Origin, build, load_preset};
 
-#[test]
-#[ignore = "about a minute in release mode; run with --ignored"]
-fn duck_st_declares_in_most_seeds_with_errors_mostly_along_the_flow() {
-    let cfg = load_preset("duck-2003-st").unwrap();
-    let seeds: Vec<u64> = (1..=20).collect();
+/// The preset's mission at seeds 1..=n on two threads, in seed order.
+fn run_seeds(preset: &str, n: u64) -> Vec<(u64, Summary)> {
+    let cfg = load_preset(preset).unwrap();
+    let seeds: Vec<u64> = (1..=n).collect();
     let results = std::sync::Mutex::new(Vec::new());
     std::thread::scope(|s| {
-        for chunk in seeds.chunks(10) {
+        for chunk in seeds.chunks(seeds.len().div_ceil(2)) {
             let (cfg, results) = (&cfg, &results);
             s.spawn(move || {
                 for &seed in chunk {
-                    let sc =
-                        build(cfg, &Origin::Preset("duck-2003-st".into()), Some(seed)).unwrap();
+                    let sc = build(cfg, &Origin::Preset(preset.into()), Some(seed)).unwrap();
                     let run = run_mission(sc, &mut |_, _| {}).unwrap();
                     results.lock().unwrap().push((seed, run.summary));
                 }
@@ -28,6 +26,13 @@ fn duck_st_declares_in_most_seeds_with_errors_mostly_along_the_flow() {
     });
     let mut results = results.into_inner().unwrap();
     results.sort_by_key(|r| r.0);
+    results
+}
+
+#[test]
+#[ignore = "about a minute in release mode; run with --ignored"]
+fn duck_st_declares_in_most_seeds_with_errors_mostly_along_the_flow() {
+    let results = run_seeds("duck-2003-st", 20);
     let declared: Vec<_> = results
         .iter()
         .filter(|r| r.1.declared)
@@ -59,5 +64,42 @@ fn duck_st_declares_in_most_seeds_with_errors_mostly_along_the_flow() {
         "the error is mostly across the flow in {} of {}",
         declared.len() - along_dominant,
         declared.len()
+    );
+}
+
+#[test]
+#[ignore = "about a minute in release mode; run with --ignored"]
+fn duck_mt_locates_the_sources_and_declares_the_southern_edges() {
+    let results = run_seeds("duck-2003-mt", 8);
+    let sources: usize = results.iter().map(|r| r.1.sources.len()).sum();
+    let located: usize = results.iter().map(|r| r.1.sources_located).sum();
+    let mut errors: Vec<f64> = results
+        .iter()
+        .flat_map(|r| r.1.sources.iter())
+        .filter(|s| s.located)
+        .map(|s| s.nearest_error_m)
+        .collect();
+    errors.sort_by(f64::total_cmp);
+    let median = errors.get(errors.len() / 2).copied().unwrap_or(f64::NAN);
+    // The plumes of the northern sources cross into the southern subregions, whose searches
+    // should end at their upflow edge (y = 550 m) with a declaration there.
+    let edges: Vec<usize> = results
+        .iter()
+        .map(|r| {
+            r.1.declarations
+                .iter()
+                .filter(|d| d.rule == "upflow_edge" && (d.y_m - 550.0).abs() < 1.0)
+                .count()
+        })
+        .collect();
+    eprintln!(
+        "located {located}/{sources}, errors {errors:?}, median {median:.1} m, edge declarations per mission {edges:?}"
+    );
+    assert_eq!(sources, 16, "two sources per mission");
+    assert!(located >= 14, "located {located} of {sources} sources");
+    assert!(median < 20.0, "median error of located sources {median} m");
+    assert!(
+        edges.iter().filter(|&&n| n == 2).count() >= 6,
+        "both southern subregions end at their edge in too few missions: {edges:?}"
     );
 }

@@ -12,7 +12,7 @@
 pub mod amp;
 pub mod flow;
 
-pub use amp::{Amp, AmpParams, DeclarationRule, MappingParams};
+pub use amp::{Amp, AmpParams, DeclarationRule, LostPointEviction, MappingParams};
 pub use flow::FlowEstimate;
 
 /// Every planner plumetrace knows, for `list` commands and campaign files.

@@ -8,7 +8,7 @@ use plumetrace_core::{
 };
 use plumetrace_guidance::OpArea;
 use plumetrace_planner::amp::BehaviourKind;
-use plumetrace_planner::{Amp, AmpParams};
+use plumetrace_planner::{Amp, AmpParams, LostPointEviction};
 
 /// Flow towards North at 0.1 m/s: upflow is South.
 fn snap(t: f64, pos: (f64, f64), heading_deg: f64, detection: bool) -> SensorSnapshot {
@@ -231,6 +231,41 @@ fn keeps_at_most_six_lost_points_dropping_the_oldest() {
     assert!(
         lost.iter().all(|p| p.y < 850.0),
         "the most downflow points were dropped: {lost:?}"
+    );
+}
+
+#[test]
+fn a_full_list_drops_the_oldest_or_the_most_downflow_older_point() {
+    // Each loss 10 m further downflow (North) than the one before: never a declaration.
+    let pts: Vec<(f64, f64)> = (0..8)
+        .map(|k| (200.0, 300.0 + 10.0 * f64::from(k)))
+        .collect();
+    let ys = |eviction| {
+        let area = OpArea::rectangle(0.0, 400.0, 0.0, 1000.0).unwrap();
+        let params = AmpParams {
+            lost_point_eviction: eviction,
+            ..AmpParams::default()
+        };
+        let mut a = Amp::new(params, area, vec![], Heading::NORTH);
+        a.decide(&snap(0.0, (200.0, 500.0), 0.0, false));
+        let events = lose_at(&mut a, &pts);
+        assert!(
+            !events
+                .iter()
+                .any(|e| matches!(e, PlannerEvent::Declared { .. }))
+        );
+        let mut y: Vec<f64> = a.lost_points().iter().map(|p| p.y).collect();
+        y.sort_by(f64::total_cmp);
+        y
+    };
+    assert_eq!(
+        ys(LostPointEviction::Oldest),
+        vec![320.0, 330.0, 340.0, 350.0, 360.0, 370.0]
+    );
+    assert_eq!(
+        ys(LostPointEviction::MostDownflow),
+        vec![300.0, 310.0, 320.0, 330.0, 340.0, 370.0],
+        "the five most upflow older points and the newest"
     );
 }
 

@@ -424,6 +424,16 @@ pub enum DeclarationKind {
     AlongAndCrossFlow,
 }
 
+/// Which lost point makes room in a full list.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum EvictionKind {
+    /// The most downflow one (the list keeps the points nearest the source).
+    MostDownflow,
+    /// The oldest one.
+    Oldest,
+}
+
 /// `[planner]`: every key is optional; defaults are the field values (Table 4).
 #[derive(Debug, Clone, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -452,6 +462,8 @@ pub struct PlannerConfig {
     pub min_turn_radius_m: Option<f64>,
     /// Most lost points kept.
     pub max_lost_points: Option<usize>,
+    /// Which lost point a full list drops.
+    pub lost_point_eviction: Option<EvictionKind>,
     /// Declaration rule.
     pub declaration: Option<DeclarationKind>,
     /// Along-flow spread of the rule, m.

@@ -228,3 +228,16 @@ fn bad_vehicle_settings_are_rejected_with_their_key_path() {
         );
     }
 }
+
+#[test]
+fn an_unknown_lost_point_eviction_is_rejected_with_its_key_path() {
+    let mt = find_preset("duck-2003-mt").unwrap().toml;
+    let from = "lost_point_eviction = \"most_downflow\"";
+    assert!(mt.contains(from));
+    assert_eq!(error_of(mt), "accepted");
+    let e = error_of(&mt.replacen(from, "lost_point_eviction = \"most_upflow\"", 1));
+    assert!(
+        e.starts_with("scenario.toml") && e.contains("planner.lost_point_eviction"),
+        "{e}"
+    );
+}

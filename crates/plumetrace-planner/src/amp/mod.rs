@@ -67,8 +67,10 @@ pub struct AmpParams {
     pub min_turn_radius_m: f64,
     /// Heading-rate limit of the commands, deg/s.
     pub max_turn_rate_deg_s: f64,
-    /// Most lost points kept (the oldest is dropped beyond it).
+    /// Most lost points kept.
     pub max_lost_points: usize,
+    /// Which lost point makes room when the list is full.
+    pub lost_point_eviction: LostPointEviction,
     /// Find offset from across-flow, deg.
     pub find_offset_deg: f64,
     /// Distance from the boundary at which Find reflects, m.
@@ -106,6 +108,7 @@ impl Default for AmpParams {
             min_turn_radius_m: 12.0,
             max_turn_rate_deg_s: 10.0,
             max_lost_points: 6,
+            lost_point_eviction: LostPointEviction::Oldest,
             find_offset_deg: 20.0,
             find_margin_m: 10.0,
             bowtie_angle_deg: 15.0,
@@ -133,6 +136,22 @@ impl AmpParams {
             self.min_turn_radius_m,
         )
     }
+}
+
+/// Which lost point is dropped when a new one arrives at a full list (the field planner kept at
+/// most six; which one made room is not recorded).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum LostPointEviction {
+    /// The oldest point (the default): the list follows the latest losses.
+    Oldest,
+    /// The most downflow of the older points (the new one always enters): the list keeps the
+    /// points nearest the source, which Track-Out, Reacquire and the declaration use. Near a
+    /// source whose plume reaches the vehicle's altitude only intermittently, points near the
+    /// plume's tip survive the losses further downflow until three agree. The price: upflow
+    /// points whose Bowties keep finding chemical downflow of them are never dropped, and a
+    /// declaration can then wait for ever (4 of 40 `duck-2003-st` runs).
+    MostDownflow,
 }
 
 /// The AMP behaviours, by their registry names.
@@ -392,14 +411,29 @@ impl Amp {
         }
     }
 
-    /// Saves a lost point, keeping at most `max_lost_points`: the oldest is dropped, so the list
-    /// follows the plume as it is now and a single early outlier cannot block the declaration
-    /// forever.
+    /// Saves a lost point, keeping at most `max_lost_points`: beyond it the point chosen by
+    /// `lost_point_eviction` is dropped.
     fn save_lost_point(&mut self, p: Vec2) {
         self.lost.push(p);
         self.events.push(PlannerEvent::LostPoint { pos_m: p });
         if self.lost.len() > self.p.max_lost_points {
-            self.lost.remove(0);
+            let drop = match self.p.lost_point_eviction {
+                LostPointEviction::Oldest => 0,
+                LostPointEviction::MostDownflow => {
+                    let u = self.flow.upflow().unit();
+                    // Among the older points (the new one always enters, or a list of six
+                    // upflow points would never change); the first of equals.
+                    let older = self.lost.len() - 1;
+                    let mut i = 0;
+                    for (j, q) in self.lost[..older].iter().enumerate() {
+                        if q.dot(&u) < self.lost[i].dot(&u) {
+                            i = j;
+                        }
+                    }
+                    i
+                }
+            };
+            self.lost.remove(drop);
         }
     }
 
