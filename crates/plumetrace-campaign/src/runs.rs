@@ -198,10 +198,19 @@ pub fn parse_rows(path: &Path, text: &str) -> Result<Vec<RunRow>, CampaignError>
     let want = header();
     let first = text.lines().next().unwrap_or_default();
     if first != want {
+        let message = if first.starts_with("scenario,config,point,") {
+            format!(
+                "its columns are not this version's (written by another plumetrace version?); \
+                 the file is left as it is: run the campaign into a new directory. Found '{first}', \
+                 expected '{want}'"
+            )
+        } else {
+            format!("unexpected header (is it a plumetrace runs file?): '{first}'")
+        };
         return Err(CampaignError::Results {
             path: path.display().to_string(),
             line: Some(1),
-            message: format!("unexpected header (is it a plumetrace runs file?): '{first}'"),
+            message,
         });
     }
     let mut rd = csv::ReaderBuilder::new()

@@ -199,6 +199,18 @@ fn a_directory_of_another_campaign_or_a_damaged_file_is_refused_without_touching
     let msg = e.to_string();
     assert!(msg.contains("runs.csv line 2"), "{msg}");
     assert_eq!(read(&dir.join("runs.csv")), damaged);
+
+    // Another version's columns (here without the source counts): refused, file kept.
+    let old_header = before
+        .lines()
+        .next()
+        .unwrap()
+        .replace(",sources,sources_located", "");
+    let older = format!("{old_header}\n");
+    std::fs::write(dir.join("runs.csv"), &older).unwrap();
+    let e = run_campaign(&c, &dir, RunOptions::default(), &|_, _| {}).unwrap_err();
+    assert!(e.to_string().contains("another plumetrace version"), "{e}");
+    assert_eq!(read(&dir.join("runs.csv")), older);
 }
 
 fn load_err(text: &str) -> CampaignError {

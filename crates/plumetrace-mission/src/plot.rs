@@ -76,6 +76,52 @@ pub fn dashed(points: &[Vec2], colour: RGBColor, width: u32) -> Vec<PathElement<
     out
 }
 
+/// The corner of the map panel where a legend of `px` pixels hides the fewest of `points` (data
+/// coordinates over `x` x `y` drawn on a panel of `panel_px`), lower right on ties.
+fn legend_corner(
+    points: &[(f64, f64)],
+    x: std::ops::Range<f64>,
+    y: std::ops::Range<f64>,
+    panel_px: (f64, f64),
+    px: (f64, f64),
+) -> SeriesLabelPosition {
+    let fx = (px.0 / panel_px.0).min(1.0) * (x.end - x.start);
+    let fy = (px.1 / panel_px.1).min(1.0) * (y.end - y.start);
+    let corners = [
+        (
+            SeriesLabelPosition::LowerRight,
+            x.end - fx..x.end,
+            y.start..y.start + fy,
+        ),
+        (
+            SeriesLabelPosition::UpperRight,
+            x.end - fx..x.end,
+            y.end - fy..y.end,
+        ),
+        (
+            SeriesLabelPosition::LowerLeft,
+            x.start..x.start + fx,
+            y.start..y.start + fy,
+        ),
+        (
+            SeriesLabelPosition::UpperLeft,
+            x.start..x.start + fx,
+            y.end - fy..y.end,
+        ),
+    ];
+    let mut best = (SeriesLabelPosition::LowerRight, usize::MAX);
+    for (pos, cx, cy) in corners {
+        let n = points
+            .iter()
+            .filter(|(px, py)| cx.contains(px) && cy.contains(py))
+            .count();
+        if n < best.1 {
+            best = (pos, n);
+        }
+    }
+    best.0
+}
+
 /// The figure as an SVG string.
 pub fn mission_figure(run: &MissionRun, title: &str) -> Result<String, String> {
     let g = *run.mean_plume.spec();
@@ -224,15 +270,53 @@ pub fn mission_figure(run: &MissionRun, title: &str) -> Result<String, String> {
             .map_err(err)?
             .label("declared source")
             .legend(|(x, y)| Circle::new((x + 8, y), 5, BLACK.filled()));
+        // What the legend could hide: the track (every 10th step), lost points, sources and
+        // declarations.
+        let mut marks: Vec<(f64, f64)> = run
+            .trajectory
+            .iter()
+            .step_by(10)
+            .map(|r| (r.est_x_m, r.est_y_m))
+            .collect();
+        marks.extend(&lost);
+        marks.extend(&declared);
+        marks.extend(run.sources.iter().map(|s| (s.x, s.y)));
+        let (pw, ph) = chart.plotting_area().dim_in_pixel();
+        let corner = legend_corner(
+            &marks,
+            x0..x1,
+            y0..y1,
+            (f64::from(pw), f64::from(ph)),
+            (250.0, 190.0),
+        );
         chart
             .configure_series_labels()
             .background_style(WHITE.mix(0.9))
             .border_style(BLACK)
             .label_font(("sans-serif", 12))
-            .position(SeriesLabelPosition::LowerRight)
+            .position(corner)
             .draw()
             .map_err(err)?;
         root.present().map_err(err)?;
     }
     Ok(svg)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_legend_goes_to_the_emptiest_corner() {
+        let panel = (800.0, 800.0);
+        let legend = (200.0, 200.0);
+        let pick = |pts: &[(f64, f64)]| legend_corner(pts, 0.0..100.0, 0.0..100.0, panel, legend);
+        assert!(matches!(pick(&[]), SeriesLabelPosition::LowerRight));
+        // A track through the lower right and upper right corners.
+        let track: Vec<(f64, f64)> = (0..100).map(|k| (90.0, f64::from(k))).collect();
+        assert!(matches!(pick(&track), SeriesLabelPosition::LowerLeft));
+        let mut more = track.clone();
+        more.push((10.0, 10.0));
+        assert!(matches!(pick(&more), SeriesLabelPosition::UpperLeft));
+    }
 }
