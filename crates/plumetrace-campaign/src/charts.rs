@@ -96,7 +96,7 @@ pub fn success_chart(c: &Campaign, groups: &[GroupSummary]) -> Result<String, Ca
             .configure_mesh()
             .disable_y_mesh()
             .y_labels(0)
-            .x_desc(success_desc(c))
+            .x_desc(success_desc(c, groups))
             .label_style(("sans-serif", 13))
             .draw()
             .map_err(&e)?;
@@ -141,8 +141,14 @@ pub fn success_chart(c: &Campaign, groups: &[GroupSummary]) -> Result<String, Ca
     Ok(svg)
 }
 
-fn success_desc(c: &Campaign) -> String {
+/// Whether some run had several sources (success then means every source located).
+fn multi_source(groups: &[GroupSummary]) -> bool {
+    groups.iter().any(|g| g.sources > g.runs)
+}
+
+fn success_desc(c: &Campaign, groups: &[GroupSummary]) -> String {
     match c.success_radius_m() {
+        _ if multi_source(groups) => "fraction of runs locating every source".into(),
         Some(r) => format!("fraction of runs declaring within {r} m of a source"),
         None => "fraction of runs declaring a source".into(),
     }
@@ -202,7 +208,7 @@ fn success_vs_sweep(
         chart
             .configure_mesh()
             .x_desc(key)
-            .y_desc(success_desc(c))
+            .y_desc(success_desc(c, groups))
             .label_style(("sans-serif", 13))
             .draw()
             .map_err(&e)?;
@@ -275,7 +281,8 @@ fn success_vs_sweep(
 
 /// `errors.svg`: per group, the total, along-flow and crossflow errors of the declaring runs as
 /// boxes (quartiles, median line, whiskers from the 5th to the 95th percentile) over every run
-/// as a dot.
+/// as a dot. With several sources per run, one panel instead: the distance from each source to
+/// its nearest declaration (the first declaration is often at a subregion's edge).
 pub fn error_chart(
     c: &Campaign,
     groups: &[GroupSummary],
@@ -286,26 +293,42 @@ pub fn error_chart(
     let n = groups.len().max(1);
     let lw = label_width(&labels);
     let panel_w = 330u32;
-    let (width, height) = (lw + 3 * panel_w + 20, (n as u32 * 46 + 140).max(240));
-    let values = |g: &GroupSummary, f: &dyn Fn(&RunRow) -> Option<f64>| -> Vec<(u64, f64)> {
+    let values = |g: &GroupSummary, f: &dyn Fn(&RunRow) -> Vec<f64>| -> Vec<(u64, f64)> {
         rows.iter()
             .map(|(_, r)| r)
             .filter(|r| {
                 r.declared && r.scenario == g.scenario && r.config == g.config && r.point == g.point
             })
-            .filter_map(|r| f(r).map(|v| (r.seed_index, v)))
+            .flat_map(|r| f(r).into_iter().map(|v| (r.seed_index, v)))
             .collect()
     };
-    type Metric<'a> = (&'a str, &'a dyn Fn(&RunRow) -> Option<f64>);
-    let metrics: [Metric; 3] = [
-        ("declaration error (m)", &|r: &RunRow| r.error_m),
-        ("along-flow error (m, + downflow)", &|r: &RunRow| {
-            r.error_along_m
-        }),
-        ("crossflow error (m, + right of flow)", &|r: &RunRow| {
-            r.error_cross_m
-        }),
-    ];
+    type Metric<'a> = (&'a str, &'a dyn Fn(&RunRow) -> Vec<f64>);
+    let metrics: Vec<Metric> = if multi_source(groups) {
+        vec![(
+            "distance from each source to its nearest declaration (m; located: within the success radius, 50 m by default)",
+            &|r: &RunRow| {
+                r.source_errors_m
+                    .split(';')
+                    .filter_map(|v| v.parse::<f64>().ok())
+                    .collect()
+            },
+        )]
+    } else {
+        vec![
+            ("declaration error (m)", &|r: &RunRow| {
+                r.error_m.into_iter().collect()
+            }),
+            ("along-flow error (m, + downflow)", &|r: &RunRow| {
+                r.error_along_m.into_iter().collect()
+            }),
+            ("crossflow error (m, + right of flow)", &|r: &RunRow| {
+                r.error_cross_m.into_iter().collect()
+            }),
+        ]
+    };
+    let k = metrics.len() as u32;
+    let panel_w = if k == 1 { 3 * panel_w } else { panel_w };
+    let (width, height) = (lw + k * panel_w + 20, (n as u32 * 46 + 140).max(240));
     let mut svg = String::new();
     {
         let root = SVGBackend::with_string(&mut svg, (width, height)).into_drawing_area();
@@ -314,17 +337,26 @@ pub fn error_chart(
         title
             .draw(&Text::new(
                 format!(
-                    "{}: declaration errors of declaring runs (box: quartiles and median; \
-                     whiskers: 5th–95th percentile; dots: runs)",
-                    c.file.name
+                    "{}: {} (box: quartiles and median; whiskers: 5th–95th percentile; dots: {})",
+                    c.file.name,
+                    if k == 1 {
+                        "nearest declaration to each source"
+                    } else {
+                        "declaration errors of declaring runs"
+                    },
+                    if k == 1 { "sources" } else { "runs" }
                 ),
                 (12, 10),
                 ("sans-serif", 16).into_font().color(&BLACK),
             ))
             .map_err(&e)?;
-        let (left, rest) = body.split_horizontally(lw + panel_w);
-        let (mid, right) = rest.split_horizontally(panel_w);
-        let panels = [&left, &mid, &right];
+        let mut panels = Vec::new();
+        let mut rest = body;
+        for m in 0..metrics.len() {
+            let (panel, r) = rest.split_horizontally(if m == 0 { lw + panel_w } else { panel_w });
+            panels.push(panel);
+            rest = r;
+        }
         for (m, (name, f)) in metrics.iter().enumerate() {
             let per_group: Vec<Vec<(u64, f64)>> = groups.iter().map(|g| values(g, *f)).collect();
             let mut all: Vec<f64> = per_group.iter().flatten().map(|(_, v)| *v).collect();
@@ -351,7 +383,7 @@ pub fn error_chart(
                 name.to_string()
             };
             let pad = ((hi - lo) * 0.05).max(0.5);
-            let area = panels[m];
+            let area = &panels[m];
             let mut chart = ChartBuilder::on(area)
                 .margin(8)
                 .margin_right(14)
@@ -572,4 +604,25 @@ pub fn write_charts(
         .filter_map(|g| ExampleRun::read(out, &g.scenario, &g.config, &g.point))
         .collect();
     write("trajectories.svg", trajectory_chart(c, &examples)?)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::stats::summarise;
+    use crate::stats::tests::multi_source_fixture;
+
+    #[test]
+    fn multi_source_charts_show_each_source_and_every_source_success() {
+        let (c, rows) = multi_source_fixture();
+        let groups = summarise(&c, &rows);
+        let errors = error_chart(&c, &groups, &rows).unwrap();
+        assert!(errors.contains("nearest declaration to each source"));
+        assert!(
+            !errors.contains("along-flow error"),
+            "no first-declaration panels"
+        );
+        let success = success_chart(&c, &groups).unwrap();
+        assert!(success.contains("fraction of runs locating every source"));
+    }
 }

@@ -388,12 +388,13 @@ pub fn summary_md(c: &Campaign, groups: &[GroupSummary], expected_runs: u64) -> 
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     #![allow(clippy::unwrap_used)]
     use super::*;
 
-    #[test]
-    fn multi_source_groups_count_located_sources_and_pool_their_errors() {
+    /// A two-run campaign on the multi-source preset: the first run located both sources, the
+    /// second only one (the other has only a far edge declaration).
+    pub(crate) fn multi_source_fixture() -> (Campaign, Vec<(RunKey, RunRow)>) {
         let path = std::path::Path::new("mt.toml");
         let text = "name = \"mt\"\nseed = 1\nseeds = 2\nscenarios = [\"duck-2003-mt\"]\n";
         let file = crate::spec::parse_campaign(text, path).unwrap();
@@ -417,8 +418,15 @@ mod tests {
             };
             (key, r)
         };
-        // The second run's other source has only a far (edge) declaration: not located.
-        let rows = vec![row(0, 2, "4.000;6.000"), row(1, 1, "3.000;290.000")];
+        (
+            c,
+            vec![row(0, 2, "4.000;6.000"), row(1, 1, "3.000;290.000")],
+        )
+    }
+
+    #[test]
+    fn multi_source_groups_count_located_sources_and_pool_their_errors() {
+        let (c, rows) = multi_source_fixture();
         let g = summarise(&c, &rows);
         assert_eq!(
             (g[0].sources, g[0].sources_located, g[0].successes),
