@@ -5,7 +5,7 @@ use crate::error::CampaignError;
 use crate::example::ExampleRun;
 use crate::runs::RunRow;
 use crate::spec::{Campaign, RunKey};
-use crate::stats::{GroupSummary, quantile};
+use crate::stats::{GroupSummary, multi_source, quantile};
 use plotters::coord::types::RangedCoordf64;
 use plotters::prelude::*;
 use plotters::style::text_anchor;
@@ -139,11 +139,6 @@ pub fn success_chart(c: &Campaign, groups: &[GroupSummary]) -> Result<String, Ca
         root.present().map_err(&e)?;
     }
     Ok(svg)
-}
-
-/// Whether some run had several sources (success then means every source located).
-fn multi_source(groups: &[GroupSummary]) -> bool {
-    groups.iter().any(|g| g.sources > g.runs)
 }
 
 fn success_desc(c: &Campaign, groups: &[GroupSummary]) -> String {

@@ -87,9 +87,7 @@ impl RunRow {
     /// The row of a finished mission.
     pub fn from_summary(c: &Campaign, key: &RunKey, outcome: &str, s: &Summary) -> Self {
         let declared = s.declared;
-        let radius = c
-            .success_radius_m()
-            .unwrap_or(plumetrace_mission::LOCATED_RADIUS_M);
+        let radius = c.located_radius_m();
         let located = s
             .sources
             .iter()

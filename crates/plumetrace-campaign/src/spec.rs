@@ -315,6 +315,14 @@ impl Campaign {
         self.file.success_radius_m
     }
 
+    /// Within this distance of a declaration a source counts as located: the success radius, or
+    /// the mission's 50 m without one.
+    pub fn located_radius_m(&self) -> f64 {
+        self.file
+            .success_radius_m
+            .unwrap_or(plumetrace_mission::LOCATED_RADIUS_M)
+    }
+
     /// Every run, in the canonical order: scenario, configuration, sweep point, seed index.
     pub fn runs(&self) -> Vec<RunKey> {
         let mut out = Vec::new();

@@ -108,6 +108,12 @@ pub struct GroupSummary {
     pub outcomes: Vec<u64>,
 }
 
+/// Whether some run had several sources: success then means every source located, and the
+/// tables and charts show the sources rather than the first declaration.
+pub fn multi_source(groups: &[GroupSummary]) -> bool {
+    groups.iter().any(|g| g.sources > g.runs)
+}
+
 /// Summarises sorted rows group by group, in campaign order; groups without rows are left out.
 pub fn summarise(c: &Campaign, rows: &[(RunKey, RunRow)]) -> Vec<GroupSummary> {
     let mut out = Vec::new();
@@ -140,9 +146,7 @@ fn summarise_group(c: &Campaign, key: &RunKey, rows: &[&RunRow]) -> GroupSummary
     let decl = sorted(dec.iter().filter_map(|r| r.declaration_s));
     let path = sorted(rows.iter().filter_map(|r| r.path_length_m));
     let ratio = sorted(dec.iter().filter_map(|r| r.path_ratio));
-    let radius = c
-        .success_radius_m()
-        .unwrap_or(plumetrace_mission::LOCATED_RADIUS_M);
+    let radius = c.located_radius_m();
     let located = sorted(
         rows.iter()
             .flat_map(|r| r.source_errors_m.split(';'))
@@ -269,11 +273,8 @@ pub fn summary_md(c: &Campaign, groups: &[GroupSummary], expected_runs: u64) -> 
         let _ = writeln!(s, "{}\n", c.file.description);
     }
     let recorded: u64 = groups.iter().map(|g| g.runs).sum();
-    // Several sources per run somewhere: success means every source located.
-    let multi_source = groups.iter().any(|g| g.sources > g.runs);
-    let radius = c
-        .success_radius_m()
-        .unwrap_or(plumetrace_mission::LOCATED_RADIUS_M);
+    let multi_source = multi_source(groups);
+    let radius = c.located_radius_m();
     let _ = writeln!(
         s,
         "{recorded} of {expected_runs} runs recorded; campaign seed {}, {} seeds per group. \

@@ -554,11 +554,7 @@ fn declaration_record(
     sources: &[Vec3],
     mean_flow: Vec2,
 ) -> DeclarationRecord {
-    let src = sources
-        .iter()
-        .map(|s| s.xy())
-        .min_by(|a, b| (a - p).norm().total_cmp(&(b - p).norm()))
-        .unwrap_or(p);
+    let src = nearest_source(p, sources).map_or(p, |i| sources[i].xy());
     let d = p - src;
     let along = Heading::of_vector(mean_flow).unwrap_or(Heading::NORTH);
     let u = along.unit();
@@ -576,15 +572,30 @@ fn declaration_record(
     }
 }
 
-/// Each true source with the declarations attributed to it (those nearest to it).
-fn source_records(sources: &[Vec3], declarations: &[DeclarationRecord]) -> Vec<SourceRecord> {
+/// Index of the true source nearest to `p` (the first of equals).
+fn nearest_source(p: Vec2, sources: &[Vec3]) -> Option<usize> {
     sources
         .iter()
-        .map(|s| {
+        .enumerate()
+        .min_by(|a, b| (a.1.xy() - p).norm().total_cmp(&(b.1.xy() - p).norm()))
+        .map(|(i, _)| i)
+}
+
+/// Each true source with the declarations attributed to it (those nearest to it).
+fn source_records(sources: &[Vec3], declarations: &[DeclarationRecord]) -> Vec<SourceRecord> {
+    let owner: Vec<Option<usize>> = declarations
+        .iter()
+        .map(|d| nearest_source(Vec2::new(d.x_m, d.y_m), sources))
+        .collect();
+    sources
+        .iter()
+        .enumerate()
+        .map(|(k, s)| {
             let mine: Vec<f64> = declarations
                 .iter()
-                .filter(|d| d.source_x_m == s.x && d.source_y_m == s.y)
-                .map(|d| d.error_m)
+                .zip(&owner)
+                .filter(|(_, o)| **o == Some(k))
+                .map(|(d, _)| d.error_m)
                 .collect();
             let nearest = mine.iter().copied().fold(f64::NAN, f64::min);
             SourceRecord {

@@ -422,15 +422,13 @@ impl Amp {
                 LostPointEviction::MostDownflow => {
                     let u = self.flow.upflow().unit();
                     // Among the older points (the new one always enters, or a list of six
-                    // upflow points would never change); the first of equals.
-                    let older = self.lost.len() - 1;
-                    let mut i = 0;
-                    for (j, q) in self.lost[..older].iter().enumerate() {
-                        if q.dot(&u) < self.lost[i].dot(&u) {
-                            i = j;
-                        }
-                    }
-                    i
+                    // upflow points would never change); `min_by` keeps the first of equals.
+                    let older = &self.lost[..self.lost.len() - 1];
+                    older
+                        .iter()
+                        .enumerate()
+                        .min_by(|a, b| a.1.dot(&u).total_cmp(&b.1.dot(&u)))
+                        .map_or(0, |(i, _)| i)
                 }
             };
             self.lost.remove(drop);
