@@ -515,8 +515,8 @@ pub fn trajectory_chart(c: &Campaign, examples: &[ExampleRun]) -> Result<String,
                 name = format!("{} · {name}", ex.scenario);
             }
             let result = match ex.error_m {
-                Some(d) => format!("{}, {d:.1} m", ex.outcome),
-                None => ex.outcome.clone(),
+                Some(d) => format!("{}, {d:.1} m", ex.outcome.name()),
+                None => ex.outcome.name().to_string(),
             };
             let mut chart = plumetrace_mission::plot::map_chart(
                 area,

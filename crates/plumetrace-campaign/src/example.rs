@@ -2,8 +2,7 @@
 
 use crate::spec::{Campaign, RunKey};
 use plumetrace_core::PlannerEvent;
-use plumetrace_mission::MissionRun;
-use plumetrace_mission::run::EventKind;
+use plumetrace_mission::{EventKind, MissionRun, Outcome};
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 
@@ -24,8 +23,8 @@ pub struct ExampleRun {
     pub point: String,
     /// Run seed.
     pub seed: u64,
-    /// Outcome name.
-    pub outcome: String,
+    /// Outcome.
+    pub outcome: Outcome,
     /// Declaration error, m.
     pub error_m: Option<f64>,
     /// Op-area corners.
@@ -38,7 +37,8 @@ pub struct ExampleRun {
     pub declared: Vec<[f64; 2]>,
     /// Lost points.
     pub lost_points: Vec<[f64; 2]>,
-    /// The first AUV's track as it logged it (navigation estimate), thinned.
+    /// The lead vehicle's track as it logged it (navigation estimate), thinned: the vehicle of
+    /// the first declaration, or the first with a planner.
     pub track: Vec<[f64; 2]>,
 }
 
@@ -46,19 +46,31 @@ impl ExampleRun {
     /// Extracts the example from a finished run.
     pub fn from_run(c: &Campaign, key: &RunKey, run: &MissionRun) -> Self {
         let xy = |p: &plumetrace_core::Vec2| [p.x, p.y];
-        let rows: Vec<_> = run.trajectory.iter().filter(|r| r.vehicle == 0).collect();
+        let lead = run
+            .summary
+            .first_declaration
+            .as_ref()
+            .map(|d| d.vehicle)
+            .or_else(|| {
+                run.vehicles
+                    .iter()
+                    .position(|v| v.planner.is_some())
+                    .map(|k| k as u32)
+            })
+            .unwrap_or(0);
+        let rows: Vec<_> = run
+            .trajectory
+            .iter()
+            .filter(|r| r.vehicle == lead)
+            .collect();
         let step = rows.len().div_ceil(MAX_TRACK_POINTS).max(1);
         ExampleRun {
             scenario: c.scenarios[key.scenario].label.clone(),
             config: c.configs[key.config].name.clone(),
             point: c.points[key.point].label(),
             seed: c.run_seed(key),
-            outcome: run.outcome.name().to_string(),
-            error_m: run
-                .summary
-                .error_m
-                .is_finite()
-                .then_some(run.summary.error_m),
+            outcome: run.outcome,
+            error_m: run.summary.first_declaration.as_ref().map(|d| d.error_m),
             op_area: run.op_area.iter().map(xy).collect(),
             subregions: run
                 .subregions
@@ -83,7 +95,7 @@ impl ExampleRun {
             track: rows
                 .iter()
                 .step_by(step)
-                .map(|r| [r.est_x_m, r.est_y_m])
+                .filter_map(|r| Some([r.est_x_m?, r.est_y_m?]))
                 .collect(),
         }
     }

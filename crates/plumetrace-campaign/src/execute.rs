@@ -146,7 +146,7 @@ pub fn run_campaign(
                 return;
             }
             let row = run_one(c, key, out);
-            if row.outcome == crate::runs::ERROR_OUTCOME {
+            if row.outcome == crate::runs::RunOutcome::ERROR {
                 failed.fetch_add(1, Ordering::Relaxed);
             }
             let written = appender
@@ -195,12 +195,7 @@ fn run_one(c: &Campaign, key: &RunKey, out: &Path) -> RunRow {
             let ex = ExampleRun::from_run(c, key, &run);
             ex.write(out).map_err(|e| e.to_string())?;
         }
-        Ok::<RunRow, String>(RunRow::from_summary(
-            c,
-            key,
-            run.outcome.name(),
-            &run.summary,
-        ))
+        Ok::<RunRow, String>(RunRow::from_summary(c, key, &run.summary))
     }));
     match attempt {
         Ok(Ok(row)) => row,

@@ -106,7 +106,7 @@ pub fn write_parquet(path: &Path, rows: &[(RunKey, RunRow)]) -> Result<(), Campa
             ),
             5 => col
                 .typed::<ByteArrayType>()
-                .write_batch(&text(|r| &r.outcome), None, None),
+                .write_batch(&text(|r| r.outcome.name()), None, None),
             6 => col.typed::<BoolType>().write_batch(
                 &rows.iter().map(|r| r.success).collect::<Vec<_>>(),
                 None,
@@ -169,12 +169,11 @@ mod tests {
             point: String::new(),
             seed_index,
             seed: u64::MAX - seed_index,
-            outcome: if error.is_some() {
-                "declared"
+            outcome: crate::runs::RunOutcome::Mission(if error.is_some() {
+                plumetrace_mission::Outcome::Declared
             } else {
-                "timed_out"
-            }
-            .into(),
+                plumetrace_mission::Outcome::TimedOut
+            }),
             success: error.is_some(),
             declared: error.is_some(),
             declarations: u32::from(error.is_some()),

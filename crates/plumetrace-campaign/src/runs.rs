@@ -6,7 +6,7 @@
 
 use crate::error::CampaignError;
 use crate::spec::{Campaign, RunKey};
-use plumetrace_mission::Summary;
+use plumetrace_mission::{Outcome, Summary};
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 use std::io::{Read, Seek, Write};
@@ -15,8 +15,49 @@ use std::path::{Path, PathBuf};
 /// The name of the results file in a campaign directory.
 pub const RUNS_FILE: &str = "runs.csv";
 
-/// Outcome name of a run that failed to run (a diverging flow, an internal error).
-pub const ERROR_OUTCOME: &str = "error";
+/// A run that could not run (a diverging flow, an internal error): outcome `error`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum RunFailed {
+    /// The run failed; its message says why.
+    Error,
+}
+
+/// A run's outcome: the mission's, or `error` when it could not run. Written by serde as the
+/// mission outcome's name or `error`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(untagged)]
+pub enum RunOutcome {
+    /// The mission ran to this outcome.
+    Mission(Outcome),
+    /// The run failed.
+    Failed(RunFailed),
+}
+
+impl RunOutcome {
+    /// The outcome of a failed run.
+    pub const ERROR: RunOutcome = RunOutcome::Failed(RunFailed::Error);
+
+    /// Every outcome, in table order: the mission's, then `error`.
+    pub fn all() -> Vec<RunOutcome> {
+        Outcome::ALL
+            .into_iter()
+            .map(RunOutcome::Mission)
+            .chain([RunOutcome::ERROR])
+            .collect()
+    }
+
+    /// The name in files (serde's).
+    pub fn name(self) -> &'static str {
+        plumetrace_core::variant_name(&self).unwrap_or("?")
+    }
+}
+
+impl Default for RunOutcome {
+    fn default() -> Self {
+        RunOutcome::ERROR
+    }
+}
 
 /// One run's keys and results. Missing numbers (no declaration, no detection) are empty fields.
 #[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
@@ -31,8 +72,8 @@ pub struct RunRow {
     pub seed_index: u64,
     /// Run seed (the same for every group at this seed index).
     pub seed: u64,
-    /// Outcome name (`declared`, `no_declaration`, `timed_out`, ..., or `error`).
-    pub outcome: String,
+    /// Outcome (`declared`, `no_declaration`, `timed_out`, ..., or `error`).
+    pub outcome: RunOutcome,
     /// Single source: declared (within the success radius, if the campaign sets one). Several
     /// sources: every source located (`sources_located == sources`).
     pub success: bool,
@@ -79,60 +120,61 @@ pub struct RunRow {
     pub message: String,
 }
 
-fn finite(v: f64) -> Option<f64> {
-    v.is_finite().then_some(v)
-}
-
 impl RunRow {
     /// The row of a finished mission.
-    pub fn from_summary(c: &Campaign, key: &RunKey, outcome: &str, s: &Summary) -> Self {
+    pub fn from_summary(c: &Campaign, key: &RunKey, s: &Summary) -> Self {
         let declared = s.declared;
         let radius = c.located_radius_m();
         let located = s
             .sources
             .iter()
-            .filter(|src| src.nearest_error_m <= radius)
+            .filter(|src| src.nearest_error_m.is_some_and(|e| e <= radius))
             .count();
+        let first = s.first_declaration.as_ref();
         let success = if s.sources.len() > 1 {
             located == s.sources.len()
         } else {
             declared
                 && c.success_radius_m()
-                    .is_none_or(|r| s.error_m.is_finite() && s.error_m <= r)
+                    .is_none_or(|r| first.is_some_and(|d| d.error_m <= r))
         };
-        let ratio = if s.trace_length_m.is_finite()
-            && s.detection_to_source_m.is_finite()
-            && s.detection_to_source_m > 0.0
-        {
-            Some(s.trace_length_m / s.detection_to_source_m)
-        } else {
-            None
-        };
+        let ratio = s
+            .trace_length_m
+            .zip(s.detection_to_source_m)
+            .filter(|(_, d)| *d > 0.0)
+            .map(|(t, d)| t / d);
         RunRow {
-            outcome: outcome.to_string(),
+            outcome: RunOutcome::Mission(s.outcome),
             success,
             declared,
             declarations: u32::try_from(s.declarations.len()).unwrap_or(u32::MAX),
             sources: u32::try_from(s.sources.len()).unwrap_or(u32::MAX),
             sources_located: u32::try_from(located).unwrap_or(u32::MAX),
-            declared_x: finite(s.declared_x),
-            declared_y: finite(s.declared_y),
-            source_x: finite(s.source_x),
-            source_y: finite(s.source_y),
-            error_m: finite(s.error_m),
-            error_along_m: finite(s.error_along_m),
-            error_cross_m: finite(s.error_cross_m),
-            first_detection_s: finite(s.first_detection_s),
-            declaration_s: finite(s.declaration_s),
-            path_length_m: finite(s.path_length_m),
-            trace_length_m: finite(s.trace_length_m),
-            detection_to_source_m: finite(s.detection_to_source_m),
+            declared_x: first.map(|d| d.x_m),
+            declared_y: first.map(|d| d.y_m),
+            source_x: first
+                .map(|d| d.source_x_m)
+                .or_else(|| s.sources.first().map(|src| src.x_m)),
+            source_y: first
+                .map(|d| d.source_y_m)
+                .or_else(|| s.sources.first().map(|src| src.y_m)),
+            error_m: first.map(|d| d.error_m),
+            error_along_m: first.map(|d| d.error_along_m),
+            error_cross_m: first.map(|d| d.error_cross_m),
+            first_detection_s: s.first_detection_s,
+            declaration_s: first.map(|d| d.t_s),
+            path_length_m: Some(s.path_length_m).filter(|v| v.is_finite()),
+            trace_length_m: s.trace_length_m,
+            detection_to_source_m: s.detection_to_source_m,
             path_ratio: ratio,
-            sim_time_s: finite(s.sim_time_s),
+            sim_time_s: Some(s.sim_time_s),
             source_errors_m: s
                 .sources
                 .iter()
-                .map(|src| finite(src.nearest_error_m).map_or(String::new(), |e| format!("{e:.3}")))
+                .map(|src| {
+                    src.nearest_error_m
+                        .map_or(String::new(), |e| format!("{e:.3}"))
+                })
                 .collect::<Vec<_>>()
                 .join(";"),
             ..RunRow::empty(c, key)
@@ -142,7 +184,7 @@ impl RunRow {
     /// The row of a run that could not run.
     pub fn failed(c: &Campaign, key: &RunKey, message: String) -> Self {
         RunRow {
-            outcome: ERROR_OUTCOME.to_string(),
+            outcome: RunOutcome::ERROR,
             message,
             ..RunRow::empty(c, key)
         }

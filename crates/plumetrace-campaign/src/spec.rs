@@ -43,8 +43,13 @@ pub struct CampaignFile {
 pub struct ConfigFile {
     /// Its name in tables and charts.
     pub name: String,
-    /// Keys to set in the scenario: bare names are `[planner]` keys (`beta_deg`, `declaration`),
-    /// dotted paths reach any table (`plume.vertical_diffusivity_m2ps`, `sources.0.z_m`).
+    /// A whole planner table (`kind` and its keys) that replaces the scenario's planner (its
+    /// `[planner]`, or its only `[planners.NAME]`): to compare planners on the same scenarios.
+    #[serde(default)]
+    pub planner: Option<toml::Table>,
+    /// Keys to set in the scenario: bare names are keys of the scenario's planner (`beta_deg`,
+    /// `declaration`), dotted paths reach any table (`plume.vertical_diffusivity_m2ps`,
+    /// `sources.0.z_m`, `planners.tracer.beta_deg`).
     #[serde(default)]
     pub set: toml::Table,
 }
@@ -260,6 +265,7 @@ impl Campaign {
         let configs = if file.configs.is_empty() {
             vec![ConfigFile {
                 name: "default".into(),
+                planner: None,
                 set: toml::Table::new(),
             }]
         } else {
@@ -371,6 +377,20 @@ impl Campaign {
     ) -> Result<toml::Table, CampaignError> {
         let mut t = self.scenarios[scenario].table.clone();
         let c = &self.configs[config];
+        if let Some(p) = &c.planner {
+            let path = planner_path(&t).map_err(|m| CampaignError::Invalid {
+                file: self.path.display().to_string(),
+                key: format!("configs.{}.planner", c.name),
+                message: m,
+            })?;
+            set_key(&mut t, &path, toml::Value::Table(p.clone())).map_err(|m| {
+                CampaignError::Invalid {
+                    file: self.path.display().to_string(),
+                    key: format!("configs.{}.planner", c.name),
+                    message: m,
+                }
+            })?;
+        }
         for (k, v) in &c.set {
             set_key(&mut t, k, v.clone()).map_err(|m| CampaignError::Invalid {
                 file: self.path.display().to_string(),
@@ -452,10 +472,8 @@ impl Campaign {
                             "the scenario has no [mission] table: campaigns run missions".into(),
                         ));
                     }
-                    let pc = cfg.planner.as_ref().ok_or_else(|| {
-                        self.group_error(s, c, p, "the scenario has no [planner] table".into())
-                    })?;
-                    plumetrace_mission::amp_params(pc)
+                    // The planner registry checks every planner key (set and sweep included).
+                    plumetrace_mission::MissionSetup::new(built)
                         .map_err(|e| self.group_error(s, c, p, e.to_string()))?;
                 }
             }
@@ -501,13 +519,42 @@ fn fnv1a(bytes: &[u8]) -> u64 {
     h
 }
 
-/// Sets `key` in a scenario table: a bare name means `planner.NAME`; a dotted path walks tables,
-/// and whole-number segments index arrays (`sources.0.mass_rate_per_s`).
+/// The key path of a scenario's single planner table: `planner`, or `planners.NAME` when it has
+/// exactly one named planner.
+pub fn planner_path(table: &toml::Table) -> Result<String, String> {
+    let named: Vec<&String> = table
+        .get("planners")
+        .and_then(toml::Value::as_table)
+        .map(|t| t.keys().collect())
+        .unwrap_or_default();
+    match (table.contains_key("planner"), named.as_slice()) {
+        (true, []) => Ok("planner".into()),
+        (false, [one]) => Ok(format!("planners.{one}")),
+        (false, []) => Err("the scenario has no planner table".into()),
+        _ => Err(format!(
+            "the scenario has several planners ({}): name one with a dotted key \
+             (planners.NAME.KEY)",
+            table
+                .contains_key("planner")
+                .then_some("planner".to_string())
+                .into_iter()
+                .chain(named.iter().map(|n| format!("planners.{n}")))
+                .collect::<Vec<_>>()
+                .join(", ")
+        )),
+    }
+}
+
+/// Sets `key` in a scenario table: a bare name is a key of the scenario's planner (see
+/// [`planner_path`]); a dotted path walks tables, and whole-number segments index arrays
+/// (`sources.0.mass_rate_per_s`).
 pub fn set_key(table: &mut toml::Table, key: &str, value: toml::Value) -> Result<(), String> {
+    let planner;
     let path: Vec<&str> = if key.contains('.') {
         key.split('.').collect()
     } else {
-        vec!["planner", key]
+        planner = planner_path(table)?;
+        planner.split('.').chain([key]).collect()
     };
     if path.iter().any(|s| s.is_empty()) {
         return Err(format!("'{key}' is not a key path"));
@@ -591,6 +638,17 @@ mod tests {
         assert!(e.is_err_and(|m| m.contains("index 3")));
         let e = set_key(&mut t, "planner.strategy.x", toml::Value::Float(5.0));
         assert!(e.is_err_and(|m| m.contains("not a table")));
+        // A scenario with one named planner: bare keys go there; with two they are ambiguous.
+        let mut named = table("[planners.tracer]\nkind = \"amp\"\n");
+        assert!(set_key(&mut named, "beta_deg", toml::Value::Float(25.0)).is_ok());
+        assert_eq!(
+            named["planners"]["tracer"]["beta_deg"].as_float(),
+            Some(25.0)
+        );
+        let mut two = table("[planners.a]\nkind = \"amp\"\n[planners.b]\nkind = \"amp\"\n");
+        let e = set_key(&mut two, "beta_deg", toml::Value::Float(25.0));
+        assert!(e.is_err_and(|m| m.contains("planners.a, planners.b")));
+        assert!(set_key(&mut two, "planners.b.beta_deg", toml::Value::Float(25.0)).is_ok());
     }
 
     #[test]

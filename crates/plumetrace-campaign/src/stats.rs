@@ -1,6 +1,6 @@
 //! Per-group statistics: success rate with a Wilson interval, error quantiles, times and path.
 
-use crate::runs::{ERROR_OUTCOME, RunRow};
+use crate::runs::{RunOutcome, RunRow};
 use crate::spec::{Campaign, RunKey};
 use serde::Serialize;
 use std::fmt::Write as _;
@@ -43,17 +43,6 @@ fn sorted(values: impl Iterator<Item = f64>) -> Vec<f64> {
     v.sort_by(f64::total_cmp);
     v
 }
-
-/// Every outcome name, in table order.
-pub const OUTCOMES: [&str; 7] = [
-    "declared",
-    "no_declaration",
-    "timed_out",
-    "aborted_by_cage",
-    "left_domain",
-    "collided",
-    ERROR_OUTCOME,
-];
 
 /// The statistics of one (scenario, configuration, sweep point) group.
 #[derive(Debug, Clone, Serialize)]
@@ -104,7 +93,7 @@ pub struct GroupSummary {
     pub path_length_median_m: f64,
     /// Traced path over the straight line from the first detection to the source: median.
     pub path_ratio_median: f64,
-    /// Count of each outcome, in [`OUTCOMES`] order.
+    /// Count of each outcome, in [`RunOutcome::all`] order.
     pub outcomes: Vec<u64>,
 }
 
@@ -177,9 +166,9 @@ fn summarise_group(c: &Campaign, key: &RunKey, rows: &[&RunRow]) -> GroupSummary
         declaration_median_s: quantile(&decl, 0.5),
         path_length_median_m: quantile(&path, 0.5),
         path_ratio_median: quantile(&ratio, 0.5),
-        outcomes: OUTCOMES
-            .iter()
-            .map(|o| rows.iter().filter(|r| r.outcome == *o).count() as u64)
+        outcomes: RunOutcome::all()
+            .into_iter()
+            .map(|o| rows.iter().filter(|r| r.outcome == o).count() as u64)
             .collect(),
     }
 }
@@ -223,7 +212,7 @@ pub fn summary_csv(groups: &[GroupSummary]) -> String {
     .iter()
     .map(|s| s.to_string())
     .collect();
-    head.extend(OUTCOMES.iter().map(|o| format!("n_{o}")));
+    head.extend(RunOutcome::all().iter().map(|o| format!("n_{}", o.name())));
     let _ = w.write_record(&head);
     for g in groups {
         let mut rec = vec![
@@ -347,11 +336,11 @@ pub fn summary_md(c: &Campaign, groups: &[GroupSummary], expected_runs: u64) -> 
         if sweep {
             row.push(g.point.clone());
         }
-        let outcomes: Vec<String> = OUTCOMES
+        let outcomes: Vec<String> = RunOutcome::all()
             .iter()
             .zip(&g.outcomes)
             .filter(|(_, n)| **n > 0)
-            .map(|(o, n)| format!("{o} {n}"))
+            .map(|(o, n)| format!("{} {n}", o.name()))
             .collect();
         row.extend([
             g.runs.to_string(),
@@ -408,7 +397,7 @@ pub(crate) mod tests {
                 seed_index,
             };
             let r = RunRow {
-                outcome: "declared".into(),
+                outcome: RunOutcome::Mission(plumetrace_mission::Outcome::Declared),
                 declared: true,
                 success: located == 2,
                 sources: 2,

@@ -1,9 +1,11 @@
 //! The `plumetrace` command.
 //!
 //! Subcommands: `run` (fly a mission, or simulate a plume, and write the outputs), `presets` (list
-//! the built-in scenarios), `check` (validate a scenario file), `campaign` and `merge` (Monte
-//! Carlo campaigns), `bench plume` (time the plume model on pompy's scenario or a field-scale one)
-//! and `bench missions` (missions per second on 1 and more threads); benchmarks print JSON.
+//! the built-in scenarios), `planners` (the planner registry: every planner and its keys),
+//! `check` (validate a scenario file), `replay` (run a snapshot log through a planner again),
+//! `campaign` and `merge` (Monte Carlo campaigns), `bench plume` (time the plume model on pompy's
+//! scenario or a field-scale one) and `bench missions` (missions per second on 1 and more
+//! threads); benchmarks print JSON.
 
 mod bench;
 mod campaign;
@@ -11,6 +13,7 @@ mod mission;
 mod output;
 mod plot;
 mod progress;
+mod replay;
 mod run;
 
 use anyhow::Result;
@@ -31,11 +34,20 @@ enum Command {
     Run(run::RunArgs),
     /// List the built-in scenarios, one line each.
     Presets,
-    /// Validate a scenario file and print the first error with its key path.
+    /// List every planner with its keys, defaults, units, bounds and a line of doc.
+    Planners {
+        /// Print the README's Markdown tables instead.
+        #[arg(long)]
+        markdown: bool,
+    },
+    /// Validate a scenario file (planners included) and print the first error with its key path.
     Check {
         /// The scenario file (TOML).
         file: PathBuf,
     },
+    /// Feed a snapshot log (`snapshots.jsonl` of a run) to fresh planners and report the
+    /// decisions that differ from the logged ones.
+    Replay(replay::ReplayArgs),
     /// Run a Monte Carlo campaign (resumable, parallel, shardable) and summarise it.
     Campaign(campaign::CampaignArgs),
     /// Merge the output directories of a campaign's shards.
@@ -67,29 +79,85 @@ fn dispatch(cli: Cli) -> Result<()> {
             }
             Ok(())
         }
-        Command::Check { file } => {
-            let cfg = plumetrace_scenario::load_file(&file)?;
-            let origin = plumetrace_scenario::Origin::File(file.clone());
-            let built = plumetrace_scenario::build(&cfg, &origin, None)?;
-            if let Some(pc) = &cfg.planner {
-                plumetrace_mission::amp_params(pc)
-                    .map_err(|e| anyhow::anyhow!("{}: {e}", file.display()))?;
-            }
-            let what = if built.mission.is_some() {
-                "mission"
+        Command::Planners { markdown } => {
+            if markdown {
+                print!("{}", plumetrace_planner::registry_markdown());
             } else {
-                "plume run"
-            };
-            println!(
-                "{}: ok ({what}, {} steps of {} s)",
-                file.display(),
-                built.steps,
-                built.dt_s
-            );
+                print!("{}", planners_text());
+            }
             Ok(())
         }
+        Command::Check { file } => check(&file),
+        Command::Replay(args) => replay::run(&args),
         Command::Campaign(args) => campaign::run(&args),
         Command::Merge(args) => campaign::run_merge(&args),
         Command::Bench(b) => bench::run(&b),
     }
+}
+
+/// `plumetrace planners`: every planner and its keys, as plain text.
+fn planners_text() -> String {
+    use plumetrace_core::params::{KeyDoc, Params};
+    use std::fmt::Write as _;
+    let mut out = String::new();
+    let keys = |out: &mut String, keys: &[KeyDoc]| {
+        let width = keys.iter().map(|k| k.name.len()).max().unwrap_or(0);
+        for k in keys {
+            let unit = if k.unit.is_empty() {
+                String::new()
+            } else {
+                format!(" {}", k.unit)
+            };
+            let bounds = if k.bounds.is_empty() {
+                String::new()
+            } else {
+                format!(", {}", k.bounds)
+            };
+            let _ = writeln!(
+                out,
+                "  {:width$}  {}{unit} ({}{bounds}): {}",
+                k.name, k.default, k.type_name, k.doc
+            );
+        }
+    };
+    let _ = writeln!(out, "every planner (kind = \"NAME\" selects one):");
+    keys(&mut out, &plumetrace_planner::CommonParams::keys());
+    for p in plumetrace_planner::PLANNERS {
+        let _ = writeln!(out, "\n{}: {}", p.kind, p.summary);
+        keys(&mut out, &(p.keys)());
+    }
+    out
+}
+
+/// `plumetrace check FILE`: everything `run` would reject, rejected here with the same message.
+fn check(file: &std::path::Path) -> Result<()> {
+    let cfg = plumetrace_scenario::load_file(file)?;
+    let origin = plumetrace_scenario::Origin::File(file.to_path_buf());
+    let built = plumetrace_scenario::build(&cfg, &origin, None)?;
+    let (steps, dt) = (built.steps, built.dt_s);
+    if built.mission.is_none() {
+        println!(
+            "{}: ok (plume run, {steps} steps of {dt} s)",
+            file.display()
+        );
+        return Ok(());
+    }
+    let setup = plumetrace_mission::MissionSetup::new(built)?;
+    let vehicles: Vec<String> = setup
+        .vehicles
+        .iter()
+        .zip(&setup.planners)
+        .map(|(v, p)| match p {
+            Some(p) => format!("{} flies {} ({})", v.name, p.config.kind(), p.key),
+            None => format!("{} has no planner", v.name),
+        })
+        .collect();
+    println!(
+        "{}: ok (mission of up to {} s after {} s of plume spin-up, steps of {dt} s; {})",
+        file.display(),
+        setup.spec.time_limit_s,
+        setup.spec.spinup_s,
+        vehicles.join("; ")
+    );
+    Ok(())
 }

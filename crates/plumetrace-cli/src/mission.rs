@@ -2,12 +2,16 @@
 
 use crate::output::write_atomic;
 use anyhow::{Context, Result};
-use plumetrace_mission::{MissionRun, run_mission};
+use plumetrace_mission::snapshot_log::{Header, SnapshotLogWriter};
+use plumetrace_mission::{Mission, MissionOptions, MissionRun, MissionSetup};
 use plumetrace_scenario::BuiltScenario;
 use serde::Serialize;
 use std::fmt::Write as _;
 use std::path::Path;
 use std::time::Instant;
+
+/// The snapshot log's file name in a run's output directory.
+pub const SNAPSHOT_LOG: &str = "snapshots.jsonl.gz";
 
 #[derive(Serialize)]
 struct SummaryFile<'a> {
@@ -19,21 +23,31 @@ struct SummaryFile<'a> {
     stage_times: plumetrace_sim::StageTimes,
 }
 
-/// Flies the mission and writes `summary.json`, `trajectory.csv`, `events.jsonl`, `plot.svg`.
-pub fn run(sc: BuiltScenario, out: &Path, stats: bool) -> Result<()> {
+/// Flies the mission and writes `summary.json`, `trajectory.csv`, `events.jsonl`, `plot.svg`
+/// and (unless `snapshot_log` is false) `snapshots.jsonl.gz`.
+pub fn run(sc: BuiltScenario, out: &Path, stats: bool, snapshot_log: bool) -> Result<()> {
     let name = sc.name.clone();
     let started = Instant::now();
-    let limit = sc.mission.as_ref().map_or(1.0, |m| m.time_limit_s);
-    let progress = crate::progress::Progress::new(limit.round() as u64, "s");
-    let mut spinup_wall = None;
-    let run = run_mission(sc, &mut |t, _| {
-        spinup_wall.get_or_insert_with(|| started.elapsed().as_secs_f64());
-        progress.tick(t.round() as u64);
-    })?;
+    let setup = MissionSetup::new(sc)?;
+    let mut mission = Mission::new(setup, MissionOptions::default())?;
+    if snapshot_log {
+        let header = Header::new(
+            &name,
+            mission.seed(),
+            &mission.vehicle_names(),
+            mission.planned(),
+        );
+        let path = out.join(SNAPSHOT_LOG);
+        let writer = SnapshotLogWriter::create(&path, &header)
+            .with_context(|| format!("creating {}", path.display()))?;
+        mission.observe(Box::new(writer));
+    }
+    let progress = crate::progress::Progress::new(mission.time_limit_s().round() as u64, "s");
+    mission.run(&mut |t, _| progress.tick(t.round() as u64))?;
     progress.finish();
+    let run = mission.finish()?;
     let wall = started.elapsed().as_secs_f64();
-    write_outputs(&run, out, &name, wall, spinup_wall.unwrap_or(0.0))?;
-    let s = &run.summary;
+    write_outputs(&run, out, &name, wall)?;
     if stats {
         let t = run.stage_times;
         eprintln!(
@@ -46,19 +60,24 @@ pub fn run(sc: BuiltScenario, out: &Path, stats: bool) -> Result<()> {
             t.integrate_s,
             t.check_s,
             t.record_s,
-            spinup_wall.unwrap_or(0.0)
+            run.spinup_wall_s
         );
     }
+    println!("{}; wrote {}", run_line(&run, &name, wall), out.display());
+    Ok(())
+}
+
+/// The one-line result: outcome, the first declaration with its time and error, and when and
+/// why the mission ended.
+pub fn run_line(run: &MissionRun, name: &str, wall: f64) -> String {
+    let s = &run.summary;
     let result = if s.sources.len() > 1 || s.declarations.len() > 1 {
         let nearest: Vec<String> = s
             .sources
             .iter()
             .map(|r| {
-                if r.nearest_error_m.is_finite() {
-                    format!("{:.1} m", r.nearest_error_m)
-                } else {
-                    "none".to_string()
-                }
+                r.nearest_error_m
+                    .map_or("none".into(), |e| format!("{e:.1} m"))
             })
             .collect();
         format!(
@@ -69,47 +88,50 @@ pub fn run(sc: BuiltScenario, out: &Path, stats: bool) -> Result<()> {
             plumetrace_mission::LOCATED_RADIUS_M,
             nearest.join(", ")
         )
-    } else if s.declared {
+    } else if let Some(d) = &s.first_declaration {
         format!(
-            "declared at ({:.1}, {:.1}), {:.1} m from the source ({:+.1} m along, {:+.1} m across the flow)",
-            s.declared_x, s.declared_y, s.error_m, s.error_along_m, s.error_cross_m
+            "declared at {:.0} s at ({:.1}, {:.1}), {:.1} m from the source ({:+.1} m along, {:+.1} m across the flow)",
+            d.t_s, d.x_m, d.y_m, d.error_m, d.error_along_m, d.error_cross_m
         )
     } else {
         "no source declared".to_string()
     };
-    println!(
-        "{name}: {} after {:.0} s of mission in {wall:.1} s; {result}; wrote {}",
-        s.outcome,
-        s.sim_time_s,
-        out.display()
-    );
-    Ok(())
+    let ended = match s.ended.reason {
+        plumetrace_mission::EndReason::PlannersDone => "planners done",
+        plumetrace_mission::EndReason::TimeLimit => "time limit",
+    };
+    format!(
+        "{name}: {}; {result}; mission ended at {:.0} s ({ended}), {wall:.1} s of wall time",
+        s.outcome.name(),
+        s.ended.t_s,
+    )
 }
 
-fn write_outputs(
-    run: &MissionRun,
-    out: &Path,
-    name: &str,
-    wall: f64,
-    spinup_wall: f64,
-) -> Result<()> {
+/// `x` with `digits` decimals, or an empty field.
+fn opt(x: Option<f64>, digits: usize) -> String {
+    x.map_or(String::new(), |v| format!("{v:.digits$}"))
+}
+
+fn write_outputs(run: &MissionRun, out: &Path, name: &str, wall: f64) -> Result<()> {
     let mut csv = String::from(
         "t_s,vehicle,true_x_m,true_y_m,true_z_m,est_x_m,est_y_m,heading_deg,speed_mps,behaviour,reading_v,detection\n",
     );
     for r in &run.trajectory {
         let _ = writeln!(
             csv,
-            "{:.1},{},{:.2},{:.2},{:.2},{:.2},{:.2},{:.1},{:.2},{},{:.3},{}",
+            "{:.1},{},{:.2},{:.2},{:.2},{},{},{:.1},{:.2},{},{:.3},{}",
             r.t_s,
             r.vehicle,
             r.true_x_m,
             r.true_y_m,
             r.true_z_m,
-            r.est_x_m,
-            r.est_y_m,
+            opt(r.est_x_m, 2),
+            opt(r.est_y_m, 2),
             r.heading_deg,
             r.speed_mps,
-            r.behaviour,
+            r.behaviour
+                .and_then(|b| plumetrace_core::variant_name(&b))
+                .unwrap_or(""),
             r.reading_v,
             u8::from(r.detection)
         );
@@ -124,32 +146,27 @@ fn write_outputs(
     let file = SummaryFile {
         summary: &run.summary,
         wall_s: wall,
-        real_time_factor: run.summary.sim_time_s / (wall - spinup_wall).max(1e-9),
-        spinup_wall_s: spinup_wall,
+        real_time_factor: run.summary.sim_time_s / (wall - run.spinup_wall_s).max(1e-9),
+        spinup_wall_s: run.spinup_wall_s,
         stage_times: run.stage_times,
     };
     write_atomic(
         &out.join("summary.json"),
         serde_json::to_string_pretty(&file)?.as_bytes(),
     )?;
-    let svg = plumetrace_mission::plot::mission_figure(
-        run,
-        &if run.summary.sources.len() > 1 {
-            format!(
-                "{name}: {}, {} of {} sources located (seed {})",
-                run.summary.outcome,
-                run.summary.sources_located,
-                run.summary.sources.len(),
-                run.summary.seed
-            )
-        } else {
-            format!(
-                "{name}: {} (seed {})",
-                run.summary.outcome, run.summary.seed
-            )
-        },
-    )
-    .map_err(anyhow::Error::msg)?;
+    let s = &run.summary;
+    let title = if s.sources.len() > 1 {
+        format!(
+            "{name}: {}, {} of {} sources located (seed {})",
+            s.outcome.name(),
+            s.sources_located,
+            s.sources.len(),
+            s.seed
+        )
+    } else {
+        format!("{name}: {} (seed {})", s.outcome.name(), s.seed)
+    };
+    let svg = plumetrace_mission::plot::mission_figure(run, &title).map_err(anyhow::Error::msg)?;
     write_atomic(&out.join("plot.svg"), svg.as_bytes())?;
     Ok(())
 }

@@ -1,8 +1,8 @@
 //! `plumetrace run`: simulate a scenario and write its outputs.
 //!
-//! Until vehicles and planners join the world, a run simulates the environment alone and writes
-//! a concentration snapshot, the time-averaged concentration and intermittency, the final
-//! filaments, statistics and a figure.
+//! A mission scenario is flown ([`crate::mission`]); a scenario without vehicles simulates the
+//! environment alone and writes a concentration snapshot, the time-averaged concentration and
+//! intermittency, the final filaments, statistics and a figure.
 
 use crate::output::write_atomic;
 use crate::plot;
@@ -31,14 +31,10 @@ pub struct RunArgs {
     /// Print the time spent in each stage of the step.
     #[arg(long)]
     stats: bool,
-}
-
-/// Wall time spent in each named stage of the step loop.
-#[derive(Debug, Default, Serialize)]
-pub struct StageTimes {
-    advance_environment_s: f64,
-    sample_s: f64,
-    record_s: f64,
+    /// Do not write the snapshot log (`snapshots.jsonl.gz`: every snapshot and decision of every
+    /// planner, for `plumetrace replay`).
+    #[arg(long)]
+    no_snapshot_log: bool,
 }
 
 /// Loads a scenario from a file or preset.
@@ -80,7 +76,9 @@ struct RunStats {
     max_concentration: f64,
     max_mean_concentration: f64,
     intermittency_threshold: f64,
-    stage_times: StageTimes,
+    /// The plume run's stages: advance environment, sense (sampling the time average), record
+    /// (writing the outputs).
+    stage_times: plumetrace_sim::StageTimes,
 }
 
 /// Runs the scenario: a mission when it has one, otherwise the plume alone.
@@ -89,7 +87,7 @@ pub fn run(args: &RunArgs) -> Result<()> {
     std::fs::create_dir_all(&args.out)
         .with_context(|| format!("creating {}", args.out.display()))?;
     if sc.mission.is_some() {
-        crate::mission::run(sc, &args.out, args.stats)
+        crate::mission::run(sc, &args.out, args.stats, !args.no_snapshot_log)
     } else {
         run_plume(sc, args)
     }
@@ -98,7 +96,7 @@ pub fn run(args: &RunArgs) -> Result<()> {
 /// Runs the plume alone and writes `stats.json`, `snapshot.csv`, `filaments.csv` and `plume.svg`.
 fn run_plume(mut sc: BuiltScenario, args: &RunArgs) -> Result<()> {
     let started = Instant::now();
-    let mut times = StageTimes::default();
+    let mut times = plumetrace_sim::StageTimes::default();
     let spec = sc.output;
     let mut mean = MeanConcentrationGrid::new(spec.grid, spec.threshold);
     let steady = matches!(sc.env.plume(), Plume::Steady(_));
@@ -115,7 +113,7 @@ fn run_plume(mut sc: BuiltScenario, args: &RunArgs) -> Result<()> {
         }
         let t2 = Instant::now();
         times.advance_environment_s += (t1 - t0).as_secs_f64();
-        times.sample_s += (t2 - t1).as_secs_f64();
+        times.sense_s += (t2 - t1).as_secs_f64();
         progress.tick(step);
     }
     progress.finish();
@@ -174,9 +172,9 @@ fn run_plume(mut sc: BuiltScenario, args: &RunArgs) -> Result<()> {
     write_atomic(&args.out.join("stats.json"), json.as_bytes())?;
     if args.stats {
         eprintln!(
-            "stage times: advance environment {:.3} s, sample {:.3} s, record {:.3} s",
+            "stage times: advance environment {:.3} s, sense (time average) {:.3} s, record {:.3} s",
             stats.stage_times.advance_environment_s,
-            stats.stage_times.sample_s,
+            stats.stage_times.sense_s,
             stats.stage_times.record_s
         );
     }

@@ -69,6 +69,7 @@ const RULES: &[(&str, Side, &[&str])] = &[
             "plumetrace-env",
             "plumetrace-sim",
             "plumetrace-scenario",
+            "plumetrace-planner",
             "plumetrace-mission",
             "plumetrace-campaign",
         ],

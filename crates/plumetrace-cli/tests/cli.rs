@@ -208,25 +208,29 @@ fn mission_run_writes_summary_trajectory_events_and_plot() {
         serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
     for key in [
         "outcome",
+        "ended",
         "declared",
-        "declared_x",
-        "declared_y",
-        "source_x",
-        "source_y",
-        "error_m",
-        "error_along_m",
-        "error_cross_m",
+        "first_declaration",
+        "declarations",
         "first_detection_s",
-        "declaration_s",
         "path_length_m",
+        "trace_length_m",
         "sim_time_s",
+        "sources",
+        "vehicles",
+        "stage_times",
     ] {
         assert!(summary.get(key).is_some(), "summary.json lacks {key}");
     }
     assert_eq!(summary["sim_time_s"], 200.0);
+    assert_eq!(summary["outcome"], "timed_out");
+    assert_eq!(summary["ended"]["reason"], "time_limit");
+    assert_eq!(summary["ended"]["t_s"], 200.0);
+    assert!(summary["first_declaration"].is_null());
+    assert_eq!(summary["vehicles"][0]["planner"], "amp");
     let sources = summary["sources"].as_array().unwrap();
     assert_eq!(sources.len(), 1);
-    assert_eq!(sources[0]["x_m"], summary["source_x"]);
+    assert_eq!(sources[0]["x_m"], 100.0);
     assert_eq!(
         summary["sources_located"].as_u64().unwrap(),
         u64::from(sources[0]["located"].as_bool().unwrap())
@@ -241,16 +245,66 @@ fn mission_run_writes_summary_trajectory_events_and_plot() {
     }
     assert!(events.contains("\"behaviour\""));
     let svg = std::fs::read_to_string(out.join("plot.svg")).unwrap();
-    for label in [
-        "East (m)",
-        "North (m)",
-        "op-area",
-        "detection",
-        "true source",
-        "declared source",
-    ] {
+    for label in ["East (m)", "North (m)", "op-area", "true source"] {
         assert!(svg.contains(label), "plot lacks {label}");
     }
+    // The legend lists only what is drawn.
+    let detected = traj.lines().skip(1).any(|l| l.ends_with(",1"));
+    assert_eq!(
+        svg.contains("\ndetection\n"),
+        detected,
+        "detections in the track: {detected}"
+    );
+    assert!(!svg.contains("declared source"));
+    // The snapshot log replays to the same decisions.
+    let log = out.join("snapshots.jsonl.gz");
+    assert!(log.exists());
+    let replayed = stdout(run_ok(&["replay", log.to_str().unwrap()]));
+    assert!(
+        replayed.contains("2000 decisions replayed, 0 differ"),
+        "{replayed}"
+    );
+    let other = dir.path().join("other.toml");
+    std::fs::write(&other, "kind = \"amp\"\nspeed_mps = 1.5\n").unwrap();
+    let replayed = stdout(run_ok(&[
+        "replay",
+        log.to_str().unwrap(),
+        "--planner-file",
+        other.to_str().unwrap(),
+    ]));
+    assert!(
+        !replayed.contains(", 0 differ") && replayed.contains("line "),
+        "{replayed}"
+    );
+}
+
+#[test]
+fn planners_lists_every_planner_with_its_keys_and_the_readme_has_the_table() {
+    let text = stdout(run_ok(&["planners"]));
+    assert!(
+        text.contains("amp: REMUS Adaptive Mission Planner"),
+        "{text}"
+    );
+    for key in [
+        "decision_period_s",
+        "beta_deg",
+        "threshold_v",
+        "lost_point_eviction",
+    ] {
+        assert!(text.contains(key), "{key} missing from:\n{text}");
+    }
+    let md = stdout(run_ok(&["planners", "--markdown"]));
+    let readme =
+        std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/../../README.md")).unwrap();
+    let start = readme
+        .find("<!-- planners:start -->\n")
+        .expect("README marks its planner table");
+    let end = readme.find("<!-- planners:end -->").unwrap();
+    assert_eq!(
+        &readme[start + "<!-- planners:start -->\n".len()..end],
+        md,
+        "the README's planner table is not the registry's: paste `plumetrace planners --markdown`"
+    );
 }
 
 #[test]
@@ -264,7 +318,14 @@ fn check_names_bad_planner_and_mission_keys() {
         ),
         (
             demo.replace("mapping_lines = 3", "mapping_lines = 3\nbeta = 20"),
-            "planner",
+            "planner.beta: unknown field",
+        ),
+        (
+            format!(
+                "{}\n[planners.tracer]\nkind = \"amp\"\nlamda_s = 5.0\n",
+                demo.replace("x_m = 470.0", "x_m = 470.0\nplanner = \"tracer\"")
+            ),
+            "planners.tracer.lamda_s: unknown field",
         ),
         (
             demo.replace("time_limit_s = 2400.0", "time_limit_s = -1.0"),
@@ -289,5 +350,25 @@ fn check_names_bad_planner_and_mission_keys() {
             err.contains(key) && err.contains(&format!("bad{k}.toml")),
             "case {k}: {err}"
         );
+        // `run` rejects it with the same message, before any step.
+        let run = bin()
+            .args(["run", path.to_str().unwrap(), "--out"])
+            .arg(dir.path().join(format!("out{k}")))
+            .output()
+            .unwrap();
+        assert_eq!(run.status.code(), Some(1), "case {k}");
+        assert_eq!(String::from_utf8_lossy(&run.stderr), err, "case {k}");
     }
+    // A good file: check says how long the mission can be and who flies what.
+    let path = dir.path().join("good.toml");
+    std::fs::write(&path, demo).unwrap();
+    let ok = stdout(run_ok(&["check", path.to_str().unwrap()]));
+    assert!(
+        ok.contains("mission of up to 2400 s") && ok.contains("auv flies amp (planner)"),
+        "{ok}"
+    );
+}
+
+fn stdout(out: std::process::Output) -> String {
+    String::from_utf8(out.stdout).unwrap()
 }

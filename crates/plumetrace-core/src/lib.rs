@@ -15,13 +15,19 @@
 pub mod angle;
 pub mod frame;
 pub mod message;
+pub mod names;
+pub mod params;
 pub mod planner;
 pub mod vehicle;
 
 pub use angle::{Heading, wrap_deg_180, wrap_deg_360, wrap_rad_pi};
 pub use frame::{Vec2, Vec3, bearing_between, heading_vector};
-pub use message::{Message, MessageBody, Recipient};
-pub use planner::{Decision, PlanStatus, Planner, PlannerEvent, RegionEvent};
+pub use message::{Link, Message, MessageBody, Outgoing, Recipient};
+pub use names::variant_name;
+pub use planner::{
+    BehaviourKind, Decision, DeclarationKind, PlanStatus, Planner, PlannerEvent, RegionEvent,
+    Telemetry,
+};
 pub use vehicle::{
     ChemSample, Command, FlowSample, NavEstimate, RangeReturn, SensorSnapshot, VehicleId,
     VehicleKind, VerticalCommand,

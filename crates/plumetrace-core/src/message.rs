@@ -1,4 +1,8 @@
 //! Messages between vehicles (acoustic modem, radio) as the onboard side sees them.
+//!
+//! A planner puts [`Outgoing`] messages in its decision; whatever carries them (the simulated
+//! world's channel models, or a real modem) stamps sender and time and hands the receiver a
+//! [`Message`] in its next snapshot, or loses it.
 
 use crate::{Heading, Vec2, VehicleId};
 use serde::{Deserialize, Serialize};
@@ -11,6 +15,17 @@ pub enum Recipient {
     Vehicle(VehicleId),
     /// Every vehicle in range.
     Broadcast,
+}
+
+/// The physical link a message travels over; each has its own channel model (delay, loss,
+/// range).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Link {
+    /// Underwater acoustic modem: slow (sound speed), lossy, limited range.
+    Acoustic,
+    /// Radio between surface craft: fast, usually reliable.
+    Radio,
 }
 
 /// What a message carries. New kinds are added as variants so that the link code stays exhaustive.
@@ -43,13 +58,26 @@ pub enum MessageBody {
     },
 }
 
-/// One message between vehicles.
+/// A message as a planner sends it.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Outgoing {
+    /// Recipient.
+    pub to: Recipient,
+    /// Link to send it over.
+    pub link: Link,
+    /// Content.
+    pub body: MessageBody,
+}
+
+/// One message between vehicles, as delivered.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Message {
     /// Sender.
     pub from: VehicleId,
     /// Recipient.
     pub to: Recipient,
+    /// Link it travelled over.
+    pub link: Link,
     /// Transmission time, s.
     pub sent_s: f64,
     /// Content.

@@ -1,20 +1,78 @@
 //! The interface between a world (simulated, logged or real) and a planner.
 //!
 //! A planner receives one [`SensorSnapshot`] per decision and returns a [`Decision`]: the
-//! command, anything worth logging, and whether the mission goes on. The same planner code runs
-//! against the simulator, a replayed log or a vehicle link.
+//! command, the messages it sends, what it reports (events and telemetry), and whether the mission
+//! goes on. The same planner code runs against the simulator, a replayed log or a vehicle link.
+//!
+//! Everything a planner reports is typed: behaviours are [`BehaviourKind`]s, declaration rules
+//! [`DeclarationKind`]s. Their names in files come from serde (`snake_case`), in one place.
 
-use crate::{Command, SensorSnapshot, Vec2};
+use crate::{Command, Outgoing, SensorSnapshot, Vec2};
 use serde::{Deserialize, Serialize};
 
-/// Something a planner reports for the event stream (written to logs, never read back).
-#[derive(Debug, Clone, PartialEq, Serialize)]
+/// The behaviours of plume-tracing planners: one vocabulary shared by every planner, so that
+/// figures colour them alike and campaigns can compare time spent in each.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum BehaviourKind {
+    /// Drive to the start of the search.
+    GoTo,
+    /// Drive to the next subregion, ignoring detections.
+    Transit,
+    /// Search for the plume.
+    Find,
+    /// Follow the plume up-flow while in contact.
+    TrackIn,
+    /// Cross the plume up-flow of the last contact after losing it.
+    TrackOut,
+    /// Search around where the plume was lost.
+    Reacquire,
+    /// Survey lanes over the area (exhaustive search).
+    Survey,
+    /// A pattern over a declared source (e.g. sidescan lines).
+    Mapping,
+    /// Mission over: no more commands.
+    Done,
+}
+
+impl BehaviourKind {
+    /// Every behaviour, in the order above.
+    pub const ALL: [BehaviourKind; 9] = [
+        BehaviourKind::GoTo,
+        BehaviourKind::Transit,
+        BehaviourKind::Find,
+        BehaviourKind::TrackIn,
+        BehaviourKind::TrackOut,
+        BehaviourKind::Reacquire,
+        BehaviourKind::Survey,
+        BehaviourKind::Mapping,
+        BehaviourKind::Done,
+    ];
+}
+
+/// What made a planner declare a source.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum DeclarationKind {
+    /// The three most up-flow lost points lie close together along the flow (the field rule).
+    AlongFlow,
+    /// The same, and close together across the flow too.
+    AlongAndCrossFlow,
+    /// A multi-source search traced the plume to its subregion's up-flow edge.
+    UpflowEdge,
+    /// The position of the strongest reading of a survey.
+    StrongestReading,
+}
+
+/// Something a planner reports for the event stream (written to logs, never read back by the
+/// planner).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case", tag = "event")]
 pub enum PlannerEvent {
     /// The active behaviour changed.
     Behaviour {
-        /// The behaviour now active (a registry name such as `"track_in"`).
-        name: &'static str,
+        /// The behaviour now active.
+        behaviour: BehaviourKind,
     },
     /// A detection was registered (the first after a gap, to keep logs small).
     Detection {
@@ -30,8 +88,8 @@ pub enum PlannerEvent {
     Declared {
         /// Declared position, m.
         pos_m: Vec2,
-        /// Which rule declared it (a registry name such as `"along_flow"`).
-        rule: &'static str,
+        /// What made the planner declare.
+        rule: DeclarationKind,
     },
     /// Work on a subregion of a multi-source mission started or ended.
     Region {
@@ -39,6 +97,11 @@ pub enum PlannerEvent {
         index: usize,
         /// What happened.
         what: RegionEvent,
+    },
+    /// The op-area cage aborted the mission: the vehicle was too far outside.
+    CageAbort {
+        /// How far outside the op-area the estimate was, m.
+        distance_outside_m: f64,
     },
 }
 
@@ -56,6 +119,17 @@ pub enum RegionEvent {
     TimedOut,
 }
 
+/// What a planner believes, reported for logs and displays (never read back by the planner).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case", tag = "event")]
+pub enum Telemetry {
+    /// The planner's current best guess of the source position.
+    SourceEstimate {
+        /// Estimated source position, m.
+        pos_m: Vec2,
+    },
+}
+
 /// Whether the mission goes on.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
@@ -69,24 +143,84 @@ pub enum PlanStatus {
 }
 
 /// A planner's answer to one snapshot.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Decision {
     /// What the vehicle should do until the next decision.
     pub command: Command,
+    /// Messages to send; the world (or the vehicle's modem) delivers them.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub outbox: Vec<Outgoing>,
     /// Events for the log, in order.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub events: Vec<PlannerEvent>,
+    /// What the planner reports about its beliefs, for the log.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub telemetry: Vec<Telemetry>,
     /// Whether the mission goes on.
     pub status: PlanStatus,
 }
 
-/// A planner: decides one vehicle's commands from what that vehicle can know.
-pub trait Planner: Send {
-    /// A short name for logs ("amp", ...).
-    fn name(&self) -> &'static str;
+impl Decision {
+    /// A decision with only a command and a status.
+    pub fn new(command: Command, status: PlanStatus) -> Self {
+        Decision {
+            command,
+            outbox: Vec::new(),
+            events: Vec::new(),
+            telemetry: Vec::new(),
+            status,
+        }
+    }
+}
 
-    /// The decision for this snapshot.
+/// A planner: decides one vehicle's commands from what that vehicle can know.
+///
+/// Kept small on purpose: behaviours, arbitration and the autopilot live in the onboard crates;
+/// a world needs only this.
+pub trait Planner: Send {
+    /// The decision for this snapshot (samples and messages since the previous one).
     fn decide(&mut self, snapshot: &SensorSnapshot) -> Decision;
 
-    /// Declared source positions so far, in order.
-    fn declarations(&self) -> Vec<Vec2>;
+    /// Time between decisions, s; 0 means at every step of the world. Between decisions the
+    /// vehicle keeps its last command and samples accumulate for the next snapshot.
+    fn decision_period_s(&self) -> f64 {
+        0.0
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::{Heading, VerticalCommand};
+
+    #[test]
+    fn decisions_round_trip_through_json_exactly_with_names_from_serde() {
+        let d = Decision {
+            command: Command {
+                heading: Heading::from_deg(123.456_789_012_345),
+                speed_mps: 1.0 / 3.0,
+                vertical: VerticalCommand::Altitude(2.0),
+            },
+            outbox: vec![],
+            events: vec![
+                PlannerEvent::Behaviour {
+                    behaviour: BehaviourKind::TrackIn,
+                },
+                PlannerEvent::Declared {
+                    pos_m: Vec2::new(0.1, -7.0e-9),
+                    rule: DeclarationKind::UpflowEdge,
+                },
+            ],
+            telemetry: vec![Telemetry::SourceEstimate {
+                pos_m: Vec2::new(1.5, 2.5),
+            }],
+            status: PlanStatus::Running,
+        };
+        let text = serde_json::to_string(&d).unwrap_or_default();
+        assert!(text.contains(r#""behaviour":"track_in""#), "{text}");
+        assert!(text.contains(r#""rule":"upflow_edge""#), "{text}");
+        assert!(!text.contains("outbox"), "empty lists are left out: {text}");
+        let back: Decision = serde_json::from_str(&text).unwrap_or_else(|e| panic!("{e}: {text}"));
+        assert_eq!(back, d);
+    }
 }

@@ -22,30 +22,33 @@ pub enum VehicleKind {
     Surface,
 }
 
-/// The vehicle's own estimate of where it is (dead reckoning plus fixes, or GPS).
+/// The vehicle's own estimate of where it is and how it moves, as its instruments report it.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct NavEstimate {
-    /// Estimated position `(east, north)`, m.
-    pub pos_m: Vec2,
+    /// Estimated position `(east, north)`, m (dead reckoning plus fixes, or GPS); `None` for a
+    /// vehicle without a position estimate (an underwater follower without fixes).
+    pub pos_m: Option<Vec2>,
     /// Compass heading, as measured by the vehicle.
     pub heading: Heading,
-    /// Water-relative speed, m/s.
+    /// Water-relative speed as the speed log reports it, m/s.
     pub speed_mps: f64,
-    /// Height above the seabed as measured by the altimeter, m (0 for surface craft).
-    pub altitude_m: f64,
+    /// Height above the seabed as the altimeter reports it, m (`None`: no altimeter, as on
+    /// surface craft).
+    pub altitude_m: Option<f64>,
+    /// Depth below the surface as the depth sensor reports it, m (`None` when unknown).
+    pub depth_m: Option<f64>,
     /// Time of the last position fix, s (`None` before the first one).
     pub last_fix_s: Option<f64>,
 }
 
-/// One chemical sensor sample.
+/// One chemical sensor sample: the analog reading only. Whether it counts as a detection is the
+/// planner's decision (the field planner thresholded the sensor's voltage itself).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct ChemSample {
     /// Sample time, s.
     pub time_s: f64,
     /// Analog reading in sensor units (volts for the field sensor).
     pub reading: f64,
-    /// Whether the reading exceeded the detection threshold.
-    pub detection: bool,
 }
 
 /// One flow (current) measurement, as an ADCP would give it.

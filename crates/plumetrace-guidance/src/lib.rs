@@ -12,11 +12,14 @@
 //!   the edge, steering back when outside, aborting far outside;
 //! - [`RateFilter`]: limit the commanded heading rate;
 //! - [`compensate_flow`]: the water-relative heading and speed that keep the ground track on the
-//!   desired course in a current (crab angle), or a report that the current is too strong.
+//!   desired course in a current (crab angle), or a report that the current is too strong;
+//! - [`Autopilot`]: the three above in the order every planner uses them (cage, flow
+//!   compensation, rate filter), turning a desired course over ground into a command.
 //!
 //! Headings are compass headings ([`plumetrace_core::Heading`]); the Dubins crate's
 //! anticlockwise-from-East angles are converted at its boundary only.
 
+mod autopilot;
 mod cage;
 mod dubins;
 mod flow_comp;
@@ -26,6 +29,7 @@ mod op_area;
 mod point;
 mod rate;
 
+pub use autopilot::{Autopilot, AutopilotParams, CageAbort};
 pub use cage::{Cage, CageAction};
 pub use dubins::{CscPath, CscWord, GoToPointWithHeading, Pose, csc_candidates, shortest_csc};
 pub use flow_comp::{FlowCompensation, compensate_flow};

@@ -1,18 +1,33 @@
-//! Missions: an onboard planner flying simulated vehicles until an outcome.
+//! Missions: onboard planners flying simulated vehicles until an outcome.
 //!
-//! This crate is where the two sides meet. It builds planners from a scenario's `[planner]`
-//! table, puts them in a [`plumetrace_sim::World`] built from the scenario, develops the plume
-//! first (spin-up), steps the world until every planner has finished, a vehicle stopped or the
-//! time limit, and records what happened: the trajectory, the event stream, a summary with the
-//! declaration errors, and a figure.
+//! This crate is where the two sides meet. [`MissionSetup`] reads every vehicle's planner from
+//! a built scenario through the planner registry (so `check` catches every bad key), [`Mission`]
+//! develops the plume first (spin-up) and steps the world until every planner has finished or
+//! stopped or the time limit comes, and observers record what happened: the events, every
+//! vehicle's trajectory, a summary with the declaration errors, a snapshot log that a planner can
+//! replay, and the figure.
+//!
+//! - [`setup`]: scenario to mission, planners checked;
+//! - [`mission`]: the stepper ([`Mission::new`], [`Mission::step`], [`Mission::finish`]);
+//! - [`outcome`]: how a mission ends and what it comes to;
+//! - [`record`]: the observer trait and the mission's own recorders;
+//! - [`summary`]: the key numbers written as `summary.json`;
+//! - [`snapshot_log`]: the replayable log of snapshots and decisions;
+//! - [`plot`]: the mission figure; [`output`]: atomic file writing.
 
+pub mod mission;
+pub mod outcome;
 pub mod output;
-pub mod planner_config;
 pub mod plot;
-pub mod run;
+pub mod record;
+pub mod setup;
+pub mod snapshot_log;
+pub mod summary;
 
-pub use planner_config::{PlannerError, amp_params};
-pub use run::{
-    DeclarationRecord, LOCATED_RADIUS_M, MissionError, MissionOptions, MissionRun, Outcome,
-    SourceRecord, Summary, TrajectoryRow, run_mission, run_mission_with,
+pub use mission::{
+    Mission, MissionOptions, MissionRun, VehicleInfo, run_mission, run_mission_with,
 };
+pub use outcome::{EndReason, MissionEnd, MissionEvent, Outcome, VehicleStatus};
+pub use record::{EventKind, EventRecord, Observer, StepView, TrajectoryRow};
+pub use setup::{MissionError, MissionSetup, PlannedVehicle};
+pub use summary::{DeclarationRecord, LOCATED_RADIUS_M, SourceRecord, Summary, VehicleSummary};

@@ -1,9 +1,11 @@
 //! The mission figure, drawn from the recorded run (like the field-test figures): op-area and
-//! subregions dashed, the estimated track as the vehicle logged it (the true track thin and grey),
-//! detections as x, lost points as open circles, declared sources as filled dots, true sources as
-//! triangles, and the time-averaged plume at the vehicle's altitude as a light heat map.
+//! subregions dashed, each vehicle's estimated track as it logged it in a colour of its own (the
+//! true tracks thin and grey), detections as x, lost points as open circles, declared sources as
+//! filled dots, true sources as triangles, and the time-averaged plume at the first vehicle's
+//! altitude as a light heat map. The legend lists only what is drawn.
 
-use crate::run::{EventKind, MissionRun};
+use crate::mission::MissionRun;
+use crate::record::{EventKind, MeanPlumeRecorder};
 use plotters::coord::types::RangedCoordf64;
 use plotters::prelude::*;
 use plumetrace_core::{PlannerEvent, Vec2};
@@ -122,9 +124,26 @@ fn legend_corner(
     best.0
 }
 
+/// Track colours, one per vehicle (cycled).
+const TRACK_COLOURS: [RGBColor; 6] = [
+    RGBColor(20, 60, 160),
+    RGBColor(150, 40, 150),
+    RGBColor(0, 120, 120),
+    RGBColor(160, 90, 0),
+    RGBColor(90, 90, 200),
+    RGBColor(120, 40, 40),
+];
+
 /// The figure as an SVG string.
 pub fn mission_figure(run: &MissionRun, title: &str) -> Result<String, String> {
-    let g = *run.mean_plume.spec();
+    let g = match &run.mean_plume {
+        Some(m) => *m.spec(),
+        None => {
+            let all: Vec<Vec2> = run.op_area.clone();
+            let wide = plumetrace_env::Rect::new(-1e12, 1e12, -1e12, 1e12).map_err(err)?;
+            MeanPlumeRecorder::grid_over(&all, wide, 0.0)
+        }
+    };
     let (x0, x1, y0, y1) = (g.x_min_m, g.x_max_m, g.y_min_m, g.y_max_m);
     let width = 900u32;
     let plot_w = f64::from(width - 90);
@@ -136,14 +155,18 @@ pub fn mission_figure(run: &MissionRun, title: &str) -> Result<String, String> {
         let mut chart = map_chart(&root, title, x0..x1, y0..y1)?;
 
         // Plume: square-root scale of the time-averaged concentration, light.
-        let mean = run.mean_plume.mean();
-        let max = mean.iter().copied().fold(0.0, f64::max);
-        let (dx, dy) = ((x1 - x0) / (g.nx - 1) as f64, (y1 - y0) / (g.ny - 1) as f64);
-        if max > 0.0 {
+        if let Some(mp) = &run.mean_plume {
+            let mean = mp.mean();
+            let max = mean.iter().copied().fold(0.0, f64::max);
+            let (dx, dy) = ((x1 - x0) / (g.nx - 1) as f64, (y1 - y0) / (g.ny - 1) as f64);
             let mut cells = Vec::new();
             for j in 0..g.ny {
                 for i in 0..g.nx {
-                    let c = mean[j * g.nx + i] / max;
+                    let c = if max > 0.0 {
+                        mean[j * g.nx + i] / max
+                    } else {
+                        0.0
+                    };
                     if c > 1e-3 {
                         let l = c.sqrt();
                         let col =
@@ -156,16 +179,18 @@ pub fn mission_figure(run: &MissionRun, title: &str) -> Result<String, String> {
                     }
                 }
             }
-            chart
-                .draw_series(cells)
-                .map_err(err)?
-                .label("mean plume at vehicle altitude")
-                .legend(|(x, y)| {
-                    Rectangle::new(
-                        [(x, y - 5), (x + 14, y + 5)],
-                        RGBColor(255, 170, 100).filled(),
-                    )
-                });
+            if !cells.is_empty() {
+                chart
+                    .draw_series(cells)
+                    .map_err(err)?
+                    .label("mean plume at vehicle altitude")
+                    .legend(|(x, y)| {
+                        Rectangle::new(
+                            [(x, y - 5), (x + 14, y + 5)],
+                            RGBColor(255, 170, 100).filled(),
+                        )
+                    });
+            }
         }
         chart
             .draw_series(dashed(&run.op_area, BLACK, 2))
@@ -184,7 +209,9 @@ pub fn mission_figure(run: &MissionRun, title: &str) -> Result<String, String> {
             v.dedup();
             v
         };
-        for &vid in &vehicles {
+        let grey = RGBColor(150, 150, 150);
+        let mut hits: Vec<(f64, f64)> = Vec::new();
+        for (n, &vid) in vehicles.iter().enumerate() {
             let rows: Vec<_> = run.trajectory.iter().filter(|r| r.vehicle == vid).collect();
             let step = (rows.len() / 20_000).max(1);
             let truth: Vec<(f64, f64)> = rows
@@ -195,39 +222,54 @@ pub fn mission_figure(run: &MissionRun, title: &str) -> Result<String, String> {
             let est: Vec<(f64, f64)> = rows
                 .iter()
                 .step_by(step)
-                .map(|r| (r.est_x_m, r.est_y_m))
+                .filter_map(|r| r.est_x_m.zip(r.est_y_m))
                 .collect();
-            chart
+            let true_track = chart
                 .draw_series(std::iter::once(PathElement::new(
                     truth,
-                    RGBColor(150, 150, 150).stroke_width(1),
+                    grey.stroke_width(1),
                 )))
-                .map_err(err)?
-                .label("true track")
-                .legend(|(x, y)| {
-                    PathElement::new(
-                        vec![(x, y), (x + 16, y)],
-                        RGBColor(150, 150, 150).stroke_width(1),
-                    )
-                });
-            chart
-                .draw_series(std::iter::once(PathElement::new(
-                    est,
-                    RGBColor(20, 60, 160).stroke_width(2),
-                )))
-                .map_err(err)?
-                .label("track (navigation estimate)")
-                .legend(|(x, y)| {
-                    PathElement::new(
-                        vec![(x, y), (x + 16, y)],
-                        RGBColor(20, 60, 160).stroke_width(2),
-                    )
-                });
-            let hits: Vec<(f64, f64)> = rows
-                .iter()
-                .filter(|r| r.detection)
-                .map(|r| (r.est_x_m, r.est_y_m))
-                .collect();
+                .map_err(err)?;
+            if n == 0 {
+                true_track
+                    .label(if vehicles.len() > 1 {
+                        "true tracks"
+                    } else {
+                        "true track"
+                    })
+                    .legend(move |(x, y)| {
+                        PathElement::new(vec![(x, y), (x + 16, y)], grey.stroke_width(1))
+                    });
+            }
+            let colour = TRACK_COLOURS[n % TRACK_COLOURS.len()];
+            let info = run.vehicles.get(vid as usize);
+            let label = match info {
+                Some(v) if vehicles.len() > 1 => format!(
+                    "{} ({}) estimated track",
+                    v.name,
+                    v.planner.as_deref().unwrap_or("no planner")
+                ),
+                _ => "track (navigation estimate)".to_string(),
+            };
+            if !est.is_empty() {
+                chart
+                    .draw_series(std::iter::once(PathElement::new(
+                        est,
+                        colour.stroke_width(2),
+                    )))
+                    .map_err(err)?
+                    .label(label)
+                    .legend(move |(x, y)| {
+                        PathElement::new(vec![(x, y), (x + 16, y)], colour.stroke_width(2))
+                    });
+            }
+            hits.extend(
+                rows.iter()
+                    .filter(|r| r.detection)
+                    .filter_map(|r| r.est_x_m.zip(r.est_y_m)),
+            );
+        }
+        if !hits.is_empty() {
             chart
                 .draw_series(hits.iter().map(|&p| Cross::new(p, 3, RED.stroke_width(1))))
                 .map_err(err)?
@@ -242,41 +284,47 @@ pub fn mission_figure(run: &MissionRun, title: &str) -> Result<String, String> {
                 _ => None,
             })
             .collect();
-        chart
-            .draw_series(
-                lost.iter()
-                    .map(|&p| Circle::new(p, 5, RGBColor(230, 120, 0).stroke_width(2))),
-            )
-            .map_err(err)?
-            .label("lost point")
-            .legend(|(x, y)| Circle::new((x + 8, y), 5, RGBColor(230, 120, 0).stroke_width(2)));
-        chart
-            .draw_series(
-                run.sources
-                    .iter()
-                    .map(|s| TriangleMarker::new((s.x, s.y), 9, RGBColor(0, 140, 60).filled())),
-            )
-            .map_err(err)?
-            .label("true source")
-            .legend(|(x, y)| TriangleMarker::new((x + 8, y), 6, RGBColor(0, 140, 60).filled()));
+        if !lost.is_empty() {
+            chart
+                .draw_series(
+                    lost.iter()
+                        .map(|&p| Circle::new(p, 5, RGBColor(230, 120, 0).stroke_width(2))),
+                )
+                .map_err(err)?
+                .label("lost point")
+                .legend(|(x, y)| Circle::new((x + 8, y), 5, RGBColor(230, 120, 0).stroke_width(2)));
+        }
+        if !run.sources.is_empty() {
+            chart
+                .draw_series(
+                    run.sources
+                        .iter()
+                        .map(|s| TriangleMarker::new((s.x, s.y), 9, RGBColor(0, 140, 60).filled())),
+                )
+                .map_err(err)?
+                .label("true source")
+                .legend(|(x, y)| TriangleMarker::new((x + 8, y), 6, RGBColor(0, 140, 60).filled()));
+        }
         let declared: Vec<(f64, f64)> = run
             .summary
             .declarations
             .iter()
             .map(|d| (d.x_m, d.y_m))
             .collect();
-        chart
-            .draw_series(declared.iter().map(|&p| Circle::new(p, 7, BLACK.filled())))
-            .map_err(err)?
-            .label("declared source")
-            .legend(|(x, y)| Circle::new((x + 8, y), 5, BLACK.filled()));
-        // What the legend could hide: the track (every 10th step), lost points, sources and
+        if !declared.is_empty() {
+            chart
+                .draw_series(declared.iter().map(|&p| Circle::new(p, 7, BLACK.filled())))
+                .map_err(err)?
+                .label("declared source")
+                .legend(|(x, y)| Circle::new((x + 8, y), 5, BLACK.filled()));
+        }
+        // What the legend could hide: the tracks (every 10th step), lost points, sources and
         // declarations.
         let mut marks: Vec<(f64, f64)> = run
             .trajectory
             .iter()
             .step_by(10)
-            .map(|r| (r.est_x_m, r.est_y_m))
+            .filter_map(|r| r.est_x_m.zip(r.est_y_m))
             .collect();
         marks.extend(&lost);
         marks.extend(&declared);
@@ -287,7 +335,7 @@ pub fn mission_figure(run: &MissionRun, title: &str) -> Result<String, String> {
             x0..x1,
             y0..y1,
             (f64::from(pw), f64::from(ph)),
-            (250.0, 190.0),
+            (if vehicles.len() > 1 { 330.0 } else { 250.0 }, 190.0),
         );
         chart
             .configure_series_labels()

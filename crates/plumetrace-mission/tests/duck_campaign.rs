@@ -4,6 +4,7 @@
 
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
+use plumetrace_core::DeclarationKind;
 use plumetrace_mission::{Summary, run_mission};
 use plumetrace_scenario::{Origin, build, load_preset};
 
@@ -35,10 +36,9 @@ fn duck_st_declares_in_most_seeds_with_errors_mostly_along_the_flow() {
     let results = run_seeds("duck-2003-st", 20);
     let declared: Vec<_> = results
         .iter()
-        .filter(|r| r.1.declared)
-        .map(|r| &r.1)
+        .filter_map(|r| r.1.first_declaration.as_ref())
         .collect();
-    let mut errors: Vec<f64> = declared.iter().map(|s| s.error_m).collect();
+    let mut errors: Vec<f64> = declared.iter().map(|d| d.error_m).collect();
     errors.sort_by(f64::total_cmp);
     let median = if errors.is_empty() {
         f64::NAN
@@ -47,7 +47,7 @@ fn duck_st_declares_in_most_seeds_with_errors_mostly_along_the_flow() {
     };
     let along_dominant = declared
         .iter()
-        .filter(|s| s.error_along_m.abs() > s.error_cross_m.abs())
+        .filter(|d| d.error_along_m.abs() > d.error_cross_m.abs())
         .count();
     eprintln!(
         "declared {}/20, errors {errors:?}, median {median:.1} m, along-dominant {along_dominant}",
@@ -77,7 +77,7 @@ fn duck_mt_locates_the_sources_and_declares_the_southern_edges() {
         .iter()
         .flat_map(|r| r.1.sources.iter())
         .filter(|s| s.located)
-        .map(|s| s.nearest_error_m)
+        .filter_map(|s| s.nearest_error_m)
         .collect();
     errors.sort_by(f64::total_cmp);
     let median = errors.get(errors.len() / 2).copied().unwrap_or(f64::NAN);
@@ -88,7 +88,7 @@ fn duck_mt_locates_the_sources_and_declares_the_southern_edges() {
         .map(|r| {
             r.1.declarations
                 .iter()
-                .filter(|d| d.rule == "upflow_edge" && (d.y_m - 550.0).abs() < 1.0)
+                .filter(|d| d.rule == DeclarationKind::UpflowEdge && (d.y_m - 550.0).abs() < 1.0)
                 .count()
         })
         .collect();

@@ -1,9 +1,15 @@
-//! Missions end to end on shortened presets: no panics, reproducible, sane summaries.
+//! Missions end to end on shortened presets and small scenarios: no panics, reproducible, sane
+//! summaries, several vehicles, replayable logs.
 
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
-use plumetrace_mission::{Outcome, run_mission};
-use plumetrace_scenario::{Origin, PRESETS, build, load_preset};
+use plumetrace_core::{BehaviourKind, PlannerEvent, VehicleKind};
+use plumetrace_mission::snapshot_log::{Header, SnapshotLogWriter, open, replay};
+use plumetrace_mission::{
+    EndReason, EventKind, Mission, MissionOptions, MissionSetup, Outcome, VehicleStatus,
+    run_mission,
+};
+use plumetrace_scenario::{Origin, PRESETS, ScenarioConfig, build, load_preset};
 
 /// A preset with its spin-up and time limit cut down for a quick test.
 fn shortened(
@@ -13,11 +19,15 @@ fn shortened(
     seed: u64,
 ) -> plumetrace_scenario::BuiltScenario {
     let mut cfg = load_preset(name).unwrap();
+    shorten(&mut cfg, spinup_s, limit_s);
+    build(&cfg, &Origin::Preset(name.into()), Some(seed)).unwrap()
+}
+
+fn shorten(cfg: &mut ScenarioConfig, spinup_s: f64, limit_s: f64) {
     if let Some(m) = cfg.mission.as_mut() {
         m.spinup_s = m.spinup_s.min(spinup_s);
         m.time_limit_s = limit_s;
     }
-    build(&cfg, &Origin::Preset(name.into()), Some(seed)).unwrap()
 }
 
 #[test]
@@ -46,7 +56,7 @@ fn every_mission_preset_runs_without_panicking() {
                 && run
                     .events
                     .iter()
-                    .any(|e| matches!(e.event, plumetrace_mission::run::EventKind::Planner(_)))
+                    .any(|e| matches!(e.event, EventKind::Planner(_)))
         );
         assert!(
             matches!(
@@ -80,36 +90,247 @@ fn the_demo_finds_the_plume_and_traces_it_towards_the_source() {
     let run = run_mission(shortened("demo", 3500.0, 900.0, 1), &mut |_, _| {}).unwrap();
     let s = &run.summary;
     assert!(
-        s.first_detection_s.is_finite() && s.first_detection_s < 300.0,
-        "first detection at {} s",
+        s.first_detection_s.is_some_and(|t| t < 300.0),
+        "first detection at {:?} s",
         s.first_detection_s
     );
-    // The closest approach of the estimated track to the source, once tracing.
+    let src = run.sources[0];
     let closest = run
         .trajectory
         .iter()
-        .map(|r| ((r.true_x_m - s.source_x).powi(2) + (r.true_y_m - s.source_y).powi(2)).sqrt())
+        .map(|r| ((r.true_x_m - src.x).powi(2) + (r.true_y_m - src.y).powi(2)).sqrt())
         .fold(f64::MAX, f64::min);
     assert!(
         closest < 30.0,
         "never got within 30 m of the source: {closest}"
     );
+    // Behaviours are typed from the planner to the trajectory.
+    assert!(
+        run.trajectory
+            .iter()
+            .any(|r| r.behaviour == Some(BehaviourKind::TrackIn))
+    );
 }
 
 #[test]
-fn bad_planner_settings_are_rejected_with_their_key_path() {
-    let mut cfg = load_preset("demo").unwrap();
-    cfg.planner.as_mut().unwrap().beta_deg = Some(-5.0);
-    let sc = build(&cfg, &Origin::Preset("demo".into()), None).unwrap();
-    let e = run_mission(sc, &mut |_, _| {}).unwrap_err().to_string();
-    assert!(e.contains("planner.beta_deg"), "{e}");
-    let mut cfg = load_preset("demo").unwrap();
-    cfg.planner.as_mut().unwrap().n_re = Some(0);
-    let sc = build(&cfg, &Origin::Preset("demo".into()), None).unwrap();
+fn bad_planner_settings_are_rejected_with_the_file_and_key_path() {
+    let text = load_preset_text("demo")
+        .replace("strategy = \"amp\"", "strategy = \"amp\"\nbeta_deg = -5.0");
+    let e = setup_error(&text);
     assert!(
-        run_mission(sc, &mut |_, _| {})
-            .unwrap_err()
-            .to_string()
-            .contains("planner.n_re")
+        e.contains("scenario.toml") && e.contains("planner.beta_deg"),
+        "{e}"
     );
+    let text =
+        load_preset_text("demo").replace("strategy = \"amp\"", "strategy = \"amp\"\nnre = 2");
+    let e = setup_error(&text);
+    assert!(
+        e.contains("planner.nre") && e.contains("unknown field"),
+        "{e}"
+    );
+    let text = load_preset_text("demo").replace("strategy = \"amp\"", "strategy = \"moth\"");
+    let e = setup_error(&text);
+    assert!(
+        e.contains("planner.kind") && e.contains("unknown planner 'moth'"),
+        "{e}"
+    );
+}
+
+fn load_preset_text(name: &str) -> String {
+    plumetrace_scenario::find_preset(name)
+        .unwrap()
+        .toml
+        .to_string()
+}
+
+fn setup_error(text: &str) -> String {
+    let origin = Origin::File("scenario.toml".into());
+    let cfg = plumetrace_scenario::parse(text, &origin).unwrap();
+    let sc = build(&cfg, &origin, None).unwrap();
+    MissionSetup::new(sc).err().unwrap().to_string()
+}
+
+#[test]
+fn a_sensor_threshold_in_an_older_file_reaches_the_planner() {
+    // The demo with a threshold above any reading the plume gives: no detection at all.
+    let text = load_preset_text("demo").replace(
+        "heading_deg = 270.0",
+        "heading_deg = 270.0\n[vehicles.chem_sensor]\nthreshold_v = 4.99",
+    );
+    let origin = Origin::File("scenario.toml".into());
+    let mut cfg = plumetrace_scenario::parse(&text, &origin).unwrap();
+    shorten(&mut cfg, 600.0, 400.0);
+    let setup = MissionSetup::new(build(&cfg, &origin, Some(1)).unwrap()).unwrap();
+    let p = setup.planners[0].as_ref().unwrap();
+    assert_eq!(p.config.detection_threshold_v(), Some(4.99));
+    let mut m = Mission::new(setup, MissionOptions::default()).unwrap();
+    m.run(&mut |_, _| {}).unwrap();
+    let run = m.finish().unwrap();
+    assert_eq!(run.summary.first_detection_s, None);
+    assert!(run.trajectory.iter().all(|r| !r.detection));
+    // The same run at the default threshold detects.
+    let run = run_mission(shortened("demo", 600.0, 400.0, 1), &mut |_, _| {}).unwrap();
+    assert!(run.summary.first_detection_s.is_some());
+}
+
+/// The demo with a second AUV starting from the other downflow corner, both flying the AMP.
+const TWO_AUVS: &str = r#"
+[[vehicles]]
+kind = "auv"
+name = "north"
+x_m = 470.0
+y_m = 60.0
+heading_deg = 270.0
+planner = "tracer"
+
+[[vehicles]]
+kind = "auv"
+name = "south"
+x_m = 470.0
+y_m = -60.0
+heading_deg = 270.0
+planner = "tracer"
+
+[planners.tracer]
+kind = "amp"
+mapping = false
+"#;
+
+fn demo_with(vehicles_and_planners: &str, limit_s: f64, seed: u64) -> MissionSetup {
+    let base = load_preset_text("demo");
+    // Drop the demo's own vehicle and planner tables.
+    let start = base.find("[[vehicles]]").unwrap();
+    let mission = base.find("[mission]").unwrap();
+    let planner = base.find("[planner]").unwrap();
+    let output = base.find("[output]").unwrap();
+    let text = format!(
+        "{}{}\n{}{}",
+        &base[..start],
+        vehicles_and_planners,
+        &base[mission..planner],
+        &base[output..]
+    );
+    let origin = Origin::File("two.toml".into());
+    let mut cfg = plumetrace_scenario::parse(&text, &origin).unwrap();
+    shorten(&mut cfg, 2000.0, limit_s);
+    MissionSetup::new(build(&cfg, &origin, Some(seed)).unwrap()).unwrap()
+}
+
+#[test]
+fn two_auvs_fly_the_amp_from_different_corners_and_are_recorded_apart() {
+    let setup = demo_with(TWO_AUVS, 1500.0, 3);
+    assert_eq!(setup.planners.iter().flatten().count(), 2);
+    let mut m = Mission::new(setup, MissionOptions::default()).unwrap();
+    let end = m.run(&mut |_, _| {}).unwrap();
+    let run = m.finish().unwrap();
+    let s = &run.summary;
+    assert_eq!(s.vehicles.len(), 2);
+    assert_eq!(s.vehicles[0].name, "north");
+    assert_eq!(s.vehicles[1].planner.as_deref(), Some("amp"));
+    for v in &s.vehicles {
+        assert!(v.path_length_m > 500.0, "{v:?}");
+        assert!(v.first_detection_s.is_some(), "{v:?}");
+    }
+    // Both tracks, both event streams.
+    for k in 0..2u32 {
+        assert!(run.trajectory.iter().filter(|r| r.vehicle == k).count() > 1000);
+        assert!(run.events.iter().any(|e| e.vehicle == k
+            && matches!(e.event, EventKind::Planner(PlannerEvent::Behaviour { .. }))));
+    }
+    // They started on different sides and were apart at the start.
+    let first = |k: u32| run.trajectory.iter().find(|r| r.vehicle == k).unwrap();
+    assert!((first(0).true_y_m - first(1).true_y_m).abs() > 100.0);
+    // The mission ends when both planners are done, or at the limit.
+    match end.reason {
+        EndReason::PlannersDone => assert!(
+            s.vehicles.iter().all(|v| v.status != VehicleStatus::Active),
+            "{:?}",
+            s.vehicles
+        ),
+        EndReason::TimeLimit => assert!((end.t_s - 1500.0).abs() < 1e-6),
+    }
+    assert!(matches!(
+        run.outcome,
+        Outcome::Declared | Outcome::TimedOut | Outcome::NoDeclaration
+    ));
+    let svg = plumetrace_mission::plot::mission_figure(&run, "two AUVs").unwrap();
+    assert!(
+        svg.contains("north (amp) estimated track") && svg.contains("south (amp) estimated track"),
+        "the legend names both vehicles"
+    );
+}
+
+#[test]
+fn a_vehicle_without_a_position_estimate_cannot_fly_the_amp() {
+    let text = TWO_AUVS.replacen(
+        "planner = \"tracer\"",
+        "planner = \"tracer\"\n[vehicles.nav]\nposition_estimate = false",
+        1,
+    );
+    let base = load_preset_text("demo");
+    let start = base.find("[[vehicles]]").unwrap();
+    let mission = base.find("[mission]").unwrap();
+    let planner = base.find("[planner]").unwrap();
+    let output = base.find("[output]").unwrap();
+    let full = format!(
+        "{}{}\n{}{}",
+        &base[..start],
+        text,
+        &base[mission..planner],
+        &base[output..]
+    );
+    let e = setup_error(&full);
+    assert!(
+        e.contains("vehicles[0].nav.position_estimate") && e.contains("'amp'"),
+        "{e}"
+    );
+}
+
+#[test]
+fn replaying_a_snapshot_log_reproduces_every_decision() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("snapshots.jsonl.gz");
+    let setup = MissionSetup::new(shortened("demo", 2000.0, 700.0, 5)).unwrap();
+    let mut m = Mission::new(setup, MissionOptions::default()).unwrap();
+    let header = Header::new(m.name(), m.seed(), &m.vehicle_names(), m.planned());
+    m.observe(Box::new(SnapshotLogWriter::create(&path, &header).unwrap()));
+    m.run(&mut |_, _| {}).unwrap();
+    let run = m.finish().unwrap();
+    let steps = run.trajectory.iter().filter(|r| r.vehicle == 0).count() as u64;
+    let report = replay(open(&path).unwrap(), &|_| None).unwrap();
+    assert_eq!(report.decisions, steps, "one decision per step");
+    assert_eq!(report.differing, 0, "{:?}", report.first.first());
+    // Another configuration decides differently somewhere: the replay reports it.
+    let other: toml::Table = "kind = \"amp\"\nbeta_deg = 40.0".parse().unwrap();
+    let report = replay(open(&path).unwrap(), &|_| Some(other.clone())).unwrap();
+    assert!(report.differing > 0 && report.first[0].line >= 2);
+    // A log that is not one is refused with its line.
+    let bad = dir.path().join("bad.jsonl");
+    std::fs::write(&bad, "{\"format\":\"x\"}\n").unwrap();
+    let e = replay(open(&bad).unwrap(), &|_| None)
+        .err()
+        .unwrap()
+        .to_string();
+    assert!(e.starts_with("line 1:"), "{e}");
+}
+
+#[test]
+fn the_summary_keeps_the_declaration_and_the_end_apart() {
+    let run = run_mission(shortened("demo", 3500.0, 2400.0, 1), &mut |_, _| {}).unwrap();
+    let s = &run.summary;
+    let d = s.first_declaration.as_ref().expect("the demo declares");
+    assert_eq!(s.outcome, Outcome::Declared);
+    assert!(
+        d.t_s < s.ended.t_s,
+        "declared at {} s, ended at {} s",
+        d.t_s,
+        s.ended.t_s
+    );
+    assert_eq!(
+        s.ended.reason,
+        EndReason::PlannersDone,
+        "the mapping ends the mission"
+    );
+    assert_eq!(s.vehicles[0].kind, VehicleKind::Auv);
+    assert_eq!(s.vehicles[0].status, VehicleStatus::Finished);
 }

@@ -4,19 +4,22 @@
 //! commands, through the [`plumetrace_core::Planner`] trait. It depends on no simulator code, so
 //! the same planner runs in simulation, on a replayed log or on a vehicle.
 //!
+//! - [`planners`]: the registry of every planner (parameters, defaults, bounds, validation,
+//!   construction) and the mission geometry planners are built with;
 //! - [`amp`]: the REMUS Adaptive Mission Planner: behaviours Go-To, Find, Track-In, Track-Out and
 //!   Reacquire switched on the time since the last detection, source declaration after Track-Out,
-//!   post-declaration mapping and multi-source (subregion) missions.
+//!   post-declaration mapping and multi-source (subregion) missions;
+//! - [`behaviour`]: the small behaviour and arbiter traits planners are built from, and the
+//!   behaviours any planner can use;
 //! - [`flow`]: the planner's running estimate of the current from flow measurements.
 
-pub mod amp;
+pub mod behaviour;
 pub mod flow;
+pub mod planners;
 
-pub use amp::{Amp, AmpParams, DeclarationRule, LostPointEviction, MappingParams};
 pub use flow::FlowEstimate;
-
-/// Every planner plumetrace knows, for `list` commands and campaign files.
-pub const REGISTRY: &[(&str, &str)] = &[(
-    "amp",
-    "REMUS Adaptive Mission Planner: Find, Track-In, Track-Out, Reacquire (Bowtie), declaration, mapping",
-)];
+pub use planners::amp::{self, Amp, AmpParams, DeclarationRule, LostPointEviction, MappingParams};
+pub use planners::{
+    BuildContext, CommonParams, MissionGeometry, PLANNERS, PlannerConfig, PlannerEntry,
+    PlannerParams, PlannerSpec, registry_markdown,
+};

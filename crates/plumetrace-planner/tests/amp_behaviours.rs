@@ -3,11 +3,10 @@
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
 use plumetrace_core::{
-    ChemSample, FlowSample, Heading, NavEstimate, PlanStatus, Planner, PlannerEvent,
-    SensorSnapshot, Vec2, VehicleId,
+    BehaviourKind, ChemSample, DeclarationKind, FlowSample, Heading, NavEstimate, PlanStatus,
+    Planner, PlannerEvent, SensorSnapshot, Vec2, VehicleId, bearing_between,
 };
 use plumetrace_guidance::OpArea;
-use plumetrace_planner::amp::BehaviourKind;
 use plumetrace_planner::{Amp, AmpParams, LostPointEviction};
 
 /// Flow towards North at 0.1 m/s: upflow is South.
@@ -16,16 +15,17 @@ fn snap(t: f64, pos: (f64, f64), heading_deg: f64, detection: bool) -> SensorSna
         time_s: t,
         vehicle: VehicleId(0),
         nav: NavEstimate {
-            pos_m: Vec2::new(pos.0, pos.1),
+            pos_m: Some(Vec2::new(pos.0, pos.1)),
             heading: Heading::from_deg(heading_deg),
             speed_mps: 2.0,
-            altitude_m: 2.0,
+            altitude_m: Some(2.0),
+            depth_m: None,
             last_fix_s: None,
         },
+        // Above and below the default 0.2 V detection threshold.
         chem: vec![ChemSample {
             time_s: t,
-            reading: if detection { 1.0 } else { 0.0 },
-            detection,
+            reading: if detection { 1.0 } else { 0.1 },
         }],
         flow: Some(FlowSample {
             time_s: t,
@@ -41,12 +41,12 @@ fn amp() -> Amp {
     Amp::new(AmpParams::default(), area, vec![], Heading::NORTH)
 }
 
-fn behaviours(events: &[PlannerEvent]) -> Vec<&'static str> {
+fn behaviours(events: &[PlannerEvent]) -> Vec<BehaviourKind> {
     events
         .iter()
         .filter_map(|e| {
-            if let PlannerEvent::Behaviour { name } = e {
-                Some(*name)
+            if let PlannerEvent::Behaviour { behaviour } = e {
+                Some(*behaviour)
             } else {
                 None
             }
@@ -60,15 +60,31 @@ fn starts_by_going_to_the_most_downflow_corner_then_finds() {
     let d = a.decide(&snap(0.0, (200.0, 500.0), 0.0, false));
     assert_eq!(a.behaviour(), BehaviourKind::GoTo);
     assert_eq!(d.status, PlanStatus::Running);
-    // The goal is near a North corner (flow goes North): the command heads North-ish.
-    assert!(
-        d.command.heading.diff_deg(Heading::NORTH).abs() < 30.0 || d.command.heading.deg() < 30.0
-    );
-    // Near a North corner the search starts across and up the flow.
+    assert_eq!(behaviours(&d.events), [BehaviourKind::GoTo]);
+    // Near a North corner (flow goes North) the search starts across and up the flow, and
+    // Go-To asks for the bearing to it.
     let start = a.search_start(0);
     assert!(
         start.y > 980.0 && (start.x < 20.0 || start.x > 380.0),
         "{start:?}"
+    );
+    let bearing = bearing_between(Vec2::new(200.0, 500.0), start).unwrap();
+    assert!(
+        a.last_course().diff_deg(bearing).abs() < 1e-9,
+        "course {} towards the start {}",
+        a.last_course().deg(),
+        bearing.deg()
+    );
+    // The first command still heads where the vehicle points (the rate filter starts there);
+    // a second later it has turned towards the start by at most 10 deg.
+    assert_eq!(d.command.heading, Heading::NORTH);
+    let d = a.decide(&snap(1.0, (200.0, 502.0), 0.0, false));
+    let turned = d.command.heading.diff_deg(Heading::NORTH);
+    assert!(
+        turned.abs() > 9.99
+            && turned.abs() <= 10.0 + 1e-9
+            && turned.signum() == bearing.diff_deg(Heading::NORTH).signum(),
+        "{turned}"
     );
     a.decide(&snap(1.0, (start.x, start.y), 0.0, false));
     assert_eq!(a.behaviour(), BehaviourKind::Find);
@@ -136,7 +152,7 @@ fn losing_the_plume_saves_a_lost_point_and_tracks_out_to_the_opposite_side() {
             .iter()
             .any(|e| matches!(e, PlannerEvent::LostPoint { .. }))
     );
-    assert!(behaviours(&d.events).contains(&"track_out"));
+    assert!(behaviours(&d.events).contains(&BehaviourKind::TrackOut));
     // LHS +1: it left on the left looking upflow (South): left is East. The goal is on the
     // other side (West), 18 m upflow (South) and 18 m across.
     let goal = a.track_out_goal().unwrap();
@@ -275,6 +291,15 @@ fn cage_abort_ends_the_mission() {
     a.decide(&snap(0.0, (200.0, 500.0), 0.0, false));
     let d = a.decide(&snap(1.0, (-40.0, 500.0), 0.0, false));
     assert_eq!(d.status, PlanStatus::Abort);
+    assert_eq!(d.command.speed_mps, 0.0);
+    assert!(
+        d.events.iter().any(|e| matches!(
+            e,
+            PlannerEvent::CageAbort { distance_outside_m } if (distance_outside_m - 40.0).abs() < 1e-9
+        )),
+        "{:?}",
+        d.events
+    );
 }
 
 #[test]
@@ -351,7 +376,8 @@ fn multi_source_tracing_to_the_upflow_edge_declares_there() {
         .collect();
     assert_eq!(declared.len(), 1, "{:?}", d.events);
     assert!(
-        (declared[0].0 - Vec2::new(150.0, 500.0)).norm() < 1e-9 && declared[0].1 == "upflow_edge"
+        (declared[0].0 - Vec2::new(150.0, 500.0)).norm() < 1e-9
+            && declared[0].1 == DeclarationKind::UpflowEdge
     );
     assert_eq!(a.behaviour(), BehaviourKind::Transit);
 }

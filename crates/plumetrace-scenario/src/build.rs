@@ -41,6 +41,20 @@ pub struct VehicleSetup {
     pub flow_sensor: plumetrace_sim::FlowSensorParams,
     /// Obstacle range sensors, if fitted.
     pub range_sensor: Option<plumetrace_sim::RangeSensorParams>,
+    /// The planner it flies, as written (checked by the planner registry when the mission is
+    /// built); `None`: no planner, the vehicle keeps its last command.
+    pub planner: Option<PlannerRef>,
+    /// `[vehicles.chem_sensor] threshold_v`, if given: the detection threshold its planner gets.
+    pub detection_threshold_v: Option<f64>,
+}
+
+/// A vehicle's planner table as written in the scenario.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PlannerRef {
+    /// Its key path: `planner` or `planners.NAME`.
+    pub key: String,
+    /// The table (`kind` and the planner's keys; a legacy `strategy` is read as `kind`).
+    pub table: toml::Table,
 }
 
 /// The mission part of a scenario (present when it has vehicles to fly).
@@ -77,8 +91,10 @@ pub struct BuiltScenario {
     pub vehicles: Vec<VehicleSetup>,
     /// The mission, if the scenario flies vehicles.
     pub mission: Option<MissionSpec>,
-    /// The planner table as written (its values are checked when the planner is made).
-    pub planner: Option<crate::config::PlannerConfig>,
+    /// Where the scenario came from (for errors found later, e.g. by the planner registry).
+    pub origin: Origin,
+    /// Message channels between vehicles.
+    pub comms: plumetrace_sim::CommsParams,
     /// The vehicles' step, s (`sim.dt_s`; the environment may step more coarsely).
     pub dt_s: f64,
     /// Water depth, m.
@@ -332,15 +348,58 @@ pub fn build(
         obstacles.push(SoftObstacle::new(name, &o.vertices, &key).map_err(env_err)?);
     }
 
+    let legacy = match &cfg.planner {
+        Some(t) => Some(legacy_planner(t).map_err(|(k, m)| invalid(&k, m))?),
+        None => None,
+    };
     let mut vehicles = Vec::new();
     for (k, v) in cfg.vehicles.iter().enumerate() {
-        vehicles.push(
-            vehicle_setup(v, k, &domain, d.depth_m).map_err(|e| match e {
-                EnvError::InvalidParameter { key, message } => invalid(&key, message),
-                other => invalid(&format!("vehicles[{k}]"), other.to_string()),
-            })?,
-        );
+        let mut setup = vehicle_setup(v, k, &domain, d.depth_m).map_err(|e| match e {
+            EnvError::InvalidParameter { key, message } => invalid(&key, message),
+            other => invalid(&format!("vehicles[{k}]"), other.to_string()),
+        })?;
+        setup.planner = match &v.planner {
+            Some(name) => {
+                let table = cfg.planners.get(name).ok_or_else(|| {
+                    let known: Vec<&str> = cfg.planners.keys().map(String::as_str).collect();
+                    invalid(
+                        &format!("vehicles[{k}].planner"),
+                        if known.is_empty() {
+                            format!("no [planners.{name}] table (the scenario defines none)")
+                        } else {
+                            format!("no [planners.{name}] table (defined: {})", known.join(", "))
+                        },
+                    )
+                })?;
+                Some(PlannerRef {
+                    key: format!("planners.{name}"),
+                    table: table.clone(),
+                })
+            }
+            None if v.kind == plumetrace_core::VehicleKind::Auv => legacy.clone(),
+            None => None,
+        };
+        vehicles.push(setup);
     }
+    if let Some(name) = cfg.planners.keys().find(|n| {
+        !cfg.vehicles
+            .iter()
+            .any(|v| v.planner.as_deref() == Some(n.as_str()))
+    }) {
+        return Err(invalid(
+            &format!("planners.{name}"),
+            "no vehicle flies it (name it in a vehicle: planner = \"NAME\")".into(),
+        ));
+    }
+    let comms = plumetrace_sim::CommsParams {
+        acoustic: channel(cfg.comms.acoustic.as_ref()),
+        radio: channel(cfg.comms.radio.as_ref()),
+    };
+    comms
+        .acoustic
+        .validate("comms.acoustic")
+        .and_then(|()| comms.radio.validate("comms.radio"))
+        .map_err(env_err)?;
 
     let seed = seed.unwrap_or(cfg.seed);
     let env = Environment::new(
@@ -353,9 +412,10 @@ pub fn build(
     )
     .map_err(env_err)?;
 
+    let flown = vehicles.iter().any(|v| v.planner.is_some());
     let mission = match &cfg.mission {
         None => {
-            if !vehicles.is_empty() && cfg.planner.is_some() {
+            if flown {
                 return Err(invalid(
                     "mission",
                     "a scenario with vehicles and a planner needs a [mission] table".into(),
@@ -368,20 +428,16 @@ pub fn build(
             other => invalid("mission", other.to_string()),
         })?),
     };
-    if mission.is_some() && cfg.planner.is_none() {
+    if mission.is_some() && !flown {
         return Err(invalid(
-            "planner",
-            "a [mission] needs a [planner] table".into(),
-        ));
-    }
-    if mission.is_some()
-        && !vehicles
-            .iter()
-            .any(|v| v.vehicle.params.kind == plumetrace_core::VehicleKind::Auv)
-    {
-        return Err(invalid(
-            "vehicles",
-            "a [mission] needs at least one vehicle with kind = \"auv\"".into(),
+            if cfg.vehicles.is_empty() {
+                "vehicles"
+            } else {
+                "planner"
+            },
+            "a [mission] needs a vehicle with a planner: a [planner] table (flown by every AUV) \
+             or [planners.NAME] tables named by vehicles (planner = \"NAME\")"
+                .into(),
         ));
     }
 
@@ -429,7 +485,8 @@ pub fn build(
         output,
         vehicles,
         mission,
-        planner: cfg.planner.clone(),
+        origin: origin.clone(),
+        comms,
         dt_s,
         depth_m: d.depth_m,
     })
@@ -569,6 +626,9 @@ fn vehicle_setup(
         velocity_error_sd_mps: n.velocity_error_sd_mps.unwrap_or(nb.velocity_error_sd_mps),
         velocity_error_tau_s: n.velocity_error_tau_s.unwrap_or(nb.velocity_error_tau_s),
         heading_sd_deg: n.heading_sd_deg.unwrap_or(nb.heading_sd_deg),
+        position_estimate: n.position_estimate.unwrap_or(nb.position_estimate),
+        speed_sd_mps: n.speed_sd_mps.unwrap_or(nb.speed_sd_mps),
+        altimeter_sd_m: n.altimeter_sd_m.unwrap_or(nb.altimeter_sd_m),
     };
     nav.validate(&format!("{key}.nav"))?;
     let cb = ChemSensorParams::default();
@@ -579,9 +639,11 @@ fn vehicle_setup(
         full_scale_v: c.full_scale_v.unwrap_or(cb.full_scale_v),
         noise_sd_v: c.noise_sd_v.unwrap_or(cb.noise_sd_v),
         lag_time_constant_s: c.lag_time_constant_s.unwrap_or(cb.lag_time_constant_s),
-        threshold_v: c.threshold_v.unwrap_or(cb.threshold_v),
     };
     chem_sensor.validate(&format!("{key}.chem_sensor"))?;
+    if let Some(t) = c.threshold_v {
+        plumetrace_env::error::require_non_negative(&format!("{key}.chem_sensor.threshold_v"), t)?;
+    }
     let fb = FlowSensorParams::default();
     let f = &v.flow_sensor;
     let fault = match (f.fault_start_s, f.fault_end_s) {
@@ -652,6 +714,38 @@ fn vehicle_setup(
         chem_sensor,
         flow_sensor,
         range_sensor,
+        planner: None,
+        detection_threshold_v: c.threshold_v,
+    })
+}
+
+/// The legacy `[planner]` table (flown by every AUV that names no planner): `strategy` is read
+/// as `kind`. On error returns `(key, message)`.
+fn legacy_planner(t: &toml::Table) -> Result<PlannerRef, (String, String)> {
+    let mut table = t.clone();
+    if let Some(s) = table.remove("strategy") {
+        if table.contains_key("kind") {
+            return Err((
+                "planner.strategy".into(),
+                "give `kind` (or the older `strategy`), not both".into(),
+            ));
+        }
+        table.insert("kind".into(), s);
+    }
+    Ok(PlannerRef {
+        key: "planner".into(),
+        table,
+    })
+}
+
+/// A channel model from its table (absent keys: ideal).
+fn channel(c: Option<&crate::config::ChannelConfig>) -> plumetrace_sim::ChannelParams {
+    let ideal = plumetrace_sim::ChannelParams::IDEAL;
+    c.map_or(ideal, |c| plumetrace_sim::ChannelParams {
+        latency_s: c.latency_s.unwrap_or(ideal.latency_s),
+        sound_speed_mps: c.sound_speed_mps,
+        loss_probability: c.loss_probability.unwrap_or(ideal.loss_probability),
+        max_range_m: c.max_range_m,
     })
 }
 

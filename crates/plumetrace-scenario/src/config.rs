@@ -2,6 +2,7 @@
 //! [`crate::build`]. Every key carries its unit (`_m`, `_s`, `_mps`, `_deg`, `_m2ps`, `_hz`).
 
 use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
 use std::path::PathBuf;
 
 /// A whole scenario file.
@@ -36,8 +37,15 @@ pub struct ScenarioConfig {
     pub vehicles: Vec<VehicleConfig>,
     /// The mission: op-area, subregions, time limit, plume spin-up (needed with vehicles).
     pub mission: Option<MissionConfig>,
-    /// The planner flown by every AUV.
-    pub planner: Option<PlannerConfig>,
+    /// The planner flown by every AUV that names none (`strategy` or `kind` names it; its keys
+    /// are checked by the planner registry when the mission is built).
+    pub planner: Option<toml::Table>,
+    /// Named planners, flown by the vehicles that name them (`planner = "NAME"`).
+    #[serde(default)]
+    pub planners: BTreeMap<String, toml::Table>,
+    /// Message channels between vehicles.
+    #[serde(default)]
+    pub comms: CommsConfig,
     /// What a plume run writes.
     #[serde(default)]
     pub output: OutputConfig,
@@ -284,6 +292,9 @@ pub struct VehicleConfig {
     pub heading_deg: f64,
     /// Start height above the seabed, m (AUV; default 2). Surface craft start at the surface.
     pub altitude_m: Option<f64>,
+    /// The planner it flies: a `[planners.NAME]` table (absent: an AUV flies `[planner]`, if
+    /// any; otherwise the vehicle has no planner and keeps its last command).
+    pub planner: Option<String>,
     /// Dynamics.
     #[serde(default)]
     pub dynamics: DynamicsConfig,
@@ -332,6 +343,12 @@ pub struct NavConfig {
     pub velocity_error_tau_s: Option<f64>,
     /// Compass noise, deg.
     pub heading_sd_deg: Option<f64>,
+    /// Whether the vehicle has a position estimate at all.
+    pub position_estimate: Option<bool>,
+    /// Speed-log noise, m/s.
+    pub speed_sd_mps: Option<f64>,
+    /// Altimeter noise, m.
+    pub altimeter_sd_m: Option<f64>,
 }
 
 /// `[vehicles.chem_sensor]`
@@ -348,7 +365,8 @@ pub struct ChemSensorConfig {
     pub noise_sd_v: Option<f64>,
     /// First-order lag, s.
     pub lag_time_constant_s: Option<f64>,
-    /// Detection threshold, V.
+    /// Detection threshold, V: passed to the vehicle's planner as its `threshold_v` (the
+    /// threshold belongs to the planner; this key is kept for older scenario files).
     pub threshold_v: Option<f64>,
 }
 
@@ -406,82 +424,26 @@ pub struct MissionConfig {
     pub prior_flow_toward_deg: f64,
 }
 
-/// Which planner.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum PlannerKind {
-    /// The REMUS Adaptive Mission Planner.
-    Amp,
-}
-
-/// Which declaration rule.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum DeclarationKind {
-    /// Three most upflow lost points within `declaration_along_m` along the flow.
-    AlongFlow,
-    /// The same and within `declaration_cross_m` across the flow.
-    AlongAndCrossFlow,
-}
-
-/// Which lost point makes room in a full list.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum EvictionKind {
-    /// The most downflow one (the list keeps the points nearest the source).
-    MostDownflow,
-    /// The oldest one.
-    Oldest,
-}
-
-/// `[planner]`: every key is optional; defaults are the field values (Table 4).
-#[derive(Debug, Clone, Serialize, Deserialize)]
+/// `[comms]`: one channel model per link kind (absent: ideal, no delay and no loss).
+#[derive(Debug, Clone, Default, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
-pub struct PlannerConfig {
-    /// Planner name ("amp").
-    pub strategy: PlannerKind,
-    /// Speed command, m/s.
-    pub speed_mps: Option<f64>,
-    /// Altitude command, m.
-    pub altitude_m: Option<f64>,
-    /// lambda, s.
-    pub lambda_s: Option<f64>,
-    /// beta, deg.
-    pub beta_deg: Option<f64>,
-    /// L_u, m.
-    pub l_u_m: Option<f64>,
-    /// L_c, m.
-    pub l_c_m: Option<f64>,
-    /// N_re.
-    pub n_re: Option<usize>,
-    /// K, deg/m.
-    pub k_deg_per_m: Option<f64>,
-    /// R, m.
-    pub r_m: Option<f64>,
-    /// Minimum turning radius, m.
-    pub min_turn_radius_m: Option<f64>,
-    /// Most lost points kept.
-    pub max_lost_points: Option<usize>,
-    /// Which lost point a full list drops.
-    pub lost_point_eviction: Option<EvictionKind>,
-    /// Declaration rule.
-    pub declaration: Option<DeclarationKind>,
-    /// Along-flow spread of the rule, m.
-    pub declaration_along_m: Option<f64>,
-    /// Crossflow spread of the crossflow-aware rule, m.
-    pub declaration_cross_m: Option<f64>,
-    /// Fly the post-declaration mapping pattern.
-    pub mapping: Option<bool>,
-    /// Mapping lines.
-    pub mapping_lines: Option<usize>,
-    /// Mapping line length, m.
-    pub mapping_length_m: Option<f64>,
-    /// Mapping line spacing, m.
-    pub mapping_spacing_m: Option<f64>,
-    /// Search time per subregion, s.
-    pub region_timeout_s: Option<f64>,
-    /// Flow estimate time constant, s.
-    pub flow_average_s: Option<f64>,
-    /// Compensate for the measured flow.
-    pub flow_compensation: Option<bool>,
+pub struct CommsConfig {
+    /// Acoustic modems.
+    pub acoustic: Option<ChannelConfig>,
+    /// Radio between surface craft.
+    pub radio: Option<ChannelConfig>,
+}
+
+/// `[comms.acoustic]`, `[comms.radio]`
+#[derive(Debug, Clone, Default, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ChannelConfig {
+    /// Fixed delay, s (0).
+    pub latency_s: Option<f64>,
+    /// Propagation speed, m/s (none: no travel time; 1500 for sound in sea water).
+    pub sound_speed_mps: Option<f64>,
+    /// Probability that a message is lost on its way to one recipient (0).
+    pub loss_probability: Option<f64>,
+    /// Longest distance a message carries, m (none: any).
+    pub max_range_m: Option<f64>,
 }

@@ -10,7 +10,7 @@ pub mod config;
 pub mod error;
 pub mod presets;
 
-pub use build::{BuiltScenario, MissionSpec, OutputSpec, VehicleSetup, build};
+pub use build::{BuiltScenario, MissionSpec, OutputSpec, PlannerRef, VehicleSetup, build};
 pub use config::ScenarioConfig;
 pub use error::ScenarioError;
 pub use presets::{PRESETS, Preset, find_preset};

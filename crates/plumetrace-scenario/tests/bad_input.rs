@@ -166,10 +166,12 @@ fn vehicles_take_the_field_defaults_of_their_kind() {
     assert_eq!(auv.vehicle.params.max_turn_rate_deg_s, 10.0);
     assert_eq!(auv.vehicle.state.z_m, 2.0);
     assert_eq!(auv.chem_sensor.rate_hz, 10.0);
-    assert!(
-        (auv.chem_sensor.threshold_v / auv.chem_sensor.full_scale_v - 0.04).abs() < 1e-12,
-        "4 % of full scale"
+    assert_eq!(auv.chem_sensor.full_scale_v, 5.0);
+    assert_eq!(
+        auv.detection_threshold_v, None,
+        "the threshold is the planner's unless the file sets one on the sensor"
     );
+    assert!(auv.planner.is_none() && auv.nav.position_estimate);
     assert!(auv.range_sensor.is_none());
     let boat = &built.vehicles[1];
     assert_eq!(
@@ -230,14 +232,60 @@ fn bad_vehicle_settings_are_rejected_with_their_key_path() {
 }
 
 #[test]
-fn an_unknown_lost_point_eviction_is_rejected_with_its_key_path() {
+fn planner_tables_are_wired_to_vehicles_with_key_paths() {
     let mt = find_preset("duck-2003-mt").unwrap().toml;
-    let from = "lost_point_eviction = \"most_downflow\"";
-    assert!(mt.contains(from));
     assert_eq!(error_of(mt), "accepted");
-    let e = error_of(&mt.replacen(from, "lost_point_eviction = \"most_upflow\"", 1));
-    assert!(
-        e.starts_with("scenario.toml") && e.contains("planner.lost_point_eviction"),
-        "{e}"
+    // Planner keys themselves are the registry's to check (when the mission is set up); here
+    // the tables are only attached to vehicles.
+    let origin = Origin::File("scenario.toml".into());
+    let cfg = parse(mt, &origin).unwrap();
+    let built = build(&cfg, &origin, None).unwrap();
+    let p = built.vehicles[0].planner.as_ref().unwrap();
+    assert_eq!(p.key, "planner");
+    assert_eq!(
+        p.table.get("kind").and_then(|v| v.as_str()),
+        Some("amp"),
+        "strategy is read as kind"
     );
+    let named = |extra: &str| {
+        format!(
+            "{}\n[[vehicles]]\nkind = \"surface\"\nx_m = 300.0\ny_m = 0.0\nplanner = \"tracer\"\n{extra}",
+            find_preset("demo").unwrap().toml
+        )
+    };
+    let cases: &[(String, &str)] = &[
+        (named(""), "vehicles[1].planner: no [planners.tracer] table"),
+        (
+            named("[planners.tracer]\nkind = \"amp\"\n[planners.spare]\nkind = \"amp\""),
+            "planners.spare: no vehicle flies it",
+        ),
+        (
+            find_preset("demo")
+                .unwrap()
+                .toml
+                .replace("strategy = \"amp\"", "strategy = \"amp\"\nkind = \"amp\""),
+            "planner.strategy: give `kind`",
+        ),
+        (
+            {
+                let demo = find_preset("demo").unwrap().toml;
+                let (a, b) = (
+                    demo.find("[planner]").unwrap(),
+                    demo.find("[output]").unwrap(),
+                );
+                format!("{}{}", &demo[..a], &demo[b..])
+            },
+            "a [mission] needs a vehicle with a planner",
+        ),
+        (
+            format!("{}\n[comms.acoustic]\nloss_probability = 1.5", mt),
+            "comms.acoustic.loss_probability",
+        ),
+    ];
+    for (text, want) in cases {
+        let e = error_of(text);
+        assert!(e.contains(want), "error {e:?} does not say {want:?}");
+    }
+    let ok = error_of(&named("[planners.tracer]\nkind = \"amp\""));
+    assert_eq!(ok, "accepted");
 }

@@ -12,21 +12,26 @@
 //!   corrected by position fixes (long-baseline for an AUV, GPS for a surface craft);
 //! - [`world`]: an environment and several vehicles stepped together in named, timed stages,
 //!   with planners plugged in through `plumetrace_core::Planner`;
-//! - [`sensors`]: the 10 Hz chemical sensor used as a threshold detector, an ADCP-like flow sensor
+//! - [`sensors`]: the 10 Hz chemical sensor (readings; planners threshold them), an ADCP-like flow sensor
 //!   with bias and a wrong-layer fault, and three-group obstacle range sensors.
+//!
+//! - [`comms`]: messages between vehicles through a channel model per link (acoustic modem,
+//!   radio): delay, loss and range, seeded.
 //!
 //! Acoustic ranging between vehicles arrives with formation tracing; its messages already have
 //! a type in `plumetrace_core::MessageBody::RangeReply`.
 
+pub mod comms;
 pub mod nav;
 pub mod sensors;
 pub mod vehicle;
 pub mod world;
 
+pub use comms::{ChannelParams, CommsParams, LossReason};
 pub use nav::{FixEvent, NavParams, Navigator};
 pub use sensors::{
     ChemSensor, ChemSensorParams, FlowFault, FlowSensor, FlowSensorParams, RangeSensor,
     RangeSensorParams,
 };
 pub use vehicle::{Vehicle, VehicleParams, VehicleState};
-pub use world::{Incident, SimVehicle, StageTimes, StepReport, World};
+pub use world::{Incident, SimVehicle, StageTimes, StepReport, World, WorldEvent};

@@ -8,7 +8,7 @@
 //! way with frequent, accurate GPS fixes. The planner sees only the estimate.
 
 use crate::vehicle::VehicleState;
-use plumetrace_core::{Heading, NavEstimate, Vec2};
+use plumetrace_core::{Heading, NavEstimate, Vec2, VehicleKind};
 use plumetrace_env::error::{require_non_negative, require_positive};
 use plumetrace_env::{EnvError, SimRng};
 use rand_distr::{Distribution, StandardNormal};
@@ -28,6 +28,14 @@ pub struct NavParams {
     pub velocity_error_tau_s: f64,
     /// Compass noise, degrees (standard deviation).
     pub heading_sd_deg: f64,
+    /// Whether the vehicle has a position estimate at all (an underwater follower without fixes
+    /// has none: its snapshots carry no position).
+    pub position_estimate: bool,
+    /// Speed-log noise of the reported water speed, m/s (standard deviation; its effect on dead
+    /// reckoning is in the velocity error).
+    pub speed_sd_mps: f64,
+    /// Altimeter noise, m (standard deviation); surface craft report no altitude.
+    pub altimeter_sd_m: f64,
 }
 
 impl NavParams {
@@ -41,6 +49,9 @@ impl NavParams {
             velocity_error_sd_mps: 0.01,
             velocity_error_tau_s: 1200.0,
             heading_sd_deg: 0.5,
+            position_estimate: true,
+            speed_sd_mps: 0.01,
+            altimeter_sd_m: 0.05,
         }
     }
 
@@ -52,6 +63,9 @@ impl NavParams {
             velocity_error_sd_mps: 0.0,
             velocity_error_tau_s: 1200.0,
             heading_sd_deg: 1.0,
+            position_estimate: true,
+            speed_sd_mps: 0.02,
+            altimeter_sd_m: 0.0,
         }
     }
 
@@ -67,7 +81,9 @@ impl NavParams {
             &format!("{key}.velocity_error_tau_s"),
             self.velocity_error_tau_s,
         )?;
-        require_non_negative(&format!("{key}.heading_sd_deg"), self.heading_sd_deg)
+        require_non_negative(&format!("{key}.heading_sd_deg"), self.heading_sd_deg)?;
+        require_non_negative(&format!("{key}.speed_sd_mps"), self.speed_sd_mps)?;
+        require_non_negative(&format!("{key}.altimeter_sd_m"), self.altimeter_sd_m)
     }
 }
 
@@ -119,6 +135,16 @@ impl Navigator {
     /// The estimated position.
     pub fn estimate_m(&self) -> Vec2 {
         self.estimate_m
+    }
+
+    /// The measured heading (compass with its noise) at the last update.
+    pub fn heading(&self) -> Heading {
+        self.heading
+    }
+
+    /// The parameters.
+    pub fn params(&self) -> &NavParams {
+        &self.params
     }
 
     /// Advances the estimate over a step of `dt_s` ending at `t_s`, given the true state and the
@@ -177,14 +203,32 @@ impl Navigator {
         }
     }
 
-    /// What the onboard side sees.
-    pub fn estimate(&self, truth: &VehicleState) -> NavEstimate {
+    /// What the onboard side sees: the position estimate (if the vehicle has one), the measured
+    /// heading, the speed log's and the altimeter's readings (drawn from `rng`, the vehicle's
+    /// measurement stream) and the depth (`water_depth_m` minus the height; 0 at the surface).
+    pub fn estimate(
+        &self,
+        truth: &VehicleState,
+        kind: VehicleKind,
+        water_depth_m: Option<f64>,
+        rng: &mut SimRng,
+    ) -> NavEstimate {
+        let p = self.params;
+        let (ns, na): (f64, f64) = (StandardNormal.sample(rng), StandardNormal.sample(rng));
+        let (altitude_m, depth_m) = match kind {
+            VehicleKind::Auv => (
+                Some((truth.z_m + p.altimeter_sd_m * na).max(0.0)),
+                water_depth_m.map(|d| (d - truth.z_m).max(0.0)),
+            ),
+            VehicleKind::Surface => (None, Some(0.0)),
+        };
         NavEstimate {
-            pos_m: self.estimate_m,
+            pos_m: p.position_estimate.then_some(self.estimate_m),
             heading: self.heading,
-            speed_mps: truth.speed_mps,
-            altitude_m: truth.z_m,
-            last_fix_s: self.last_fix_s,
+            speed_mps: (truth.speed_mps + p.speed_sd_mps * ns).max(0.0),
+            altitude_m,
+            depth_m,
+            last_fix_s: self.last_fix_s.filter(|_| p.position_estimate),
         }
     }
 }

@@ -32,8 +32,8 @@ impl Schedule {
     }
 }
 
-/// Parameters of the chemical sensor. Defaults: the field sensor, 10 Hz, 5 V full scale, 0.2 V
-/// (4 %) detection threshold.
+/// Parameters of the chemical sensor. Defaults: the field sensor, 10 Hz, 5 V full scale. The
+/// sensor reports readings; what counts as a detection is the planner's threshold.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct ChemSensorParams {
     /// Sampling rate, Hz.
@@ -46,8 +46,6 @@ pub struct ChemSensorParams {
     pub noise_sd_v: f64,
     /// First-order lag of the sensor, s (0 = none).
     pub lag_time_constant_s: f64,
-    /// Detection threshold, V.
-    pub threshold_v: f64,
 }
 
 impl Default for ChemSensorParams {
@@ -58,7 +56,6 @@ impl Default for ChemSensorParams {
             full_scale_v: 5.0,
             noise_sd_v: 0.02,
             lag_time_constant_s: 0.0,
-            threshold_v: 0.2,
         }
     }
 }
@@ -73,12 +70,11 @@ impl ChemSensorParams {
         require_non_negative(
             &format!("{key}.lag_time_constant_s"),
             self.lag_time_constant_s,
-        )?;
-        require_non_negative(&format!("{key}.threshold_v"), self.threshold_v)
+        )
     }
 }
 
-/// The chemical sensor: an analog reading and a threshold detection.
+/// The chemical sensor: an analog reading with noise, lag and saturation.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ChemSensor {
     params: ChemSensorParams,
@@ -127,7 +123,6 @@ impl ChemSensor {
         ChemSample {
             time_s: t_s,
             reading,
-            detection: reading > p.threshold_v,
         }
     }
 }
@@ -180,8 +175,8 @@ impl FlowSensorParams {
             && !(f.start_s.is_finite() && f.end_s.is_finite() && f.end_s >= f.start_s)
         {
             return Err(EnvError::invalid(
-                format!("{key}.fault"),
-                "needs finite start_s <= end_s",
+                format!("{key}.fault_end_s"),
+                "needs finite fault_start_s <= fault_end_s",
             ));
         }
         Ok(())

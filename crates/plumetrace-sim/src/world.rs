@@ -4,27 +4,33 @@
 //! 1. **advance environment**: the flow and plume advance every `env_every` steps (the plume's
 //!    step is a multiple of the vehicles'; its physics does not depend on the step);
 //! 2. **sense**: each vehicle's due chemical, flow and range samples, taken at its true position;
-//! 3. **communicate**: messages sent at the previous step are delivered (the seam for acoustic
-//!    delays and losses);
-//! 4. **decide**: each vehicle with a planner gets its [`SensorSnapshot`] (navigation estimate,
-//!    samples since the last decision, messages) and returns a [`Decision`];
-//! 5. **control**: a command that is not finite is replaced by the previous one;
+//! 3. **communicate**: messages that have arrived by now are delivered to their recipients'
+//!    inboxes;
+//! 4. **decide**: each active vehicle with a planner whose decision is due (every step, or every
+//!    `decision_period_s`) gets its [`SensorSnapshot`] (navigation estimate, samples since its
+//!    last decision, messages) and returns a [`Decision`]; its outgoing messages go through their
+//!    link's channel model ([`crate::comms`]: delay from the distance between sender and
+//!    recipient at sending, loss, range) and are on their way;
+//! 5. **control**: a command that is not finite is recorded as an event and replaced by the
+//!    vehicle's previous command (the safe one: finite, and what the vehicle is already doing);
 //! 6. **integrate**: vehicle dynamics in the local current, then navigation (fixes jump here);
 //! 7. **check**: vehicles that left the domain or entered an obstacle are stopped with an incident;
-//! 8. **record**: the caller's observer sees the world after the step.
+//! 8. **record**: observers of the run (in the mission) look at the world after the step; their
+//!    time is added with [`World::add_record_time`].
 //!
 //! Each stage is a function, and its wall time is summed in [`StageTimes`].
 
+use crate::comms::{Comms, CommsParams, LossReason, Transmission};
 use crate::{
-    ChemSensor, ChemSensorParams, FixEvent, FlowSensor, FlowSensorParams, NavParams, Navigator,
-    RangeSensor, RangeSensorParams, Vehicle,
+    ChemSensor, ChemSensorParams, FlowSensor, FlowSensorParams, NavParams, Navigator, RangeSensor,
+    RangeSensorParams, Vehicle,
 };
 use plumetrace_core::{
-    ChemSample, Command, Decision, FlowSample, Message, Planner, RangeReturn, SensorSnapshot, Vec3,
-    VehicleId, VerticalCommand,
+    ChemSample, Command, Decision, FlowSample, Link, Message, Planner, RangeReturn, Recipient,
+    SensorSnapshot, Vec2, Vec3, VehicleId, VerticalCommand,
 };
 use plumetrace_env::{EnvError, Environment, FlowField, SimRng, StreamId, stream_rng};
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 use std::time::Instant;
 
 /// Wall time spent in each stage of the step.
@@ -44,18 +50,61 @@ pub struct StageTimes {
     pub integrate_s: f64,
     /// Domain and obstacle checks.
     pub check_s: f64,
-    /// The observer.
+    /// The observers.
     pub record_s: f64,
 }
 
 /// Something that stopped a vehicle.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
-#[serde(rename_all = "snake_case", tag = "incident")]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
 pub enum Incident {
     /// The vehicle's true position left the simulated domain.
     LeftDomain,
     /// The vehicle entered an obstacle (kelp is no-go for vehicles).
     Collided,
+}
+
+/// What the world reports about a vehicle in a step (planners report their own events).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case", tag = "event")]
+pub enum WorldEvent {
+    /// A position fix moved the navigation estimate.
+    NavFix {
+        /// How far the estimate jumped, m.
+        jump_m: f64,
+        /// The estimate after the fix.
+        to_m: Vec2,
+    },
+    /// The vehicle was stopped.
+    Incident {
+        /// Why.
+        what: Incident,
+    },
+    /// The planner returned a command with a non-finite number; the previous command was kept.
+    NonFiniteCommand {
+        /// The planner's command as text (NaN and infinities do not fit in JSON numbers).
+        command: String,
+    },
+    /// A message reached this vehicle.
+    MessageDelivered {
+        /// Sender.
+        from: VehicleId,
+        /// Link.
+        link: Link,
+        /// When it was sent, s.
+        sent_s: f64,
+    },
+    /// A message to this vehicle was lost.
+    MessageLost {
+        /// Sender.
+        from: VehicleId,
+        /// Link.
+        link: Link,
+        /// When it was sent, s.
+        sent_s: f64,
+        /// Why.
+        reason: LossReason,
+    },
 }
 
 /// A vehicle with its navigation, sensors and random streams.
@@ -79,6 +128,7 @@ pub struct SimVehicle {
     pub active: bool,
     /// The latest chemical sample (for logs).
     pub last_chem: Option<ChemSample>,
+    next_decision_s: f64,
     pending_chem: Vec<ChemSample>,
     last_flow: Option<FlowSample>,
     last_ranges: Option<RangeReturn>,
@@ -87,6 +137,7 @@ pub struct SimVehicle {
     rng_nav: SimRng,
     rng_chem: SimRng,
     rng_flow: SimRng,
+    rng_measure: SimRng,
 }
 
 impl SimVehicle {
@@ -116,6 +167,7 @@ impl SimVehicle {
             command,
             active: true,
             last_chem: None,
+            next_decision_s: 0.0,
             pending_chem: Vec::new(),
             last_flow: None,
             last_ranges: None,
@@ -124,6 +176,7 @@ impl SimVehicle {
             rng_nav: stream_rng(seed, StreamId::Sensor(i, 0)),
             rng_chem: stream_rng(seed, StreamId::Sensor(i, 1)),
             rng_flow: stream_rng(seed, StreamId::Sensor(i, 2)),
+            rng_measure: stream_rng(seed, StreamId::Sensor(i, 3)),
         }
     }
 }
@@ -131,12 +184,15 @@ impl SimVehicle {
 /// What one step produced.
 #[derive(Debug, Default)]
 pub struct StepReport {
-    /// Each vehicle's decision, if it has a planner and is active (indexed by vehicle).
+    /// Time at the start of the step (when the snapshots were taken), s.
+    pub t_s: f64,
+    /// Each vehicle's decision, if it decided in this step (indexed by vehicle).
     pub decisions: Vec<Option<Decision>>,
-    /// Navigation fixes.
-    pub fixes: Vec<(VehicleId, FixEvent)>,
-    /// Incidents.
-    pub incidents: Vec<(VehicleId, Incident)>,
+    /// The snapshots behind those decisions, when the world records them
+    /// ([`World::record_snapshots`]).
+    pub snapshots: Vec<Option<SensorSnapshot>>,
+    /// What happened to vehicles, in order.
+    pub events: Vec<(VehicleId, WorldEvent)>,
 }
 
 /// The simulated world.
@@ -148,7 +204,8 @@ pub struct World {
     env_every: u64,
     step: u64,
     water_depth_m: Option<f64>,
-    outbox: Vec<Message>,
+    comms: Comms,
+    record_snapshots: bool,
     times: StageTimes,
 }
 
@@ -160,13 +217,32 @@ fn timed<T>(acc: &mut f64, f: impl FnOnce() -> T) -> T {
 }
 
 impl World {
-    /// A world stepping vehicles at `dt_s`; the environment's own step must be a whole number of
-    /// vehicle steps.
+    /// A world stepping vehicles at `dt_s` with ideal message channels; the environment's own
+    /// step must be a whole number of vehicle steps. `seed` seeds the channels' random stream.
     pub fn new(
         env: Environment,
         vehicles: Vec<SimVehicle>,
         dt_s: f64,
         water_depth_m: Option<f64>,
+    ) -> Result<Self, EnvError> {
+        World::with_comms(
+            env,
+            vehicles,
+            dt_s,
+            water_depth_m,
+            CommsParams::default(),
+            0,
+        )
+    }
+
+    /// A world with the given channel models, their losses drawn from the run `seed`.
+    pub fn with_comms(
+        env: Environment,
+        vehicles: Vec<SimVehicle>,
+        dt_s: f64,
+        water_depth_m: Option<f64>,
+        comms: CommsParams,
+        seed: u64,
     ) -> Result<Self, EnvError> {
         plumetrace_env::error::require_positive("sim.dt_s", dt_s)?;
         let ratio = env.dt_s() / dt_s;
@@ -179,6 +255,18 @@ impl World {
                 ),
             ));
         }
+        if let Some(k) = vehicles
+            .iter()
+            .enumerate()
+            .position(|(k, v)| v.vehicle.id.0 as usize != k)
+        {
+            return Err(EnvError::invalid(
+                format!("vehicles[{k}]"),
+                "vehicle ids must be their index in the list",
+            ));
+        }
+        comms.acoustic.validate("comms.acoustic")?;
+        comms.radio.validate("comms.radio")?;
         Ok(World {
             env,
             vehicles,
@@ -186,9 +274,15 @@ impl World {
             env_every: ratio.round() as u64,
             step: 0,
             water_depth_m,
-            outbox: Vec::new(),
+            comms: Comms::new(comms, stream_rng(seed, StreamId::Custom(COMMS_STREAM))),
+            record_snapshots: false,
             times: StageTimes::default(),
         })
+    }
+
+    /// Keep every snapshot given to a planner in the step reports (for snapshot logs).
+    pub fn record_snapshots(&mut self, on: bool) {
+        self.record_snapshots = on;
     }
 
     /// Mission time, s (0 at the start, after any spin-up).
@@ -196,9 +290,19 @@ impl World {
         self.step as f64 * self.dt_s
     }
 
+    /// Steps taken.
+    pub fn steps(&self) -> u64 {
+        self.step
+    }
+
     /// The vehicles' step, s.
     pub fn dt_s(&self) -> f64 {
         self.dt_s
+    }
+
+    /// Water depth, m, if the scenario gives one.
+    pub fn water_depth_m(&self) -> Option<f64> {
+        self.water_depth_m
     }
 
     /// The environment.
@@ -211,6 +315,16 @@ impl World {
         &self.vehicles
     }
 
+    /// The vehicles, mutably (tests and scripted scenarios: a forced fix, a moved vehicle).
+    pub fn vehicles_mut(&mut self) -> &mut [SimVehicle] {
+        &mut self.vehicles
+    }
+
+    /// Messages on their way.
+    pub fn messages_in_flight(&self) -> usize {
+        self.comms.in_flight()
+    }
+
     /// Stops a vehicle (it keeps its position and takes no more decisions).
     pub fn stop(&mut self, id: VehicleId) {
         if let Some(v) = self.vehicles.get_mut(id.0 as usize) {
@@ -219,9 +333,44 @@ impl World {
         }
     }
 
-    /// Queues a message for delivery at the next step.
-    pub fn send(&mut self, m: Message) {
-        self.outbox.push(m);
+    /// Sends a message now from its sender's true position (scripted scenarios, tests); what
+    /// became of it for each recipient that lost it is returned as events.
+    pub fn send(&mut self, message: Message) -> Vec<(VehicleId, WorldEvent)> {
+        let mut events = Vec::new();
+        self.transmit(&message, &mut events);
+        events
+    }
+
+    /// Puts a message through its channel to every recipient (one vehicle, or every other
+    /// active vehicle); losses become events.
+    fn transmit(&mut self, m: &Message, events: &mut Vec<(VehicleId, WorldEvent)>) {
+        let from_m = self
+            .vehicles
+            .get(m.from.0 as usize)
+            .map_or(Vec2::zeros(), |v| v.vehicle.state.pos_m);
+        for v in &self.vehicles {
+            let id = v.vehicle.id;
+            let addressed = match m.to {
+                Recipient::Broadcast => id != m.from,
+                Recipient::Vehicle(to) => to == id,
+            };
+            if !(addressed && v.active) {
+                continue;
+            }
+            if let Transmission::Lost(reason) =
+                self.comms.transmit(m, from_m, id, v.vehicle.state.pos_m)
+            {
+                events.push((
+                    id,
+                    WorldEvent::MessageLost {
+                        from: m.from,
+                        link: m.link,
+                        sent_s: m.sent_s,
+                        reason,
+                    },
+                ));
+            }
+        }
     }
 
     /// Time spent per stage so far.
@@ -229,33 +378,41 @@ impl World {
         self.times
     }
 
+    /// Adds the observers' time of a step to the record stage.
+    pub fn add_record_time(&mut self, s: f64) {
+        self.times.record_s += s;
+    }
+
     /// One step with one planner slot per vehicle (`None`: no planner, the vehicle keeps its
-    /// command).
+    /// command), stages 1 to 7.
     pub fn step(
         &mut self,
         planners: &mut [Option<Box<dyn Planner>>],
-        observer: &mut dyn FnMut(&World, &StepReport),
     ) -> Result<StepReport, EnvError> {
         let mut times = self.times;
         let t = self.time_s();
+        let mut report = StepReport {
+            t_s: t,
+            ..StepReport::default()
+        };
         timed(&mut times.advance_environment_s, || {
             self.advance_environment()
         })?;
         timed(&mut times.sense_s, || self.sense(t));
-        timed(&mut times.communicate_s, || self.communicate());
-        let decisions = timed(&mut times.decide_s, || self.decide(t, planners));
-        timed(&mut times.control_s, || self.control(&decisions));
-        let fixes = timed(&mut times.integrate_s, || self.integrate(t));
-        let incidents = timed(&mut times.check_s, || self.check());
-        let report = StepReport {
-            decisions,
-            fixes,
-            incidents,
-        };
+        timed(&mut times.communicate_s, || {
+            self.communicate(t, &mut report.events)
+        });
+        timed(&mut times.decide_s, || {
+            self.decide(t, planners, &mut report)
+        });
+        timed(&mut times.control_s, || {
+            self.control(&report.decisions, &mut report.events)
+        });
+        timed(&mut times.integrate_s, || {
+            self.integrate(t, &mut report.events)
+        });
+        timed(&mut times.check_s, || self.check(&mut report.events));
         self.step += 1;
-        let t0 = Instant::now();
-        observer(self, &report);
-        times.record_s += t0.elapsed().as_secs_f64();
         self.times = times;
         Ok(report)
     }
@@ -287,21 +444,25 @@ impl World {
         }
     }
 
-    fn communicate(&mut self) {
-        for m in self.outbox.drain(..) {
-            for v in self
+    fn communicate(&mut self, t: f64, events: &mut Vec<(VehicleId, WorldEvent)>) {
+        for arrived in self.comms.arrived(t) {
+            let Some(v) = self
                 .vehicles
-                .iter_mut()
-                .filter(|v| v.active && v.vehicle.id != m.from)
-            {
-                let for_it = match m.to {
-                    plumetrace_core::Recipient::Broadcast => true,
-                    plumetrace_core::Recipient::Vehicle(id) => id == v.vehicle.id,
-                };
-                if for_it {
-                    v.inbox.push(m.clone());
-                }
-            }
+                .get_mut(arrived.to.0 as usize)
+                .filter(|v| v.active)
+            else {
+                continue;
+            };
+            let m = arrived.message;
+            events.push((
+                arrived.to,
+                WorldEvent::MessageDelivered {
+                    from: m.from,
+                    link: m.link,
+                    sent_s: m.sent_s,
+                },
+            ));
+            v.inbox.push(m);
         }
     }
 
@@ -309,41 +470,82 @@ impl World {
         &mut self,
         t: f64,
         planners: &mut [Option<Box<dyn Planner>>],
-    ) -> Vec<Option<Decision>> {
-        let mut out = Vec::with_capacity(self.vehicles.len());
+        report: &mut StepReport,
+    ) {
+        let n = self.vehicles.len();
+        report.decisions = vec![None; n];
+        if self.record_snapshots {
+            report.snapshots = vec![None; n];
+        }
+        let depth = self.water_depth_m;
+        let mut sent = Vec::new();
         for (k, v) in self.vehicles.iter_mut().enumerate() {
-            let planner = planners.get_mut(k).and_then(|p| p.as_mut());
-            match planner {
-                Some(p) if v.active => {
-                    let snapshot = SensorSnapshot {
-                        time_s: t,
-                        vehicle: v.vehicle.id,
-                        nav: v.nav.estimate(&v.vehicle.state),
-                        chem: std::mem::take(&mut v.pending_chem),
-                        flow: v.last_flow,
-                        ranges: v.last_ranges,
-                        inbox: std::mem::take(&mut v.inbox),
-                    };
-                    out.push(Some(p.decide(&snapshot)));
-                }
-                _ => out.push(None),
+            let Some(p) = planners.get_mut(k).and_then(|p| p.as_mut()) else {
+                continue;
+            };
+            if !v.active || t + 1e-9 < v.next_decision_s {
+                continue;
             }
+            let period = p.decision_period_s();
+            v.next_decision_s = if period > 0.0 && period.is_finite() {
+                // Decisions on the grid k * period, whatever the step.
+                ((t + 1e-9) / period).floor() * period + period
+            } else {
+                t
+            };
+            let snapshot = SensorSnapshot {
+                time_s: t,
+                vehicle: v.vehicle.id,
+                nav: v.nav.estimate(
+                    &v.vehicle.state,
+                    v.vehicle.params.kind,
+                    depth,
+                    &mut v.rng_measure,
+                ),
+                chem: std::mem::take(&mut v.pending_chem),
+                flow: v.last_flow,
+                ranges: v.last_ranges,
+                inbox: std::mem::take(&mut v.inbox),
+            };
+            let decision = p.decide(&snapshot);
+            sent.extend(decision.outbox.iter().map(|o| Message {
+                from: v.vehicle.id,
+                to: o.to,
+                link: o.link,
+                sent_s: t,
+                body: o.body.clone(),
+            }));
+            if self.record_snapshots {
+                report.snapshots[k] = Some(snapshot);
+            }
+            report.decisions[k] = Some(decision);
         }
-        out
+        for m in &sent {
+            self.transmit(m, &mut report.events);
+        }
     }
 
-    fn control(&mut self, decisions: &[Option<Decision>]) {
+    fn control(
+        &mut self,
+        decisions: &[Option<Decision>],
+        events: &mut Vec<(VehicleId, WorldEvent)>,
+    ) {
         for (v, d) in self.vehicles.iter_mut().zip(decisions) {
-            if let Some(d) = d
-                && d.command.is_finite()
-            {
+            let Some(d) = d else { continue };
+            if d.command.is_finite() {
                 v.command = d.command;
+            } else {
+                events.push((
+                    v.vehicle.id,
+                    WorldEvent::NonFiniteCommand {
+                        command: format!("{:?}", d.command),
+                    },
+                ));
             }
         }
     }
 
-    fn integrate(&mut self, t: f64) -> Vec<(VehicleId, FixEvent)> {
-        let mut fixes = Vec::new();
+    fn integrate(&mut self, t: f64, events: &mut Vec<(VehicleId, WorldEvent)>) {
         let dt = self.dt_s;
         for v in self.vehicles.iter_mut().filter(|v| v.active) {
             let flow = self.env.flow().velocity(v.vehicle.state.pos_m);
@@ -354,14 +556,18 @@ impl World {
                 .nav
                 .update(&v.vehicle.state, measured, t + dt, dt, &mut v.rng_nav)
             {
-                fixes.push((v.vehicle.id, fix));
+                events.push((
+                    v.vehicle.id,
+                    WorldEvent::NavFix {
+                        jump_m: fix.jump_m(),
+                        to_m: fix.after_m,
+                    },
+                ));
             }
         }
-        fixes
     }
 
-    fn check(&mut self) -> Vec<(VehicleId, Incident)> {
-        let mut incidents = Vec::new();
+    fn check(&mut self, events: &mut Vec<(VehicleId, WorldEvent)>) {
         let domain = self.env.domain();
         for v in self.vehicles.iter_mut().filter(|v| v.active) {
             let p = v.vehicle.state.pos_m;
@@ -372,12 +578,14 @@ impl World {
             } else {
                 None
             };
-            if let Some(i) = incident {
+            if let Some(what) = incident {
                 v.active = false;
                 v.command.speed_mps = 0.0;
-                incidents.push((v.vehicle.id, i));
+                events.push((v.vehicle.id, WorldEvent::Incident { what }));
             }
         }
-        incidents
     }
 }
+
+/// The `StreamId::Custom` number of the message channels' stream.
+const COMMS_STREAM: u64 = 0xC0_4445;

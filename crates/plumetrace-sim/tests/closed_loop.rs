@@ -46,10 +46,9 @@ impl Rig {
     }
 
     fn pose(&self) -> Pose {
-        let e = self.nav.estimate(&self.vehicle.state);
         Pose {
-            pos_m: e.pos_m,
-            heading: e.heading,
+            pos_m: self.nav.estimate_m(),
+            heading: self.nav.heading(),
         }
     }
 
@@ -85,6 +84,7 @@ fn perfect_nav() -> NavParams {
         velocity_error_sd_mps: 0.0,
         velocity_error_tau_s: 1200.0,
         heading_sd_deg: 0.0,
+        ..NavParams::lbl()
     }
 }
 

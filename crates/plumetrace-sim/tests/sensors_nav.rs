@@ -23,8 +23,8 @@ fn phi(x: f64) -> f64 {
 }
 
 #[test]
-fn detection_rate_matches_the_threshold_on_known_concentrations() {
-    // Threshold 0.2 V, noise 0.05 V, 1 V per unit: P(detect) = 1 - Phi((0.2 - c) / 0.05).
+fn readings_exceed_a_threshold_at_the_rate_the_noise_gives() {
+    // A planner's 0.2 V threshold, noise 0.05 V, 1 V per unit: P(detect) = 1 - Phi((0.2 - c) / 0.05).
     let params = ChemSensorParams {
         noise_sd_v: 0.05,
         ..ChemSensorParams::default()
@@ -34,7 +34,7 @@ fn detection_rate_matches_the_threshold_on_known_concentrations() {
         let mut s = ChemSensor::new(params);
         let n = 40_000;
         let hits = (0..n)
-            .filter(|k| s.sample(c, f64::from(*k) * 0.1, &mut rng).detection)
+            .filter(|k| s.sample(c, f64::from(*k) * 0.1, &mut rng).reading > 0.2)
             .count();
         let rate = hits as f64 / f64::from(n);
         let want = 1.0 - phi((0.2 - c) / 0.05);
@@ -53,6 +53,7 @@ fn navigation_error_grows_between_fixes_and_jumps_back_at_each() {
         velocity_error_sd_mps: 0.03,
         velocity_error_tau_s: 600.0,
         heading_sd_deg: 0.5,
+        ..NavParams::lbl()
     };
     let mut v = Vehicle::new(
         VehicleId(0),
@@ -116,6 +117,7 @@ fn dead_reckoning_drift_is_stationary_and_matches_the_gauss_markov_variance() {
         velocity_error_sd_mps: 0.01,
         velocity_error_tau_s: 1200.0,
         heading_sd_deg: 0.0,
+        ..NavParams::lbl()
     };
     let v = Vehicle::new(
         VehicleId(0),

@@ -1,11 +1,10 @@
 //! Post-declaration mapping: parallel lines centred on the declared source, flown with Follow Line.
 
 use plumetrace_core::{Heading, Vec2};
-use serde::{Deserialize, Serialize};
 
 /// A lawnmower of `lines` parallel lines along the flow, `spacing_m` apart and `length_m` long,
 /// centred on the declared source (the pattern a sidescan survey of the source would fly).
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub struct MappingParams {
     /// Number of lines.
     pub lines: usize,
@@ -13,16 +12,6 @@ pub struct MappingParams {
     pub length_m: f64,
     /// Spacing between lines, m.
     pub spacing_m: f64,
-}
-
-impl Default for MappingParams {
-    fn default() -> Self {
-        MappingParams {
-            lines: 4,
-            length_m: 80.0,
-            spacing_m: 20.0,
-        }
-    }
 }
 
 impl MappingParams {

@@ -1,11 +1,28 @@
 //! Source declaration: a check run at the end of every Track-Out.
 
-use plumetrace_core::{Heading, Vec2};
+use plumetrace_core::params::Choice;
+use plumetrace_core::{DeclarationKind, Heading, Vec2};
 use serde::{Deserialize, Serialize};
 
+/// The `declaration` key: which rule the AMP declares with.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum DeclarationChoice {
+    /// The field rule ([`DeclarationRule::AlongFlow`]).
+    AlongFlow,
+    /// The field rule with a crossflow bound ([`DeclarationRule::AlongAndCrossFlow`]).
+    AlongAndCrossFlow,
+}
+
+impl Choice for DeclarationChoice {
+    const ALL: &'static [Self] = &[
+        DeclarationChoice::AlongFlow,
+        DeclarationChoice::AlongAndCrossFlow,
+    ];
+}
+
 /// How the planner decides that the source has been found.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case", tag = "rule")]
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub enum DeclarationRule {
     /// The field rule: the three most upflow lost points lie within `along_m` of each other along
     /// the flow; the most upflow one is declared. Crossflow spread is ignored (the cause of the
@@ -25,11 +42,11 @@ pub enum DeclarationRule {
 }
 
 impl DeclarationRule {
-    /// Registry name of the rule (for events and campaign keys).
-    pub fn name(&self) -> &'static str {
+    /// The rule as reported in events.
+    pub fn kind(&self) -> DeclarationKind {
         match self {
-            DeclarationRule::AlongFlow { .. } => "along_flow",
-            DeclarationRule::AlongAndCrossFlow { .. } => "along_and_cross_flow",
+            DeclarationRule::AlongFlow { .. } => DeclarationKind::AlongFlow,
+            DeclarationRule::AlongAndCrossFlow { .. } => DeclarationKind::AlongAndCrossFlow,
         }
     }
 

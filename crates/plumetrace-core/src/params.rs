@@ -1,0 +1,433 @@
+//! Documented parameters: one table per parameter set gives the defaults, the bounds that are
+//! checked, and the docs that `plumetrace planners` and the README print.
+//!
+//! A parameter set is declared once with [`params!`](crate::params!): each key with its type,
+//! default, unit, bounds and one line of doc. The macro makes the struct (serde, unknown keys
+//! refused, omitted keys defaulted), its `Default`, and its [`Params`] implementation (the key
+//! table and the bounds check), so the list of keys exists in one place only.
+
+use serde::Serialize;
+use std::fmt::Write as _;
+
+/// The bounds of one parameter.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Bounds {
+    /// Any value of its type (booleans and choices).
+    Any,
+    /// A finite real number between `min` and `max`; `*_open` excludes the end.
+    Real {
+        /// Lower end.
+        min: f64,
+        /// The lower end itself is not allowed.
+        min_open: bool,
+        /// Upper end.
+        max: f64,
+        /// The upper end itself is not allowed.
+        max_open: bool,
+    },
+    /// A whole number in `min..=max`.
+    Whole {
+        /// Smallest value.
+        min: u64,
+        /// Largest value.
+        max: u64,
+    },
+}
+
+impl Bounds {
+    /// `min <= v <= max`.
+    pub const fn closed(min: f64, max: f64) -> Self {
+        Bounds::Real {
+            min,
+            min_open: false,
+            max,
+            max_open: false,
+        }
+    }
+
+    /// `0 < v <= max`.
+    pub const fn positive(max: f64) -> Self {
+        Bounds::Real {
+            min: 0.0,
+            min_open: true,
+            max,
+            max_open: false,
+        }
+    }
+
+    /// `0 <= v <= max`.
+    pub const fn non_negative(max: f64) -> Self {
+        Bounds::closed(0.0, max)
+    }
+
+    /// `min..=max` for whole numbers.
+    pub const fn whole(min: u64, max: u64) -> Self {
+        Bounds::Whole { min, max }
+    }
+
+    /// The bounds as text for docs and errors (`"> 0 and <= 10"`, `"1..=50"`, `""`).
+    pub fn describe(&self) -> String {
+        match *self {
+            Bounds::Any => String::new(),
+            Bounds::Real {
+                min,
+                min_open,
+                max,
+                max_open,
+            } => format!(
+                "{} {min} and {} {max}",
+                if min_open { ">" } else { ">=" },
+                if max_open { "<" } else { "<=" }
+            ),
+            Bounds::Whole { min, max } => format!("{min}..={max}"),
+        }
+    }
+
+    fn check_real(&self, v: f64) -> Result<(), String> {
+        if !v.is_finite() {
+            return Err(format!("must be a finite number, got {v}"));
+        }
+        match *self {
+            Bounds::Real {
+                min,
+                min_open,
+                max,
+                max_open,
+            } => {
+                let low = if min_open { v > min } else { v >= min };
+                let high = if max_open { v < max } else { v <= max };
+                if low && high {
+                    Ok(())
+                } else {
+                    Err(format!("must be {}, got {v}", self.describe()))
+                }
+            }
+            _ => Ok(()),
+        }
+    }
+
+    fn check_whole(&self, v: u64) -> Result<(), String> {
+        match *self {
+            Bounds::Whole { min, max } if !(min..=max).contains(&v) => {
+                Err(format!("must be {}, got {v}", self.describe()))
+            }
+            _ => Ok(()),
+        }
+    }
+}
+
+/// A value a parameter can hold: it knows its type name for docs and how to check bounds.
+pub trait ParamValue {
+    /// The type in words, for docs (`"number"`, `"whole number"`, `"true/false"`, `"one of ..."`).
+    fn type_name() -> String;
+    /// The value as it is written in a file.
+    fn show(&self) -> String;
+    /// Checks the value against its bounds; the message says what is wrong.
+    fn check(&self, bounds: &Bounds) -> Result<(), String>;
+}
+
+impl ParamValue for f64 {
+    fn type_name() -> String {
+        "number".into()
+    }
+    fn show(&self) -> String {
+        // Debug keeps the decimal point (`2.0`), as the value is written in TOML.
+        format!("{self:?}")
+    }
+    fn check(&self, bounds: &Bounds) -> Result<(), String> {
+        bounds.check_real(*self)
+    }
+}
+
+macro_rules! whole_param {
+    ($($t:ty),*) => {$(
+        impl ParamValue for $t {
+            fn type_name() -> String {
+                "whole number".into()
+            }
+            fn show(&self) -> String {
+                format!("{self}")
+            }
+            fn check(&self, bounds: &Bounds) -> Result<(), String> {
+                bounds.check_whole(u64::try_from(*self).unwrap_or(u64::MAX))
+            }
+        }
+    )*};
+}
+whole_param!(u32, u64, usize);
+
+impl ParamValue for bool {
+    fn type_name() -> String {
+        "true/false".into()
+    }
+    fn show(&self) -> String {
+        format!("{self}")
+    }
+    fn check(&self, _: &Bounds) -> Result<(), String> {
+        Ok(())
+    }
+}
+
+/// An enum parameter written as one of its variant names (serde's names).
+pub trait Choice: Serialize + Copy + 'static {
+    /// Every variant.
+    const ALL: &'static [Self];
+}
+
+impl<T: Choice> ParamValue for T {
+    fn type_name() -> String {
+        let names: Vec<String> = T::ALL.iter().map(|v| format!("\"{}\"", v.show())).collect();
+        format!("one of {}", names.join(", "))
+    }
+    fn show(&self) -> String {
+        crate::names::variant_name(self).unwrap_or("?").to_string()
+    }
+    fn check(&self, _: &Bounds) -> Result<(), String> {
+        Ok(())
+    }
+}
+
+/// A bad parameter value; `key` is the full key path.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("{key}: {message}")]
+pub struct ParamError {
+    /// Key path, e.g. `planners.tracer.beta_deg`.
+    pub key: String,
+    /// What is wrong.
+    pub message: String,
+}
+
+impl ParamError {
+    /// An error at `prefix.name` (or `name` without a prefix).
+    pub fn at(prefix: &str, name: &str, message: impl Into<String>) -> Self {
+        ParamError {
+            key: key_path(prefix, name),
+            message: message.into(),
+        }
+    }
+}
+
+/// `prefix.name`, or `name` when the prefix is empty.
+pub fn key_path(prefix: &str, name: &str) -> String {
+    if prefix.is_empty() {
+        name.to_string()
+    } else {
+        format!("{prefix}.{name}")
+    }
+}
+
+/// One documented key.
+#[derive(Debug, Clone, PartialEq)]
+pub struct KeyDoc {
+    /// The key as written in files.
+    pub name: &'static str,
+    /// Unit (empty for counts, flags and choices).
+    pub unit: &'static str,
+    /// One line of doc.
+    pub doc: &'static str,
+    /// The type in words.
+    pub type_name: String,
+    /// The default as written in files.
+    pub default: String,
+    /// Allowed values (empty: any of its type).
+    pub bounds: String,
+}
+
+impl KeyDoc {
+    /// The doc of a key of type `T` with default `default`.
+    pub fn new<T: ParamValue>(
+        name: &'static str,
+        unit: &'static str,
+        doc: &'static str,
+        default: &T,
+        bounds: Bounds,
+    ) -> Self {
+        KeyDoc {
+            name,
+            unit,
+            doc,
+            type_name: T::type_name(),
+            default: default.show(),
+            bounds: bounds.describe(),
+        }
+    }
+}
+
+/// A parameter set made by [`params!`](crate::params!).
+pub trait Params {
+    /// Every key, in declaration order.
+    fn keys() -> Vec<KeyDoc>;
+    /// Checks every value against its bounds; errors name `prefix.key`.
+    fn check_bounds(&self, prefix: &str) -> Result<(), ParamError>;
+}
+
+/// Checks one value (used by [`params!`](crate::params!)).
+pub fn check<T: ParamValue>(
+    prefix: &str,
+    name: &str,
+    value: &T,
+    bounds: &Bounds,
+) -> Result<(), ParamError> {
+    value
+        .check(bounds)
+        .map_err(|message| ParamError::at(prefix, name, message))
+}
+
+/// The keys as Markdown table rows (`| key | type | default | unit | bounds | doc |`).
+pub fn markdown_rows(keys: &[KeyDoc]) -> String {
+    let mut out = String::new();
+    for k in keys {
+        let _ = writeln!(
+            out,
+            "| `{}` | {} | `{}` | {} | {} | {} |",
+            k.name, k.type_name, k.default, k.unit, k.bounds, k.doc
+        );
+    }
+    out
+}
+
+/// Declares a documented parameter set: a struct whose fields carry type, default, unit, bounds
+/// and one line of doc. The struct deserialises from a table with every key optional (defaults
+/// fill the rest) and unknown keys refused.
+///
+/// ```
+/// use plumetrace_core::params::{Bounds, Params};
+/// plumetrace_core::params! {
+///     /// A planner's settings.
+///     pub struct Example {
+///         /// Speed command.
+///         speed_mps: f64 = 2.0, "m/s", Bounds::positive(10.0);
+///         /// Repetitions.
+///         n: u32 = 2, "", Bounds::whole(1, 50);
+///     }
+/// }
+/// assert_eq!(Example::default().speed_mps, 2.0);
+/// assert_eq!(Example::keys()[1].bounds, "1..=50");
+/// let bad = Example { n: 0, ..Example::default() };
+/// assert_eq!(bad.check_bounds("p").unwrap_err().to_string(), "p.n: must be 1..=50, got 0");
+/// ```
+#[macro_export]
+macro_rules! params {
+    (
+        $(#[$meta:meta])*
+        $vis:vis struct $name:ident {
+            $(
+                #[doc = $doc:literal]
+                $field:ident : $ty:ty = $default:expr, $unit:literal, $bounds:expr;
+            )*
+        }
+    ) => {
+        $(#[$meta])*
+        #[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+        #[serde(deny_unknown_fields, default)]
+        $vis struct $name {
+            $(
+                #[doc = $doc]
+                pub $field: $ty,
+            )*
+        }
+
+        impl Default for $name {
+            fn default() -> Self {
+                $name { $( $field: $default, )* }
+            }
+        }
+
+        impl $crate::params::Params for $name {
+            fn keys() -> Vec<$crate::params::KeyDoc> {
+                vec![$(
+                    $crate::params::KeyDoc::new::<$ty>(
+                        stringify!($field),
+                        $unit,
+                        $doc.trim(),
+                        &$default,
+                        $bounds,
+                    ),
+                )*]
+            }
+
+            fn check_bounds(&self, prefix: &str) -> Result<(), $crate::params::ParamError> {
+                $( $crate::params::check(prefix, stringify!($field), &self.$field, &$bounds)?; )*
+                Ok(())
+            }
+        }
+    };
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[derive(Debug, Clone, Copy, PartialEq, Serialize, serde::Deserialize)]
+    #[serde(rename_all = "snake_case")]
+    enum Mode {
+        Oldest,
+        MostDownflow,
+    }
+
+    impl Choice for Mode {
+        const ALL: &'static [Self] = &[Mode::Oldest, Mode::MostDownflow];
+    }
+
+    crate::params! {
+        /// Test set.
+        struct Set {
+            /// A rate.
+            rate_hz: f64 = 10.0, "Hz", Bounds::positive(100.0);
+            /// A count.
+            count: usize = 3, "", Bounds::whole(3, 10);
+            /// A switch.
+            on: bool = true, "", Bounds::Any;
+            /// A choice.
+            mode: Mode = Mode::Oldest, "", Bounds::Any;
+        }
+    }
+
+    #[test]
+    fn bounds_table() {
+        let cases: [(Bounds, f64, bool); 8] = [
+            (Bounds::positive(10.0), 0.0, false),
+            (Bounds::positive(10.0), 1e-300, true),
+            (Bounds::positive(10.0), 10.0, true),
+            (Bounds::positive(10.0), 10.000_001, false),
+            (Bounds::non_negative(1.0), 0.0, true),
+            (Bounds::closed(-1.0, 1.0), -1.0, true),
+            (Bounds::closed(-1.0, 1.0), f64::NAN, false),
+            (Bounds::closed(-1.0, 1.0), f64::INFINITY, false),
+        ];
+        for (b, v, ok) in cases {
+            assert_eq!(b.check_real(v).is_ok(), ok, "{b:?} {v}");
+        }
+        assert!(Bounds::whole(1, 5).check_whole(0).is_err());
+        assert!(Bounds::whole(1, 5).check_whole(5).is_ok());
+    }
+
+    #[test]
+    fn the_table_drives_docs_defaults_and_checks() {
+        let keys = Set::keys();
+        let names: Vec<&str> = keys.iter().map(|k| k.name).collect();
+        assert_eq!(names, ["rate_hz", "count", "on", "mode"]);
+        assert_eq!(keys[0].default, "10.0");
+        assert_eq!(keys[0].bounds, "> 0 and <= 100");
+        assert_eq!(keys[0].doc, "A rate.");
+        assert_eq!(keys[3].type_name, r#"one of "oldest", "most_downflow""#);
+        assert_eq!(keys[3].default, "oldest");
+        assert!(Set::default().check_bounds("p").is_ok());
+        let e = Set {
+            count: 2,
+            ..Set::default()
+        }
+        .check_bounds("planners.a")
+        .unwrap_err();
+        assert_eq!(e.key, "planners.a.count");
+        assert_eq!(e.message, "must be 3..=10, got 2");
+        let rows = markdown_rows(&keys);
+        assert!(
+            rows.starts_with("| `rate_hz` | number | `10.0` | Hz | > 0 and <= 100 | A rate. |")
+        );
+        let t: Set = serde_json::from_str(r#"{"mode":"most_downflow"}"#).unwrap_or_default();
+        assert_eq!(t.mode, Mode::MostDownflow);
+        assert_eq!(t.rate_hz, 10.0, "omitted keys take their default");
+        assert!(serde_json::from_str::<Set>(r#"{"rat_hz":1}"#).is_err());
+    }
+}

@@ -1,0 +1,436 @@
+//! A mission as a stepper: [`Mission::new`] spins the plume up and builds the world and the
+//! planners, [`Mission::step`] runs one step and lets the observers record it,
+//! [`Mission::finish`] returns what was recorded.
+//!
+//! The step itself is the world's (stages 1-7); the mission then applies the planners' statuses
+//! (a planner that finishes or aborts stops its vehicle), records (stage 8, the observers) and
+//! checks for the end. What the mission comes to is decided in [`crate::outcome`].
+
+use crate::outcome::{EndReason, MissionEnd, MissionEvent, Outcome, VehicleStatus};
+use crate::record::{
+    EventRecord, EventRecorder, MeanPlumeRecorder, Observer, StepView, TrackStats,
+    TrajectoryRecorder, TrajectoryRow, true_sources,
+};
+use crate::setup::{MissionError, MissionSetup, PlannedVehicle};
+use crate::summary::{Summary, SummaryInput};
+use plumetrace_core::{PlanStatus, Planner, Vec2, Vec3, VehicleId, VehicleKind};
+use plumetrace_env::MeanConcentrationGrid;
+use plumetrace_planner::MissionGeometry;
+use plumetrace_sim::{SimVehicle, StageTimes, World, WorldEvent};
+use std::time::Instant;
+
+/// What a mission records besides its summary and events.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct MissionOptions {
+    /// Accumulate the time-averaged plume over the op-area for the figure (a grid of
+    /// concentration queries every 20 s).
+    pub mean_plume: bool,
+    /// Keep every step of every vehicle's trajectory.
+    pub trajectory: bool,
+}
+
+impl Default for MissionOptions {
+    fn default() -> Self {
+        MissionOptions {
+            mean_plume: true,
+            trajectory: true,
+        }
+    }
+}
+
+/// A vehicle as the figure and summaries name it.
+#[derive(Debug, Clone, PartialEq)]
+pub struct VehicleInfo {
+    /// Name.
+    pub name: String,
+    /// AUV or surface craft.
+    pub kind: VehicleKind,
+    /// Its planner's kind, if any.
+    pub planner: Option<String>,
+}
+
+/// Everything a mission produced.
+#[derive(Debug)]
+pub struct MissionRun {
+    /// What it came to.
+    pub outcome: Outcome,
+    /// Key numbers.
+    pub summary: Summary,
+    /// Every step of every vehicle (empty unless recorded).
+    pub trajectory: Vec<TrajectoryRow>,
+    /// The event stream.
+    pub events: Vec<EventRecord>,
+    /// Wall time per stage.
+    pub stage_times: StageTimes,
+    /// Wall time of the spin-up, s.
+    pub spinup_wall_s: f64,
+    /// Time-averaged concentration at the first vehicle's altitude over the op-area (if
+    /// recorded).
+    pub mean_plume: Option<MeanConcentrationGrid>,
+    /// True sources.
+    pub sources: Vec<Vec3>,
+    /// Op-area polygon.
+    pub op_area: Vec<Vec2>,
+    /// Subregions.
+    pub subregions: Vec<Vec<Vec2>>,
+    /// Mean flow at the first source over the mission, m/s.
+    pub mean_flow_mps: Vec2,
+    /// The vehicles, by index.
+    pub vehicles: Vec<VehicleInfo>,
+}
+
+/// A mission being flown.
+pub struct Mission {
+    name: String,
+    seed: u64,
+    world: World,
+    planners: Vec<Option<Box<dyn Planner>>>,
+    planned: Vec<Option<PlannedVehicle>>,
+    statuses: Vec<VehicleStatus>,
+    step_limit: u64,
+    first_failure: Option<Outcome>,
+    end: Option<MissionEnd>,
+    events: EventRecorder,
+    trajectory: Option<TrajectoryRecorder>,
+    stats: TrackStats,
+    mean_plume: Option<MeanPlumeRecorder>,
+    observers: Vec<Box<dyn Observer>>,
+    sources: Vec<Vec3>,
+    geometry: MissionGeometry,
+    op_area: Vec<Vec2>,
+    subregions: Vec<Vec<Vec2>>,
+    spinup_wall_s: f64,
+}
+
+impl Mission {
+    /// Develops the plume (spin-up), then builds the world and every vehicle's planner.
+    pub fn new(setup: MissionSetup, options: MissionOptions) -> Result<Self, MissionError> {
+        let origin = setup.origin.to_string();
+        let env_error = |error| MissionError::Env {
+            origin: origin.clone(),
+            error,
+        };
+        let MissionSetup {
+            name,
+            seed,
+            mut env,
+            vehicles: setups,
+            planners: planned,
+            geometry,
+            spec,
+            dt_s,
+            depth_m,
+            comms,
+            ..
+        } = setup;
+        let started = Instant::now();
+        env.spin_up(spec.spinup_s, spec.spinup_dt_s)
+            .map_err(env_error)?;
+        let spinup_wall_s = started.elapsed().as_secs_f64();
+        let mut vehicles = Vec::with_capacity(setups.len());
+        let mut planners: Vec<Option<Box<dyn Planner>>> = Vec::with_capacity(setups.len());
+        for (v, p) in setups.iter().zip(&planned) {
+            vehicles.push(SimVehicle::new(
+                v.name.clone(),
+                v.vehicle.clone(),
+                v.nav,
+                v.chem_sensor,
+                v.flow_sensor,
+                v.range_sensor,
+                seed,
+            ));
+            planners.push(match p {
+                Some(p) => {
+                    Some(
+                        p.config
+                            .build(&p.context)
+                            .map_err(|error| MissionError::Invalid {
+                                origin: origin.clone(),
+                                error,
+                            })?,
+                    )
+                }
+                None => None,
+            });
+        }
+        let world =
+            World::with_comms(env, vehicles, dt_s, depth_m, comms, seed).map_err(env_error)?;
+        let sources = true_sources(&world);
+        let statuses: Vec<VehicleStatus> = planned
+            .iter()
+            .map(|p| {
+                if p.is_some() {
+                    VehicleStatus::Active
+                } else {
+                    VehicleStatus::NoPlanner
+                }
+            })
+            .collect();
+        let sample_every = (20.0 / dt_s).round().max(1.0) as u64;
+        let thresholds: Vec<Option<f64>> = planned
+            .iter()
+            .map(|p| p.as_ref().and_then(|p| p.config.detection_threshold_v()))
+            .collect();
+        let positions: Vec<bool> = setups.iter().map(|v| v.nav.position_estimate).collect();
+        // The figure's plume at the height of the first vehicle with a planner.
+        let z = planned
+            .iter()
+            .position(Option::is_some)
+            .and_then(|k| setups.get(k))
+            .map_or(0.0, |v| v.vehicle.state.z_m);
+        let mean_plume = options.mean_plume.then(|| {
+            MeanPlumeRecorder::new(
+                MeanPlumeRecorder::grid_over(&spec.op_area, world.env().domain(), z),
+                sample_every,
+            )
+        });
+        Ok(Mission {
+            name,
+            seed,
+            step_limit: (spec.time_limit_s / dt_s).round() as u64,
+            stats: TrackStats::new(setups.len(), sources.first().map(|s| s.xy()), sample_every),
+            trajectory: options
+                .trajectory
+                .then(|| TrajectoryRecorder::new(thresholds, positions)),
+            world,
+            planners,
+            planned,
+            statuses,
+            first_failure: None,
+            end: None,
+            events: EventRecorder::default(),
+            mean_plume,
+            observers: Vec::new(),
+            sources,
+            geometry,
+            op_area: spec.op_area,
+            subregions: spec.subregions,
+            spinup_wall_s,
+        })
+    }
+
+    /// Adds an observer (e.g. a snapshot log); the world keeps snapshots if it wants them.
+    pub fn observe(&mut self, o: Box<dyn Observer>) {
+        if o.wants_snapshots() {
+            self.world.record_snapshots(true);
+        }
+        self.observers.push(o);
+    }
+
+    /// Scenario name.
+    pub fn name(&self) -> &str {
+        &self.name
+    }
+
+    /// Run seed.
+    pub fn seed(&self) -> u64 {
+        self.seed
+    }
+
+    /// The world.
+    pub fn world(&self) -> &World {
+        &self.world
+    }
+
+    /// Each vehicle's planner as configured.
+    pub fn planned(&self) -> &[Option<PlannedVehicle>] {
+        &self.planned
+    }
+
+    /// The mission geometry the planners fly.
+    pub fn geometry(&self) -> &MissionGeometry {
+        &self.geometry
+    }
+
+    /// Each vehicle's status.
+    pub fn statuses(&self) -> &[VehicleStatus] {
+        &self.statuses
+    }
+
+    /// The vehicles' names, by index.
+    pub fn vehicle_names(&self) -> Vec<String> {
+        self.world
+            .vehicles()
+            .iter()
+            .map(|v| v.name.clone())
+            .collect()
+    }
+
+    /// Mission time, s.
+    pub fn time_s(&self) -> f64 {
+        self.world.time_s()
+    }
+
+    /// The mission's time limit, s.
+    pub fn time_limit_s(&self) -> f64 {
+        self.step_limit as f64 * self.world.dt_s()
+    }
+
+    /// The end, once reached.
+    pub fn end(&self) -> Option<MissionEnd> {
+        self.end
+    }
+
+    /// One step; returns the end when this step (or an earlier one) ended the mission.
+    pub fn step(&mut self) -> Result<Option<MissionEnd>, MissionError> {
+        if self.end.is_some() {
+            return Ok(self.end);
+        }
+        let report = self
+            .world
+            .step(&mut self.planners)
+            .map_err(|error| MissionError::Env {
+                origin: format!("scenario '{}'", self.name),
+                error,
+            })?;
+        let mut mission_events = Vec::new();
+        for (i, d) in report.decisions.iter().enumerate() {
+            let Some(d) = d else { continue };
+            let id = VehicleId(i as u32);
+            match d.status {
+                PlanStatus::Running => {}
+                PlanStatus::Finished => {
+                    if self.statuses[i] == VehicleStatus::Active {
+                        self.statuses[i] = VehicleStatus::Finished;
+                        self.world.stop(id);
+                        mission_events.push((id, MissionEvent::PlannerFinished));
+                    }
+                }
+                PlanStatus::Abort => {
+                    self.statuses[i] = VehicleStatus::Aborted;
+                    self.first_failure.get_or_insert(Outcome::AbortedByCage);
+                    self.world.stop(id);
+                    mission_events.push((id, MissionEvent::PlannerAborted));
+                }
+            }
+        }
+        for (id, e) in &report.events {
+            if let WorldEvent::Incident { what } = e {
+                self.statuses[id.0 as usize] = VehicleStatus::of_incident(*what);
+                self.first_failure
+                    .get_or_insert(Outcome::of_incident(*what));
+            }
+        }
+        let t0 = Instant::now();
+        {
+            let view = StepView {
+                world: &self.world,
+                report: &report,
+                mission_events: &mission_events,
+                statuses: &self.statuses,
+            };
+            self.events.observe(&view);
+            self.stats.observe(&view);
+            if let Some(t) = self.trajectory.as_mut() {
+                t.observe(&view);
+            }
+            if let Some(m) = self.mean_plume.as_mut() {
+                m.observe(&view);
+            }
+            for o in &mut self.observers {
+                o.observe(&view);
+            }
+        }
+        self.world.add_record_time(t0.elapsed().as_secs_f64());
+        let t = self.world.time_s();
+        if !self.statuses.contains(&VehicleStatus::Active) {
+            self.end = Some(MissionEnd {
+                reason: EndReason::PlannersDone,
+                t_s: t,
+            });
+        } else if self.world.steps() >= self.step_limit {
+            self.end = Some(MissionEnd {
+                reason: EndReason::TimeLimit,
+                t_s: t,
+            });
+        }
+        Ok(self.end)
+    }
+
+    /// Steps to the end; `progress(t, limit)` is called every 600 steps.
+    pub fn run(&mut self, progress: &mut dyn FnMut(f64, f64)) -> Result<MissionEnd, MissionError> {
+        let limit = self.time_limit_s();
+        loop {
+            if let Some(end) = self.step()? {
+                return Ok(end);
+            }
+            if self.world.steps().is_multiple_of(600) {
+                progress(self.world.time_s(), limit);
+            }
+        }
+    }
+
+    /// What was recorded; the observers are finished (their buffered output flushed).
+    pub fn finish(mut self) -> Result<MissionRun, MissionError> {
+        for o in &mut self.observers {
+            o.finish().map_err(|message| MissionError::Output {
+                what: "an observer's output".into(),
+                message,
+            })?;
+        }
+        let end = self.end.unwrap_or(MissionEnd {
+            reason: EndReason::TimeLimit,
+            t_s: self.world.time_s(),
+        });
+        let vehicles: Vec<VehicleInfo> = self
+            .world
+            .vehicles()
+            .iter()
+            .zip(&self.planned)
+            .map(|(v, p)| VehicleInfo {
+                name: v.name.clone(),
+                kind: v.vehicle.params.kind,
+                planner: p.as_ref().map(|p| p.config.kind().to_string()),
+            })
+            .collect();
+        let mean_flow = self.stats.mean_flow_mps();
+        let summary = Summary::new(SummaryInput {
+            scenario: self.name.clone(),
+            seed: self.seed,
+            end,
+            first_failure: self.first_failure,
+            statuses: &self.statuses,
+            tracks: &self.stats.tracks,
+            vehicles: vehicles
+                .iter()
+                .map(|v| (v.name.clone(), v.kind, v.planner.clone()))
+                .collect(),
+            sources: &self.sources,
+            mean_flow_mps: mean_flow,
+        });
+        Ok(MissionRun {
+            outcome: summary.outcome,
+            summary,
+            trajectory: self.trajectory.map(|t| t.rows).unwrap_or_default(),
+            events: self.events.events,
+            stage_times: self.world.stage_times(),
+            spinup_wall_s: self.spinup_wall_s,
+            mean_plume: self.mean_plume.map(|m| m.grid),
+            sources: self.sources,
+            op_area: self.op_area,
+            subregions: self.subregions,
+            mean_flow_mps: mean_flow,
+            vehicles,
+        })
+    }
+}
+
+/// Sets up, flies and finishes a scenario's mission recording what `options` asks for;
+/// `progress(t, limit)` is called now and then.
+pub fn run_mission_with(
+    sc: plumetrace_scenario::BuiltScenario,
+    options: MissionOptions,
+    progress: &mut dyn FnMut(f64, f64),
+) -> Result<MissionRun, MissionError> {
+    let mut m = Mission::new(MissionSetup::new(sc)?, options)?;
+    m.run(progress)?;
+    m.finish()
+}
+
+/// [`run_mission_with`] recording everything.
+pub fn run_mission(
+    sc: plumetrace_scenario::BuiltScenario,
+    progress: &mut dyn FnMut(f64, f64),
+) -> Result<MissionRun, MissionError> {
+    run_mission_with(sc, MissionOptions::default(), progress)
+}

@@ -1,0 +1,360 @@
+//! Recording a mission: observers of the step.
+//!
+//! An [`Observer`] sees every step after it ran ([`StepView`]: the world, the step's decisions,
+//! snapshots and world events, and what the mission made of them). The mission's own records are
+//! observers too: [`EventRecorder`] (every vehicle's planner events, telemetry, world and mission
+//! events), [`TrajectoryRecorder`] (every vehicle, every step), [`TrackStats`] (path lengths and
+//! first detections for the summary) and [`MeanPlumeRecorder`] (the figure's time-averaged
+//! plume). Plots are drawn afterwards from what they recorded, never inside the loop.
+
+use crate::outcome::{MissionEvent, VehicleStatus};
+use plumetrace_core::{BehaviourKind, PlannerEvent, Telemetry, Vec2, Vec3, VehicleId};
+use plumetrace_env::{FlowField, GridSpec, MeanConcentrationGrid};
+use plumetrace_sim::{StepReport, World, WorldEvent};
+use serde::Serialize;
+
+/// What observers see after a step.
+pub struct StepView<'a> {
+    /// The world after the step.
+    pub world: &'a World,
+    /// The step's decisions, snapshots (when recorded) and world events; `report.t_s` is the
+    /// time the snapshots were taken.
+    pub report: &'a StepReport,
+    /// What the mission recorded about vehicles in this step.
+    pub mission_events: &'a [(VehicleId, MissionEvent)],
+    /// Every vehicle's status after the step.
+    pub statuses: &'a [VehicleStatus],
+}
+
+/// Something that records a mission as it runs.
+pub trait Observer: Send {
+    /// Looks at one step.
+    fn observe(&mut self, step: &StepView<'_>);
+
+    /// Whether it needs the snapshots given to planners (the world then keeps them).
+    fn wants_snapshots(&self) -> bool {
+        false
+    }
+
+    /// The mission is over: flush what is buffered; errors name what could not be written.
+    fn finish(&mut self) -> Result<(), String> {
+        Ok(())
+    }
+}
+
+/// Any event of a vehicle, as written to `events.jsonl` (every kind tagged by its `event`
+/// field, names from serde).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+#[serde(untagged)]
+pub enum EventKind {
+    /// From the vehicle's planner.
+    Planner(PlannerEvent),
+    /// The planner's beliefs.
+    Telemetry(Telemetry),
+    /// From the world (fixes, incidents, messages, bad commands).
+    World(WorldEvent),
+    /// From the mission (planner finished or aborted).
+    Mission(MissionEvent),
+}
+
+/// One timestamped event of one vehicle.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct EventRecord {
+    /// Time, s (the decision time of the step it happened in).
+    pub t_s: f64,
+    /// Vehicle index.
+    pub vehicle: u32,
+    /// The event.
+    #[serde(flatten)]
+    pub event: EventKind,
+}
+
+/// Records every event of every vehicle, in order.
+#[derive(Debug, Default)]
+pub struct EventRecorder {
+    /// The events so far.
+    pub events: Vec<EventRecord>,
+}
+
+impl Observer for EventRecorder {
+    fn observe(&mut self, step: &StepView<'_>) {
+        let t = step.report.t_s;
+        for (i, d) in step.report.decisions.iter().enumerate() {
+            let Some(d) = d else { continue };
+            let vehicle = i as u32;
+            self.events.extend(d.events.iter().map(|e| EventRecord {
+                t_s: t,
+                vehicle,
+                event: EventKind::Planner(e.clone()),
+            }));
+            self.events.extend(d.telemetry.iter().map(|e| EventRecord {
+                t_s: t,
+                vehicle,
+                event: EventKind::Telemetry(e.clone()),
+            }));
+        }
+        self.events
+            .extend(step.report.events.iter().map(|(id, e)| EventRecord {
+                t_s: t,
+                vehicle: id.0,
+                event: EventKind::World(e.clone()),
+            }));
+        self.events
+            .extend(step.mission_events.iter().map(|(id, e)| EventRecord {
+                t_s: t,
+                vehicle: id.0,
+                event: EventKind::Mission(*e),
+            }));
+    }
+}
+
+/// One row of the trajectory (one vehicle, one step).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct TrajectoryRow {
+    /// Time, s.
+    pub t_s: f64,
+    /// Vehicle index.
+    pub vehicle: u32,
+    /// True position, m.
+    pub true_x_m: f64,
+    /// True position, m.
+    pub true_y_m: f64,
+    /// True height above the seabed, m.
+    pub true_z_m: f64,
+    /// Estimated position, m (`None`: the vehicle has no position estimate).
+    pub est_x_m: Option<f64>,
+    /// Estimated position, m.
+    pub est_y_m: Option<f64>,
+    /// True heading, deg.
+    pub heading_deg: f64,
+    /// Water-relative speed, m/s.
+    pub speed_mps: f64,
+    /// Active behaviour (`None`: no planner, or before its first decision).
+    pub behaviour: Option<BehaviourKind>,
+    /// Latest chemical reading, V.
+    pub reading_v: f64,
+    /// The latest reading exceeds the vehicle's planner's detection threshold.
+    pub detection: bool,
+}
+
+/// Records every vehicle's state at every step, and each vehicle's behaviour from its planner's
+/// events.
+#[derive(Debug)]
+pub struct TrajectoryRecorder {
+    /// The rows so far.
+    pub rows: Vec<TrajectoryRow>,
+    behaviour: Vec<Option<BehaviourKind>>,
+    thresholds: Vec<Option<f64>>,
+    positions: Vec<bool>,
+}
+
+impl TrajectoryRecorder {
+    /// A recorder for vehicles whose planners threshold at `thresholds` (`None`: no detections
+    /// marked) and which have a position estimate or not.
+    pub fn new(thresholds: Vec<Option<f64>>, positions: Vec<bool>) -> Self {
+        TrajectoryRecorder {
+            rows: Vec::new(),
+            behaviour: vec![None; thresholds.len()],
+            thresholds,
+            positions,
+        }
+    }
+}
+
+/// The behaviour each decision switched to (the last one of the step).
+fn behaviour_switches(report: &StepReport) -> impl Iterator<Item = (usize, BehaviourKind)> + '_ {
+    report.decisions.iter().enumerate().filter_map(|(i, d)| {
+        d.as_ref()?
+            .events
+            .iter()
+            .rev()
+            .find_map(|e| match e {
+                PlannerEvent::Behaviour { behaviour } => Some(*behaviour),
+                _ => None,
+            })
+            .map(|b| (i, b))
+    })
+}
+
+impl Observer for TrajectoryRecorder {
+    fn observe(&mut self, step: &StepView<'_>) {
+        for (i, b) in behaviour_switches(step.report) {
+            if let Some(slot) = self.behaviour.get_mut(i) {
+                *slot = Some(b);
+            }
+        }
+        let t = step.world.time_s();
+        for v in step.world.vehicles() {
+            let i = v.vehicle.id.0 as usize;
+            let s = v.vehicle.state;
+            let est = self
+                .positions
+                .get(i)
+                .copied()
+                .unwrap_or(true)
+                .then(|| v.nav.estimate_m());
+            let reading = v.last_chem.map_or(0.0, |c| c.reading);
+            let threshold = self.thresholds.get(i).copied().flatten();
+            self.rows.push(TrajectoryRow {
+                t_s: t,
+                vehicle: v.vehicle.id.0,
+                true_x_m: s.pos_m.x,
+                true_y_m: s.pos_m.y,
+                true_z_m: s.z_m,
+                est_x_m: est.map(|e| e.x),
+                est_y_m: est.map(|e| e.y),
+                heading_deg: s.heading.deg(),
+                speed_mps: s.speed_mps,
+                behaviour: self.behaviour.get(i).copied().flatten(),
+                reading_v: reading,
+                detection: v.last_chem.is_some() && threshold.is_some_and(|th| reading > th),
+            });
+        }
+    }
+}
+
+/// Per-vehicle numbers for the summary: path over ground, first detection, the path traced from
+/// the first detection to the first declaration, declarations.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct VehicleTrack {
+    /// Distance over ground, m.
+    pub path_length_m: f64,
+    /// Time and estimated position of the planner's first detection.
+    pub first_detection: Option<(f64, Vec2)>,
+    /// Distance from the first detection to the first declaration, m.
+    pub trace_length_m: f64,
+    /// Declarations: time, position and rule.
+    pub declarations: Vec<(f64, Vec2, plumetrace_core::DeclarationKind)>,
+    last_pos: Option<Vec2>,
+}
+
+/// Records [`VehicleTrack`]s and the mean flow at the first source.
+#[derive(Debug)]
+pub struct TrackStats {
+    /// One per vehicle.
+    pub tracks: Vec<VehicleTrack>,
+    flow_sum: Vec2,
+    flow_n: f64,
+    flow_at: Option<Vec2>,
+    sample_every: u64,
+}
+
+impl TrackStats {
+    /// Stats for `vehicles` vehicles; the mean flow is sampled at `flow_at` every `sample_every`
+    /// steps.
+    pub fn new(vehicles: usize, flow_at: Option<Vec2>, sample_every: u64) -> Self {
+        TrackStats {
+            tracks: vec![VehicleTrack::default(); vehicles],
+            flow_sum: Vec2::zeros(),
+            flow_n: 0.0,
+            flow_at,
+            sample_every: sample_every.max(1),
+        }
+    }
+
+    /// The mean flow at the first source over the mission, m/s.
+    pub fn mean_flow_mps(&self) -> Vec2 {
+        if self.flow_n > 0.0 {
+            self.flow_sum / self.flow_n
+        } else {
+            Vec2::zeros()
+        }
+    }
+}
+
+impl Observer for TrackStats {
+    fn observe(&mut self, step: &StepView<'_>) {
+        let t = step.report.t_s;
+        for (i, d) in step.report.decisions.iter().enumerate() {
+            let (Some(d), Some(track)) = (d, self.tracks.get_mut(i)) else {
+                continue;
+            };
+            for e in &d.events {
+                match e {
+                    PlannerEvent::Detection { pos_m } if track.first_detection.is_none() => {
+                        track.first_detection = Some((t, *pos_m));
+                    }
+                    PlannerEvent::Declared { pos_m, rule } => {
+                        track.declarations.push((t, *pos_m, *rule));
+                    }
+                    _ => {}
+                }
+            }
+        }
+        for v in step.world.vehicles() {
+            let Some(track) = self.tracks.get_mut(v.vehicle.id.0 as usize) else {
+                continue;
+            };
+            let p = v.vehicle.state.pos_m;
+            if let Some(q) = track.last_pos {
+                let d = (p - q).norm();
+                track.path_length_m += d;
+                if track.first_detection.is_some() && track.declarations.is_empty() {
+                    track.trace_length_m += d;
+                }
+            }
+            track.last_pos = Some(p);
+        }
+        if (step.world.steps() - 1).is_multiple_of(self.sample_every)
+            && let Some(at) = self.flow_at
+        {
+            self.flow_sum += step.world.env().flow().velocity(at);
+            self.flow_n += 1.0;
+        }
+    }
+}
+
+/// Accumulates the time-averaged concentration over a grid every `sample_every` steps (the
+/// figure's plume).
+#[derive(Debug)]
+pub struct MeanPlumeRecorder {
+    /// The average so far.
+    pub grid: MeanConcentrationGrid,
+    sample_every: u64,
+}
+
+impl MeanPlumeRecorder {
+    /// An average over `grid`, sampled every `sample_every` steps.
+    pub fn new(grid: GridSpec, sample_every: u64) -> Self {
+        MeanPlumeRecorder {
+            grid: MeanConcentrationGrid::new(grid, 0.0),
+            sample_every: sample_every.max(1),
+        }
+    }
+
+    /// The grid covering `vertices` with a 5 % margin, inside the domain, at height `z_m`.
+    pub fn grid_over(vertices: &[Vec2], domain: plumetrace_env::Rect, z_m: f64) -> GridSpec {
+        let (mut x0, mut x1, mut y0, mut y1) = (f64::MAX, f64::MIN, f64::MAX, f64::MIN);
+        for p in vertices {
+            (x0, x1, y0, y1) = (x0.min(p.x), x1.max(p.x), y0.min(p.y), y1.max(p.y));
+        }
+        let pad = 0.05 * (x1 - x0).max(y1 - y0);
+        GridSpec {
+            x_min_m: (x0 - pad).max(domain.x_min_m),
+            x_max_m: (x1 + pad).min(domain.x_max_m),
+            y_min_m: (y0 - pad).max(domain.y_min_m),
+            y_max_m: (y1 + pad).min(domain.y_max_m),
+            nx: 160,
+            ny: (160.0 * (y1 - y0) / (x1 - x0).max(1e-9)).clamp(40.0, 400.0) as usize,
+            z_m,
+        }
+    }
+}
+
+impl Observer for MeanPlumeRecorder {
+    fn observe(&mut self, step: &StepView<'_>) {
+        if (step.world.steps() - 1).is_multiple_of(self.sample_every) {
+            self.grid.accumulate(step.world.env().plume());
+        }
+    }
+}
+
+/// The true sources of the mission's plume.
+pub fn true_sources(world: &World) -> Vec<Vec3> {
+    world
+        .env()
+        .plume()
+        .filaments()
+        .map(|f| f.sources().iter().map(|s| s.pos_m).collect())
+        .unwrap_or_default()
+}

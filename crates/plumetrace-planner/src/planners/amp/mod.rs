@@ -1,0 +1,707 @@
+//! The REMUS Adaptive Mission Planner (AMP).
+//!
+//! Behaviours and the switching logic of the field system:
+//! - **Go-To** drives to the most downflow corner of the area (or of the next subregion; during
+//!   that transit of a multi-source mission detections are ignored);
+//! - **Find** sweeps across the flow at `psi_f +- 90 +- 20` degrees with billiard reflections at the
+//!   boundary;
+//! - **Track-In** (any detection before declaration) heads `upflow + LHS beta`, updating LHS from
+//!   the wrapped difference between vehicle heading and flow direction, and saves the last detection
+//!   point; after `lambda` seconds without detection it saves that point as a lost point;
+//! - **Track-Out** goes `L_u` upflow and `L_c` across the flow from the most upflow lost point, to the
+//!   side opposite the exit; it ends on detection or arrival, and the declaration check runs;
+//! - **Reacquire** flies `N_re` Bowties from 10 m upflow of the most upflow lost point down to it,
+//!   then drops the point; with no point left it returns to Find.
+//!
+//! Declaration ([`DeclarationRule`]) leads to post-declaration mapping ([`MappingParams`]) and the
+//! end of the mission. In a multi-source mission the area is split into subregions searched in
+//! turn; a subregion ends on timeout (source-free), on a declaration, or when the plume is traced
+//! to its upflow edge (declared there); no mapping is flown between subregions.
+//!
+//! Each behaviour is a [`Behaviour`](crate::behaviour::Behaviour); the switching logic above is
+//! the AMP's [`Arbiter`](crate::behaviour::Arbiter). Every course passes the shared
+//! [`Autopilot`] (op-area cage, flow compensation, heading-rate filter); a cage abort ends the
+//! mission. A chemical sample counts as a detection when its reading exceeds `threshold_v`.
+
+mod behaviours;
+mod bowtie;
+mod declaration;
+mod find;
+mod mapping;
+
+pub use bowtie::{Bowtie, centres as bowtie_centres};
+pub use declaration::{DeclarationChoice, DeclarationRule};
+pub use find::{candidates as find_candidates, reflect as find_reflect};
+pub use mapping::MappingParams;
+
+use crate::behaviour::{Arbiter, Behaviour, EventLog, GoTo, Idle, Legs, LineParams, Percept};
+use crate::behaviour::{Proposal, Reached};
+use crate::flow::FlowEstimate;
+use crate::planners::{BuildContext, PlannerParams};
+use behaviours::{Find, Reacquire, TrackIn, TrackOut};
+use plumetrace_core::params::{Bounds, Choice, ParamError};
+use plumetrace_core::{
+    BehaviourKind, Decision, DeclarationKind, Heading, PlanStatus, Planner, PlannerEvent,
+    RegionEvent, SensorSnapshot, Telemetry, Vec2, VerticalCommand, wrap_deg_360,
+};
+use plumetrace_guidance::{Autopilot, AutopilotParams, FollowLine, GoToPoint, OpArea, Steer};
+use serde::{Deserialize, Serialize};
+
+plumetrace_core::params! {
+    /// Parameters of the AMP. Defaults: Table 4 of the field tests and the field vehicle.
+    pub struct AmpParams {
+        /// Speed command.
+        speed_mps: f64 = 2.0, "m/s", Bounds::positive(10.0);
+        /// Altitude command (height above the seabed).
+        altitude_m: f64 = 2.0, "m", Bounds::non_negative(1000.0);
+        /// A chemical reading above this is a detection (4 % of the field sensor's 5 V).
+        threshold_v: f64 = 0.2, "V", Bounds::non_negative(1e6);
+        /// lambda: time without detection that ends Track-In.
+        lambda_s: f64 = 5.0, "s", Bounds::positive(3600.0);
+        /// beta: Track-In offset from upflow.
+        beta_deg: f64 = 20.0, "deg", Bounds::closed(0.0, 90.0);
+        /// L_u: Track-Out goal distance upflow of the most upflow lost point.
+        l_u_m: f64 = 18.0, "m", Bounds::non_negative(1000.0);
+        /// L_c: Track-Out goal distance across the flow.
+        l_c_m: f64 = 18.0, "m", Bounds::non_negative(1000.0);
+        /// N_re: Bowties per lost point.
+        n_re: u32 = 2, "", Bounds::whole(1, 50);
+        /// K: Follow Line cross-track gain.
+        k_deg_per_m: f64 = 5.0, "deg/m", Bounds::positive(180.0);
+        /// R: arrival radius of Go-To, Track-Out and Follow Line.
+        r_m: f64 = 10.0, "m", Bounds::positive(1000.0);
+        /// Turning radius of the Dubins approach to each line.
+        min_turn_radius_m: f64 = 12.0, "m", Bounds::positive(1000.0);
+        /// Heading-rate limit of the commands.
+        max_turn_rate_deg_s: f64 = 10.0, "deg/s", Bounds::positive(360.0);
+        /// Most lost points kept (the field planner kept six).
+        max_lost_points: u32 = 6, "", Bounds::whole(3, 1000);
+        /// Which lost point a full list drops.
+        lost_point_eviction: LostPointEviction = LostPointEviction::Oldest, "", Bounds::Any;
+        /// Find offset from across-flow.
+        find_offset_deg: f64 = 20.0, "deg", Bounds::closed(0.0, 80.0);
+        /// Distance from the boundary at which Find reflects.
+        find_margin_m: f64 = 10.0, "m", Bounds::non_negative(1000.0);
+        /// Bowtie line angle from upflow.
+        bowtie_angle_deg: f64 = 15.0, "deg", Bounds::closed(1.0, 80.0);
+        /// Bowtie reach across the flow on each side.
+        bowtie_half_width_m: f64 = 13.0, "m", Bounds::positive(1000.0);
+        /// Distance upflow of the lost point of the first Bowtie centre.
+        bowtie_offset_m: f64 = 10.0, "m", Bounds::non_negative(1000.0);
+        /// Declaration rule.
+        declaration: DeclarationChoice = DeclarationChoice::AlongFlow, "", Bounds::Any;
+        /// Along-flow spread of the three most upflow lost points that declares.
+        declaration_along_m: f64 = 4.0, "m", Bounds::positive(1000.0);
+        /// Crossflow spread bound of the along_and_cross_flow rule.
+        declaration_cross_m: f64 = 8.0, "m", Bounds::positive(1000.0);
+        /// Fly the post-declaration mapping pattern (single-source missions).
+        mapping: bool = true, "", Bounds::Any;
+        /// Mapping lines.
+        mapping_lines: u32 = 4, "", Bounds::whole(1, 100);
+        /// Mapping line length.
+        mapping_length_m: f64 = 80.0, "m", Bounds::positive(10_000.0);
+        /// Mapping line spacing.
+        mapping_spacing_m: f64 = 20.0, "m", Bounds::positive(1000.0);
+        /// Time constant of the flow estimate.
+        flow_average_s: f64 = 60.0, "s", Bounds::non_negative(100_000.0);
+        /// Compensate courses for the measured flow (crab angle).
+        flow_compensation: bool = true, "", Bounds::Any;
+        /// Search time per subregion of a multi-source mission before it is declared source-free.
+        region_timeout_s: f64 = 1800.0, "s", Bounds::positive(1e6);
+    }
+}
+
+impl AmpParams {
+    /// The declaration rule the keys describe.
+    pub fn declaration_rule(&self) -> DeclarationRule {
+        match self.declaration {
+            DeclarationChoice::AlongFlow => DeclarationRule::AlongFlow {
+                along_m: self.declaration_along_m,
+            },
+            DeclarationChoice::AlongAndCrossFlow => DeclarationRule::AlongAndCrossFlow {
+                along_m: self.declaration_along_m,
+                cross_m: self.declaration_cross_m,
+            },
+        }
+    }
+
+    /// The mapping pattern, if one is flown.
+    pub fn mapping_params(&self) -> Option<MappingParams> {
+        self.mapping.then_some(MappingParams {
+            lines: self.mapping_lines as usize,
+            length_m: self.mapping_length_m,
+            spacing_m: self.mapping_spacing_m,
+        })
+    }
+
+    fn line_params(&self) -> LineParams {
+        LineParams {
+            speed_mps: self.speed_mps,
+            radius_m: self.r_m,
+            gain_deg_per_m: self.k_deg_per_m,
+            min_turn_radius_m: self.min_turn_radius_m,
+        }
+    }
+
+    /// A Follow Line leg from `a` to `b` with the planner's speed, radius, gain and turning radius
+    /// (approaching the start with the line's heading).
+    fn line(&self, a: Vec2, b: Vec2) -> FollowLine {
+        self.line_params().line(a, b)
+    }
+
+    fn go_to(&self, target_m: Vec2) -> GoToPoint {
+        GoToPoint {
+            target_m,
+            speed_mps: self.speed_mps,
+            radius_m: self.r_m,
+        }
+    }
+}
+
+impl PlannerParams for AmpParams {
+    const KIND: &'static str = "amp";
+    const SUMMARY: &'static str = "REMUS Adaptive Mission Planner: Find, Track-In, Track-Out, Reacquire (Bowtie), lost-point declaration, mapping, subregions";
+
+    fn detection_threshold_v(&self) -> Option<f64> {
+        Some(self.threshold_v)
+    }
+
+    fn build(&self, ctx: &BuildContext) -> Result<Box<dyn Planner>, ParamError> {
+        Ok(Box::new(Amp::new(
+            self.clone(),
+            ctx.geometry.op_area.clone(),
+            ctx.geometry.subregions.clone(),
+            ctx.geometry.prior_flow_toward(),
+        )))
+    }
+}
+
+/// Which lost point is dropped when a new one arrives at a full list (the field planner kept at
+/// most six; which one made room is not recorded).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum LostPointEviction {
+    /// The oldest point (the default): the list follows the latest losses.
+    Oldest,
+    /// The most downflow of the older points (the new one always enters): the list keeps the
+    /// points nearest the source, which Track-Out, Reacquire and the declaration use. Near a
+    /// source whose plume reaches the vehicle's altitude only intermittently, points near the
+    /// plume's tip survive the losses further downflow until three agree. The price: upflow
+    /// points whose Bowties keep finding chemical downflow of them are never dropped, and a
+    /// declaration can then wait for ever (4 of 40 `duck-2003-st` runs).
+    MostDownflow,
+}
+
+impl Choice for LostPointEviction {
+    const ALL: &'static [Self] = &[LostPointEviction::Oldest, LostPointEviction::MostDownflow];
+}
+
+/// Why an AMP behaviour finished.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum AmpDone {
+    /// A goal reached or a pattern flown (Go-To, Transit, Track-Out, Mapping).
+    Reached,
+    /// Track-In lost contact `lambda` after the last detection, which was here.
+    Lost { at: Vec2 },
+    /// Tracing reached the subregion's upflow edge here (multi-source missions).
+    AtEdge { at: Vec2 },
+    /// Reacquire flew every Bowtie of this lost point without a detection.
+    Searched { point: Vec2 },
+}
+
+impl From<Reached> for AmpDone {
+    fn from(_: Reached) -> Self {
+        AmpDone::Reached
+    }
+}
+
+/// What the AMP's behaviours share: parameters, areas, the flow estimate, LHS, the lost points
+/// and the events of the current decision.
+#[derive(Debug, Clone)]
+struct Memory {
+    p: AmpParams,
+    regions: Vec<OpArea>,
+    region: usize,
+    region_started_s: f64,
+    lhs: f64,
+    last_detection: Option<(f64, Vec2)>,
+    lost: Vec<Vec2>,
+    declared: Vec<Vec2>,
+    flow: FlowEstimate,
+    events: Vec<PlannerEvent>,
+}
+
+impl EventLog for Memory {
+    fn log(&mut self, e: PlannerEvent) {
+        self.events.push(e);
+    }
+}
+
+impl Memory {
+    fn multi_region(&self) -> bool {
+        self.regions.len() > 1
+    }
+
+    fn lhs_from_heading(&self, heading: Heading) -> f64 {
+        // Table 1: psi_v - psi_f wrapped to [0, 360) and compared with 180.
+        if wrap_deg_360(heading.deg() - self.flow.toward().deg()) < 180.0 {
+            1.0
+        } else {
+            -1.0
+        }
+    }
+
+    fn most_upflow_lost(&self) -> Option<Vec2> {
+        let u = self.flow.upflow().unit();
+        self.lost
+            .iter()
+            .copied()
+            .max_by(|a, b| a.dot(&u).total_cmp(&b.dot(&u)))
+    }
+
+    /// Saves a lost point, keeping at most `max_lost_points`: beyond it the point chosen by
+    /// `lost_point_eviction` is dropped.
+    fn save_lost_point(&mut self, p: Vec2) {
+        self.lost.push(p);
+        self.events.push(PlannerEvent::LostPoint { pos_m: p });
+        if self.lost.len() > self.p.max_lost_points as usize {
+            let drop = match self.p.lost_point_eviction {
+                LostPointEviction::Oldest => 0,
+                LostPointEviction::MostDownflow => {
+                    let u = self.flow.upflow().unit();
+                    // Among the older points (the new one always enters, or a list of six
+                    // upflow points would never change); `min_by` keeps the first of equals.
+                    let older = &self.lost[..self.lost.len() - 1];
+                    older
+                        .iter()
+                        .enumerate()
+                        .min_by(|a, b| a.1.dot(&u).total_cmp(&b.1.dot(&u)))
+                        .map_or(0, |(i, _)| i)
+                }
+            };
+            self.lost.remove(drop);
+        }
+    }
+
+    /// The Track-Out goal: `L_u` upflow and `L_c` across the flow from the most upflow lost
+    /// point, on the side opposite to where the vehicle left the plume.
+    fn track_out_goal(&self) -> Option<Vec2> {
+        let p = self.most_upflow_lost()?;
+        let up = self.flow.upflow();
+        // LHS = +1: left the plume on its left (looking upflow): go to the right, clockwise.
+        Some(p + up.unit() * self.p.l_u_m + up.turned_deg(90.0 * self.lhs).unit() * self.p.l_c_m)
+    }
+
+    /// In a multi-source mission: the point on the subregion's upflow edge when the vehicle at
+    /// `pos` has traced the plume there.
+    fn upflow_edge(&self, pos: Vec2) -> Option<Vec2> {
+        if !self.multi_region() {
+            return None;
+        }
+        let e = self.regions[self.region].edge_info(pos);
+        let up = self.flow.upflow().unit();
+        (e.distance_m < self.p.r_m && e.outward_normal.dot(&up) > 0.7).then(|| {
+            if e.inside {
+                pos + e.outward_normal * e.distance_m
+            } else {
+                pos - e.outward_normal * e.distance_m
+            }
+        })
+    }
+
+    /// Where the search of subregion `k` starts: its most downflow corner (for the current flow
+    /// estimate), moved 1.5 `R` towards the subregion's centre.
+    fn search_start(&self, k: usize) -> Vec2 {
+        let region = &self.regions[k];
+        let corner = region.furthest_vertex_along(self.flow.toward().unit());
+        let centre = region.vertices().iter().fold(Vec2::zeros(), |a, v| a + v)
+            / region.vertices().len() as f64;
+        let d = centre - corner;
+        let n = d.norm();
+        if n > 2.0 * self.p.r_m {
+            corner + d / n * (1.5 * self.p.r_m)
+        } else {
+            centre
+        }
+    }
+}
+
+type AmpBehaviour = Box<dyn Behaviour<Memory, AmpDone>>;
+
+/// The AMP's switching logic: which behaviour runs, and what follows each one's end.
+struct Switching {
+    active: AmpBehaviour,
+}
+
+impl Switching {
+    fn set(&mut self, m: &mut Memory, next: AmpBehaviour) {
+        let changed = next.kind() != self.active.kind();
+        self.active = next;
+        if changed {
+            m.log(PlannerEvent::Behaviour {
+                behaviour: self.active.kind(),
+            });
+        }
+    }
+
+    fn start_region(&mut self, m: &mut Memory, k: usize, t: f64) {
+        m.region = k;
+        m.region_started_s = t;
+        m.lost.clear();
+        m.last_detection = None;
+        m.log(PlannerEvent::Region {
+            index: k,
+            what: RegionEvent::Started,
+        });
+        let kind = if m.multi_region() {
+            BehaviourKind::Transit
+        } else {
+            BehaviourKind::GoTo
+        };
+        let goal = m.p.go_to(m.search_start(k));
+        self.set(m, Box::new(GoTo { goal, kind }));
+    }
+
+    fn next_region(&mut self, m: &mut Memory, t: f64) {
+        if m.region + 1 < m.regions.len() {
+            self.start_region(m, m.region + 1, t);
+        } else {
+            self.set(m, Box::new(Idle));
+        }
+    }
+
+    fn enter_find(&mut self, m: &mut Memory, pos: Vec2) {
+        let h = find::initial_heading(
+            &m.regions[m.region],
+            pos,
+            m.flow.toward(),
+            m.p.find_offset_deg,
+        );
+        self.set(m, Box::new(Find { heading: h }));
+    }
+
+    fn enter_track_in(&mut self, m: &mut Memory, p: &Percept) {
+        if m.last_detection.is_none() {
+            m.lhs = m.lhs_from_heading(p.heading);
+        }
+        let h = m.flow.upflow().turned_deg(m.lhs * m.p.beta_deg);
+        self.set(m, Box::new(TrackIn { heading: h }));
+    }
+
+    fn enter_reacquire(&mut self, m: &mut Memory, pos: Vec2) {
+        match m.most_upflow_lost() {
+            Some(point) => {
+                let r = Reacquire::new(m, point);
+                self.set(m, Box::new(r));
+            }
+            None => self.enter_find(m, pos),
+        }
+    }
+
+    fn declare(
+        &mut self,
+        m: &mut Memory,
+        at: Vec2,
+        rule: DeclarationKind,
+        what: RegionEvent,
+        t: f64,
+    ) {
+        m.declared.push(at);
+        m.log(PlannerEvent::Declared { pos_m: at, rule });
+        if m.multi_region() {
+            m.log(PlannerEvent::Region {
+                index: m.region,
+                what,
+            });
+            self.next_region(m, t);
+        } else if let Some(map) = m.p.mapping_params() {
+            let legs = map.legs(at, m.flow.toward());
+            let pattern = Legs::new(legs, m.p.line_params(), BehaviourKind::Mapping);
+            self.set(m, Box::new(pattern));
+        } else {
+            self.set(m, Box::new(Idle));
+        }
+    }
+
+    /// Runs the declaration check; true when a source was declared.
+    fn try_declare(&mut self, m: &mut Memory, t: f64) -> bool {
+        let rule = m.p.declaration_rule();
+        match rule.check(&m.lost, m.flow.upflow()) {
+            Some(at) => {
+                self.declare(m, at, rule.kind(), RegionEvent::Declared, t);
+                true
+            }
+            None => false,
+        }
+    }
+
+    /// What follows the end of the active behaviour.
+    fn after(&mut self, m: &mut Memory, p: &Percept, done: AmpDone) {
+        match (self.active.kind(), done) {
+            (_, AmpDone::AtEdge { at }) => {
+                self.declare(
+                    m,
+                    at,
+                    DeclarationKind::UpflowEdge,
+                    RegionEvent::DeclaredAtEdge,
+                    p.t_s,
+                );
+            }
+            (_, AmpDone::Lost { at }) => {
+                m.save_lost_point(at);
+                match m.track_out_goal() {
+                    Some(goal) => {
+                        let g = m.p.go_to(goal);
+                        self.set(m, Box::new(TrackOut { goal: g }));
+                    }
+                    None => self.enter_find(m, p.pos_m),
+                }
+            }
+            (_, AmpDone::Searched { point }) => {
+                m.lost.retain(|q| *q != point);
+                self.enter_reacquire(m, p.pos_m);
+            }
+            (BehaviourKind::TrackOut, AmpDone::Reached) => {
+                if !self.try_declare(m, p.t_s) {
+                    self.enter_reacquire(m, p.pos_m);
+                }
+            }
+            (BehaviourKind::Mapping, AmpDone::Reached) => self.set(m, Box::new(Idle)),
+            (_, AmpDone::Reached) => {
+                // Go-To or Transit arrived: the subregion's search starts now.
+                m.region_started_s = p.t_s;
+                self.enter_find(m, p.pos_m);
+            }
+        }
+    }
+}
+
+impl Arbiter<Memory> for Switching {
+    fn arbitrate(&mut self, p: &Percept, m: &mut Memory) -> Option<Steer> {
+        // Subregion timeout (multi-source missions).
+        let kind = self.active.kind();
+        if m.multi_region()
+            && !matches!(kind, BehaviourKind::Transit | BehaviourKind::Done)
+            && p.t_s - m.region_started_s > m.p.region_timeout_s
+        {
+            m.log(PlannerEvent::Region {
+                index: m.region,
+                what: RegionEvent::TimedOut,
+            });
+            self.next_region(m, p.t_s);
+        }
+        // A decision may switch behaviours a few times (e.g. Track-Out arrives, the check
+        // declares, mapping starts); the bound only guards against a switching loop.
+        for _ in 0..8 {
+            let kind = self.active.kind();
+            let tracking_allowed = !matches!(
+                kind,
+                BehaviourKind::Transit | BehaviourKind::Mapping | BehaviourKind::Done
+            );
+            if p.detected && tracking_allowed && kind != BehaviourKind::TrackIn {
+                if kind == BehaviourKind::TrackOut && self.try_declare(m, p.t_s) {
+                    continue;
+                }
+                self.enter_track_in(m, p);
+            }
+            match self.active.propose(p, m) {
+                Proposal::Steer(s) => return Some(s),
+                Proposal::Idle => return None,
+                Proposal::Done(done) => self.after(m, p, done),
+            }
+        }
+        None
+    }
+
+    fn active(&self) -> BehaviourKind {
+        self.active.kind()
+    }
+}
+
+/// The Adaptive Mission Planner for one AUV.
+pub struct Amp {
+    m: Memory,
+    switching: Switching,
+    autopilot: Autopilot,
+    in_contact: bool,
+    started: bool,
+    last_steer: Steer,
+    reported_estimate: Option<Vec2>,
+}
+
+impl Amp {
+    /// A planner for `area`, searched whole (single-source mission) or, with several `regions`,
+    /// one subregion after the other. `prior_flow` is the flow direction assumed until the first
+    /// flow measurement.
+    pub fn new(p: AmpParams, area: OpArea, regions: Vec<OpArea>, prior_flow: Heading) -> Self {
+        let regions = if regions.is_empty() {
+            vec![area.clone()]
+        } else {
+            regions
+        };
+        let autopilot = Autopilot::new(AutopilotParams {
+            op_area: area,
+            flow_compensation: p.flow_compensation,
+            max_turn_rate_deg_s: p.max_turn_rate_deg_s,
+            vertical: VerticalCommand::Altitude(p.altitude_m),
+        });
+        Amp {
+            last_steer: Steer {
+                heading: Heading::NORTH,
+                speed_mps: p.speed_mps,
+            },
+            m: Memory {
+                flow: FlowEstimate::new(p.flow_average_s, prior_flow),
+                p,
+                regions,
+                region: 0,
+                region_started_s: 0.0,
+                lhs: 1.0,
+                last_detection: None,
+                lost: Vec::new(),
+                declared: Vec::new(),
+                events: Vec::new(),
+            },
+            switching: Switching {
+                active: Box::new(Idle),
+            },
+            autopilot,
+            in_contact: false,
+            started: false,
+            reported_estimate: None,
+        }
+    }
+
+    /// The active behaviour.
+    pub fn behaviour(&self) -> BehaviourKind {
+        self.switching.active()
+    }
+
+    /// The saved lost points.
+    pub fn lost_points(&self) -> &[Vec2] {
+        &self.m.lost
+    }
+
+    /// Declared source positions so far, in order.
+    pub fn declarations(&self) -> &[Vec2] {
+        &self.m.declared
+    }
+
+    /// The course the active behaviour asked for at the last decision (before the cage, flow
+    /// compensation and rate filtering).
+    pub fn last_course(&self) -> Heading {
+        self.last_steer.heading
+    }
+
+    /// The LHS variable (+1: expected to leave the plume on its left looking upflow).
+    pub fn lhs(&self) -> f64 {
+        self.m.lhs
+    }
+
+    /// The parameters.
+    pub fn params(&self) -> &AmpParams {
+        &self.m.p
+    }
+
+    /// Where the search of subregion `k` starts: its most downflow corner (for the current flow
+    /// estimate), moved 1.5 `R` towards the subregion's centre.
+    pub fn search_start(&self, k: usize) -> Vec2 {
+        self.m.search_start(k)
+    }
+
+    /// The Track-Out goal: `L_u` upflow and `L_c` across the flow from the most upflow lost
+    /// point, on the side opposite to where the vehicle left the plume.
+    pub fn track_out_goal(&self) -> Option<Vec2> {
+        self.m.track_out_goal()
+    }
+
+    /// The source estimate: the last declaration, else the most upflow lost point.
+    fn source_estimate(&self) -> Option<Vec2> {
+        self.m
+            .declared
+            .last()
+            .copied()
+            .or_else(|| self.m.most_upflow_lost())
+    }
+}
+
+impl Planner for Amp {
+    fn decide(&mut self, s: &SensorSnapshot) -> Decision {
+        let t = s.time_s;
+        if let Some(f) = s.flow {
+            self.m.flow.add(f.time_s, f.velocity_mps);
+        }
+        let Some(pos) = s.nav.pos_m else {
+            // Without a position estimate the AMP can only hold its course (the registry refuses
+            // vehicles that never have one).
+            let command = self
+                .autopilot
+                .command(
+                    t,
+                    None,
+                    s.nav.heading,
+                    self.last_steer,
+                    self.m.flow.velocity_mps(),
+                )
+                .unwrap_or_else(|a| a.command);
+            return Decision::new(command, PlanStatus::Running);
+        };
+        if !self.started {
+            self.started = true;
+            self.switching.start_region(&mut self.m, 0, t);
+        }
+        let transit = self.switching.active() == BehaviourKind::Transit;
+        let threshold = self.m.p.threshold_v;
+        let detected = !transit && s.chem.iter().any(|c| c.reading > threshold);
+        if detected && !self.in_contact {
+            self.m.log(PlannerEvent::Detection { pos_m: pos });
+        }
+        self.in_contact = detected
+            || self
+                .m
+                .last_detection
+                .is_some_and(|(tl, _)| t - tl <= self.m.p.lambda_s)
+                && self.in_contact;
+        let percept = Percept {
+            t_s: t,
+            pos_m: pos,
+            heading: s.nav.heading,
+            detected,
+        };
+        let steer = self.switching.arbitrate(&percept, &mut self.m);
+        let status = if self.switching.active() == BehaviourKind::Done {
+            PlanStatus::Finished
+        } else {
+            PlanStatus::Running
+        };
+        let steer = steer.unwrap_or(self.last_steer);
+        self.last_steer = steer;
+        let mut telemetry = Vec::new();
+        let estimate = self.source_estimate();
+        if estimate.is_some() && estimate != self.reported_estimate {
+            self.reported_estimate = estimate;
+            telemetry.extend(estimate.map(|pos_m| Telemetry::SourceEstimate { pos_m }));
+        }
+        let flow = self.m.flow.velocity_mps();
+        let (command, status) =
+            match self
+                .autopilot
+                .command(t, Some(pos), s.nav.heading, steer, flow)
+            {
+                Ok(c) => (c, status),
+                Err(abort) => {
+                    self.m.log(PlannerEvent::CageAbort {
+                        distance_outside_m: abort.distance_outside_m,
+                    });
+                    (abort.command, PlanStatus::Abort)
+                }
+            };
+        Decision {
+            command,
+            outbox: Vec::new(),
+            events: std::mem::take(&mut self.m.events),
+            telemetry,
+            status,
+        }
+    }
+}

@@ -1,0 +1,425 @@
+//! The planner registry: every planner plumetrace can fly, with its parameters, defaults, bounds,
+//! validation and construction, in one place.
+//!
+//! A planner is configured by a table whose `kind` names it (`kind = "amp"`) and whose other keys
+//! are its parameters plus the keys every planner takes ([`CommonParams`]). Each planner's
+//! parameters are one [`params!`](plumetrace_core::params!) table in its own module; this module
+//! lists the planners once ([`registry!`]-generated [`PlannerSpec`] and [`PLANNERS`]), and
+//! everything else reads that list: `plumetrace check`, campaign `set` and `sweep` keys,
+//! `plumetrace planners`, the README's planner table and the vehicle process.
+//!
+//! Adding a planner: write its module (parameters with [`PlannerParams`], the planner behind
+//! [`plumetrace_core::Planner`]) and add one line to the `registry!` call below.
+//!
+//! What a planner needs of the mission besides its parameters ([`MissionGeometry`]: op-area,
+//! subregions, prior flow direction) is an onboard type, so a process on a vehicle builds any
+//! planner without the simulator.
+
+pub mod amp;
+
+use plumetrace_core::params::{Bounds, KeyDoc, ParamError, Params, key_path, markdown_rows};
+use plumetrace_core::{Decision, Heading, Planner, SensorSnapshot, Vec2, VehicleId, VehicleKind};
+use plumetrace_guidance::OpArea;
+use serde::de::DeserializeOwned;
+use serde::{Deserialize, Serialize};
+use std::fmt::Write as _;
+
+/// The mission as a planner needs it: where it may go and what it searches.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct MissionGeometry {
+    /// The op-area (the cage keeps the vehicle in it).
+    pub op_area: OpArea,
+    /// Subregions searched in turn (empty: the whole op-area).
+    pub subregions: Vec<OpArea>,
+    /// Flow direction assumed until the first flow measurement, compass degrees (towards).
+    pub prior_flow_toward_deg: f64,
+}
+
+impl MissionGeometry {
+    /// The prior flow direction.
+    pub fn prior_flow_toward(&self) -> Heading {
+        Heading::from_deg(self.prior_flow_toward_deg)
+    }
+
+    /// The op-area's vertices.
+    pub fn op_area_vertices(&self) -> &[Vec2] {
+        self.op_area.vertices()
+    }
+}
+
+/// Everything a planner is built from besides its parameters.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct BuildContext {
+    /// The mission geometry.
+    pub geometry: MissionGeometry,
+    /// The vehicle the planner flies.
+    pub vehicle: VehicleId,
+    /// Its kind.
+    pub vehicle_kind: VehicleKind,
+}
+
+/// The parameters of one planner, and how to make the planner from them.
+pub trait PlannerParams:
+    Params + Serialize + DeserializeOwned + Clone + std::fmt::Debug + PartialEq + Send + Sync + 'static
+{
+    /// The `kind` that selects it.
+    const KIND: &'static str;
+    /// One line saying what it is.
+    const SUMMARY: &'static str;
+    /// It needs a position estimate (vehicles without one cannot fly it).
+    const NEEDS_POSITION: bool = true;
+
+    /// Checks every value (bounds, and rules across keys); errors name `prefix.key`.
+    fn validate(&self, prefix: &str) -> Result<(), ParamError> {
+        self.check_bounds(prefix)
+    }
+
+    /// The reading above which a chemical sample is a detection, if the planner thresholds.
+    fn detection_threshold_v(&self) -> Option<f64>;
+
+    /// The planner.
+    fn build(&self, ctx: &BuildContext) -> Result<Box<dyn Planner>, ParamError>;
+}
+
+plumetrace_core::params! {
+    /// Keys every planner takes, besides `kind`.
+    pub struct CommonParams {
+        /// Time between decisions; 0 decides at every simulation step (the field planner decided at the sensor's 10 Hz).
+        decision_period_s: f64 = 0.0, "s", Bounds::non_negative(3600.0);
+    }
+}
+
+/// One planner of the registry, for lists and docs.
+#[derive(Debug, Clone, Copy)]
+pub struct PlannerEntry {
+    /// The `kind` that selects it.
+    pub kind: &'static str,
+    /// One line saying what it is.
+    pub summary: &'static str,
+    /// Its keys (without the common ones).
+    pub keys: fn() -> Vec<KeyDoc>,
+    /// It needs a position estimate.
+    pub needs_position: bool,
+}
+
+/// Reads a parameter set from a table; errors name `prefix.key` (unknown keys, wrong types,
+/// values out of bounds).
+fn parse_params<T: PlannerParamsLike>(table: toml::Table, prefix: &str) -> Result<T, ParamError> {
+    let value = toml::Value::Table(table);
+    let parsed: T = serde_path_to_error::deserialize(value).map_err(|e| {
+        let path = e.path().to_string();
+        ParamError {
+            key: if path == "." {
+                prefix.to_string()
+            } else {
+                key_path(prefix, &path)
+            },
+            message: e.into_inner().to_string(),
+        }
+    })?;
+    parsed.validate_like(prefix)?;
+    Ok(parsed)
+}
+
+/// What [`parse_params`] needs: the common keys and every planner's parameters.
+trait PlannerParamsLike: DeserializeOwned {
+    fn validate_like(&self, prefix: &str) -> Result<(), ParamError>;
+}
+
+impl<T: PlannerParams> PlannerParamsLike for T {
+    fn validate_like(&self, prefix: &str) -> Result<(), ParamError> {
+        self.validate(prefix)
+    }
+}
+
+impl PlannerParamsLike for CommonParams {
+    fn validate_like(&self, prefix: &str) -> Result<(), ParamError> {
+        self.check_bounds(prefix)
+    }
+}
+
+/// Declares the registry: the [`PlannerSpec`] enum with one variant per planner, its dispatch,
+/// and [`PLANNERS`].
+macro_rules! registry {
+    ($($variant:ident($ty:ty)),* $(,)?) => {
+        /// The parameters of one planner, by kind.
+        #[derive(Debug, Clone, PartialEq)]
+        pub enum PlannerSpec {
+            $(
+                #[doc = concat!("`kind = \"", stringify!($variant), "\"`: see [`", stringify!($ty), "`].")]
+                $variant($ty),
+            )*
+        }
+
+        /// Every planner, in registry order.
+        pub const PLANNERS: &[PlannerEntry] = &[$(
+            PlannerEntry {
+                kind: <$ty as PlannerParams>::KIND,
+                summary: <$ty as PlannerParams>::SUMMARY,
+                keys: <$ty as Params>::keys,
+                needs_position: <$ty as PlannerParams>::NEEDS_POSITION,
+            },
+        )*];
+
+        impl PlannerSpec {
+            fn parse(kind: &str, table: toml::Table, prefix: &str) -> Result<Self, ParamError> {
+                $(
+                    if kind == <$ty as PlannerParams>::KIND {
+                        return parse_params::<$ty>(table, prefix).map(PlannerSpec::$variant);
+                    }
+                )*
+                Err(ParamError::at(prefix, "kind", format!(
+                    "unknown planner '{kind}' (known: {})",
+                    PLANNERS.iter().map(|p| p.kind).collect::<Vec<_>>().join(", ")
+                )))
+            }
+
+            /// The planner's `kind`.
+            pub fn kind(&self) -> &'static str {
+                match self {
+                    $(PlannerSpec::$variant(_) => <$ty as PlannerParams>::KIND,)*
+                }
+            }
+
+            /// The detection threshold, if the planner thresholds readings.
+            pub fn detection_threshold_v(&self) -> Option<f64> {
+                match self {
+                    $(PlannerSpec::$variant(p) => p.detection_threshold_v(),)*
+                }
+            }
+
+            fn build(&self, ctx: &BuildContext) -> Result<Box<dyn Planner>, ParamError> {
+                match self {
+                    $(PlannerSpec::$variant(p) => p.build(ctx),)*
+                }
+            }
+
+            fn to_table(&self) -> toml::Table {
+                match self {
+                    $(PlannerSpec::$variant(p) => toml::Table::try_from(p).unwrap_or_default(),)*
+                }
+            }
+        }
+    };
+}
+
+registry! {
+    Amp(amp::AmpParams),
+}
+
+/// The registry entry of a kind.
+pub fn entry(kind: &str) -> Option<&'static PlannerEntry> {
+    PLANNERS.iter().find(|p| p.kind == kind)
+}
+
+/// A planner's whole configuration: its kind and parameters, and the common keys.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PlannerConfig {
+    /// Kind and parameters.
+    pub spec: PlannerSpec,
+    /// Keys every planner takes.
+    pub common: CommonParams,
+}
+
+impl PlannerConfig {
+    /// Reads a planner table (`kind` plus keys); errors name `prefix.key`.
+    pub fn from_table(table: &toml::Table, prefix: &str) -> Result<Self, ParamError> {
+        let mut t = table.clone();
+        let kinds = || {
+            PLANNERS
+                .iter()
+                .map(|p| format!("\"{}\"", p.kind))
+                .collect::<Vec<_>>()
+                .join(", ")
+        };
+        let kind = match t.remove("kind") {
+            Some(toml::Value::String(s)) => s,
+            Some(other) => {
+                return Err(ParamError::at(
+                    prefix,
+                    "kind",
+                    format!("must be a string, one of {}; got {other}", kinds()),
+                ));
+            }
+            None => {
+                return Err(ParamError::at(
+                    prefix,
+                    "kind",
+                    format!("missing: name the planner, one of {}", kinds()),
+                ));
+            }
+        };
+        let mut common = toml::Table::new();
+        for k in CommonParams::keys() {
+            if let Some(v) = t.remove(k.name) {
+                common.insert(k.name.to_string(), v);
+            }
+        }
+        Ok(PlannerConfig {
+            common: parse_params(common, prefix)?,
+            spec: PlannerSpec::parse(&kind, t, prefix)?,
+        })
+    }
+
+    /// The configuration as a table (every key, defaults included): what
+    /// [`PlannerConfig::from_table`] reads back to an equal configuration.
+    pub fn to_table(&self) -> toml::Table {
+        let mut t = toml::Table::new();
+        t.insert("kind".into(), toml::Value::String(self.kind().into()));
+        t.extend(toml::Table::try_from(&self.common).unwrap_or_default());
+        t.extend(self.spec.to_table());
+        t
+    }
+
+    /// The planner's `kind`.
+    pub fn kind(&self) -> &'static str {
+        self.spec.kind()
+    }
+
+    /// The detection threshold, if the planner thresholds readings.
+    pub fn detection_threshold_v(&self) -> Option<f64> {
+        self.spec.detection_threshold_v()
+    }
+
+    /// It needs a position estimate.
+    pub fn needs_position(&self) -> bool {
+        entry(self.kind()).is_some_and(|e| e.needs_position)
+    }
+
+    /// The planner, ready to fly.
+    pub fn build(&self, ctx: &BuildContext) -> Result<Box<dyn Planner>, ParamError> {
+        let inner = self.spec.build(ctx)?;
+        let period = self.common.decision_period_s;
+        Ok(if period > 0.0 {
+            Box::new(Periodic {
+                inner,
+                period_s: period,
+            })
+        } else {
+            inner
+        })
+    }
+}
+
+/// A planner that decides every `period_s`.
+struct Periodic {
+    inner: Box<dyn Planner>,
+    period_s: f64,
+}
+
+impl Planner for Periodic {
+    fn decide(&mut self, snapshot: &SensorSnapshot) -> Decision {
+        self.inner.decide(snapshot)
+    }
+
+    fn decision_period_s(&self) -> f64 {
+        self.period_s
+    }
+}
+
+/// Every planner with its keys as Markdown (the README's planner section is this text).
+pub fn registry_markdown() -> String {
+    let mut out = String::new();
+    out.push_str(
+        "Every planner table takes `kind` (which planner) and these keys:\n\n\
+         | key | type | default | unit | bounds | what it is |\n| --- | --- | --- | --- | --- | --- |\n",
+    );
+    out.push_str(&markdown_rows(&CommonParams::keys()));
+    for p in PLANNERS {
+        let _ = write!(
+            out,
+            "\n### `kind = \"{}\"`\n\n{}.\n\n| key | type | default | unit | bounds | what it is |\n| --- | --- | --- | --- | --- | --- |\n",
+            p.kind, p.summary
+        );
+        out.push_str(&markdown_rows(&(p.keys)()));
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn table(text: &str) -> toml::Table {
+        text.parse().unwrap_or_else(|e| panic!("{e}"))
+    }
+
+    #[test]
+    fn a_table_becomes_a_config_and_back() {
+        let c = PlannerConfig::from_table(
+            &table("kind = \"amp\"\nbeta_deg = 30.0\ndecision_period_s = 0.5\nlost_point_eviction = \"most_downflow\""),
+            "planners.tracer",
+        )
+        .unwrap_or_else(|e| panic!("{e}"));
+        assert_eq!(c.kind(), "amp");
+        assert_eq!(c.common.decision_period_s, 0.5);
+        let t = c.to_table();
+        assert_eq!(t["beta_deg"].as_float(), Some(30.0));
+        assert_eq!(t["lost_point_eviction"].as_str(), Some("most_downflow"));
+        assert_eq!(
+            t["lambda_s"].as_float(),
+            Some(5.0),
+            "omitted keys take their default"
+        );
+        let back = PlannerConfig::from_table(&c.to_table(), "x").unwrap_or_else(|e| panic!("{e}"));
+        assert_eq!(back, c);
+    }
+
+    #[test]
+    fn bad_tables_name_the_key() {
+        let cases = [
+            ("beta_deg = 3.0", "planners.a.kind", "missing"),
+            (
+                "kind = \"moth\"",
+                "planners.a.kind",
+                "unknown planner 'moth'",
+            ),
+            ("kind = 3", "planners.a.kind", "must be a string"),
+            (
+                "kind = \"amp\"\nbeta = 3.0",
+                "planners.a.beta",
+                "unknown field `beta`",
+            ),
+            (
+                "kind = \"amp\"\nbeta_deg = \"x\"",
+                "planners.a.beta_deg",
+                "invalid type",
+            ),
+            (
+                "kind = \"amp\"\nbeta_deg = 95.0",
+                "planners.a.beta_deg",
+                "<= 90",
+            ),
+            ("kind = \"amp\"\nn_re = 0", "planners.a.n_re", "1..=50"),
+            (
+                "kind = \"amp\"\ndecision_period_s = -1.0",
+                "planners.a.decision_period_s",
+                ">= 0",
+            ),
+            (
+                "kind = \"amp\"\ndeclaration = \"nearest\"",
+                "planners.a.declaration",
+                "unknown variant",
+            ),
+        ];
+        for (text, key, message) in cases {
+            let e = PlannerConfig::from_table(&table(text), "planners.a")
+                .err()
+                .unwrap_or_else(|| panic!("accepted: {text}"));
+            assert_eq!(e.key, key, "{text}: {e}");
+            assert!(e.message.contains(message), "{text}: {e}");
+        }
+    }
+
+    #[test]
+    fn the_markdown_lists_every_planner_and_key() {
+        let md = registry_markdown();
+        for p in PLANNERS {
+            assert!(md.contains(&format!("`kind = \"{}\"`", p.kind)));
+            for k in (p.keys)() {
+                assert!(md.contains(&format!("| `{}` |", k.name)), "{}", k.name);
+            }
+        }
+        assert!(md.contains("| `decision_period_s` |"));
+    }
+}

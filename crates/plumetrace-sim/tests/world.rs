@@ -1,0 +1,410 @@
+//! The world's stages with hand-made planners: incidents, non-finite commands, message delivery
+//! with delay and loss, decision periods, several vehicles with different planners.
+
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
+use plumetrace_core::{
+    Command, Decision, Heading, Link, MessageBody, Outgoing, PlanStatus, Planner, Recipient,
+    SensorSnapshot, Vec2, Vec3, VehicleId, VerticalCommand,
+};
+use plumetrace_env::flow::{MeanFlow, UniformFlow};
+use plumetrace_env::steady::GaussianPlume;
+use plumetrace_env::{Environment, FlowModel, ObstacleSet, Plume, Rect, SoftObstacle};
+use plumetrace_sim::{
+    ChannelParams, ChemSensorParams, CommsParams, FlowSensorParams, Incident, LossReason,
+    NavParams, SimVehicle, Vehicle, VehicleParams, World, WorldEvent,
+};
+
+const DT: f64 = 0.1;
+
+fn env(obstacles: Vec<SoftObstacle>) -> Environment {
+    let domain = Rect::new(0.0, 200.0, 0.0, 200.0).unwrap();
+    let mean = MeanFlow::Steady {
+        speed_mps: 0.1,
+        toward_deg: 90.0,
+    };
+    let plume = GaussianPlume::new(
+        Vec3::new(20.0, 100.0, 0.0),
+        1.0,
+        0.1,
+        90.0,
+        0.05,
+        0.01,
+        Some(10.0),
+    )
+    .unwrap();
+    Environment::new(
+        domain,
+        FlowModel::Uniform(UniformFlow::new(mean).unwrap()),
+        Plume::Steady(Box::new(plume)),
+        ObstacleSet::new(obstacles),
+        DT,
+        1,
+    )
+    .unwrap()
+}
+
+fn vehicle(
+    id: u32,
+    kind: plumetrace_core::VehicleKind,
+    pos: (f64, f64),
+    heading: f64,
+) -> SimVehicle {
+    let params = match kind {
+        plumetrace_core::VehicleKind::Auv => VehicleParams::auv(),
+        plumetrace_core::VehicleKind::Surface => VehicleParams::surface(),
+    };
+    SimVehicle::new(
+        format!("v{id}"),
+        Vehicle::new(
+            VehicleId(id),
+            params,
+            Vec2::new(pos.0, pos.1),
+            2.0,
+            Heading::from_deg(heading),
+        ),
+        NavParams::lbl(),
+        ChemSensorParams::default(),
+        FlowSensorParams::default(),
+        None,
+        7,
+    )
+}
+
+fn auv(id: u32, pos: (f64, f64), heading: f64) -> SimVehicle {
+    vehicle(id, plumetrace_core::VehicleKind::Auv, pos, heading)
+}
+
+fn command(heading_deg: f64, speed_mps: f64) -> Command {
+    Command {
+        heading: Heading::from_deg(heading_deg),
+        speed_mps,
+        vertical: VerticalCommand::Altitude(2.0),
+    }
+}
+
+/// Holds a heading and speed; counts its decisions and the samples it received.
+struct Hold {
+    command: Command,
+    period_s: f64,
+    decisions: std::sync::Arc<std::sync::Mutex<Vec<(f64, usize)>>>,
+}
+
+impl Planner for Hold {
+    fn decide(&mut self, s: &SensorSnapshot) -> Decision {
+        if let Ok(mut d) = self.decisions.lock() {
+            d.push((s.time_s, s.chem.len()));
+        }
+        Decision::new(self.command, PlanStatus::Running)
+    }
+
+    fn decision_period_s(&self) -> f64 {
+        self.period_s
+    }
+}
+
+fn hold(heading_deg: f64, speed: f64) -> Box<dyn Planner> {
+    Box::new(Hold {
+        command: command(heading_deg, speed),
+        period_s: 0.0,
+        decisions: Default::default(),
+    })
+}
+
+#[test]
+fn a_vehicle_that_enters_kelp_or_leaves_the_domain_is_stopped_with_an_incident() {
+    let kelp = SoftObstacle::new(
+        "kelp",
+        &[[60.0, 40.0], [80.0, 40.0], [80.0, 60.0], [60.0, 60.0]],
+        "obstacles[0]",
+    )
+    .unwrap();
+    let mut w = World::new(
+        env(vec![kelp]),
+        vec![auv(0, (40.0, 50.0), 90.0), auv(1, (180.0, 150.0), 90.0)],
+        DT,
+        Some(10.0),
+    )
+    .unwrap();
+    let mut planners = vec![Some(hold(90.0, 2.0)), Some(hold(90.0, 2.0))];
+    let mut incidents = Vec::new();
+    for _ in 0..400 {
+        let r = w.step(&mut planners).unwrap();
+        for (id, e) in r.events {
+            if let WorldEvent::Incident { what } = e {
+                incidents.push((id, what, w.time_s()));
+            }
+        }
+    }
+    assert_eq!(incidents.len(), 2, "{incidents:?}");
+    let kelp_hit = incidents.iter().find(|i| i.0 == VehicleId(0)).unwrap();
+    assert_eq!(kelp_hit.1, Incident::Collided);
+    // 20 m at about 2 m/s (plus the current), after the speed builds up.
+    assert!(kelp_hit.2 > 8.0 && kelp_hit.2 < 14.0, "{kelp_hit:?}");
+    let out = incidents.iter().find(|i| i.0 == VehicleId(1)).unwrap();
+    assert_eq!(out.1, Incident::LeftDomain);
+    // Stopped vehicles stay where they stopped and decide no more.
+    let p = w.vehicles()[0].vehicle.state.pos_m;
+    let r = w.step(&mut planners).unwrap();
+    assert!(r.decisions.iter().all(Option::is_none));
+    assert_eq!(w.vehicles()[0].vehicle.state.pos_m, p);
+    assert!(!w.vehicles()[0].active && !w.vehicles()[1].active);
+}
+
+/// Returns a non-finite command every other decision.
+struct Broken {
+    n: u32,
+}
+
+impl Planner for Broken {
+    fn decide(&mut self, _: &SensorSnapshot) -> Decision {
+        self.n += 1;
+        let speed = if self.n.is_multiple_of(2) {
+            f64::NAN
+        } else {
+            1.5
+        };
+        Decision::new(command(0.0, speed), PlanStatus::Running)
+    }
+}
+
+#[test]
+fn a_non_finite_command_is_recorded_and_replaced_by_the_previous_one() {
+    let mut w = World::new(
+        env(vec![]),
+        vec![auv(0, (100.0, 20.0), 0.0)],
+        DT,
+        Some(10.0),
+    )
+    .unwrap();
+    let mut planners: Vec<Option<Box<dyn Planner>>> = vec![Some(Box::new(Broken { n: 0 }))];
+    let r = w.step(&mut planners).unwrap();
+    assert!(r.events.is_empty());
+    assert_eq!(w.vehicles()[0].command.speed_mps, 1.5);
+    let r = w.step(&mut planners).unwrap();
+    assert!(
+        matches!(&r.events[..], [(VehicleId(0), WorldEvent::NonFiniteCommand { command })] if command.contains("NaN")),
+        "{:?}",
+        r.events
+    );
+    assert_eq!(
+        w.vehicles()[0].command.speed_mps,
+        1.5,
+        "the previous command stays"
+    );
+    for _ in 0..100 {
+        w.step(&mut planners).unwrap();
+    }
+    let s = w.vehicles()[0].vehicle.state;
+    assert!(s.pos_m.x.is_finite() && s.pos_m.y > 20.0 && s.speed_mps > 1.0);
+}
+
+/// What a talker heard: receive time, send time, text.
+type Heard = std::sync::Arc<std::sync::Mutex<Vec<(f64, f64, String)>>>;
+
+/// Broadcasts its decision count as text over `link` at every decision; records what it hears.
+struct Talker {
+    link: Link,
+    heard: Heard,
+    n: u32,
+}
+
+impl Planner for Talker {
+    fn decide(&mut self, s: &SensorSnapshot) -> Decision {
+        if let Ok(mut h) = self.heard.lock() {
+            for m in &s.inbox {
+                if let MessageBody::Text { text } = &m.body {
+                    h.push((s.time_s, m.sent_s, text.clone()));
+                }
+            }
+        }
+        self.n += 1;
+        let mut d = Decision::new(command(0.0, 0.0), PlanStatus::Running);
+        d.outbox.push(Outgoing {
+            to: Recipient::Broadcast,
+            link: self.link,
+            body: MessageBody::Text {
+                text: self.n.to_string(),
+            },
+        });
+        d
+    }
+}
+
+fn talkers(
+    comms: CommsParams,
+    link: Link,
+    separation_m: f64,
+) -> (World, Vec<Option<Box<dyn Planner>>>, Heard) {
+    let heard = std::sync::Arc::new(std::sync::Mutex::new(Vec::new()));
+    let w = World::with_comms(
+        env(vec![]),
+        vec![
+            auv(0, (10.0, 100.0), 0.0),
+            auv(1, (10.0 + separation_m, 100.0), 0.0),
+        ],
+        DT,
+        Some(10.0),
+        comms,
+        11,
+    )
+    .unwrap();
+    let planners: Vec<Option<Box<dyn Planner>>> = vec![
+        Some(Box::new(Talker {
+            link,
+            heard: Default::default(),
+            n: 0,
+        })),
+        Some(Box::new(Talker {
+            link,
+            heard: heard.clone(),
+            n: 0,
+        })),
+    ];
+    (w, planners, heard)
+}
+
+#[test]
+fn messages_arrive_after_the_channels_delay_or_are_lost() {
+    // Ideal radio: a message sent at a decision arrives at the next one.
+    let (mut w, mut p, heard) = talkers(CommsParams::default(), Link::Radio, 150.0);
+    for _ in 0..10 {
+        w.step(&mut p).unwrap();
+    }
+    let h = heard.lock().unwrap().clone();
+    assert_eq!(h.len(), 9);
+    assert!(
+        h.iter().all(|(t, sent, _)| (t - sent - DT).abs() < 1e-9),
+        "{h:?}"
+    );
+    // Acoustic: 150 m at 1500 m/s plus 0.3 s latency = 0.4 s; 20 % lost.
+    let acoustic = ChannelParams {
+        latency_s: 0.3,
+        sound_speed_mps: Some(1500.0),
+        loss_probability: 0.2,
+        max_range_m: None,
+    };
+    let comms = CommsParams {
+        acoustic,
+        radio: ChannelParams::IDEAL,
+    };
+    let (mut w, mut p, heard) = talkers(comms, Link::Acoustic, 150.0);
+    let mut lost = 0;
+    let mut delivered = 0;
+    for _ in 0..5000 {
+        let r = w.step(&mut p).unwrap();
+
+        for (id, e) in &r.events {
+            match e {
+                WorldEvent::MessageLost { reason, .. } if *id == VehicleId(1) => {
+                    assert_eq!(*reason, LossReason::Dropped);
+                    lost += 1;
+                }
+                WorldEvent::MessageDelivered { .. } if *id == VehicleId(1) => delivered += 1,
+                _ => {}
+            }
+        }
+    }
+    let h = heard.lock().unwrap().clone();
+    assert_eq!(h.len(), delivered);
+    // Delivered at the first step at or after sent + 0.4 s (0.4 s is four steps; rounding
+    // may put the arrival just after the fourth).
+    assert!(
+        h.iter()
+            .all(|(t, sent, _)| t - sent > 0.4 - 1e-9 && t - sent < 0.4 + DT + 1e-9),
+        "{:?}",
+        &h[..3]
+    );
+    let sent = lost + delivered + w.messages_in_flight();
+    let rate = lost as f64 / sent as f64;
+    // About 5,000 messages at p = 0.2: sd 0.0057.
+    assert!((rate - 0.2).abs() < 0.025, "loss rate {rate}");
+    // Out of range: nothing arrives.
+    let short = CommsParams {
+        acoustic: ChannelParams {
+            max_range_m: Some(100.0),
+            ..ChannelParams::IDEAL
+        },
+        radio: ChannelParams::IDEAL,
+    };
+    let (mut w, mut p, heard) = talkers(short, Link::Acoustic, 150.0);
+    let r = w.step(&mut p).unwrap();
+    assert!(r.events.iter().any(|(_, e)| matches!(
+        e,
+        WorldEvent::MessageLost {
+            reason: LossReason::OutOfRange,
+            ..
+        }
+    )));
+    assert!(heard.lock().unwrap().is_empty());
+}
+
+#[test]
+fn vehicles_with_different_planners_decide_at_their_own_periods() {
+    let fast = std::sync::Arc::new(std::sync::Mutex::new(Vec::new()));
+    let slow = std::sync::Arc::new(std::sync::Mutex::new(Vec::new()));
+    let mut w = World::new(
+        env(vec![]),
+        vec![
+            auv(0, (50.0, 50.0), 0.0),
+            vehicle(
+                1,
+                plumetrace_core::VehicleKind::Surface,
+                (50.0, 150.0),
+                90.0,
+            ),
+            auv(2, (150.0, 50.0), 0.0),
+        ],
+        DT,
+        Some(10.0),
+    )
+    .unwrap();
+    let mut planners: Vec<Option<Box<dyn Planner>>> = vec![
+        Some(Box::new(Hold {
+            command: command(0.0, 2.0),
+            period_s: 0.0,
+            decisions: fast.clone(),
+        })),
+        Some(Box::new(Hold {
+            command: command(90.0, 1.0),
+            period_s: 1.0,
+            decisions: slow.clone(),
+        })),
+        None,
+    ];
+    let mut snapshots = 0;
+    w.record_snapshots(true);
+    for _ in 0..100 {
+        let r = w.step(&mut planners).unwrap();
+        snapshots += r.snapshots.iter().flatten().count();
+        if let Some(s) = &r.snapshots[1] {
+            assert_eq!(s.nav.altitude_m, None, "surface craft have no altimeter");
+            assert_eq!(s.nav.depth_m, Some(0.0));
+        }
+        if let Some(s) = &r.snapshots[0] {
+            assert!(s.nav.altitude_m.is_some_and(|a| (a - 2.0).abs() < 1.0));
+            assert!(s.nav.pos_m.is_some());
+        }
+    }
+    let fast = fast.lock().unwrap().clone();
+    let slow = slow.lock().unwrap().clone();
+    assert_eq!(fast.len(), 100, "every step");
+    assert_eq!(slow.len(), 10, "every second");
+    assert_eq!(snapshots, 110);
+    // The 10 Hz chemical samples accumulate between the slow planner's decisions.
+    assert!(slow[1..].iter().all(|(_, n)| *n == 10), "{slow:?}");
+    assert!(
+        slow.iter()
+            .zip(0..)
+            .all(|((t, _), k)| (t - f64::from(k)).abs() < 1e-9)
+    );
+    // Each vehicle flew its own command; the one without a planner stayed put (drifting).
+    let v = w.vehicles();
+    assert!(v[0].vehicle.state.pos_m.y > 60.0);
+    assert!(v[1].vehicle.state.pos_m.x > 55.0 && (v[1].vehicle.state.pos_m.y - 150.0).abs() < 1.0);
+    assert!(
+        (v[2].vehicle.state.pos_m - Vec2::new(151.0, 50.0)).norm() < 0.1,
+        "{:?}",
+        v[2].vehicle.state.pos_m
+    );
+}
