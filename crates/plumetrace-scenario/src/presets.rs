@@ -22,6 +22,11 @@ pub const PRESETS: &[Preset] = &[
         toml: include_str!("../presets/demo.toml"),
     },
     Preset {
+        name: "demo-survey",
+        summary: "the demo site surveyed by a lawnmower, declaring at the strongest reading (the exhaustive baseline)",
+        toml: include_str!("../presets/demo-survey.toml"),
+    },
+    Preset {
         name: "duck-2003-st",
         summary: "Duck 2003 single-source mission: 1094 m x 367 m op-area, 0.10-0.15 m/s, about 1 km of plume",
         toml: include_str!("../presets/duck-2003-st.toml"),

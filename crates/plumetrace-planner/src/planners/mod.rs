@@ -16,6 +16,7 @@
 //! planner without the simulator.
 
 pub mod amp;
+pub mod lawnmower;
 
 use plumetrace_core::params::{Bounds, KeyDoc, ParamError, Params, key_path, markdown_rows};
 use plumetrace_core::{Decision, Heading, Planner, SensorSnapshot, Vec2, VehicleId, VehicleKind};
@@ -205,6 +206,7 @@ macro_rules! registry {
 
 registry! {
     Amp(amp::AmpParams),
+    Lawnmower(lawnmower::LawnmowerParams),
 }
 
 /// The registry entry of a kind.
