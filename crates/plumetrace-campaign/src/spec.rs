@@ -383,7 +383,8 @@ impl Campaign {
                 key: format!("configs.{}.planner", c.name),
                 message: m,
             })?;
-            set_key(&mut t, &path, toml::Value::Table(p.clone())).map_err(|m| {
+            let segments: Vec<&str> = path.split('.').collect();
+            set_path(&mut t, &segments, toml::Value::Table(p.clone())).map_err(|m| {
                 CampaignError::Invalid {
                     file: self.path.display().to_string(),
                     key: format!("configs.{}.planner", c.name),
@@ -556,6 +557,13 @@ pub fn set_key(table: &mut toml::Table, key: &str, value: toml::Value) -> Result
         planner = planner_path(table)?;
         planner.split('.').chain([key]).collect()
     };
+    set_path(table, &path, value)
+}
+
+/// Sets the value at `path` (table keys, or whole numbers indexing arrays), making tables on
+/// the way.
+fn set_path(table: &mut toml::Table, path: &[&str], value: toml::Value) -> Result<(), String> {
+    let key = path.join(".");
     if path.iter().any(|s| s.is_empty()) {
         return Err(format!("'{key}' is not a key path"));
     }
@@ -649,6 +657,34 @@ mod tests {
         let e = set_key(&mut two, "beta_deg", toml::Value::Float(25.0));
         assert!(e.is_err_and(|m| m.contains("planners.a, planners.b")));
         assert!(set_key(&mut two, "planners.b.beta_deg", toml::Value::Float(25.0)).is_ok());
+    }
+
+    #[test]
+    fn a_config_can_replace_the_scenarios_planner_and_the_registry_checks_it() {
+        let text = "name = \"c\"\nseed = 1\nseeds = 1\nscenarios = [\"demo\"]\n\
+                    [[configs]]\nname = \"survey\"\n[configs.planner]\nkind = \"lawnmower\"\n\
+                    [configs.set]\nlane_spacing_m = 30.0\n";
+        let path = Path::new("c.toml");
+        let file = parse_campaign(text, path).unwrap();
+        let c = Campaign::resolve(file, path, text.to_string(), true).unwrap();
+        let t = c.group_table(0, 0, 0).unwrap();
+        let planner = t["planner"].as_table().unwrap();
+        assert_eq!(planner["kind"].as_str(), Some("lawnmower"));
+        assert_eq!(planner["lane_spacing_m"].as_float(), Some(30.0));
+        assert!(
+            !planner.contains_key("mapping_lines"),
+            "the AMP's keys are gone"
+        );
+        assert!(c.check_groups().is_ok());
+        // A key the lawnmower does not have is refused with its path.
+        let bad = text.replace("lane_spacing_m = 30.0", "beta_deg = 30.0");
+        let file = parse_campaign(&bad, path).unwrap();
+        let c = Campaign::resolve(file, path, bad.clone(), true).unwrap();
+        let e = c.check_groups().unwrap_err().to_string();
+        assert!(
+            e.contains("planner.beta_deg") && e.contains("unknown field"),
+            "{e}"
+        );
     }
 
     #[test]

@@ -257,3 +257,22 @@ fn malformed_campaigns_are_rejected_with_their_key_path() {
         assert!(msg.contains("campaign.toml"), "no file in: {msg}");
     }
 }
+
+#[test]
+fn every_shipped_example_campaign_loads_and_builds_every_group() {
+    let dir = std::path::Path::new(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../examples/campaigns"
+    ));
+    let mut n = 0;
+    for entry in std::fs::read_dir(dir).unwrap() {
+        let path = entry.unwrap().path();
+        if path.extension().is_some_and(|e| e == "toml") {
+            let c = plumetrace_campaign::Campaign::load(&path, Some(1))
+                .unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+            assert!(!c.runs().is_empty());
+            n += 1;
+        }
+    }
+    assert!(n >= 3, "found {n} example campaigns");
+}

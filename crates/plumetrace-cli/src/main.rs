@@ -88,7 +88,12 @@ fn dispatch(cli: Cli) -> Result<()> {
             Ok(())
         }
         Command::Check { file } => check(&file),
-        Command::Replay(args) => replay::run(&args),
+        Command::Replay(args) => {
+            if !replay::run(&args)? {
+                std::process::exit(replay::DIFFER);
+            }
+            Ok(())
+        }
         Command::Campaign(args) => campaign::run(&args),
         Command::Merge(args) => campaign::run_merge(&args),
         Command::Bench(b) => bench::run(&b),

@@ -36,11 +36,13 @@ pub fn run(sc: BuiltScenario, out: &Path, stats: bool, snapshot_log: bool) -> Re
             mission.seed(),
             &mission.vehicle_names(),
             mission.planned(),
-        );
+        )
+        .map_err(anyhow::Error::msg)
+        .context("writing the snapshot log's header")?;
         let path = out.join(SNAPSHOT_LOG);
         let writer = SnapshotLogWriter::create(&path, &header)
             .with_context(|| format!("creating {}", path.display()))?;
-        mission.observe(Box::new(writer));
+        mission.observe(Box::new(writer))?;
     }
     let progress = crate::progress::Progress::new(mission.time_limit_s().round() as u64, "s");
     mission.run(&mut |t, _| progress.tick(t.round() as u64))?;
@@ -96,10 +98,7 @@ pub fn run_line(run: &MissionRun, name: &str, wall: f64) -> String {
     } else {
         "no source declared".to_string()
     };
-    let ended = match s.ended.reason {
-        plumetrace_mission::EndReason::PlannersDone => "planners done",
-        plumetrace_mission::EndReason::TimeLimit => "time limit",
-    };
+    let ended = plumetrace_core::variant_name(&s.ended.reason).unwrap_or("?");
     format!(
         "{name}: {}; {result}; mission ended at {:.0} s ({ended}), {wall:.1} s of wall time",
         s.outcome.name(),

@@ -1,7 +1,10 @@
 //! `plumetrace replay LOG`: feed a snapshot log to fresh planners built from its header (or from
 //! another planner table) and report where their decisions differ from the logged ones.
+//!
+//! Exit status: 0 when every decision is the same, 3 when some differ, 1 on an error.
 
 use anyhow::{Context, Result};
+use plumetrace_core::variant_name;
 use std::path::PathBuf;
 
 /// Arguments of `plumetrace replay`.
@@ -9,26 +12,40 @@ use std::path::PathBuf;
 pub struct ReplayArgs {
     /// The snapshot log (`snapshots.jsonl.gz` written by `plumetrace run`).
     pub log: PathBuf,
-    /// A planner table (TOML with `kind` and keys) to replay every logged vehicle with instead
-    /// of its own configuration.
+    /// A planner table (TOML: `kind` and its keys) to replay with instead of the logged
+    /// configuration.
     #[arg(long)]
     pub planner_file: Option<PathBuf>,
+    /// With `--planner-file`: replace only this vehicle's planner (its index in the scenario);
+    /// the others replay their own.
+    #[arg(long, requires = "planner_file")]
+    pub vehicle: Option<u32>,
 }
 
-/// Replays and prints the report; exits with an error if the log cannot be read.
-pub fn run(args: &ReplayArgs) -> Result<()> {
+/// The exit status when decisions differ.
+pub const DIFFER: i32 = 3;
+
+/// Replays and prints the report; returns whether every decision was the same.
+pub fn run(args: &ReplayArgs) -> Result<bool> {
     let other: Option<toml::Table> = match &args.planner_file {
         Some(p) => {
             let text =
                 std::fs::read_to_string(p).with_context(|| format!("reading {}", p.display()))?;
-            Some(text.parse().with_context(|| format!("{}", p.display()))?)
+            let table: toml::Table = text.parse().with_context(|| format!("{}", p.display()))?;
+            // Checked here so that errors name this file, not the log's planner.
+            plumetrace_planner::PlannerConfig::from_table(&table, "")
+                .with_context(|| format!("{}", p.display()))?;
+            Some(table)
         }
         None => None,
     };
     let log = plumetrace_mission::snapshot_log::open(&args.log)
         .with_context(|| format!("opening {}", args.log.display()))?;
-    let report = plumetrace_mission::snapshot_log::replay(log, &|_| other.clone())
-        .with_context(|| format!("{}", args.log.display()))?;
+    let only = args.vehicle;
+    let report = plumetrace_mission::snapshot_log::replay(log, &|v| {
+        other.clone().filter(|_| only.is_none_or(|o| o == v))
+    })
+    .with_context(|| format!("{}", args.log.display()))?;
     println!(
         "{}: {} decisions replayed, {} differ",
         args.log.display(),
@@ -37,17 +54,17 @@ pub fn run(args: &ReplayArgs) -> Result<()> {
     );
     for d in &report.first {
         println!(
-            "  line {}, vehicle {}, t = {:.1} s: logged heading {:.2} deg, speed {:.2} m/s, status {:?}; replayed heading {:.2} deg, speed {:.2} m/s, status {:?}",
+            "  line {}, vehicle {}, t = {:.1} s: logged heading {:.2} deg, speed {:.2} m/s, {}; replayed heading {:.2} deg, speed {:.2} m/s, {}",
             d.line,
             d.vehicle,
             d.t_s,
             d.logged.command.heading.deg(),
             d.logged.command.speed_mps,
-            d.logged.status,
+            variant_name(&d.logged.status).unwrap_or("?"),
             d.replayed.command.heading.deg(),
             d.replayed.command.speed_mps,
-            d.replayed.status,
+            variant_name(&d.replayed.status).unwrap_or("?"),
         );
     }
-    Ok(())
+    Ok(report.differing == 0)
 }

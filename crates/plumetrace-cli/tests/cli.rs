@@ -266,15 +266,33 @@ fn mission_run_writes_summary_trajectory_events_and_plot() {
     );
     let other = dir.path().join("other.toml");
     std::fs::write(&other, "kind = \"amp\"\nspeed_mps = 1.5\n").unwrap();
-    let replayed = stdout(run_ok(&[
-        "replay",
-        log.to_str().unwrap(),
-        "--planner-file",
-        other.to_str().unwrap(),
-    ]));
+    let out = bin()
+        .args(["replay", log.to_str().unwrap(), "--planner-file"])
+        .arg(&other)
+        .output()
+        .unwrap();
+    assert_eq!(
+        out.status.code(),
+        Some(3),
+        "decisions differ: exit status 3"
+    );
+    let replayed = stdout(out);
     assert!(
-        !replayed.contains(", 0 differ") && replayed.contains("line "),
+        !replayed.contains(", 0 differ") && replayed.contains("line 2, vehicle 0"),
         "{replayed}"
+    );
+    // A bad planner file is named in the error.
+    std::fs::write(&other, "kind = \"amp\"\nspeed = 1.5\n").unwrap();
+    let out = bin()
+        .args(["replay", log.to_str().unwrap(), "--planner-file"])
+        .arg(&other)
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("other.toml") && err.contains("speed: unknown field"),
+        "{err}"
     );
 }
 
@@ -323,7 +341,8 @@ fn check_names_bad_planner_and_mission_keys() {
         (
             format!(
                 "{}\n[planners.tracer]\nkind = \"amp\"\nlamda_s = 5.0\n",
-                demo.replace("x_m = 470.0", "x_m = 470.0\nplanner = \"tracer\"")
+                without_legacy_planner(demo)
+                    .replace("x_m = 470.0", "x_m = 470.0\nplanner = \"tracer\"")
             ),
             "planners.tracer.lamda_s: unknown field",
         ),
@@ -367,6 +386,15 @@ fn check_names_bad_planner_and_mission_keys() {
         ok.contains("mission of up to 2400 s") && ok.contains("auv flies amp (planner)"),
         "{ok}"
     );
+}
+
+/// A scenario's text without its `[planner]` table (up to the next table, `[output]`).
+fn without_legacy_planner(text: &str) -> String {
+    let (a, b) = (
+        text.find("[planner]").unwrap(),
+        text.find("[output]").unwrap(),
+    );
+    format!("{}{}", &text[..a], &text[b..])
 }
 
 fn stdout(out: std::process::Output) -> String {

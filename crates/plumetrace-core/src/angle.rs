@@ -28,6 +28,7 @@ pub fn wrap_rad_pi(rad: f64) -> f64 {
 /// A compass heading: clockwise from North, stored in radians in [0, 2 pi).
 #[derive(Debug, Clone, Copy, PartialEq, PartialOrd, Serialize, Deserialize)]
 pub struct Heading {
+    #[serde(with = "crate::any_f64")]
     rad: f64,
 }
 

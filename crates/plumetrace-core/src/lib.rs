@@ -13,6 +13,7 @@
 //! - time in seconds, as an integer step count times a fixed `dt`.
 
 pub mod angle;
+pub mod any_f64;
 pub mod frame;
 pub mod message;
 pub mod names;

@@ -102,7 +102,8 @@ impl Bounds {
                     Err(format!("must be {}, got {v}", self.describe()))
                 }
             }
-            _ => Ok(()),
+            Bounds::Any => Ok(()),
+            Bounds::Whole { .. } => Err("whole-number bounds on a real-valued key".into()),
         }
     }
 
@@ -111,7 +112,8 @@ impl Bounds {
             Bounds::Whole { min, max } if !(min..=max).contains(&v) => {
                 Err(format!("must be {}, got {v}", self.describe()))
             }
-            _ => Ok(()),
+            Bounds::Whole { .. } | Bounds::Any => Ok(()),
+            Bounds::Real { .. } => Err("real-valued bounds on a whole-number key".into()),
         }
     }
 }
@@ -399,6 +401,11 @@ mod tests {
             assert_eq!(b.check_real(v).is_ok(), ok, "{b:?} {v}");
         }
         assert!(Bounds::whole(1, 5).check_whole(0).is_err());
+        assert!(
+            Bounds::whole(1, 5).check_real(3.0).is_err(),
+            "bounds of the wrong type"
+        );
+        assert!(Bounds::positive(5.0).check_whole(3).is_err());
         assert!(Bounds::whole(1, 5).check_whole(5).is_ok());
     }
 

@@ -105,6 +105,16 @@ pub enum PlannerEvent {
     },
 }
 
+impl PlannerEvent {
+    /// The behaviour switched to, if this is a behaviour switch.
+    pub fn behaviour(&self) -> Option<BehaviourKind> {
+        match self {
+            PlannerEvent::Behaviour { behaviour } => Some(*behaviour),
+            _ => None,
+        }
+    }
+}
+
 /// What happened to a subregion.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]

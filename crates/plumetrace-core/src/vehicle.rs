@@ -96,9 +96,9 @@ pub struct SensorSnapshot {
 #[serde(rename_all = "snake_case")]
 pub enum VerticalCommand {
     /// Height above the seabed, m.
-    Altitude(f64),
+    Altitude(#[serde(with = "crate::any_f64")] f64),
     /// Depth below the surface, m.
-    Depth(f64),
+    Depth(#[serde(with = "crate::any_f64")] f64),
     /// Stay at the surface.
     Surface,
 }
@@ -109,6 +109,7 @@ pub struct Command {
     /// Commanded compass heading.
     pub heading: Heading,
     /// Commanded water-relative speed, m/s.
+    #[serde(with = "crate::any_f64")]
     pub speed_mps: f64,
     /// Commanded vertical behaviour.
     pub vertical: VerticalCommand,

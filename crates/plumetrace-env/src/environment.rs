@@ -25,22 +25,6 @@ impl std::fmt::Debug for Plume {
 }
 
 impl Plume {
-    /// Names and one-line descriptions of the plume models, for `list` commands and docs.
-    pub const REGISTRY: &'static [(&'static str, &'static str)] = &[
-        (
-            "filaments",
-            "Farrell et al. 2002 filament (puff) model: Poisson release, meander, intermittency",
-        ),
-        (
-            "gaussian",
-            "steady Gaussian plume of a continuous source in a uniform current (freshwater case)",
-        ),
-        (
-            "gridded",
-            "steady concentration grid read from a CSV file (x_m,y_m[,z_m],concentration)",
-        ),
-    ];
-
     /// The filament plume, if this is one.
     pub fn filaments(&self) -> Option<&FilamentPlume> {
         match self {

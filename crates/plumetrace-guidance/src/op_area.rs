@@ -28,12 +28,28 @@ pub struct EdgeInfo {
     pub inside: bool,
 }
 
-/// A simple polygon, vertices in order (either winding), `(east, north)` in metres.
+/// A simple polygon, vertices in order (either winding), `(east, north)` in metres. It is written
+/// as its list of vertices and read back through [`OpArea::new`], so a file cannot make an
+/// invalid one.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(try_from = "Vec<Vec2>", into = "Vec<Vec2>")]
 pub struct OpArea {
     vertices: Vec<Vec2>,
     /// +1 for anticlockwise vertex order, -1 for clockwise.
     orientation: f64,
+}
+
+impl TryFrom<Vec<Vec2>> for OpArea {
+    type Error = OpAreaError;
+    fn try_from(vertices: Vec<Vec2>) -> Result<Self, OpAreaError> {
+        OpArea::new(vertices)
+    }
+}
+
+impl From<OpArea> for Vec<Vec2> {
+    fn from(a: OpArea) -> Self {
+        a.vertices
+    }
 }
 
 impl OpArea {
@@ -188,6 +204,18 @@ impl OpArea {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn reads_back_only_valid_areas() {
+        let a = OpArea::rectangle(0.0, 10.0, 0.0, 5.0).unwrap_or_else(|e| panic!("{e}"));
+        let text = serde_json::to_string(&a).unwrap_or_default();
+        assert_eq!(text, "[[0.0,0.0],[10.0,0.0],[10.0,5.0],[0.0,5.0]]");
+        let back: OpArea = serde_json::from_str(&text).unwrap_or_else(|e| panic!("{e}"));
+        assert_eq!(back, a);
+        for bad in ["[[0.0,0.0],[1.0,0.0]]", "[[0,0],[1,0],[2,0]]", "[]"] {
+            assert!(serde_json::from_str::<OpArea>(bad).is_err(), "{bad}");
+        }
+    }
 
     #[test]
     fn rectangle_edge_info_table() {

@@ -15,7 +15,7 @@ use crate::setup::{MissionError, MissionSetup, PlannedVehicle};
 use crate::summary::{Summary, SummaryInput};
 use plumetrace_core::{PlanStatus, Planner, Vec2, Vec3, VehicleId, VehicleKind};
 use plumetrace_env::MeanConcentrationGrid;
-use plumetrace_planner::MissionGeometry;
+use plumetrace_planner::{MissionGeometry, PlannerKind};
 use plumetrace_sim::{SimVehicle, StageTimes, World, WorldEvent};
 use std::time::Instant;
 
@@ -46,7 +46,7 @@ pub struct VehicleInfo {
     /// AUV or surface craft.
     pub kind: VehicleKind,
     /// Its planner's kind, if any.
-    pub planner: Option<String>,
+    pub planner: Option<PlannerKind>,
 }
 
 /// Everything a mission produced.
@@ -140,16 +140,12 @@ impl Mission {
                 seed,
             ));
             planners.push(match p {
-                Some(p) => {
-                    Some(
-                        p.config
-                            .build(&p.context)
-                            .map_err(|error| MissionError::Invalid {
-                                origin: origin.clone(),
-                                error,
-                            })?,
-                    )
-                }
+                Some(p) => Some(p.config.build(&p.context, &p.key).map_err(|error| {
+                    MissionError::Invalid {
+                        origin: origin.clone(),
+                        error,
+                    }
+                })?),
                 None => None,
             });
         }
@@ -209,12 +205,24 @@ impl Mission {
         })
     }
 
-    /// Adds an observer (e.g. a snapshot log); the world keeps snapshots if it wants them.
-    pub fn observe(&mut self, o: Box<dyn Observer>) {
+    /// Adds an observer (e.g. a snapshot log); the world keeps snapshots if it wants them. An
+    /// observer that wants snapshots must come before the first step (a log that misses the first
+    /// decisions could not be replayed).
+    pub fn observe(&mut self, o: Box<dyn Observer>) -> Result<(), MissionError> {
         if o.wants_snapshots() {
+            if self.world.steps() > 0 {
+                return Err(MissionError::Output {
+                    what: "a snapshot log".into(),
+                    message: format!(
+                        "it must observe the mission from its start, not from step {}",
+                        self.world.steps()
+                    ),
+                });
+            }
             self.world.record_snapshots(true);
         }
         self.observers.push(o);
+        Ok(())
     }
 
     /// Scenario name.
@@ -298,7 +306,8 @@ impl Mission {
                 }
                 PlanStatus::Abort => {
                     self.statuses[i] = VehicleStatus::Aborted;
-                    self.first_failure.get_or_insert(Outcome::AbortedByCage);
+                    self.first_failure
+                        .get_or_insert(Outcome::of_abort(&d.events));
                     self.world.stop(id);
                     mission_events.push((id, MissionEvent::PlannerAborted));
                 }
@@ -306,9 +315,13 @@ impl Mission {
         }
         for (id, e) in &report.events {
             if let WorldEvent::Incident { what } = e {
-                self.statuses[id.0 as usize] = VehicleStatus::of_incident(*what);
-                self.first_failure
-                    .get_or_insert(Outcome::of_incident(*what));
+                let k = id.0 as usize;
+                // A vehicle without a planner is recorded, but fails nothing.
+                if self.statuses[k] != VehicleStatus::NoPlanner {
+                    self.first_failure
+                        .get_or_insert(Outcome::of_incident(*what));
+                }
+                self.statuses[k] = VehicleStatus::of_incident(*what);
             }
         }
         let t0 = Instant::now();
@@ -380,7 +393,7 @@ impl Mission {
             .map(|(v, p)| VehicleInfo {
                 name: v.name.clone(),
                 kind: v.vehicle.params.kind,
-                planner: p.as_ref().map(|p| p.config.kind().to_string()),
+                planner: p.as_ref().map(|p| p.config.kind()),
             })
             .collect();
         let mean_flow = self.stats.mean_flow_mps();
@@ -393,7 +406,7 @@ impl Mission {
             tracks: &self.stats.tracks,
             vehicles: vehicles
                 .iter()
-                .map(|v| (v.name.clone(), v.kind, v.planner.clone()))
+                .map(|v| (v.name.clone(), v.kind, v.planner))
                 .collect(),
             sources: &self.sources,
             mean_flow_mps: mean_flow,

@@ -3,10 +3,11 @@
 //! Each vehicle has a [`VehicleStatus`]. A planner that finishes or aborts, and a vehicle that
 //! leaves the domain or hits an obstacle, stops that vehicle; the mission ends when no vehicle
 //! with a planner is active ([`EndReason::PlannersDone`]) or at the time limit
-//! ([`EndReason::TimeLimit`]). Its [`Outcome`] is, in this order: the first failure (a cage abort
-//! or an incident, even after a declaration), else `declared` if any planner declared (even if the
-//! time ran out during a mapping pattern), else `no_declaration` if every planner finished, else
-//! `timed_out`. The summary keeps the declaration and the end apart, each with its time.
+//! ([`EndReason::TimeLimit`]). Its [`Outcome`] is, in this order: the first failure of a vehicle
+//! with a planner (an abort or an incident, even after a declaration; a vehicle without a planner
+//! that drifts away is recorded but fails nothing), else `declared` if any planner declared (even
+//! if the time ran out during a mapping pattern), else `no_declaration` if every planner finished,
+//! else `timed_out`. The summary keeps the declaration and the end apart, each with its time.
 
 use plumetrace_sim::Incident;
 use serde::{Deserialize, Serialize};
@@ -21,8 +22,10 @@ pub enum Outcome {
     NoDeclaration,
     /// The time limit came first.
     TimedOut,
-    /// A planner aborted (the cage: far outside the op-area).
+    /// A planner's cage aborted the mission (far outside the op-area).
     AbortedByCage,
+    /// A planner aborted for another reason.
+    Aborted,
     /// A vehicle left the simulated domain.
     LeftDomain,
     /// A vehicle entered an obstacle.
@@ -31,11 +34,12 @@ pub enum Outcome {
 
 impl Outcome {
     /// Every outcome, in table order.
-    pub const ALL: [Outcome; 6] = [
+    pub const ALL: [Outcome; 7] = [
         Outcome::Declared,
         Outcome::NoDeclaration,
         Outcome::TimedOut,
         Outcome::AbortedByCage,
+        Outcome::Aborted,
         Outcome::LeftDomain,
         Outcome::Collided,
     ];
@@ -43,6 +47,18 @@ impl Outcome {
     /// The name used in files (serde's).
     pub fn name(self) -> &'static str {
         plumetrace_core::variant_name(&self).unwrap_or("?")
+    }
+
+    /// The outcome of a planner that aborted with these events (a cage abort says so).
+    pub fn of_abort(events: &[plumetrace_core::PlannerEvent]) -> Self {
+        if events
+            .iter()
+            .any(|e| matches!(e, plumetrace_core::PlannerEvent::CageAbort { .. }))
+        {
+            Outcome::AbortedByCage
+        } else {
+            Outcome::Aborted
+        }
     }
 
     /// The outcome of a vehicle stopped by an incident.

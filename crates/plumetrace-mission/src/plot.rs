@@ -247,7 +247,7 @@ pub fn mission_figure(run: &MissionRun, title: &str) -> Result<String, String> {
                 Some(v) if vehicles.len() > 1 => format!(
                     "{} ({}) estimated track",
                     v.name,
-                    v.planner.as_deref().unwrap_or("no planner")
+                    v.planner.map_or("no planner", |k| k.name())
                 ),
                 _ => "track (navigation estimate)".to_string(),
             };

@@ -168,10 +168,7 @@ fn behaviour_switches(report: &StepReport) -> impl Iterator<Item = (usize, Behav
             .events
             .iter()
             .rev()
-            .find_map(|e| match e {
-                PlannerEvent::Behaviour { behaviour } => Some(*behaviour),
-                _ => None,
-            })
+            .find_map(PlannerEvent::behaviour)
             .map(|b| (i, b))
     })
 }
@@ -357,4 +354,118 @@ pub fn true_sources(world: &World) -> Vec<Vec3> {
         .filaments()
         .map(|f| f.sources().iter().map(|s| s.pos_m).collect())
         .unwrap_or_default()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::outcome::MissionEvent;
+    use plumetrace_core::{DeclarationKind, Link, RegionEvent};
+    use plumetrace_sim::{Incident, LossReason};
+
+    /// One event of every kind, so the tags can be checked. The matches make this list fail to
+    /// compile when a variant is added without being listed here.
+    fn one_of_each() -> Vec<EventKind> {
+        let p = Vec2::zeros();
+        let planner = [
+            PlannerEvent::Behaviour {
+                behaviour: BehaviourKind::Find,
+            },
+            PlannerEvent::Detection { pos_m: p },
+            PlannerEvent::LostPoint { pos_m: p },
+            PlannerEvent::Declared {
+                pos_m: p,
+                rule: DeclarationKind::AlongFlow,
+            },
+            PlannerEvent::Region {
+                index: 0,
+                what: RegionEvent::Started,
+            },
+            PlannerEvent::CageAbort {
+                distance_outside_m: 31.0,
+            },
+        ];
+        for e in &planner {
+            match e {
+                PlannerEvent::Behaviour { .. }
+                | PlannerEvent::Detection { .. }
+                | PlannerEvent::LostPoint { .. }
+                | PlannerEvent::Declared { .. }
+                | PlannerEvent::Region { .. }
+                | PlannerEvent::CageAbort { .. } => {}
+            }
+        }
+        let telemetry = [Telemetry::SourceEstimate { pos_m: p }];
+        for e in &telemetry {
+            match e {
+                Telemetry::SourceEstimate { .. } => {}
+            }
+        }
+        let world = [
+            WorldEvent::NavFix {
+                jump_m: 1.0,
+                to_m: p,
+            },
+            WorldEvent::Incident {
+                what: Incident::Collided,
+            },
+            WorldEvent::NonFiniteCommand {
+                command: "NaN".into(),
+            },
+            WorldEvent::MessageDelivered {
+                from: VehicleId(1),
+                link: Link::Acoustic,
+                sent_s: 0.0,
+            },
+            WorldEvent::MessageLost {
+                from: VehicleId(1),
+                link: Link::Radio,
+                sent_s: 0.0,
+                reason: LossReason::Dropped,
+            },
+        ];
+        for e in &world {
+            match e {
+                WorldEvent::NavFix { .. }
+                | WorldEvent::Incident { .. }
+                | WorldEvent::NonFiniteCommand { .. }
+                | WorldEvent::MessageDelivered { .. }
+                | WorldEvent::MessageLost { .. } => {}
+            }
+        }
+        let mission = [MissionEvent::PlannerFinished, MissionEvent::PlannerAborted];
+        for e in &mission {
+            match e {
+                MissionEvent::PlannerFinished | MissionEvent::PlannerAborted => {}
+            }
+        }
+        planner
+            .into_iter()
+            .map(EventKind::Planner)
+            .chain(telemetry.into_iter().map(EventKind::Telemetry))
+            .chain(world.into_iter().map(EventKind::World))
+            .chain(mission.into_iter().map(EventKind::Mission))
+            .collect()
+    }
+
+    #[test]
+    fn every_event_has_its_own_tag_in_the_event_field() {
+        let mut tags = Vec::new();
+        for e in one_of_each() {
+            let record = EventRecord {
+                t_s: 1.0,
+                vehicle: 0,
+                event: e,
+            };
+            let v: serde_json::Value =
+                serde_json::to_value(&record).unwrap_or(serde_json::Value::Null);
+            let tag = v["event"].as_str().unwrap_or_else(|| panic!("no tag: {v}"));
+            assert_eq!(v["t_s"], 1.0);
+            tags.push(tag.to_string());
+        }
+        let n = tags.len();
+        tags.sort();
+        tags.dedup();
+        assert_eq!(tags.len(), n, "two kinds of event share a tag: {tags:?}");
+    }
 }

@@ -7,7 +7,7 @@
 use plumetrace_core::params::ParamError;
 use plumetrace_env::{EnvError, Environment};
 use plumetrace_guidance::OpArea;
-use plumetrace_planner::{BuildContext, MissionGeometry, PlannerConfig, planners};
+use plumetrace_planner::{BuildContext, MissionGeometry, PlannerConfig, PlannerKind, planners};
 use plumetrace_scenario::{BuiltScenario, MissionSpec, Origin, VehicleSetup};
 use plumetrace_sim::CommsParams;
 
@@ -119,6 +119,14 @@ impl MissionSetup {
         let mut planned = Vec::with_capacity(sc.vehicles.len());
         for (k, v) in sc.vehicles.iter().enumerate() {
             let Some(r) = &v.planner else {
+                if v.detection_threshold_v.is_some() {
+                    return Err(invalid(ParamError {
+                        key: format!("vehicles[{k}].chem_sensor.threshold_v"),
+                        message: "the vehicle has no planner to take the detection threshold \
+                                  (the sensor reports readings; thresholds are the planner's)"
+                            .into(),
+                    }));
+                }
                 planned.push(None);
                 continue;
             };
@@ -141,7 +149,7 @@ impl MissionSetup {
                 vehicle_kind: v.vehicle.params.kind,
             };
             // Build once here so that `check` catches what building would reject.
-            config.build(&context).map_err(&invalid)?;
+            config.build(&context, &r.key).map_err(&invalid)?;
             planned.push(Some(PlannedVehicle {
                 key: r.key.clone(),
                 config,
@@ -182,28 +190,33 @@ fn with_sensor_threshold(
         return Ok(table.clone());
     };
     let sensor_key = format!("vehicles[{vehicle}].chem_sensor.threshold_v");
-    if let Some(own) = table.get("threshold_v") {
-        return if own.as_float() == Some(v) || own.as_integer().map(|i| i as f64) == Some(v) {
-            Ok(table.clone())
-        } else {
-            Err(ParamError {
-                key: sensor_key,
-                message: format!(
-                    "{v} conflicts with {key}.threshold_v = {own}: the detection threshold is the \
-                     planner's; set it there only"
-                ),
-            })
-        };
-    }
     let kind = table
         .get("kind")
         .and_then(toml::Value::as_str)
         .unwrap_or("");
-    match planners::entry(kind) {
-        Some(e) if (e.keys)().iter().any(|k| k.name == "threshold_v") => {
-            let mut t = table.clone();
-            t.insert("threshold_v".into(), toml::Value::Float(v));
-            Ok(t)
+    match PlannerKind::from_name(kind).map(planners::entry) {
+        Some(e) if e.threshold_key.is_some() => {
+            let name = e.threshold_key.unwrap_or_default();
+            match table.get(name) {
+                Some(own)
+                    if own.as_float() == Some(v)
+                        || own.as_integer().map(|i| i as f64) == Some(v) =>
+                {
+                    Ok(table.clone())
+                }
+                Some(own) => Err(ParamError {
+                    key: sensor_key,
+                    message: format!(
+                        "{v} conflicts with {key}.{name} = {own}: the detection threshold is \
+                         the planner's; set it there only"
+                    ),
+                }),
+                None => {
+                    let mut t = table.clone();
+                    t.insert(name.into(), toml::Value::Float(v));
+                    Ok(t)
+                }
+            }
         }
         Some(_) => Err(ParamError {
             key: sensor_key,

@@ -22,6 +22,7 @@ use flate2::write::GzEncoder;
 use plumetrace_core::{Decision, Planner, SensorSnapshot};
 use plumetrace_planner::{BuildContext, PlannerConfig};
 use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
 use std::fs::File;
 use std::io::{BufRead, BufReader, BufWriter, Read, Write};
 use std::path::{Path, PathBuf};
@@ -62,34 +63,32 @@ pub struct Header {
 }
 
 impl Header {
-    /// The header of a mission's planners.
+    /// The header of a mission's planners; an error if a planner's table cannot be written.
     pub fn new(
         scenario: &str,
         seed: u64,
         names: &[String],
         planners: &[Option<PlannedVehicle>],
-    ) -> Self {
-        let vehicles = planners
-            .iter()
-            .enumerate()
-            .filter_map(|(k, p)| {
-                let p = p.as_ref()?;
-                Some(LoggedPlanner {
-                    id: k as u32,
-                    name: names.get(k).cloned().unwrap_or_default(),
-                    planner_key: p.key.clone(),
-                    planner: toml::to_string(&p.config.to_table()).unwrap_or_default(),
-                    context: p.context.clone(),
-                })
-            })
-            .collect();
-        Header {
+    ) -> Result<Self, String> {
+        let mut vehicles = Vec::new();
+        for (k, p) in planners.iter().enumerate() {
+            let Some(p) = p else { continue };
+            let table = p.config.to_table()?;
+            vehicles.push(LoggedPlanner {
+                id: k as u32,
+                name: names.get(k).cloned().unwrap_or_default(),
+                planner_key: p.key.clone(),
+                planner: toml::to_string(&table).map_err(|e| format!("{}: {e}", p.key))?,
+                context: p.context.clone(),
+            });
+        }
+        Ok(Header {
             format: FORMAT.into(),
             version: VERSION,
             scenario: scenario.into(),
             seed,
             vehicles,
-        }
+        })
     }
 }
 
@@ -191,6 +190,15 @@ impl Observer for SnapshotLogWriter {
     }
 }
 
+impl Drop for SnapshotLogWriter {
+    /// A log whose mission never finished is removed, not left half-written.
+    fn drop(&mut self) {
+        if self.out.take().is_some() {
+            let _ = std::fs::remove_file(&self.tmp);
+        }
+    }
+}
+
 /// Opens a snapshot log for reading, gzip-compressed or plain.
 pub fn open(path: &Path) -> std::io::Result<Box<dyn BufRead>> {
     let mut file = File::open(path)?;
@@ -256,6 +264,15 @@ impl ReplayReport {
     pub const KEEP: usize = 10;
 }
 
+/// Whether two decisions are the same to the bit, non-finite numbers included (their text in the
+/// log is exact: numbers round-trip, non-finite ones are written as words).
+fn same(a: &Decision, b: &Decision) -> bool {
+    match (serde_json::to_string(a), serde_json::to_string(b)) {
+        (Ok(x), Ok(y)) => x == y,
+        _ => false,
+    }
+}
+
 /// Reads the header of a log.
 pub fn read_header(line: &str) -> Result<Header, ReplayError> {
     let header: Header = serde_json::from_str(line).map_err(|e| ReplayError::Line {
@@ -292,8 +309,20 @@ pub fn replay(
             message: e.to_string(),
         })?;
     let header = read_header(&first)?;
-    let mut planners: Vec<Option<Box<dyn Planner>>> = Vec::new();
+    let mut planners: BTreeMap<u32, Box<dyn Planner>> = BTreeMap::new();
     for v in &header.vehicles {
+        if planners.contains_key(&v.id) {
+            return Err(ReplayError::Line {
+                line: 1,
+                message: format!("vehicle {} is listed twice in the header", v.id),
+            });
+        }
+        if !v.context.geometry.prior_flow_toward_deg.is_finite() {
+            return Err(ReplayError::Planner {
+                vehicle: v.id,
+                message: "its prior flow direction is not a finite number".into(),
+            });
+        }
         let table = match tables(v.id) {
             Some(t) => t,
             None => v.planner.parse().map_err(|e| ReplayError::Planner {
@@ -302,16 +331,12 @@ pub fn replay(
             })?,
         };
         let planner = PlannerConfig::from_table(&table, &v.planner_key)
-            .and_then(|c| c.build(&v.context))
+            .and_then(|c| c.build(&v.context, &v.planner_key))
             .map_err(|e| ReplayError::Planner {
                 vehicle: v.id,
                 message: e.to_string(),
             })?;
-        let i = v.id as usize;
-        if planners.len() <= i {
-            planners.resize_with(i + 1, || None);
-        }
-        planners[i] = Some(planner);
+        planners.insert(v.id, planner);
     }
     let mut report = ReplayReport::default();
     for (n, line) in lines.enumerate() {
@@ -327,16 +352,13 @@ pub fn replay(
             line: number,
             message: e.to_string(),
         })?;
-        let planner = planners
-            .get_mut(l.vehicle as usize)
-            .and_then(Option::as_mut)
-            .ok_or(ReplayError::Line {
-                line: number,
-                message: format!("vehicle {} has no planner in the header", l.vehicle),
-            })?;
+        let planner = planners.get_mut(&l.vehicle).ok_or(ReplayError::Line {
+            line: number,
+            message: format!("vehicle {} has no planner in the header", l.vehicle),
+        })?;
         let replayed = planner.decide(&l.snapshot);
         report.decisions += 1;
-        if replayed != l.decision {
+        if !same(&replayed, &l.decision) {
             report.differing += 1;
             if report.first.len() < ReplayReport::KEEP {
                 report.first.push(Difference {
@@ -350,4 +372,34 @@ pub fn replay(
         }
     }
     Ok(report)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use plumetrace_core::{Command, Heading, PlanStatus, VerticalCommand};
+
+    #[test]
+    fn decisions_with_non_finite_numbers_read_back_the_same() {
+        let d = Decision::new(
+            Command {
+                heading: Heading::from_rad(f64::NAN),
+                speed_mps: f64::INFINITY,
+                vertical: VerticalCommand::Altitude(2.0),
+            },
+            PlanStatus::Running,
+        );
+        let text = serde_json::to_string(&d).unwrap_or_default();
+        let back: Decision = serde_json::from_str(&text).unwrap_or_else(|e| panic!("{e}: {text}"));
+        assert_ne!(back, d, "NaN is not equal to itself");
+        assert!(same(&back, &d), "but the replay compares them as the same");
+        let other = Decision::new(
+            Command {
+                speed_mps: 1.0,
+                ..d.command
+            },
+            PlanStatus::Running,
+        );
+        assert!(!same(&other, &d));
+    }
 }

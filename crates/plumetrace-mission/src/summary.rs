@@ -7,6 +7,7 @@
 use crate::outcome::{EndReason, MissionEnd, Outcome, VehicleStatus};
 use crate::record::VehicleTrack;
 use plumetrace_core::{DeclarationKind, Heading, Vec2, Vec3, VehicleKind};
+use plumetrace_planner::PlannerKind;
 use serde::Serialize;
 
 /// A source counts as located when a declaration lies within this distance of it, m. The field
@@ -65,7 +66,7 @@ pub struct VehicleSummary {
     /// AUV or surface craft.
     pub kind: VehicleKind,
     /// Its planner's kind (`None`: no planner).
-    pub planner: Option<String>,
+    pub planner: Option<PlannerKind>,
     /// Where it stands at the end.
     pub status: VehicleStatus,
     /// Distance over ground, m.
@@ -120,7 +121,7 @@ pub(crate) struct SummaryInput<'a> {
     pub first_failure: Option<Outcome>,
     pub statuses: &'a [VehicleStatus],
     pub tracks: &'a [VehicleTrack],
-    pub vehicles: Vec<(String, VehicleKind, Option<String>)>,
+    pub vehicles: Vec<(String, VehicleKind, Option<PlannerKind>)>,
     pub sources: &'a [Vec3],
     pub mean_flow_mps: Vec2,
 }
@@ -142,24 +143,22 @@ impl Summary {
             .collect();
         // Time order; a stable sort keeps vehicle order within a step.
         declarations.sort_by(|a, b| a.t_s.total_cmp(&b.t_s));
+        let has_planner: Vec<bool> = i.vehicles.iter().map(|v| v.2.is_some()).collect();
         let planned = i
             .statuses
             .iter()
-            .filter(|s| **s != VehicleStatus::NoPlanner);
+            .zip(&has_planner)
+            .filter(|(_, p)| **p)
+            .map(|(s, _)| *s);
         let all_finished =
-            planned.clone().count() > 0 && planned.clone().all(|s| *s == VehicleStatus::Finished);
+            planned.clone().count() > 0 && planned.clone().all(|s| s == VehicleStatus::Finished);
         let outcome =
             crate::outcome::judge(i.first_failure, !declarations.is_empty(), all_finished);
         let first = declarations.first().cloned();
         let lead = first
             .as_ref()
             .map(|d| d.vehicle as usize)
-            .unwrap_or_else(|| {
-                i.statuses
-                    .iter()
-                    .position(|s| *s != VehicleStatus::NoPlanner)
-                    .unwrap_or(0)
-            });
+            .unwrap_or_else(|| has_planner.iter().position(|p| *p).unwrap_or(0));
         let track = i.tracks.get(lead).cloned().unwrap_or_default();
         let src0 = first
             .as_ref()

@@ -9,6 +9,7 @@ use plumetrace_mission::{
     EndReason, EventKind, Mission, MissionOptions, MissionSetup, Outcome, VehicleStatus,
     run_mission,
 };
+use plumetrace_planner::PlannerKind;
 use plumetrace_scenario::{Origin, PRESETS, ScenarioConfig, build, load_preset};
 
 /// A preset with its spin-up and time limit cut down for a quick test.
@@ -134,6 +135,24 @@ fn bad_planner_settings_are_rejected_with_the_file_and_key_path() {
         e.contains("planner.kind") && e.contains("unknown planner 'moth'"),
         "{e}"
     );
+    // A sensor threshold on a vehicle without a planner has no effect: refused.
+    let text = demo_text_with(
+        &AMP_AND_SURVEY
+            .replacen(
+                "planner = \"survey\"",
+                "[vehicles.chem_sensor]\nthreshold_v = 0.3",
+                1,
+            )
+            .replace(
+                "[planners.survey]\nkind = \"lawnmower\"\nlane_spacing_m = 60.0",
+                "",
+            ),
+    );
+    let e = setup_error(&text);
+    assert!(
+        e.contains("vehicles[1].chem_sensor.threshold_v") && e.contains("no planner"),
+        "{e}"
+    );
 }
 
 fn load_preset_text(name: &str) -> String {
@@ -196,22 +215,26 @@ kind = "amp"
 mapping = false
 "#;
 
-fn demo_with(vehicles_and_planners: &str, limit_s: f64, seed: u64) -> MissionSetup {
+/// The demo's text with its vehicle and planner tables replaced.
+fn demo_text_with(vehicles_and_planners: &str) -> String {
     let base = load_preset_text("demo");
-    // Drop the demo's own vehicle and planner tables.
     let start = base.find("[[vehicles]]").unwrap();
     let mission = base.find("[mission]").unwrap();
     let planner = base.find("[planner]").unwrap();
     let output = base.find("[output]").unwrap();
-    let text = format!(
+    format!(
         "{}{}\n{}{}",
         &base[..start],
         vehicles_and_planners,
         &base[mission..planner],
         &base[output..]
-    );
+    )
+}
+
+fn demo_with(vehicles_and_planners: &str, limit_s: f64, seed: u64) -> MissionSetup {
     let origin = Origin::File("two.toml".into());
-    let mut cfg = plumetrace_scenario::parse(&text, &origin).unwrap();
+    let mut cfg =
+        plumetrace_scenario::parse(&demo_text_with(vehicles_and_planners), &origin).unwrap();
     shorten(&mut cfg, 2000.0, limit_s);
     MissionSetup::new(build(&cfg, &origin, Some(seed)).unwrap()).unwrap()
 }
@@ -226,7 +249,7 @@ fn two_auvs_fly_the_amp_from_different_corners_and_are_recorded_apart() {
     let s = &run.summary;
     assert_eq!(s.vehicles.len(), 2);
     assert_eq!(s.vehicles[0].name, "north");
-    assert_eq!(s.vehicles[1].planner.as_deref(), Some("amp"));
+    assert_eq!(s.vehicles[1].planner, Some(PlannerKind::Amp));
     for v in &s.vehicles {
         assert!(v.path_length_m > 500.0, "{v:?}");
         assert!(v.first_detection_s.is_some(), "{v:?}");
@@ -260,6 +283,92 @@ fn two_auvs_fly_the_amp_from_different_corners_and_are_recorded_apart() {
     );
 }
 
+/// An AUV flying the AMP beside a surface craft flying the lawnmower.
+const AMP_AND_SURVEY: &str = r#"
+[[vehicles]]
+kind = "auv"
+name = "tracer"
+x_m = 470.0
+y_m = -60.0
+heading_deg = 270.0
+planner = "amp"
+
+[[vehicles]]
+kind = "surface"
+name = "boat"
+x_m = 470.0
+y_m = 60.0
+heading_deg = 270.0
+planner = "survey"
+
+[planners.amp]
+kind = "amp"
+
+[planners.survey]
+kind = "lawnmower"
+lane_spacing_m = 60.0
+"#;
+
+#[test]
+fn a_surface_craft_surveys_beside_an_auv_tracing_the_plume() {
+    let setup = demo_with(AMP_AND_SURVEY, 1200.0, 2);
+    let kinds: Vec<PlannerKind> = setup
+        .planners
+        .iter()
+        .flatten()
+        .map(|p| p.config.kind())
+        .collect();
+    assert_eq!(kinds, [PlannerKind::Amp, PlannerKind::Lawnmower]);
+    let mut m = Mission::new(setup, MissionOptions::default()).unwrap();
+    m.run(&mut |_, _| {}).unwrap();
+    let run = m.finish().unwrap();
+    let behaviours = |k: u32| -> Vec<BehaviourKind> {
+        let mut b: Vec<BehaviourKind> = run
+            .events
+            .iter()
+            .filter(|e| e.vehicle == k)
+            .filter_map(|e| match &e.event {
+                EventKind::Planner(p) => p.behaviour(),
+                _ => None,
+            })
+            .collect();
+        b.dedup();
+        b
+    };
+    assert!(
+        behaviours(0).contains(&BehaviourKind::TrackIn),
+        "{:?}",
+        behaviours(0)
+    );
+    assert!(
+        behaviours(1).starts_with(&[BehaviourKind::GoTo, BehaviourKind::Survey]),
+        "{:?}",
+        behaviours(1)
+    );
+    let boat: Vec<_> = run.trajectory.iter().filter(|r| r.vehicle == 1).collect();
+    assert!(boat.len() > 1000);
+    assert!(
+        boat.iter().all(|r| (r.true_z_m - 8.0).abs() < 1e-9),
+        "the boat stays at the surface of the 8 m deep site"
+    );
+    assert!(
+        boat.iter()
+            .any(|r| r.behaviour == Some(BehaviourKind::Survey))
+    );
+    let s = &run.summary;
+    assert_eq!(s.vehicles[1].kind, VehicleKind::Surface);
+    assert!(
+        s.vehicles.iter().all(|v| v.path_length_m > 500.0),
+        "{:?}",
+        s.vehicles
+    );
+    let svg = plumetrace_mission::plot::mission_figure(&run, "pair").unwrap();
+    assert!(
+        svg.contains("tracer (amp) estimated track")
+            && svg.contains("boat (lawnmower) estimated track")
+    );
+}
+
 #[test]
 fn a_vehicle_without_a_position_estimate_cannot_fly_the_amp() {
     let text = TWO_AUVS.replacen(
@@ -267,19 +376,7 @@ fn a_vehicle_without_a_position_estimate_cannot_fly_the_amp() {
         "planner = \"tracer\"\n[vehicles.nav]\nposition_estimate = false",
         1,
     );
-    let base = load_preset_text("demo");
-    let start = base.find("[[vehicles]]").unwrap();
-    let mission = base.find("[mission]").unwrap();
-    let planner = base.find("[planner]").unwrap();
-    let output = base.find("[output]").unwrap();
-    let full = format!(
-        "{}{}\n{}{}",
-        &base[..start],
-        text,
-        &base[mission..planner],
-        &base[output..]
-    );
-    let e = setup_error(&full);
+    let e = setup_error(&demo_text_with(&text));
     assert!(
         e.contains("vehicles[0].nav.position_estimate") && e.contains("'amp'"),
         "{e}"
@@ -292,8 +389,9 @@ fn replaying_a_snapshot_log_reproduces_every_decision() {
     let path = dir.path().join("snapshots.jsonl.gz");
     let setup = MissionSetup::new(shortened("demo", 2000.0, 700.0, 5)).unwrap();
     let mut m = Mission::new(setup, MissionOptions::default()).unwrap();
-    let header = Header::new(m.name(), m.seed(), &m.vehicle_names(), m.planned());
-    m.observe(Box::new(SnapshotLogWriter::create(&path, &header).unwrap()));
+    let header = Header::new(m.name(), m.seed(), &m.vehicle_names(), m.planned()).unwrap();
+    m.observe(Box::new(SnapshotLogWriter::create(&path, &header).unwrap()))
+        .unwrap();
     m.run(&mut |_, _| {}).unwrap();
     let run = m.finish().unwrap();
     let steps = run.trajectory.iter().filter(|r| r.vehicle == 0).count() as u64;
@@ -333,4 +431,76 @@ fn the_summary_keeps_the_declaration_and_the_end_apart() {
     );
     assert_eq!(s.vehicles[0].kind, VehicleKind::Auv);
     assert_eq!(s.vehicles[0].status, VehicleStatus::Finished);
+}
+
+#[test]
+fn a_vehicle_without_a_planner_that_drifts_away_fails_nothing() {
+    // A buoy-like surface craft 5 m from the domain's downflow edge, drifting out with the
+    // current, beside the AMP AUV.
+    let text = TWO_AUVS
+        .replacen(
+            "kind = \"auv\"\nname = \"north\"",
+            "kind = \"surface\"\nname = \"buoy\"",
+            1,
+        )
+        .replacen(
+            "x_m = 470.0\ny_m = 60.0\nheading_deg = 270.0\nplanner = \"tracer\"",
+            "x_m = 515.0\ny_m = 60.0\nheading_deg = 270.0",
+            1,
+        );
+    assert!(text.contains("buoy") && text.contains("x_m = 515.0"));
+    let setup = demo_with(&text, 300.0, 4);
+    assert!(setup.planners[0].is_none() && setup.planners[1].is_some());
+    let mut m = Mission::new(setup, MissionOptions::default()).unwrap();
+    m.run(&mut |_, _| {}).unwrap();
+    let run = m.finish().unwrap();
+    let s = &run.summary;
+    assert_eq!(
+        s.vehicles[0].status,
+        VehicleStatus::LeftDomain,
+        "the buoy drifted out"
+    );
+    assert!(run.events.iter().any(|e| e.vehicle == 0
+        && matches!(
+            e.event,
+            EventKind::World(plumetrace_sim::WorldEvent::Incident { .. })
+        )));
+    assert_eq!(
+        s.outcome,
+        Outcome::TimedOut,
+        "the AUV flew on to the time limit: {:?}",
+        s.vehicles
+    );
+    assert_eq!(s.ended.reason, EndReason::TimeLimit);
+    assert_eq!(s.vehicles[1].status, VehicleStatus::Active);
+}
+
+#[test]
+fn a_two_vehicle_log_with_a_decision_period_replays_exactly() {
+    let text = TWO_AUVS.replace(
+        "[planners.tracer]\nkind = \"amp\"\nmapping = false",
+        "[planners.tracer]\nkind = \"amp\"\nmapping = false\n\n[planners.slow]\nkind = \"amp\"\ndecision_period_s = 0.5",
+    )
+    .replacen("planner = \"tracer\"", "planner = \"slow\"", 1);
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("two.jsonl.gz");
+    let setup = demo_with(&text, 600.0, 6);
+    let mut m = Mission::new(setup, MissionOptions::default()).unwrap();
+    let header = Header::new(m.name(), m.seed(), &m.vehicle_names(), m.planned()).unwrap();
+    assert_eq!(header.vehicles.len(), 2);
+    m.observe(Box::new(SnapshotLogWriter::create(&path, &header).unwrap()))
+        .unwrap();
+    m.run(&mut |_, _| {}).unwrap();
+    // Too late for a second log: it would miss the first decisions.
+    let late = SnapshotLogWriter::create(&dir.path().join("late.gz"), &header).unwrap();
+    assert!(m.observe(Box::new(late)).is_err());
+    assert!(
+        !dir.path().join("late.gz").exists(),
+        "nothing is left of it"
+    );
+    m.finish().unwrap();
+    let report = replay(open(&path).unwrap(), &|_| None).unwrap();
+    // 6,000 steps: the fast vehicle decides at every one, the slow one at every fifth.
+    assert_eq!(report.decisions, 6000 + 1200);
+    assert_eq!(report.differing, 0, "{:?}", report.first.first());
 }

@@ -301,13 +301,7 @@ mod tests {
         // Past the end of the only line: done, then idle for good.
         assert_eq!(s.arbitrate(&percept(120.0, 100.0, 90.0), &mut log), None);
         assert_eq!(s.active(), BehaviourKind::Done);
-        let kinds: Vec<BehaviourKind> = log
-            .iter()
-            .filter_map(|e| match e {
-                PlannerEvent::Behaviour { behaviour } => Some(*behaviour),
-                _ => None,
-            })
-            .collect();
+        let kinds: Vec<BehaviourKind> = log.iter().filter_map(PlannerEvent::behaviour).collect();
         assert_eq!(
             kinds,
             [

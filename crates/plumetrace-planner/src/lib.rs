@@ -21,5 +21,5 @@ pub use flow::FlowEstimate;
 pub use planners::amp::{self, Amp, AmpParams, DeclarationRule, LostPointEviction, MappingParams};
 pub use planners::{
     BuildContext, CommonParams, MissionGeometry, PLANNERS, PlannerConfig, PlannerEntry,
-    PlannerParams, PlannerSpec, registry_markdown,
+    PlannerKind, PlannerParams, PlannerSpec, registry_markdown,
 };

@@ -42,16 +42,7 @@ fn amp() -> Amp {
 }
 
 fn behaviours(events: &[PlannerEvent]) -> Vec<BehaviourKind> {
-    events
-        .iter()
-        .filter_map(|e| {
-            if let PlannerEvent::Behaviour { behaviour } = e {
-                Some(*behaviour)
-            } else {
-                None
-            }
-        })
-        .collect()
+    events.iter().filter_map(PlannerEvent::behaviour).collect()
 }
 
 #[test]

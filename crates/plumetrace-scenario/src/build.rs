@@ -381,6 +381,19 @@ pub fn build(
         };
         vehicles.push(setup);
     }
+    if cfg.planner.is_some()
+        && !cfg
+            .vehicles
+            .iter()
+            .any(|v| v.planner.is_none() && v.kind == plumetrace_core::VehicleKind::Auv)
+    {
+        return Err(invalid(
+            "planner",
+            "no vehicle flies it: [planner] is for the AUVs that name no planner, and every AUV \
+             names one (or there is none); remove it or name it as [planners.NAME]"
+                .into(),
+        ));
+    }
     if let Some(name) = cfg.planners.keys().find(|n| {
         !cfg.vehicles
             .iter()

@@ -281,6 +281,14 @@ fn planner_tables_are_wired_to_vehicles_with_key_paths() {
             format!("{}\n[comms.acoustic]\nloss_probability = 1.5", mt),
             "comms.acoustic.loss_probability",
         ),
+        (
+            find_preset("demo")
+                .unwrap()
+                .toml
+                .replace("x_m = 470.0", "x_m = 470.0\nplanner = \"tracer\"")
+                + "\n[planners.tracer]\nkind = \"amp\"\n",
+            "planner: no vehicle flies it",
+        ),
     ];
     for (text, want) in cases {
         let e = error_of(text);

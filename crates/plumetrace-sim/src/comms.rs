@@ -92,6 +92,10 @@ pub enum LossReason {
     OutOfRange,
     /// The channel dropped it.
     Dropped,
+    /// The recipient was stopped (incident, finished or aborted) when it was sent or arrived.
+    RecipientStopped,
+    /// No vehicle has the recipient's index (the event is the sender's).
+    NoSuchRecipient,
 }
 
 /// What became of one message for one recipient.

@@ -348,27 +348,43 @@ impl World {
             .vehicles
             .get(m.from.0 as usize)
             .map_or(Vec2::zeros(), |v| v.vehicle.state.pos_m);
+        let lost = |to: VehicleId, reason| {
+            (
+                to,
+                WorldEvent::MessageLost {
+                    from: m.from,
+                    link: m.link,
+                    sent_s: m.sent_s,
+                    reason,
+                },
+            )
+        };
+        if let Recipient::Vehicle(to) = m.to
+            && to.0 as usize >= self.vehicles.len()
+        {
+            events.push(lost(m.from, LossReason::NoSuchRecipient));
+            return;
+        }
         for v in &self.vehicles {
             let id = v.vehicle.id;
             let addressed = match m.to {
                 Recipient::Broadcast => id != m.from,
                 Recipient::Vehicle(to) => to == id,
             };
-            if !(addressed && v.active) {
+            if !addressed {
+                continue;
+            }
+            if !v.active {
+                // A broadcast reaches whoever is listening; a message to a stopped vehicle is lost.
+                if m.to != Recipient::Broadcast {
+                    events.push(lost(id, LossReason::RecipientStopped));
+                }
                 continue;
             }
             if let Transmission::Lost(reason) =
                 self.comms.transmit(m, from_m, id, v.vehicle.state.pos_m)
             {
-                events.push((
-                    id,
-                    WorldEvent::MessageLost {
-                        from: m.from,
-                        link: m.link,
-                        sent_s: m.sent_s,
-                        reason,
-                    },
-                ));
+                events.push(lost(id, reason));
             }
         }
     }
@@ -446,14 +462,22 @@ impl World {
 
     fn communicate(&mut self, t: f64, events: &mut Vec<(VehicleId, WorldEvent)>) {
         for arrived in self.comms.arrived(t) {
-            let Some(v) = self
-                .vehicles
-                .get_mut(arrived.to.0 as usize)
-                .filter(|v| v.active)
-            else {
+            let m = arrived.message;
+            let Some(v) = self.vehicles.get_mut(arrived.to.0 as usize) else {
                 continue;
             };
-            let m = arrived.message;
+            if !v.active {
+                events.push((
+                    arrived.to,
+                    WorldEvent::MessageLost {
+                        from: m.from,
+                        link: m.link,
+                        sent_s: m.sent_s,
+                        reason: LossReason::RecipientStopped,
+                    },
+                ));
+                continue;
+            }
             events.push((
                 arrived.to,
                 WorldEvent::MessageDelivered {
@@ -481,6 +505,9 @@ impl World {
         let mut sent = Vec::new();
         for (k, v) in self.vehicles.iter_mut().enumerate() {
             let Some(p) = planners.get_mut(k).and_then(|p| p.as_mut()) else {
+                // No planner reads them: nothing piles up.
+                v.pending_chem.clear();
+                v.inbox.clear();
                 continue;
             };
             if !v.active || t + 1e-9 < v.next_decision_s {

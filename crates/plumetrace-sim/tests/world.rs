@@ -151,7 +151,7 @@ fn a_vehicle_that_enters_kelp_or_leaves_the_domain_is_stopped_with_an_incident()
     assert!(!w.vehicles()[0].active && !w.vehicles()[1].active);
 }
 
-/// Returns a non-finite command every other decision.
+/// Returns a good command, then a NaN speed, a NaN heading and an infinite altitude in turn.
 struct Broken {
     n: u32,
 }
@@ -159,12 +159,14 @@ struct Broken {
 impl Planner for Broken {
     fn decide(&mut self, _: &SensorSnapshot) -> Decision {
         self.n += 1;
-        let speed = if self.n.is_multiple_of(2) {
-            f64::NAN
-        } else {
-            1.5
-        };
-        Decision::new(command(0.0, speed), PlanStatus::Running)
+        let mut c = command(0.0, 1.5);
+        match self.n % 4 {
+            2 => c.speed_mps = f64::NAN,
+            3 => c.heading = Heading::from_rad(f64::NAN),
+            0 => c.vertical = VerticalCommand::Altitude(f64::INFINITY),
+            _ => {}
+        }
+        Decision::new(c, PlanStatus::Running)
     }
 }
 
@@ -192,9 +194,18 @@ fn a_non_finite_command_is_recorded_and_replaced_by_the_previous_one() {
         1.5,
         "the previous command stays"
     );
+    let mut bad = 0;
     for _ in 0..100 {
-        w.step(&mut planners).unwrap();
+        let r = w.step(&mut planners).unwrap();
+        bad += r
+            .events
+            .iter()
+            .filter(|(_, e)| matches!(e, WorldEvent::NonFiniteCommand { .. }))
+            .count();
+        let c = w.vehicles()[0].command;
+        assert!(c.is_finite() && c.heading.deg() == 0.0, "{c:?}");
     }
+    assert_eq!(bad, 75, "three of every four commands are bad");
     let s = w.vehicles()[0].vehicle.state;
     assert!(s.pos_m.x.is_finite() && s.pos_m.y > 20.0 && s.speed_mps > 1.0);
 }
@@ -291,7 +302,8 @@ fn messages_arrive_after_the_channels_delay_or_are_lost() {
     let (mut w, mut p, heard) = talkers(comms, Link::Acoustic, 150.0);
     let mut lost = 0;
     let mut delivered = 0;
-    for _ in 0..5000 {
+    // 300 s: the drifting vehicles stay inside the 200 m domain.
+    for _ in 0..3000 {
         let r = w.step(&mut p).unwrap();
 
         for (id, e) in &r.events {
@@ -317,7 +329,7 @@ fn messages_arrive_after_the_channels_delay_or_are_lost() {
     );
     let sent = lost + delivered + w.messages_in_flight();
     let rate = lost as f64 / sent as f64;
-    // About 5,000 messages at p = 0.2: sd 0.0057.
+    // About 3,000 messages at p = 0.2: sd 0.0073.
     assert!((rate - 0.2).abs() < 0.025, "loss rate {rate}");
     // Out of range: nothing arrives.
     let short = CommsParams {
@@ -337,6 +349,92 @@ fn messages_arrive_after_the_channels_delay_or_are_lost() {
         }
     )));
     assert!(heard.lock().unwrap().is_empty());
+}
+
+#[test]
+fn message_losses_are_the_same_for_the_same_seed() {
+    let lossy = CommsParams {
+        acoustic: ChannelParams {
+            loss_probability: 0.5,
+            ..ChannelParams::IDEAL
+        },
+        radio: ChannelParams::IDEAL,
+    };
+    let losses = |seed: u64| {
+        let (w, mut p, _) = talkers(lossy, Link::Acoustic, 150.0);
+        // The same world, its channels seeded with `seed`.
+        let mut w = World::with_comms(
+            env(vec![]),
+            w.vehicles().to_vec(),
+            DT,
+            Some(10.0),
+            lossy,
+            seed,
+        )
+        .unwrap();
+        let mut lost = Vec::new();
+        for k in 0..200 {
+            let r = w.step(&mut p).unwrap();
+            for (id, e) in r.events {
+                if matches!(e, WorldEvent::MessageLost { .. }) {
+                    lost.push((k, id));
+                }
+            }
+        }
+        lost
+    };
+    let a = losses(5);
+    assert!(a.len() > 100 && a.len() < 300, "{}", a.len());
+    assert_eq!(a, losses(5));
+    assert_ne!(a, losses(6));
+}
+
+#[test]
+fn a_message_to_a_stopped_or_missing_vehicle_is_reported_lost() {
+    let mut w = World::new(
+        env(vec![]),
+        vec![auv(0, (50.0, 50.0), 0.0), auv(1, (60.0, 50.0), 0.0)],
+        DT,
+        Some(10.0),
+    )
+    .unwrap();
+    w.stop(VehicleId(1));
+    let to = |id| plumetrace_core::Message {
+        from: VehicleId(0),
+        to: Recipient::Vehicle(VehicleId(id)),
+        link: Link::Radio,
+        sent_s: 0.0,
+        body: MessageBody::Text { text: "x".into() },
+    };
+    let e = w.send(to(1));
+    assert!(
+        matches!(
+            &e[..],
+            [(
+                VehicleId(1),
+                WorldEvent::MessageLost {
+                    reason: LossReason::RecipientStopped,
+                    ..
+                }
+            )]
+        ),
+        "{e:?}"
+    );
+    let e = w.send(to(7));
+    assert!(
+        matches!(
+            &e[..],
+            [(
+                VehicleId(0),
+                WorldEvent::MessageLost {
+                    reason: LossReason::NoSuchRecipient,
+                    ..
+                }
+            )]
+        ),
+        "{e:?}"
+    );
+    assert_eq!(w.messages_in_flight(), 0);
 }
 
 #[test]

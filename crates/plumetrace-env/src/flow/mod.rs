@@ -67,22 +67,6 @@ pub enum FlowModel {
 }
 
 impl FlowModel {
-    /// Names and one-line descriptions of the flow models, for `list` commands and docs.
-    pub const REGISTRY: &'static [(&'static str, &'static str)] = &[
-        (
-            "uniform",
-            "same velocity everywhere; steady or tidal (speed and direction varying in time)",
-        ),
-        (
-            "farrell",
-            "Farrell et al. 2002 meandering field: coloured-noise corners, advection-diffusion interior",
-        ),
-        (
-            "gridded",
-            "regular grid read from a CSV file (x_m,y_m,u_mps,v_mps[,t_s]), bilinear in space, linear in time",
-        ),
-    ];
-
     fn inner(&self) -> &dyn FlowField {
         match self {
             FlowModel::Uniform(f) => f,

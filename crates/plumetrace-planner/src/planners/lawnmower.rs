@@ -55,11 +55,32 @@ impl PlannerParams for LawnmowerParams {
     const KIND: &'static str = "lawnmower";
     const SUMMARY: &'static str = "Lawnmower survey: lanes across the mean flow over the op-area, then a declaration at the strongest reading (the exhaustive baseline)";
 
+    const THRESHOLD_KEY: Option<&'static str> = Some("threshold_v");
+
     fn detection_threshold_v(&self) -> Option<f64> {
         Some(self.threshold_v)
     }
 
     fn build(&self, ctx: &BuildContext) -> Result<Box<dyn Planner>, ParamError> {
+        let g = &ctx.geometry;
+        // Whether any lane fits does not depend on where the vehicle starts.
+        if lanes(
+            &g.op_area,
+            g.prior_flow_toward(),
+            self.lane_spacing_m,
+            self.edge_margin_m,
+            Vec2::zeros(),
+        )
+        .is_empty()
+        {
+            return Err(ParamError {
+                key: "edge_margin_m".into(),
+                message: format!(
+                    "no survey lane fits in the op-area {} m inside its edges",
+                    self.edge_margin_m
+                ),
+            });
+        }
         Ok(Box::new(Lawnmower::new(
             self.clone(),
             ctx.geometry.op_area.clone(),
@@ -68,10 +89,11 @@ impl PlannerParams for LawnmowerParams {
     }
 }
 
-/// The lanes over `area` across the flow `flow_toward`: `spacing_m` apart along the flow,
-/// `margin_m` inside the edges, in alternate directions, starting with the lane end nearest
-/// `from_m`. Lanes shorter than a metre are left out; an area narrower than two margins gets one
-/// lane through its middle.
+/// The lanes over `area` across the flow `flow_toward`: `spacing_m` apart along the flow, centred
+/// between the edges that are `margin_m` inside the area, in alternate directions, starting with
+/// the lane end nearest `from_m`. Where a lane crosses a concave area more than once it is split
+/// into the stretches inside (each `margin_m` short of the edges); stretches shorter than a metre
+/// are left out. An area narrower than two margins along the flow gets one lane through its middle.
 pub fn lanes(
     area: &OpArea,
     flow_toward: Heading,
@@ -86,50 +108,68 @@ pub fn lanes(
     let (a_min, a_max) = along
         .iter()
         .fold((f64::MAX, f64::MIN), |(lo, hi), a| (lo.min(*a), hi.max(*a)));
-    let mut offsets = Vec::new();
-    let mut a = a_min + margin_m;
-    while a <= a_max - margin_m + 1e-9 && offsets.len() < 100_000 {
-        offsets.push(a);
-        a += spacing_m;
-    }
-    if offsets.is_empty() {
-        offsets.push(0.5 * (a_min + a_max));
-    }
-    let mut segments: Vec<(Vec2, Vec2)> = offsets
+    let width = a_max - a_min - 2.0 * margin_m;
+    let offsets: Vec<f64> = if width < 0.0 {
+        vec![0.5 * (a_min + a_max)]
+    } else {
+        // As many lanes as fit, centred: the edges' strips are equal.
+        let n = ((width / spacing_m).floor() as usize).min(100_000) + 1;
+        let first = 0.5 * (a_min + a_max) - 0.5 * (n - 1) as f64 * spacing_m;
+        (0..n).map(|k| first + k as f64 * spacing_m).collect()
+    };
+    let mut per_lane: Vec<Vec<(Vec2, Vec2)>> = offsets
         .iter()
-        .filter_map(|&a| {
-            // Where the line p.u = a crosses the polygon's edges, as positions across the flow.
-            let across: Vec<f64> = (0..v.len())
+        .map(|&a| {
+            // Where the line p.u = a crosses the polygon's edges (each edge half-open, so a vertex
+            // on the line counts once), as positions across the flow, in order.
+            let mut across: Vec<f64> = (0..v.len())
                 .filter_map(|i| {
-                    let (p, q) = (v[i], v[(i + 1) % v.len()]);
-                    let (pa, qa) = (along[i], along[(i + 1) % v.len()]);
-                    ((pa - a) * (qa - a) <= 0.0 && pa != qa)
-                        .then(|| (p + (q - p) * ((a - pa) / (qa - pa))).dot(&c))
+                    let j = (i + 1) % v.len();
+                    let (pa, qa) = (along[i], along[j]);
+                    let crosses = (pa <= a && a < qa) || (qa <= a && a < pa);
+                    crosses.then(|| (v[i] + (v[j] - v[i]) * ((a - pa) / (qa - pa))).dot(&c))
                 })
                 .collect();
-            let lo = across.iter().copied().fold(f64::MAX, f64::min) + margin_m;
-            let hi = across.iter().copied().fold(f64::MIN, f64::max) - margin_m;
-            (hi - lo >= 1.0).then(|| (u * a + c * lo, u * a + c * hi))
+            across.sort_by(f64::total_cmp);
+            across
+                .chunks_exact(2)
+                .filter_map(|pair| {
+                    let (lo, hi) = (pair[0] + margin_m, pair[1] - margin_m);
+                    (hi - lo >= 1.0).then(|| (u * a + c * lo, u * a + c * hi))
+                })
+                .collect::<Vec<_>>()
         })
+        .filter(|l: &Vec<(Vec2, Vec2)>| !l.is_empty())
         .collect();
-    let Some(first) = segments.first().copied() else {
-        return segments;
+    let (Some(first), Some(last)) = (per_lane.first(), per_lane.last()) else {
+        return Vec::new();
     };
-    let last = segments[segments.len() - 1];
-    let nearest = |s: (Vec2, Vec2)| (s.0 - from_m).norm().min((s.1 - from_m).norm());
+    let ends = |l: &Vec<(Vec2, Vec2)>| l.iter().flat_map(|s| [s.0, s.1]).collect::<Vec<_>>();
+    let nearest = |l: &Vec<(Vec2, Vec2)>| {
+        ends(l)
+            .iter()
+            .map(|p| (p - from_m).norm())
+            .fold(f64::MAX, f64::min)
+    };
     if nearest(last) < nearest(first) {
-        segments.reverse();
+        per_lane.reverse();
     }
     // The first lane starts at its end nearest the vehicle; the others alternate.
-    let (s0, e0) = segments[0];
+    let l0 = &per_lane[0];
+    let (s0, e0) = (l0[0].0, l0[l0.len() - 1].1);
     let mut forward = (s0 - from_m).norm() <= (e0 - from_m).norm();
-    for s in &mut segments {
+    let mut out = Vec::new();
+    for mut lane in per_lane {
         if !forward {
-            *s = (s.1, s.0);
+            lane.reverse();
+            for s in &mut lane {
+                *s = (s.1, s.0);
+            }
         }
+        out.extend(lane);
         forward = !forward;
     }
-    segments
+    out
 }
 
 /// The lawnmower survey for one vehicle.
@@ -230,21 +270,24 @@ impl Planner for Lawnmower {
             self.start(pos);
         }
         let mut telemetry = Vec::new();
+        // The strongest sample since the last decision, placed where the vehicle was when it was
+        // taken (dead-reckoned back from now: it may be a decision period ago).
+        let velocity = s.nav.heading.unit() * s.nav.speed_mps + flow;
         if let Some(best) = s
             .chem
             .iter()
-            .map(|c| c.reading)
-            .filter(|r| *r > self.p.threshold_v)
-            .reduce(f64::max)
+            .filter(|c| c.reading > self.p.threshold_v)
+            .max_by(|a, b| a.reading.total_cmp(&b.reading))
         {
+            let at = pos - velocity * (t - best.time_s).max(0.0);
             // One detection event per contact (none within 5 s before): the log stays small.
             if self.last_detection_s.is_none_or(|l| t - l > 5.0) {
-                self.events.push(PlannerEvent::Detection { pos_m: pos });
+                self.events.push(PlannerEvent::Detection { pos_m: at });
             }
             self.last_detection_s = Some(t);
-            if self.strongest.is_none_or(|(r, _)| best > r) && !self.declared {
-                self.strongest = Some((best, pos));
-                telemetry.push(Telemetry::SourceEstimate { pos_m: pos });
+            if self.strongest.is_none_or(|(r, _)| best.reading > r) && !self.declared {
+                self.strongest = Some((best.reading, at));
+                telemetry.push(Telemetry::SourceEstimate { pos_m: at });
             }
         }
         let percept = Percept {
@@ -313,9 +356,10 @@ mod tests {
             10.0,
             Vec2::new(0.0, 0.0),
         );
-        assert_eq!(l.len(), 10, "x = 10, 50, ..., 370");
+        // Centred between x = 10 and 390: strips of 20 m at both edges.
+        assert_eq!(l.len(), 10, "x = 20, 60, ..., 380");
         for (k, (a, b)) in l.iter().enumerate() {
-            assert!((a.x - (10.0 + 40.0 * k as f64)).abs() < 1e-9 && (a.x - b.x).abs() < 1e-9);
+            assert!((a.x - (20.0 + 40.0 * k as f64)).abs() < 1e-9 && (a.x - b.x).abs() < 1e-9);
             let (lo, hi) = (a.y.min(b.y), a.y.max(b.y));
             assert!(
                 (lo - 10.0).abs() < 1e-9 && (hi - 190.0).abs() < 1e-9,
@@ -333,7 +377,7 @@ mod tests {
             Vec2::new(400.0, 200.0),
         );
         assert!(
-            (l[0].0 - Vec2::new(370.0, 190.0)).norm() < 1e-9,
+            (l[0].0 - Vec2::new(380.0, 190.0)).norm() < 1e-9,
             "{:?}",
             l[0]
         );
@@ -356,9 +400,50 @@ mod tests {
         let l = lanes(&thin, Heading::NORTH, 40.0, 10.0, Vec2::zeros());
         assert_eq!(l.len(), 1);
         assert!((l[0].0 - Vec2::new(10.0, 7.5)).norm() < 1e-9 && (l[0].1.x - 390.0).abs() < 1e-9);
+        // A U-shaped area: lanes across its two arms are split, never crossing the gap.
+        let u = OpArea::new(vec![
+            Vec2::new(0.0, 0.0),
+            Vec2::new(300.0, 0.0),
+            Vec2::new(300.0, 200.0),
+            Vec2::new(200.0, 200.0),
+            Vec2::new(200.0, 60.0),
+            Vec2::new(100.0, 60.0),
+            Vec2::new(100.0, 200.0),
+            Vec2::new(0.0, 200.0),
+        ])
+        .unwrap_or_else(|e| panic!("{e}"));
+        let l = lanes(&u, Heading::NORTH, 30.0, 10.0, Vec2::zeros());
+        let split = l.iter().filter(|(a, _)| a.y > 60.0).count();
+        assert!(split >= 8, "{l:?}");
+        for (a, b) in &l {
+            for k in 0..=20 {
+                let p = a + (b - a) * (f64::from(k) / 20.0);
+                assert!(u.contains(p), "{p:?} on {a:?}-{b:?} is outside");
+            }
+        }
         // Too narrow across the flow too: no lane at all.
         let dot = OpArea::rectangle(0.0, 15.0, 0.0, 15.0).unwrap_or_else(|e| panic!("{e}"));
         assert!(lanes(&dot, Heading::NORTH, 40.0, 10.0, Vec2::zeros()).is_empty());
+    }
+
+    #[test]
+    fn a_survey_with_no_lane_is_refused_when_it_is_built() {
+        let ctx = BuildContext {
+            geometry: crate::MissionGeometry {
+                op_area: area(),
+                subregions: vec![],
+                prior_flow_toward_deg: 90.0,
+            },
+            vehicle: VehicleId(0),
+            vehicle_kind: plumetrace_core::VehicleKind::Auv,
+        };
+        let p = LawnmowerParams {
+            edge_margin_m: 150.0,
+            ..LawnmowerParams::default()
+        };
+        let e = p.build(&ctx).err().unwrap_or_else(|| panic!("built"));
+        assert_eq!(e.key, "edge_margin_m");
+        assert!(LawnmowerParams::default().build(&ctx).is_ok());
     }
 
     /// Flies the planner on a kinematic vehicle (turn-rate limited, 0.5 s steps) over a plume
@@ -414,13 +499,7 @@ mod tests {
         let source = Vec2::new(120.0, 100.0);
         let (events, status, t) = fly(LawnmowerParams::default(), source);
         assert_eq!(status, PlanStatus::Finished, "after {t} s");
-        let kinds: Vec<BehaviourKind> = events
-            .iter()
-            .filter_map(|e| match e {
-                PlannerEvent::Behaviour { behaviour } => Some(*behaviour),
-                _ => None,
-            })
-            .collect();
+        let kinds: Vec<BehaviourKind> = events.iter().filter_map(PlannerEvent::behaviour).collect();
         assert_eq!(
             kinds,
             [

@@ -69,6 +69,9 @@ pub trait PlannerParams:
     const SUMMARY: &'static str;
     /// It needs a position estimate (vehicles without one cannot fly it).
     const NEEDS_POSITION: bool = true;
+    /// The key of its detection threshold, if it thresholds chemical readings (an older
+    /// scenario's `[vehicles.chem_sensor] threshold_v` is passed to it).
+    const THRESHOLD_KEY: Option<&'static str> = None;
 
     /// Checks every value (bounds, and rules across keys); errors name `prefix.key`.
     fn validate(&self, prefix: &str) -> Result<(), ParamError> {
@@ -78,7 +81,7 @@ pub trait PlannerParams:
     /// The reading above which a chemical sample is a detection, if the planner thresholds.
     fn detection_threshold_v(&self) -> Option<f64>;
 
-    /// The planner.
+    /// The planner; errors name keys of the planner's table (without a prefix).
     fn build(&self, ctx: &BuildContext) -> Result<Box<dyn Planner>, ParamError>;
 }
 
@@ -93,14 +96,16 @@ plumetrace_core::params! {
 /// One planner of the registry, for lists and docs.
 #[derive(Debug, Clone, Copy)]
 pub struct PlannerEntry {
-    /// The `kind` that selects it.
-    pub kind: &'static str,
+    /// Its kind.
+    pub kind: PlannerKind,
     /// One line saying what it is.
     pub summary: &'static str,
     /// Its keys (without the common ones).
     pub keys: fn() -> Vec<KeyDoc>,
     /// It needs a position estimate.
     pub needs_position: bool,
+    /// The key of its detection threshold, if it has one.
+    pub threshold_key: Option<&'static str>,
 }
 
 /// Reads a parameter set from a table; errors name `prefix.key` (unknown keys, wrong types,
@@ -143,11 +148,37 @@ impl PlannerParamsLike for CommonParams {
 /// and [`PLANNERS`].
 macro_rules! registry {
     ($($variant:ident($ty:ty)),* $(,)?) => {
+        /// Which planner: written in files as its `kind` name.
+        #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+        pub enum PlannerKind {
+            $(
+                #[doc = concat!("See [`", stringify!($ty), "`].")]
+                $variant,
+            )*
+        }
+
+        impl PlannerKind {
+            /// Every planner, in registry order.
+            pub const ALL: &'static [PlannerKind] = &[$(PlannerKind::$variant,)*];
+
+            /// The `kind` name in files.
+            pub fn name(self) -> &'static str {
+                match self {
+                    $(PlannerKind::$variant => <$ty as PlannerParams>::KIND,)*
+                }
+            }
+
+            /// The kind called `name`.
+            pub fn from_name(name: &str) -> Option<Self> {
+                Self::ALL.iter().copied().find(|k| k.name() == name)
+            }
+        }
+
         /// The parameters of one planner, by kind.
         #[derive(Debug, Clone, PartialEq)]
         pub enum PlannerSpec {
             $(
-                #[doc = concat!("`kind = \"", stringify!($variant), "\"`: see [`", stringify!($ty), "`].")]
+                #[doc = concat!("See [`", stringify!($ty), "`].")]
                 $variant($ty),
             )*
         }
@@ -155,30 +186,25 @@ macro_rules! registry {
         /// Every planner, in registry order.
         pub const PLANNERS: &[PlannerEntry] = &[$(
             PlannerEntry {
-                kind: <$ty as PlannerParams>::KIND,
+                kind: PlannerKind::$variant,
                 summary: <$ty as PlannerParams>::SUMMARY,
                 keys: <$ty as Params>::keys,
                 needs_position: <$ty as PlannerParams>::NEEDS_POSITION,
+                threshold_key: <$ty as PlannerParams>::THRESHOLD_KEY,
             },
         )*];
 
         impl PlannerSpec {
-            fn parse(kind: &str, table: toml::Table, prefix: &str) -> Result<Self, ParamError> {
-                $(
-                    if kind == <$ty as PlannerParams>::KIND {
-                        return parse_params::<$ty>(table, prefix).map(PlannerSpec::$variant);
-                    }
-                )*
-                Err(ParamError::at(prefix, "kind", format!(
-                    "unknown planner '{kind}' (known: {})",
-                    PLANNERS.iter().map(|p| p.kind).collect::<Vec<_>>().join(", ")
-                )))
+            fn parse(kind: PlannerKind, table: toml::Table, prefix: &str) -> Result<Self, ParamError> {
+                match kind {
+                    $(PlannerKind::$variant => parse_params::<$ty>(table, prefix).map(PlannerSpec::$variant),)*
+                }
             }
 
-            /// The planner's `kind`.
-            pub fn kind(&self) -> &'static str {
+            /// The planner's kind.
+            pub fn kind(&self) -> PlannerKind {
                 match self {
-                    $(PlannerSpec::$variant(_) => <$ty as PlannerParams>::KIND,)*
+                    $(PlannerSpec::$variant(_) => PlannerKind::$variant,)*
                 }
             }
 
@@ -195,9 +221,9 @@ macro_rules! registry {
                 }
             }
 
-            fn to_table(&self) -> toml::Table {
+            fn to_table(&self) -> Result<toml::Table, String> {
                 match self {
-                    $(PlannerSpec::$variant(p) => toml::Table::try_from(p).unwrap_or_default(),)*
+                    $(PlannerSpec::$variant(p) => toml::Table::try_from(p).map_err(|e| e.to_string()),)*
                 }
             }
         }
@@ -209,9 +235,41 @@ registry! {
     Lawnmower(lawnmower::LawnmowerParams),
 }
 
+impl std::fmt::Display for PlannerKind {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl Serialize for PlannerKind {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        s.serialize_str(self.name())
+    }
+}
+
+impl<'de> Deserialize<'de> for PlannerKind {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        let name = String::deserialize(d)?;
+        PlannerKind::from_name(&name)
+            .ok_or_else(|| serde::de::Error::custom(format!("unknown planner '{name}'")))
+    }
+}
+
 /// The registry entry of a kind.
-pub fn entry(kind: &str) -> Option<&'static PlannerEntry> {
-    PLANNERS.iter().find(|p| p.kind == kind)
+pub fn entry(kind: PlannerKind) -> &'static PlannerEntry {
+    PLANNERS
+        .iter()
+        .find(|p| p.kind == kind)
+        .unwrap_or(&PLANNERS[0])
+}
+
+/// The kinds as `"amp", "lawnmower"` for messages.
+fn kinds() -> String {
+    PlannerKind::ALL
+        .iter()
+        .map(|k| format!("\"{}\"", k.name()))
+        .collect::<Vec<_>>()
+        .join(", ")
 }
 
 /// A planner's whole configuration: its kind and parameters, and the common keys.
@@ -227,15 +285,14 @@ impl PlannerConfig {
     /// Reads a planner table (`kind` plus keys); errors name `prefix.key`.
     pub fn from_table(table: &toml::Table, prefix: &str) -> Result<Self, ParamError> {
         let mut t = table.clone();
-        let kinds = || {
-            PLANNERS
-                .iter()
-                .map(|p| format!("\"{}\"", p.kind))
-                .collect::<Vec<_>>()
-                .join(", ")
-        };
         let kind = match t.remove("kind") {
-            Some(toml::Value::String(s)) => s,
+            Some(toml::Value::String(s)) => PlannerKind::from_name(&s).ok_or_else(|| {
+                ParamError::at(
+                    prefix,
+                    "kind",
+                    format!("unknown planner '{s}' (known: {})", kinds()),
+                )
+            })?,
             Some(other) => {
                 return Err(ParamError::at(
                     prefix,
@@ -259,22 +316,25 @@ impl PlannerConfig {
         }
         Ok(PlannerConfig {
             common: parse_params(common, prefix)?,
-            spec: PlannerSpec::parse(&kind, t, prefix)?,
+            spec: PlannerSpec::parse(kind, t, prefix)?,
         })
     }
 
     /// The configuration as a table (every key, defaults included): what
     /// [`PlannerConfig::from_table`] reads back to an equal configuration.
-    pub fn to_table(&self) -> toml::Table {
+    pub fn to_table(&self) -> Result<toml::Table, String> {
         let mut t = toml::Table::new();
-        t.insert("kind".into(), toml::Value::String(self.kind().into()));
-        t.extend(toml::Table::try_from(&self.common).unwrap_or_default());
-        t.extend(self.spec.to_table());
-        t
+        t.insert(
+            "kind".into(),
+            toml::Value::String(self.kind().name().into()),
+        );
+        t.extend(toml::Table::try_from(&self.common).map_err(|e| e.to_string())?);
+        t.extend(self.spec.to_table()?);
+        Ok(t)
     }
 
-    /// The planner's `kind`.
-    pub fn kind(&self) -> &'static str {
+    /// The planner's kind.
+    pub fn kind(&self) -> PlannerKind {
         self.spec.kind()
     }
 
@@ -285,12 +345,16 @@ impl PlannerConfig {
 
     /// It needs a position estimate.
     pub fn needs_position(&self) -> bool {
-        entry(self.kind()).is_some_and(|e| e.needs_position)
+        entry(self.kind()).needs_position
     }
 
-    /// The planner, ready to fly.
-    pub fn build(&self, ctx: &BuildContext) -> Result<Box<dyn Planner>, ParamError> {
-        let inner = self.spec.build(ctx)?;
+    /// The planner, ready to fly; errors name `prefix.key` (`prefix`: the key path the table was
+    /// read from).
+    pub fn build(&self, ctx: &BuildContext, prefix: &str) -> Result<Box<dyn Planner>, ParamError> {
+        let inner = self.spec.build(ctx).map_err(|e| ParamError {
+            key: key_path(prefix, &e.key),
+            message: e.message,
+        })?;
         let period = self.common.decision_period_s;
         Ok(if period > 0.0 {
             Box::new(Periodic {
@@ -331,7 +395,8 @@ pub fn registry_markdown() -> String {
         let _ = write!(
             out,
             "\n### `kind = \"{}\"`\n\n{}.\n\n| key | type | default | unit | bounds | what it is |\n| --- | --- | --- | --- | --- | --- |\n",
-            p.kind, p.summary
+            p.kind.name(),
+            p.summary
         );
         out.push_str(&markdown_rows(&(p.keys)()));
     }
@@ -353,9 +418,9 @@ mod tests {
             "planners.tracer",
         )
         .unwrap_or_else(|e| panic!("{e}"));
-        assert_eq!(c.kind(), "amp");
+        assert_eq!(c.kind(), PlannerKind::Amp);
         assert_eq!(c.common.decision_period_s, 0.5);
-        let t = c.to_table();
+        let t = c.to_table().unwrap_or_default();
         assert_eq!(t["beta_deg"].as_float(), Some(30.0));
         assert_eq!(t["lost_point_eviction"].as_str(), Some("most_downflow"));
         assert_eq!(
@@ -363,8 +428,35 @@ mod tests {
             Some(5.0),
             "omitted keys take their default"
         );
-        let back = PlannerConfig::from_table(&c.to_table(), "x").unwrap_or_else(|e| panic!("{e}"));
+        let back = PlannerConfig::from_table(&t, "x").unwrap_or_else(|e| panic!("{e}"));
         assert_eq!(back, c);
+    }
+
+    #[test]
+    fn every_planner_reads_its_defaults_and_writes_them_back() {
+        for p in PLANNERS {
+            let mut t = toml::Table::new();
+            t.insert("kind".into(), toml::Value::String(p.kind.name().into()));
+            // The defaults pass their own bounds (a bound of the wrong type would not).
+            let c = PlannerConfig::from_table(&t, "p").unwrap_or_else(|e| panic!("{e}"));
+            assert_eq!(c.kind(), p.kind);
+            let full = c.to_table().unwrap_or_else(|e| panic!("{e}"));
+            assert_eq!(
+                full.len(),
+                2 + (p.keys)().len(),
+                "kind, common and own keys"
+            );
+            let back = PlannerConfig::from_table(&full, "p").unwrap_or_else(|e| panic!("{e}"));
+            assert_eq!(back, c);
+            let text = toml::to_string(&full).unwrap_or_default();
+            let reread: toml::Table = text.parse().unwrap_or_default();
+            assert_eq!(
+                reread, full,
+                "{}: the TOML text reads back the same",
+                p.kind
+            );
+            assert_eq!(PlannerKind::from_name(p.kind.name()), Some(p.kind));
+        }
     }
 
     #[test]
@@ -417,7 +509,7 @@ mod tests {
     fn the_markdown_lists_every_planner_and_key() {
         let md = registry_markdown();
         for p in PLANNERS {
-            assert!(md.contains(&format!("`kind = \"{}\"`", p.kind)));
+            assert!(md.contains(&format!("`kind = \"{}\"`", p.kind.name())));
             for k in (p.keys)() {
                 assert!(md.contains(&format!("| `{}` |", k.name)), "{}", k.name);
             }

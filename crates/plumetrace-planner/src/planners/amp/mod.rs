@@ -162,6 +162,8 @@ impl PlannerParams for AmpParams {
     const KIND: &'static str = "amp";
     const SUMMARY: &'static str = "REMUS Adaptive Mission Planner: Find, Track-In, Track-Out, Reacquire (Bowtie), lost-point declaration, mapping, subregions";
 
+    const THRESHOLD_KEY: Option<&'static str> = Some("threshold_v");
+
     fn detection_threshold_v(&self) -> Option<f64> {
         Some(self.threshold_v)
     }
