@@ -74,6 +74,18 @@ const RULES: &[(&str, Side, &[&str])] = &[
             "plumetrace-campaign",
         ],
     ),
+    (
+        "plumetrace-fuzz",
+        Side::App,
+        &[
+            "plumetrace-core",
+            "plumetrace-env",
+            "plumetrace-scenario",
+            "plumetrace-planner",
+            "plumetrace-mission",
+            "plumetrace-campaign",
+        ],
+    ),
 ];
 
 fn manifest_deps(path: &Path, table: &str) -> BTreeSet<String> {

@@ -1,0 +1,4 @@
+//! `plumetrace-fuzz`: mutated scenario and campaign files against `check`, short runs and
+//! campaign parsing.
+
+fn main() {}
