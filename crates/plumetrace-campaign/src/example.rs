@@ -120,13 +120,15 @@ fn example_file(dir: &Path, scenario: &str, config: &str, point: &str) -> PathBu
         .join(format!("{}.json", slug(&[scenario, config, point])))
 }
 
-/// A file name from labels: letters, digits, `-`, `.` and `_` kept, the rest `_`, parts joined
-/// by `__`.
-fn slug(parts: &[&str]) -> String {
-    parts
+/// A file name from labels, short, safe and unique: each label's letters, digits, `-`, `.` and
+/// `_` (the rest `_`), cut to 32 characters, joined by `__`, then a digest of the labels as they
+/// are (so `a/b` and `a_b`, or two long names alike in their first 32 characters, differ).
+pub fn slug(parts: &[&str]) -> String {
+    let readable = parts
         .iter()
         .map(|p| {
             p.chars()
+                .take(32)
                 .map(|ch| {
                     if ch.is_ascii_alphanumeric() || matches!(ch, '-' | '.' | '_') {
                         ch
@@ -137,5 +139,28 @@ fn slug(parts: &[&str]) -> String {
                 .collect::<String>()
         })
         .collect::<Vec<_>>()
-        .join("__")
+        .join("__");
+    let digest = crate::spec::fnv1a(parts.join("\u{0}").as_bytes());
+    format!("{readable}-{digest:016x}")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn file_names_are_short_safe_and_unique() {
+        let a = slug(&["demo", "a/b", ""]);
+        let b = slug(&["demo", "a_b", ""]);
+        assert_ne!(a, b, "{a} {b}");
+        assert!(a.starts_with("demo__a_b__-"), "{a}");
+        let long = "x".repeat(500);
+        let l1 = slug(&["demo", &long, "beta_deg=1e300"]);
+        let l2 = slug(&["demo", &format!("{long}y"), "beta_deg=1e300"]);
+        assert!(l1.len() < 120 && l1 != l2, "{l1}");
+        assert!(
+            l1.chars()
+                .all(|c| c.is_ascii_alphanumeric() || "-._".contains(c))
+        );
+    }
 }

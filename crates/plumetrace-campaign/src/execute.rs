@@ -62,6 +62,9 @@ pub fn claim_dir(c: &Campaign, out: &Path) -> Result<(), CampaignError> {
         fingerprint: c.fingerprint(),
         seeds: c.file.seeds,
     };
+    if !meta_path.exists() {
+        refuse_foreign(out)?;
+    }
     if meta_path.exists() {
         let text =
             std::fs::read_to_string(&meta_path).map_err(|e| CampaignError::io(&meta_path, e))?;
@@ -88,6 +91,24 @@ pub fn claim_dir(c: &Campaign, out: &Path) -> Result<(), CampaignError> {
         }
     }
     write_meta(out, &meta, &c.text)
+}
+
+/// Refuses a directory that holds files but no campaign: results are never written over someone
+/// else's files.
+pub fn refuse_foreign(out: &Path) -> Result<(), CampaignError> {
+    let entries = std::fs::read_dir(out).map_err(|e| CampaignError::io(out, e))?;
+    if let Some(first) = entries.flatten().next() {
+        return Err(CampaignError::Results {
+            path: out.display().to_string(),
+            line: None,
+            message: format!(
+                "holds files ({} among them) but no {META_FILE}: it is not a campaign directory; \
+                 use a new or empty --out directory",
+                first.file_name().to_string_lossy()
+            ),
+        });
+    }
+    Ok(())
 }
 
 /// Writes `campaign.json` and the copy of the campaign file into `out`.

@@ -35,7 +35,9 @@ fn read_meta(dir: &Path) -> Result<Meta, CampaignError> {
 }
 
 /// Merges `dirs` into `out`: every input must hold the same campaign (equal fingerprints); a run
-/// found in several inputs must have the same result in each.
+/// found in several inputs must have the same result in each. An `out` that already holds runs of
+/// the same campaign is merged in too (nothing it holds is lost); an `out` that holds another
+/// campaign, or other files, is refused.
 pub fn merge(dirs: &[PathBuf], out: &Path) -> Result<MergeReport, CampaignError> {
     let Some(first) = dirs.first() else {
         return Err(CampaignError::Io {
@@ -45,12 +47,42 @@ pub fn merge(dirs: &[PathBuf], out: &Path) -> Result<MergeReport, CampaignError>
     };
     let out_canon = std::fs::canonicalize(out).ok();
     let meta = read_meta(first)?;
+    // What `out` holds already: nothing, or runs of this same campaign (merged in below).
+    let mut dirs = dirs.to_vec();
+    if out.is_dir() {
+        if out.join(META_FILE).exists() {
+            let held = read_meta(out)?;
+            if held.fingerprint != meta.fingerprint {
+                return Err(CampaignError::Results {
+                    path: out.join(META_FILE).display().to_string(),
+                    line: None,
+                    message: format!(
+                        "{} holds campaign '{}' ({}), not '{}' ({}): its results would be lost; \
+                         merge into a new directory",
+                        out.display(),
+                        held.name,
+                        held.fingerprint,
+                        meta.name,
+                        meta.fingerprint
+                    ),
+                });
+            }
+            if out.join(RUNS_FILE).exists() {
+                dirs.push(out.to_path_buf());
+            }
+        } else {
+            crate::execute::refuse_foreign(out)?;
+        }
+    }
+    let dirs = &dirs[..];
     let mut seeds = 0;
     let mut campaign: Option<Campaign> = None;
     let mut all_rows = Vec::new();
     let mut report = MergeReport::default();
-    for d in dirs {
-        if out_canon.is_some() && std::fs::canonicalize(d).ok() == out_canon {
+    for (k, d) in dirs.iter().enumerate() {
+        // `out` may come last (its own runs, merged in), not among the inputs named.
+        let is_out = out_canon.is_some() && std::fs::canonicalize(d).ok() == out_canon;
+        if is_out && !(k + 1 == dirs.len() && d.as_path() == out) {
             return Err(CampaignError::Io {
                 path: out.display().to_string(),
                 message: "the output directory must not be one of the inputs".into(),
@@ -95,7 +127,7 @@ pub fn merge(dirs: &[PathBuf], out: &Path) -> Result<MergeReport, CampaignError>
     std::fs::create_dir_all(out.join(EXAMPLES_DIR))
         .map_err(|e| CampaignError::io(&out.join(EXAMPLES_DIR), e))?;
     write_meta(out, &Meta { seeds, ..meta }, &c.text)?;
-    for d in dirs {
+    for d in dirs.iter().filter(|d| d.as_path() != out) {
         let Ok(entries) = std::fs::read_dir(d.join(EXAMPLES_DIR)) else {
             continue;
         };

@@ -54,6 +54,17 @@ pub struct ConfigFile {
     pub set: toml::Table,
 }
 
+/// Most seeds per group.
+pub const MAX_SEEDS: u64 = 1_000_000;
+/// Most runs of one campaign (its run list is made in memory).
+pub const MAX_RUNS: u64 = 1_000_000;
+/// Most sweep points.
+pub const MAX_POINTS: usize = 10_000;
+/// Most groups (scenarios x configurations x sweep points).
+pub const MAX_GROUPS: usize = 10_000;
+/// Most scenarios, and most configurations.
+pub const MAX_LIST: usize = 1000;
+
 /// A scenario of the campaign with its TOML, ready for overrides.
 #[derive(Debug, Clone)]
 pub struct ScenarioEntry {
@@ -160,6 +171,16 @@ impl std::fmt::Display for Shard {
 /// Parses campaign text; errors name the key path.
 pub fn parse_campaign(text: &str, path: &Path) -> Result<CampaignFile, CampaignError> {
     let file = path.display().to_string();
+    if let Ok(table) = text.parse::<toml::Table>()
+        && let Some((key, value)) =
+            plumetrace_scenario::first_datetime(&toml::Value::Table(table), "")
+    {
+        return Err(CampaignError::Invalid {
+            file,
+            key,
+            message: format!("is a date/time ({value}); no campaign key takes one"),
+        });
+    }
     let de = toml::Deserializer::parse(text).map_err(|e| CampaignError::Invalid {
         file: file.clone(),
         key: String::new(),
@@ -178,10 +199,11 @@ pub fn parse_campaign(text: &str, path: &Path) -> Result<CampaignFile, CampaignE
 impl Campaign {
     /// Reads a campaign file, loads its scenarios and checks every group builds.
     pub fn load(path: &Path, seeds: Option<u64>) -> Result<Self, CampaignError> {
-        let text = std::fs::read_to_string(path).map_err(|e| CampaignError::Io {
-            path: path.display().to_string(),
-            message: e.to_string(),
-        })?;
+        let text = plumetrace_env::input::read_text(path, plumetrace_env::input::MAX_TEXT_BYTES)
+            .map_err(|message| CampaignError::Io {
+                path: path.display().to_string(),
+                message,
+            })?;
         let mut file = parse_campaign(&text, path)?;
         if let Some(n) = seeds {
             file.seeds = n;
@@ -205,8 +227,20 @@ impl Campaign {
             key,
             message,
         };
-        if file.seeds == 0 {
-            return Err(invalid("seeds".into(), "must be at least 1".into()));
+        if !(1..=MAX_SEEDS).contains(&file.seeds) {
+            return Err(invalid(
+                "seeds".into(),
+                format!("must be 1 to {MAX_SEEDS}, got {}", file.seeds),
+            ));
+        }
+        for (key, n, max) in [
+            ("scenarios", file.scenarios.len(), MAX_LIST),
+            ("configs", file.configs.len(), MAX_LIST),
+            ("sweep", file.sweep.len(), 16),
+        ] {
+            if n > max {
+                return Err(invalid(key.into(), format!("{n} entries; at most {max}")));
+            }
         }
         if file.scenarios.is_empty() {
             return Err(invalid(
@@ -234,9 +268,10 @@ impl Campaign {
             let (origin, text) = if s.ends_with(".toml") {
                 let p = base.join(s);
                 let text = if read_scenarios {
-                    std::fs::read_to_string(&p).map_err(|e| {
-                        invalid(format!("scenarios[{i}]"), format!("{}: {e}", p.display()))
-                    })?
+                    plumetrace_env::input::read_text(&p, plumetrace_env::input::MAX_TEXT_BYTES)
+                        .map_err(|e| {
+                            invalid(format!("scenarios[{i}]"), format!("{}: {e}", p.display()))
+                        })?
                 } else {
                     String::new()
                 };
@@ -284,6 +319,45 @@ impl Campaign {
                     format!("'{}' is used twice", c.name),
                 ));
             }
+        }
+        // The sweep's size is checked before its points are made.
+        let mut n_points: usize = 1;
+        for (key, values) in &file.sweep {
+            let toml::Value::Array(values) = values else {
+                continue;
+            };
+            for (i, v) in values.iter().enumerate() {
+                if values[..i].iter().any(|w| value_text(w) == value_text(v)) {
+                    return Err(invalid(
+                        format!("sweep.{key}[{i}]"),
+                        format!("{} is listed twice", value_text(v)),
+                    ));
+                }
+            }
+            n_points = n_points.saturating_mul(values.len().max(1));
+        }
+        let groups = n_points
+            .saturating_mul(configs.len())
+            .saturating_mul(scenarios.len());
+        if n_points > MAX_POINTS || groups > MAX_GROUPS {
+            return Err(invalid(
+                "sweep".into(),
+                format!(
+                    "{n_points} sweep points, {groups} groups (scenarios x configs x points); at \
+                     most {MAX_POINTS} points and {MAX_GROUPS} groups"
+                ),
+            ));
+        }
+        let runs = (groups as u64).saturating_mul(file.seeds);
+        if runs > MAX_RUNS {
+            return Err(invalid(
+                "seeds".into(),
+                format!(
+                    "{groups} groups x {} seeds = {runs} runs; at most {MAX_RUNS} in one campaign \
+                     (split it into several)",
+                    file.seeds
+                ),
+            ));
         }
         let mut points = vec![SweepPoint { values: Vec::new() }];
         for (key, values) in &file.sweep {
@@ -511,7 +585,7 @@ impl Campaign {
 }
 
 /// FNV-1a, 64 bits: a stable digest (std's hasher may change between releases).
-fn fnv1a(bytes: &[u8]) -> u64 {
+pub(crate) fn fnv1a(bytes: &[u8]) -> u64 {
     let mut h: u64 = 0xcbf2_9ce4_8422_2325;
     for b in bytes {
         h ^= u64::from(*b);

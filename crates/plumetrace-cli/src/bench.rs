@@ -35,13 +35,13 @@ pub struct MissionBenchArgs {
     #[arg(long, default_value = "duck-2003-st")]
     preset: String,
     /// Missions per thread count (the same missions, seeds derived from `--seed`, each time).
-    #[arg(long, default_value_t = 8)]
+    #[arg(long, default_value_t = 8, allow_hyphen_values = true, value_parser = crate::args::runs)]
     runs: u64,
     /// Thread counts to time, comma-separated.
-    #[arg(long, value_delimiter = ',', default_value = "1,2")]
+    #[arg(long, value_delimiter = ',', default_value = "1,2", allow_hyphen_values = true, value_parser = crate::args::jobs)]
     threads: Vec<usize>,
     /// Base seed.
-    #[arg(long, default_value_t = 1)]
+    #[arg(long, default_value_t = 1, allow_hyphen_values = true, value_parser = crate::args::seed)]
     seed: u64,
 }
 
@@ -135,17 +135,17 @@ pub struct PlumeBenchArgs {
     #[arg(long, value_enum, default_value = "pompy")]
     case: Case,
     /// Filament release rate, per second (default: 5, the scenario's).
-    #[arg(long)]
+    #[arg(long, allow_hyphen_values = true, value_parser = crate::args::number)]
     release_rate: Option<f64>,
     /// Simulated seconds timed after the warm-up (default: 20 for pompy, 200 for field).
-    #[arg(long)]
+    #[arg(long, allow_hyphen_values = true, value_parser = crate::args::number)]
     duration: Option<f64>,
     /// Time step, s (default: 0.01 for pompy, 0.1 for field).
-    #[arg(long)]
+    #[arg(long, allow_hyphen_values = true, value_parser = crate::args::number)]
     dt: Option<f64>,
     /// Simulated seconds before timing starts, to fill the domain (default: 100 for pompy,
     /// 11000 for field).
-    #[arg(long)]
+    #[arg(long, allow_hyphen_values = true, value_parser = crate::args::number)]
     warmup: Option<f64>,
     /// Use pompy's dt-scaled dispersion (the pompy case always does; this switches it on for field).
     #[arg(long)]
@@ -161,7 +161,7 @@ pub struct PlumeBenchArgs {
     #[arg(long, default_value_t = 5)]
     blocks: usize,
     /// Run seed.
-    #[arg(long, default_value_t = 1)]
+    #[arg(long, default_value_t = 1, allow_hyphen_values = true, value_parser = crate::args::seed)]
     seed: u64,
 }
 
@@ -197,12 +197,12 @@ pub fn run(cmd: &BenchCommand) -> Result<()> {
     match cmd {
         BenchCommand::Plume(a) => {
             let r = plume(a)?;
-            println!("{}", serde_json::to_string_pretty(&r)?);
+            crate::outln!("{}", serde_json::to_string_pretty(&r)?);
             Ok(())
         }
         BenchCommand::Missions(a) => {
             let r = missions(a)?;
-            println!("{}", serde_json::to_string_pretty(&r)?);
+            crate::outln!("{}", serde_json::to_string_pretty(&r)?);
             Ok(())
         }
     }

@@ -13,25 +13,19 @@ pub struct CampaignArgs {
     /// Output directory; running again into it resumes (finished runs are skipped).
     #[arg(long)]
     pub out: PathBuf,
-    /// Worker threads (default: one per core). Results do not depend on it.
-    #[arg(long)]
+    /// Worker threads, 1 to 256 (default: one per core). Results do not depend on it.
+    #[arg(long, allow_hyphen_values = true, value_parser = crate::args::jobs)]
     pub jobs: Option<usize>,
     /// Run only shard K of N (1-based, e.g. `--shard 2/4`): every N-th run of the list.
     #[arg(long)]
     pub shard: Option<Shard>,
-    /// Seeds per group (overrides the file's `seeds`).
-    #[arg(long)]
+    /// Seeds per group, 1 to 1,000,000 (overrides the file's `seeds`).
+    #[arg(long, allow_hyphen_values = true, value_parser = crate::args::seeds)]
     pub seeds: Option<u64>,
 }
 
 /// Runs (or resumes) a campaign and prints where the results are.
 pub fn run(args: &CampaignArgs) -> Result<()> {
-    if args.jobs == Some(0) {
-        anyhow::bail!("--jobs: must be at least 1");
-    }
-    if args.seeds == Some(0) {
-        anyhow::bail!("--seeds: must be at least 1");
-    }
     let c = Campaign::load(&args.file, args.seeds)?;
     let started = Instant::now();
     let planned = c.shard_runs(args.shard).len() as u64;
@@ -55,7 +49,7 @@ pub fn run(args: &CampaignArgs) -> Result<()> {
         .shard
         .map(|s| format!(" (shard {s})"))
         .unwrap_or_default();
-    println!(
+    crate::outln!(
         "{}{shard}: {} runs planned, {} already recorded, {} run now ({} failed) in {wall:.1} s{}; wrote {}",
         c.file.name,
         report.planned,
@@ -93,7 +87,7 @@ pub fn run_merge(args: &MergeArgs) -> Result<()> {
         );
     }
     let missing = report.expected.saturating_sub(report.runs);
-    println!(
+    crate::outln!(
         "merged {} directories: {} of {} runs{}; wrote {}",
         args.dirs.len(),
         report.runs,

@@ -7,6 +7,25 @@
 //! scenario or a field-scale one) and `bench missions` (missions per second on 1 and more
 //! threads); benchmarks print JSON.
 
+/// Writes to standard output; a closed pipe (`plumetrace planners | head`) is not an error.
+#[macro_export]
+macro_rules! out {
+    ($($t:tt)*) => {{
+        use std::io::Write as _;
+        let _ = write!(std::io::stdout(), $($t)*);
+    }};
+}
+
+/// [`out!`] with a newline.
+#[macro_export]
+macro_rules! outln {
+    ($($t:tt)*) => {{
+        use std::io::Write as _;
+        let _ = writeln!(std::io::stdout(), $($t)*);
+    }};
+}
+
+mod args;
 mod bench;
 mod campaign;
 mod mission;
@@ -37,6 +56,12 @@ enum Command {
     /// List every planner with its keys, defaults, units, bounds and a line of doc.
     Planners {
         /// Print the README's Markdown tables instead.
+        #[arg(long)]
+        markdown: bool,
+    },
+    /// Print the bounds of every number and list in a scenario file, with the reason for each.
+    Limits {
+        /// Print the README's Markdown table instead.
         #[arg(long)]
         markdown: bool,
     },
@@ -75,15 +100,30 @@ fn dispatch(cli: Cli) -> Result<()> {
                 .max()
                 .unwrap_or(0);
             for p in plumetrace_scenario::PRESETS {
-                println!("{:width$}  {}", p.name, p.summary);
+                crate::outln!("{:width$}  {}", p.name, p.summary);
             }
             Ok(())
         }
         Command::Planners { markdown } => {
             if markdown {
-                print!("{}", plumetrace_planner::registry_markdown());
+                crate::out!("{}", plumetrace_planner::registry_markdown());
             } else {
-                print!("{}", planners_text());
+                crate::out!("{}", planners_text());
+            }
+            Ok(())
+        }
+        Command::Limits { markdown } => {
+            if markdown {
+                crate::out!("{}", plumetrace_scenario::limits::markdown());
+            } else {
+                let width = plumetrace_scenario::limits::LIMITS
+                    .iter()
+                    .map(|l| l.key.len())
+                    .max()
+                    .unwrap_or(0);
+                for l in plumetrace_scenario::limits::LIMITS {
+                    crate::outln!("{:width$}  {} ({})", l.key, l.bound.describe(), l.why);
+                }
             }
             Ok(())
         }
@@ -141,13 +181,16 @@ fn check(file: &std::path::Path) -> Result<()> {
     let built = plumetrace_scenario::build(&cfg, &origin, None)?;
     let (steps, dt) = (built.steps, built.dt_s);
     if built.mission.is_none() {
-        println!(
+        crate::outln!(
             "{}: ok (plume run, {steps} steps of {dt} s)",
             file.display()
         );
         return Ok(());
     }
     let setup = plumetrace_mission::MissionSetup::new(built)?;
+    for w in &setup.warnings {
+        eprintln!("warning: {}: {w}", file.display());
+    }
     let vehicles: Vec<String> = setup
         .vehicles
         .iter()
@@ -157,7 +200,7 @@ fn check(file: &std::path::Path) -> Result<()> {
             None => format!("{} has no planner", v.name),
         })
         .collect();
-    println!(
+    crate::outln!(
         "{}: ok (mission of up to {} s after {} s of plume spin-up, steps of {dt} s; {})",
         file.display(),
         setup.spec.time_limit_s,

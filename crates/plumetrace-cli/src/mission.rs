@@ -29,6 +29,9 @@ pub fn run(sc: BuiltScenario, out: &Path, stats: bool, snapshot_log: bool) -> Re
     let name = sc.name.clone();
     let started = Instant::now();
     let setup = MissionSetup::new(sc)?;
+    for w in &setup.warnings {
+        eprintln!("warning: {}: {w}", setup.origin);
+    }
     let mut mission = Mission::new(setup, MissionOptions::default())?;
     if snapshot_log {
         let header = Header::new(
@@ -65,7 +68,7 @@ pub fn run(sc: BuiltScenario, out: &Path, stats: bool, snapshot_log: bool) -> Re
             run.spinup_wall_s
         );
     }
-    println!("{}; wrote {}", run_line(&run, &name, wall), out.display());
+    crate::outln!("{}; wrote {}", run_line(&run, &name, wall), out.display());
     Ok(())
 }
 

@@ -8,3 +8,19 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
     plumetrace_mission::output::write_atomic(path, bytes)
         .with_context(|| format!("writing {}", path.display()))
 }
+
+/// Refuses a run whose output directory would overwrite its own input file.
+pub fn refuse_overwriting(input: &Path, out: &Path, outputs: &[&str]) -> Result<()> {
+    let Ok(input) = std::fs::canonicalize(input) else {
+        return Ok(());
+    };
+    for name in outputs {
+        if std::fs::canonicalize(out.join(name)).is_ok_and(|p| p == input) {
+            anyhow::bail!(
+                "{}: the run would write its {name} over this input file; choose another --out",
+                input.display()
+            );
+        }
+    }
+    Ok(())
+}

@@ -18,7 +18,7 @@ pub struct ReplayArgs {
     pub planner_file: Option<PathBuf>,
     /// With `--planner-file`: replace only this vehicle's planner (its index in the scenario);
     /// the others replay their own.
-    #[arg(long, requires = "planner_file")]
+    #[arg(long, requires = "planner_file", allow_hyphen_values = true, value_parser = crate::args::vehicle)]
     pub vehicle: Option<u32>,
 }
 
@@ -29,8 +29,9 @@ pub const DIFFER: i32 = 3;
 pub fn run(args: &ReplayArgs) -> Result<bool> {
     let other: Option<toml::Table> = match &args.planner_file {
         Some(p) => {
-            let text =
-                std::fs::read_to_string(p).with_context(|| format!("reading {}", p.display()))?;
+            let text = plumetrace_env::input::read_text(p, plumetrace_env::input::MAX_TEXT_BYTES)
+                .map_err(anyhow::Error::msg)
+                .with_context(|| format!("reading {}", p.display()))?;
             let table: toml::Table = text.parse().with_context(|| format!("{}", p.display()))?;
             // Checked here so that errors name this file, not the log's planner.
             plumetrace_planner::PlannerConfig::from_table(&table, "")
@@ -46,14 +47,14 @@ pub fn run(args: &ReplayArgs) -> Result<bool> {
         other.clone().filter(|_| only.is_none_or(|o| o == v))
     })
     .with_context(|| format!("{}", args.log.display()))?;
-    println!(
+    crate::outln!(
         "{}: {} decisions replayed, {} differ",
         args.log.display(),
         report.decisions,
         report.differing
     );
     for d in &report.first {
-        println!(
+        crate::outln!(
             "  line {}, vehicle {}, t = {:.1} s: logged heading {:.2} deg, speed {:.2} m/s, {}; replayed heading {:.2} deg, speed {:.2} m/s, {}",
             d.line,
             d.vehicle,

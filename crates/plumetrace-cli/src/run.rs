@@ -23,7 +23,7 @@ pub struct RunArgs {
     #[arg(long, conflicts_with = "scenario")]
     preset: Option<String>,
     /// Run seed (overrides the scenario's).
-    #[arg(long)]
+    #[arg(long, allow_hyphen_values = true, value_parser = crate::args::seed)]
     seed: Option<u64>,
     /// Output directory (created if needed).
     #[arg(long, default_value = "out")]
@@ -86,12 +86,28 @@ pub fn run(args: &RunArgs) -> Result<()> {
     let sc = load(args.scenario.as_deref(), args.preset.as_deref(), args.seed)?;
     std::fs::create_dir_all(&args.out)
         .with_context(|| format!("creating {}", args.out.display()))?;
+    if let Some(path) = &args.scenario {
+        crate::output::refuse_overwriting(path, &args.out, OUTPUTS)?;
+    }
     if sc.mission.is_some() {
         crate::mission::run(sc, &args.out, args.stats, !args.no_snapshot_log)
     } else {
         run_plume(sc, args)
     }
 }
+
+/// Every file `run` may write into its output directory.
+pub const OUTPUTS: &[&str] = &[
+    "summary.json",
+    "trajectory.csv",
+    "events.jsonl",
+    "plot.svg",
+    crate::mission::SNAPSHOT_LOG,
+    "stats.json",
+    "snapshot.csv",
+    "filaments.csv",
+    "plume.svg",
+];
 
 /// Runs the plume alone and writes `stats.json`, `snapshot.csv`, `filaments.csv` and `plume.svg`.
 fn run_plume(mut sc: BuiltScenario, args: &RunArgs) -> Result<()> {
@@ -127,6 +143,14 @@ fn run_plume(mut sc: BuiltScenario, args: &RunArgs) -> Result<()> {
     }
     let mean_c = mean.mean();
     let inter = mean.intermittency();
+    // Nothing non-finite reaches a file: a plume whose concentrations overflow is an error here.
+    if let Some(k) = snapshot.iter().chain(&mean_c).position(|c| !c.is_finite()) {
+        bail!(
+            "the concentration at grid point {} is not a finite number: lower \
+             sources[].mass_rate_per_s or raise plume.init_radius_m",
+            k % snapshot.len().max(1)
+        );
+    }
     let mut csv = String::from("x_m,y_m,concentration,mean_concentration,intermittency\n");
     for (k, p) in spec.grid.points().iter().enumerate() {
         let _ = writeln!(
@@ -182,7 +206,7 @@ fn run_plume(mut sc: BuiltScenario, args: &RunArgs) -> Result<()> {
         .filaments
         .map(|f| format!(", {} live filaments", f.live))
         .unwrap_or_default();
-    println!(
+    crate::outln!(
         "{}: simulated {:.0} s in {:.2} s ({:.0}x real time){live}; wrote {}",
         stats.scenario,
         stats.sim_time_s,

@@ -400,3 +400,20 @@ fn without_legacy_planner(text: &str) -> String {
 fn stdout(out: std::process::Output) -> String {
     String::from_utf8(out.stdout).unwrap()
 }
+
+#[test]
+fn the_readme_has_the_limits_table() {
+    let md = stdout(run_ok(&["limits", "--markdown"]));
+    let readme =
+        std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/../../README.md")).unwrap();
+    let start = readme
+        .find("<!-- limits:start -->\n")
+        .expect("README marks its limits table")
+        + "<!-- limits:start -->\n".len();
+    let end = readme.find("<!-- limits:end -->").unwrap();
+    assert_eq!(
+        &readme[start..end],
+        md,
+        "the README's limits table is not the code's: paste `plumetrace limits --markdown`"
+    );
+}

@@ -19,6 +19,54 @@ pub fn bearing_between(from: Vec2, to: Vec2) -> Option<Heading> {
     Heading::of_vector(to - from)
 }
 
+/// The first pair of edges `(i, j)` (edge `i` runs from vertex `i` to vertex `i + 1`, the last
+/// back to the first) of a closed polygon that touch or cross without being neighbours, or that
+/// overlap as neighbours; `None` for a simple polygon.
+pub fn self_intersection(poly: &[Vec2]) -> Option<(usize, usize)> {
+    let n = poly.len();
+    if n < 3 {
+        return None;
+    }
+    let edge = |i: usize| (poly[i], poly[(i + 1) % n]);
+    for i in 0..n {
+        let (a, b) = edge(i);
+        for j in i + 1..n {
+            let (c, d) = edge(j);
+            let neighbours = j == i + 1 || (i == 0 && j == n - 1);
+            if neighbours {
+                // Neighbours share a vertex; they must not fold back onto each other.
+                let (shared, other_a, other_b) = if j == i + 1 { (b, a, d) } else { (a, b, c) };
+                let (u, v) = (other_a - shared, other_b - shared);
+                if u.x * v.y - u.y * v.x == 0.0 && u.dot(&v) > 0.0 {
+                    return Some((i, j));
+                }
+            } else if segments_touch(a, b, c, d) {
+                return Some((i, j));
+            }
+        }
+    }
+    None
+}
+
+/// Whether segments `ab` and `cd` share at least one point.
+fn segments_touch(a: Vec2, b: Vec2, c: Vec2, d: Vec2) -> bool {
+    let cross = |o: Vec2, p: Vec2, q: Vec2| (p.x - o.x) * (q.y - o.y) - (p.y - o.y) * (q.x - o.x);
+    let on = |p: Vec2, q: Vec2, r: Vec2| {
+        r.x >= p.x.min(q.x) && r.x <= p.x.max(q.x) && r.y >= p.y.min(q.y) && r.y <= p.y.max(q.y)
+    };
+    let (d1, d2) = (cross(c, d, a), cross(c, d, b));
+    let (d3, d4) = (cross(a, b, c), cross(a, b, d));
+    if ((d1 > 0.0 && d2 < 0.0) || (d1 < 0.0 && d2 > 0.0))
+        && ((d3 > 0.0 && d4 < 0.0) || (d3 < 0.0 && d4 > 0.0))
+    {
+        return true;
+    }
+    (d1 == 0.0 && on(c, d, a))
+        || (d2 == 0.0 && on(c, d, b))
+        || (d3 == 0.0 && on(a, b, c))
+        || (d4 == 0.0 && on(a, b, d))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -43,6 +91,52 @@ mod tests {
             );
         }
         assert!(bearing_between(o, o).is_none());
+    }
+
+    #[test]
+    fn self_intersections_table() {
+        let p = |v: &[(f64, f64)]| v.iter().map(|(x, y)| Vec2::new(*x, *y)).collect::<Vec<_>>();
+        type Case<'a> = (&'a [(f64, f64)], Option<(usize, usize)>);
+        let cases: [Case; 6] = [
+            (&[(0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0)], None),
+            // A bow-tie: edges 0 and 2 cross.
+            (
+                &[(0.0, 0.0), (1.0, 1.0), (1.0, 0.0), (0.0, 1.0)],
+                Some((0, 2)),
+            ),
+            // An asymmetric bow-tie.
+            (
+                &[(0.0, 0.0), (3.0, 2.0), (3.0, 0.0), (0.0, 5.0)],
+                Some((0, 2)),
+            ),
+            // A concave (U-shaped) polygon is simple.
+            (
+                &[
+                    (0.0, 0.0),
+                    (3.0, 0.0),
+                    (3.0, 2.0),
+                    (2.0, 2.0),
+                    (2.0, 1.0),
+                    (1.0, 1.0),
+                    (1.0, 2.0),
+                    (0.0, 2.0),
+                ],
+                None,
+            ),
+            // A vertex on another edge.
+            (
+                &[(0.0, 0.0), (2.0, 0.0), (2.0, 2.0), (1.0, 0.0), (0.0, 2.0)],
+                Some((0, 2)),
+            ),
+            // A spike folding back on its neighbour.
+            (
+                &[(0.0, 0.0), (2.0, 0.0), (1.0, 0.0), (1.0, 1.0)],
+                Some((0, 1)),
+            ),
+        ];
+        for (poly, want) in cases {
+            assert_eq!(self_intersection(&p(poly)), want, "{poly:?}");
+        }
     }
 
     #[test]

@@ -22,7 +22,7 @@ pub mod planner;
 pub mod vehicle;
 
 pub use angle::{Heading, wrap_deg_180, wrap_deg_360, wrap_rad_pi};
-pub use frame::{Vec2, Vec3, bearing_between, heading_vector};
+pub use frame::{Vec2, Vec3, bearing_between, heading_vector, self_intersection};
 pub use message::{Link, Message, MessageBody, Outgoing, Recipient};
 pub use names::variant_name;
 pub use planner::{

@@ -48,7 +48,7 @@ pub fn require_positive(key: &str, value: f64) -> Result<(), EnvError> {
     } else {
         Err(EnvError::invalid(
             key,
-            format!("must be a finite number > 0, got {value}"),
+            format!("must be a finite number > 0, got {value:?}"),
         ))
     }
 }
@@ -60,7 +60,7 @@ pub fn require_non_negative(key: &str, value: f64) -> Result<(), EnvError> {
     } else {
         Err(EnvError::invalid(
             key,
-            format!("must be a finite number >= 0, got {value}"),
+            format!("must be a finite number >= 0, got {value:?}"),
         ))
     }
 }
@@ -72,7 +72,7 @@ pub fn require_finite(key: &str, value: f64) -> Result<(), EnvError> {
     } else {
         Err(EnvError::invalid(
             key,
-            format!("must be a finite number, got {value}"),
+            format!("must be a finite number, got {value:?}"),
         ))
     }
 }

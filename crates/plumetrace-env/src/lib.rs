@@ -15,6 +15,7 @@ pub mod environment;
 pub mod error;
 pub mod field;
 pub mod flow;
+pub mod input;
 pub mod obstacle;
 pub mod plume;
 pub mod rng;

@@ -37,6 +37,18 @@ impl SoftObstacle {
                 "is not finite",
             ));
         }
+        let points: Vec<plumetrace_core::Vec2> = vertices
+            .iter()
+            .map(|v| plumetrace_core::Vec2::new(v[0], v[1]))
+            .collect();
+        if let Some((a, b)) = plumetrace_core::self_intersection(&points) {
+            return Err(EnvError::invalid(
+                format!("{key}.vertices"),
+                format!(
+                    "the polygon crosses itself: edges {a} and {b} meet (edge k runs from vertex k to the next)"
+                ),
+            ));
+        }
         let ring: Vec<Coord<f64>> = vertices
             .iter()
             .map(|v| Coord { x: v[0], y: v[1] })

@@ -15,6 +15,9 @@ pub enum OpAreaError {
     /// The polygon has no area.
     #[error("the op-area has zero area")]
     ZeroArea,
+    /// Two edges cross or touch (edge `k` runs from vertex `k` to the next).
+    #[error("the op-area crosses itself: edges {0} and {1} meet")]
+    SelfIntersecting(usize, usize),
 }
 
 /// Where a point is relative to the nearest edge.
@@ -72,6 +75,9 @@ impl OpArea {
             .sum();
         if area2.abs() < 1e-9 {
             return Err(OpAreaError::ZeroArea);
+        }
+        if let Some((a, b)) = plumetrace_core::self_intersection(&vertices) {
+            return Err(OpAreaError::SelfIntersecting(a, b));
         }
         Ok(OpArea {
             vertices,

@@ -84,6 +84,8 @@ pub struct MissionSetup {
     pub depth_m: Option<f64>,
     /// Message channels.
     pub comms: CommsParams,
+    /// What `check` should tell the user: missions that cannot succeed, defaults that matter.
+    pub warnings: Vec<String>,
 }
 
 impl MissionSetup {
@@ -156,6 +158,7 @@ impl MissionSetup {
                 context,
             }));
         }
+        let warnings = warnings(&sc.vehicles, &planned, &spec, &geometry, &sc.env);
         if planned.iter().all(Option::is_none) {
             return Err(MissionError::NotAMission {
                 origin,
@@ -174,8 +177,59 @@ impl MissionSetup {
             dt_s: sc.dt_s,
             depth_m: sc.depth_m,
             comms: sc.comms,
+            warnings,
         })
     }
+}
+
+/// Missions that cannot succeed, and defaults that matter.
+fn warnings(
+    vehicles: &[VehicleSetup],
+    planned: &[Option<PlannedVehicle>],
+    spec: &MissionSpec,
+    geometry: &MissionGeometry,
+    env: &Environment,
+) -> Vec<String> {
+    let mut out = Vec::new();
+    if !spec.prior_flow_given {
+        out.push(
+            "mission.prior_flow_toward_deg is not given: planners assume the flow goes North \
+             (0 deg) until their first flow measurement"
+                .into(),
+        );
+    }
+    let area = &geometry.op_area;
+    if let Some(f) = env.plume().filaments() {
+        for (k, s) in f.sources().iter().enumerate() {
+            if !area.contains(s.pos_m.xy()) {
+                out.push(format!(
+                    "sources[{k}] at ({}, {}) is outside the op-area: no planner searches there",
+                    s.pos_m.x, s.pos_m.y
+                ));
+            }
+        }
+    }
+    for (k, (v, p)) in vehicles.iter().zip(planned).enumerate() {
+        let Some(p) = p else { continue };
+        if let Some(t) = p.config.detection_threshold_v()
+            && t >= v.chem_sensor.full_scale_v
+        {
+            out.push(format!(
+                "vehicles[{k}]: its planner's detection threshold ({t} V, {}) is at or above the \
+                 sensor's full scale ({} V): no reading ever exceeds it",
+                p.key, v.chem_sensor.full_scale_v
+            ));
+        }
+        let start = v.vehicle.state.pos_m;
+        let e = area.edge_info(start);
+        if !e.inside && e.distance_m > 30.0 {
+            out.push(format!(
+                "vehicles[{k}] starts {:.0} m outside the op-area: its cage aborts beyond 30 m",
+                e.distance_m
+            ));
+        }
+    }
+    out
 }
 
 /// The planner table with `[vehicles.chem_sensor] threshold_v` passed on as the planner's

@@ -72,6 +72,8 @@ pub struct MissionSpec {
     pub spinup_dt_s: f64,
     /// Flow direction the planner assumes before measuring it, deg.
     pub prior_flow_toward_deg: f64,
+    /// Whether the file gave it (otherwise it is North, 0).
+    pub prior_flow_given: bool,
 }
 
 /// A scenario ready to run.
@@ -129,18 +131,26 @@ pub fn build(
         Origin::Preset(_) => PathBuf::new(),
     };
 
+    // Every number and list within its documented bound (crate::limits) before anything is made.
+    match toml::Value::try_from(cfg) {
+        Ok(toml::Value::Table(t)) => {
+            crate::limits::check(&t).map_err(|(k, m)| invalid(&k, m))?;
+        }
+        Ok(_) => {}
+        Err(e) => return Err(invalid("", format!("cannot be checked: {e}"))),
+    }
     let dt_s = cfg.sim.dt_s;
     if !(dt_s.is_finite() && dt_s > 0.0) {
         return Err(invalid(
             "sim.dt_s",
-            format!("must be a finite number > 0, got {dt_s}"),
+            format!("must be a finite number > 0, got {dt_s:?}"),
         ));
     }
     let duration = cfg.sim.duration_s;
     if !(duration.is_finite() && duration >= dt_s) {
         return Err(invalid(
             "sim.duration_s",
-            format!("must be a finite number >= sim.dt_s ({dt_s}), got {duration}"),
+            format!("must be a finite number >= sim.dt_s ({dt_s}), got {duration:?}"),
         ));
     }
     let env_dt_s = cfg
@@ -155,15 +165,19 @@ pub fn build(
         if !(env_dt_s.is_finite() && ratio >= 1.0 - 1e-9 && (ratio - ratio.round()).abs() < 1e-9) {
             return Err(invalid(
                 "mission.env_dt_s",
-                format!("must be a whole multiple of sim.dt_s ({dt_s}), got {env_dt_s}"),
+                format!("must be a whole multiple of sim.dt_s ({dt_s}), got {env_dt_s:?}"),
             ));
         }
     }
     let steps_f = (duration / dt_s).round();
-    if steps_f > 1e10 {
+    if steps_f > crate::limits::MAX_STEPS {
         return Err(invalid(
             "sim.duration_s",
-            format!("needs {steps_f:.0} steps; at most 1e10"),
+            format!(
+                "sim.duration_s / sim.dt_s = {steps_f:.3e} steps; at most {:.0e} (about a day of \
+                 computing): shorten the run or lengthen the step",
+                crate::limits::MAX_STEPS
+            ),
         ));
     }
     let steps = steps_f as u64;
@@ -178,7 +192,7 @@ pub fn build(
     {
         return Err(invalid(
             "domain.depth_m",
-            format!("must be a finite number > 0, got {depth}"),
+            format!("must be a finite number > 0, got {depth:?}"),
         ));
     }
 
@@ -283,6 +297,17 @@ pub fn build(
                 max_filaments: p.max_filaments,
                 vertical,
             };
+            if p.initial_filaments.saturating_mul(sources.len() as u64) > p.max_filaments as u64 {
+                return Err(invalid(
+                    "plume.initial_filaments",
+                    format!(
+                        "{} per source for {} sources is more than plume.max_filaments ({})",
+                        p.initial_filaments,
+                        sources.len(),
+                        p.max_filaments
+                    ),
+                ));
+            }
             let mut fp = FilamentPlume::new(domain, sources, params).map_err(env_err)?;
             for k in 0..fp.sources().len() {
                 fp.release_at_source(k, p.initial_filaments);
@@ -436,10 +461,19 @@ pub fn build(
             }
             None
         }
-        Some(m) => Some(mission_spec(m, &domain, env_dt_s).map_err(|e| match e {
-            EnvError::InvalidParameter { key, message } => invalid(&key, message),
-            other => invalid("mission", other.to_string()),
-        })?),
+        Some(m) => Some(
+            mission_spec(
+                m,
+                &domain,
+                env_dt_s,
+                dt_s,
+                plumetrace_env::FlowField::max_stable_dt_s(env.flow()),
+            )
+            .map_err(|e| match e {
+                EnvError::InvalidParameter { key, message } => invalid(&key, message),
+                other => invalid("mission", other.to_string()),
+            })?,
+        ),
     };
     if mission.is_some() && !flown {
         return Err(invalid(
@@ -468,20 +502,26 @@ pub fn build(
     if !(o.average_interval_s.is_finite() && o.average_interval_s >= dt_s) {
         return Err(invalid(
             "output.average_interval_s",
-            format!("must be >= sim.dt_s ({dt_s}), got {}", o.average_interval_s),
+            format!(
+                "must be >= sim.dt_s ({dt_s}), got {:?}",
+                o.average_interval_s
+            ),
         ));
     }
     if !(o.average_start_s.is_finite() && o.average_start_s >= 0.0 && o.average_start_s < duration)
     {
         return Err(invalid(
             "output.average_start_s",
-            format!("must be in [0, sim.duration_s), got {}", o.average_start_s),
+            format!(
+                "must be in [0, sim.duration_s), got {:?}",
+                o.average_start_s
+            ),
         ));
     }
     if !(o.threshold.is_finite() && o.threshold >= 0.0) {
         return Err(invalid(
             "output.threshold",
-            format!("must be a finite number >= 0, got {}", o.threshold),
+            format!("must be a finite number >= 0, got {:?}", o.threshold),
         ));
     }
     let output = OutputSpec {
@@ -578,9 +618,13 @@ fn vehicle_setup(
     plumetrace_env::error::require_finite(&format!("{key}.y_m"), v.y_m)?;
     plumetrace_env::error::require_finite(&format!("{key}.heading_deg"), v.heading_deg)?;
     if !domain.contains_xy(v.x_m, v.y_m) {
+        let off_x = v.x_m < domain.x_min_m || v.x_m > domain.x_max_m;
         return Err(EnvError::invalid(
-            format!("{key}.x_m"),
-            format!("start ({}, {}) is outside the domain", v.x_m, v.y_m),
+            format!("{key}.{}", if off_x { "x_m" } else { "y_m" }),
+            format!(
+                "start ({}, {}) is outside the domain ({}..{} East, {}..{} North)",
+                v.x_m, v.y_m, domain.x_min_m, domain.x_max_m, domain.y_min_m, domain.y_max_m
+            ),
         ));
     }
     let base = match v.kind {
@@ -784,16 +828,28 @@ fn polygon(vertices: &[[f64; 2]], key: &str) -> Result<Vec<plumetrace_core::Vec2
     if area2.abs() < 1e-9 {
         return Err(EnvError::invalid(key, "has zero area"));
     }
-    Ok(vertices
+    let points: Vec<plumetrace_core::Vec2> = vertices
         .iter()
         .map(|v| plumetrace_core::Vec2::new(v[0], v[1]))
-        .collect())
+        .collect();
+    if let Some((a, b)) = plumetrace_core::self_intersection(&points) {
+        return Err(EnvError::invalid(
+            key,
+            format!(
+                "the polygon crosses itself: edges {a} and {b} meet (edge k runs from vertex k \
+                 to the next)"
+            ),
+        ));
+    }
+    Ok(points)
 }
 
 fn mission_spec(
     m: &crate::config::MissionConfig,
     domain: &Rect,
     env_dt_s: f64,
+    dt_s: f64,
+    stable_dt_s: Option<f64>,
 ) -> Result<MissionSpec, EnvError> {
     let op_area = match &m.op_area {
         Some(v) => polygon(v, "mission.op_area")?,
@@ -816,22 +872,71 @@ fn mission_spec(
     }
     let mut subregions = Vec::new();
     for (k, r) in m.subregions.iter().enumerate() {
-        subregions.push(polygon(r, &format!("mission.subregions[{k}]"))?);
+        let key = format!("mission.subregions[{k}]");
+        let region = polygon(r, &key)?;
+        if let Some(i) = region.iter().position(|p| !domain.contains(*p)) {
+            return Err(EnvError::invalid(
+                format!("{key}[{i}]"),
+                "lies outside the domain",
+            ));
+        }
+        subregions.push(region);
     }
     plumetrace_env::error::require_positive("mission.time_limit_s", m.time_limit_s)?;
     plumetrace_env::error::require_non_negative("mission.spinup_s", m.spinup_s)?;
-    let spinup_dt_s = m.spinup_dt_s.unwrap_or(10.0 * env_dt_s);
-    plumetrace_env::error::require_positive("mission.spinup_dt_s", spinup_dt_s)?;
-    plumetrace_env::error::require_finite(
-        "mission.prior_flow_toward_deg",
-        m.prior_flow_toward_deg,
-    )?;
+    let steps = m.time_limit_s / dt_s;
+    if steps > crate::limits::MAX_STEPS {
+        return Err(EnvError::invalid(
+            "mission.time_limit_s",
+            format!(
+                "mission.time_limit_s / sim.dt_s = {steps:.3e} steps; at most {:.0e} (about a day \
+                 of computing)",
+                crate::limits::MAX_STEPS
+            ),
+        ));
+    }
+    let (spinup_dt_s, spinup_key) = match m.spinup_dt_s {
+        Some(v) => (v, "mission.spinup_dt_s".to_string()),
+        None => (
+            10.0 * env_dt_s,
+            format!(
+                "mission.spinup_dt_s (not given: 10 x mission.env_dt_s = {} s)",
+                crate::limits::show(10.0 * env_dt_s)
+            ),
+        ),
+    };
+    plumetrace_env::error::require_positive(&spinup_key, spinup_dt_s)?;
+    if let Some(limit) = stable_dt_s
+        && spinup_dt_s > limit
+    {
+        return Err(EnvError::invalid(
+            spinup_key,
+            format!(
+                "{} s is above the flow's stable step of {limit:.4} s (set by the [flow.farrell] \
+                 grid and noise keys): give a smaller mission.spinup_dt_s",
+                crate::limits::show(spinup_dt_s)
+            ),
+        ));
+    }
+    let spinup_steps = m.spinup_s / spinup_dt_s;
+    if spinup_steps > crate::limits::MAX_SPINUP_STEPS {
+        return Err(EnvError::invalid(
+            "mission.spinup_s",
+            format!(
+                "mission.spinup_s / spin-up step = {spinup_steps:.3e} steps; at most {:.0e}",
+                crate::limits::MAX_SPINUP_STEPS
+            ),
+        ));
+    }
+    let prior = m.prior_flow_toward_deg.unwrap_or(0.0);
+    plumetrace_env::error::require_finite("mission.prior_flow_toward_deg", prior)?;
     Ok(MissionSpec {
         op_area,
         subregions,
         time_limit_s: m.time_limit_s,
         spinup_s: m.spinup_s,
         spinup_dt_s,
-        prior_flow_toward_deg: m.prior_flow_toward_deg,
+        prior_flow_toward_deg: prior,
+        prior_flow_given: m.prior_flow_toward_deg.is_some(),
     })
 }

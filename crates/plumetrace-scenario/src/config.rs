@@ -239,6 +239,7 @@ pub struct ObstacleConfig {
     #[serde(default)]
     pub name: String,
     /// Polygon vertices `[east, north]`, m.
+    #[serde(deserialize_with = "points::list")]
     pub vertices: Vec<[f64; 2]>,
 }
 
@@ -379,6 +380,7 @@ pub struct FlowSensorConfig {
     /// Noise per axis, m/s.
     pub noise_sd_mps: Option<f64>,
     /// Bias `[east, north]`, m/s.
+    #[serde(default, deserialize_with = "points::optional")]
     pub bias_mps: Option<[f64; 2]>,
     /// Start of a wrong-layer (reversed) fault, s.
     pub fault_start_s: Option<f64>,
@@ -405,9 +407,10 @@ pub struct RangeSensorConfig {
 #[serde(deny_unknown_fields)]
 pub struct MissionConfig {
     /// Op-area polygon `[[east, north], ...]`, m (default: the domain shrunk by 50 m).
+    #[serde(default, deserialize_with = "points::optional_list")]
     pub op_area: Option<Vec<[f64; 2]>>,
     /// Subregions searched in turn (a multi-source mission), each a polygon.
-    #[serde(default)]
+    #[serde(default, deserialize_with = "points::lists")]
     pub subregions: Vec<Vec<[f64; 2]>>,
     /// Mission time limit, s.
     pub time_limit_s: f64,
@@ -419,9 +422,9 @@ pub struct MissionConfig {
     /// Step of the flow and plume during the mission, s (a whole multiple of `sim.dt_s`;
     /// default `sim.dt_s`).
     pub env_dt_s: Option<f64>,
-    /// Flow direction the planner assumes before its first flow measurement, deg.
-    #[serde(default)]
-    pub prior_flow_toward_deg: f64,
+    /// Flow direction the planner assumes before its first flow measurement, deg (not given:
+    /// North, with a warning).
+    pub prior_flow_toward_deg: Option<f64>,
 }
 
 /// `[comms]`: one channel model per link kind (absent: ideal, no delay and no loss).
@@ -446,4 +449,66 @@ pub struct ChannelConfig {
     pub loss_probability: Option<f64>,
     /// Longest distance a message carries, m (none: any).
     pub max_range_m: Option<f64>,
+}
+
+/// Pairs of numbers (`[east, north]`) read strictly: exactly two numbers each, so that a third
+/// number is an error rather than dropped.
+mod points {
+    use serde::Deserialize;
+    use serde::de::{Deserializer, Error, SeqAccess, Visitor};
+    use std::fmt;
+
+    /// One `[east, north]` pair.
+    struct Point([f64; 2]);
+
+    impl<'de> Deserialize<'de> for Point {
+        fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+            struct Pair;
+            impl<'de> Visitor<'de> for Pair {
+                type Value = Point;
+                fn expecting(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+                    f.write_str("a pair of numbers [east, north]")
+                }
+                fn visit_seq<A: SeqAccess<'de>>(self, mut seq: A) -> Result<Point, A::Error> {
+                    let x: f64 = seq
+                        .next_element()?
+                        .ok_or_else(|| A::Error::invalid_length(0, &self))?;
+                    let y: f64 = seq
+                        .next_element()?
+                        .ok_or_else(|| A::Error::invalid_length(1, &self))?;
+                    if seq.next_element::<serde::de::IgnoredAny>()?.is_some() {
+                        return Err(A::Error::custom(
+                            "expected a pair of numbers [east, north], got more than two",
+                        ));
+                    }
+                    Ok(Point([x, y]))
+                }
+            }
+            d.deserialize_seq(Pair)
+        }
+    }
+
+    pub fn list<'de, D: Deserializer<'de>>(d: D) -> Result<Vec<[f64; 2]>, D::Error> {
+        Ok(Vec::<Point>::deserialize(d)?
+            .into_iter()
+            .map(|p| p.0)
+            .collect())
+    }
+
+    pub fn optional<'de, D: Deserializer<'de>>(d: D) -> Result<Option<[f64; 2]>, D::Error> {
+        Ok(Some(Point::deserialize(d)?.0))
+    }
+
+    pub fn optional_list<'de, D: Deserializer<'de>>(
+        d: D,
+    ) -> Result<Option<Vec<[f64; 2]>>, D::Error> {
+        list(d).map(Some)
+    }
+
+    pub fn lists<'de, D: Deserializer<'de>>(d: D) -> Result<Vec<Vec<[f64; 2]>>, D::Error> {
+        Ok(Vec::<Vec<Point>>::deserialize(d)?
+            .into_iter()
+            .map(|l| l.into_iter().map(|p| p.0).collect())
+            .collect())
+    }
 }

@@ -8,6 +8,7 @@
 pub mod build;
 pub mod config;
 pub mod error;
+pub mod limits;
 pub mod presets;
 
 pub use build::{BuiltScenario, MissionSpec, OutputSpec, PlannerRef, VehicleSetup, build};
@@ -37,6 +38,16 @@ impl std::fmt::Display for Origin {
 
 /// Parses scenario TOML text; errors name the key path and the line.
 pub fn parse(text: &str, origin: &Origin) -> Result<ScenarioConfig, ScenarioError> {
+    // No key takes a date or a time; say so with the key rather than as a type error.
+    if let Ok(table) = text.parse::<toml::Table>()
+        && let Some((key, value)) = first_datetime(&toml::Value::Table(table), "")
+    {
+        return Err(ScenarioError::Parse {
+            origin: origin.to_string(),
+            path: key,
+            message: format!("is a date/time ({value}); no scenario key takes one"),
+        });
+    }
     let de = toml::Deserializer::parse(text).map_err(|e| ScenarioError::Parse {
         origin: origin.to_string(),
         path: String::new(),
@@ -69,10 +80,11 @@ fn deserialize<'de, D: serde::Deserializer<'de>>(
 /// Reads and parses a scenario file.
 pub fn load_file(path: &Path) -> Result<ScenarioConfig, ScenarioError> {
     let origin = Origin::File(path.to_path_buf());
-    let text = std::fs::read_to_string(path).map_err(|e| ScenarioError::Io {
-        origin: origin.to_string(),
-        message: e.to_string(),
-    })?;
+    let text = plumetrace_env::input::read_text(path, plumetrace_env::input::MAX_TEXT_BYTES)
+        .map_err(|message| ScenarioError::Io {
+            origin: origin.to_string(),
+            message,
+        })?;
     parse(&text, &origin)
 }
 
@@ -87,4 +99,24 @@ pub fn load_preset(name: &str) -> Result<ScenarioConfig, ScenarioError> {
             .join(", "),
     })?;
     parse(preset.toml, &Origin::Preset(name.to_string()))
+}
+
+/// The first date/time value in a TOML tree, with its key path.
+pub fn first_datetime(v: &toml::Value, path: &str) -> Option<(String, String)> {
+    let join = |k: &str| {
+        if path.is_empty() {
+            k.to_string()
+        } else {
+            format!("{path}.{k}")
+        }
+    };
+    match v {
+        toml::Value::Datetime(d) => Some((path.to_string(), d.to_string())),
+        toml::Value::Table(t) => t.iter().find_map(|(k, x)| first_datetime(x, &join(k))),
+        toml::Value::Array(a) => a
+            .iter()
+            .enumerate()
+            .find_map(|(i, x)| first_datetime(x, &format!("{path}[{i}]"))),
+        _ => None,
+    }
 }

@@ -175,6 +175,10 @@ impl Navigator {
         let kick = p.velocity_error_sd_mps * (1.0 - a * a).sqrt();
         self.velocity_error_mps = self.velocity_error_mps * a + Vec2::new(ex, ey) * kick;
         if t_s + 1e-9 >= self.next_fix_s {
+            // Far behind (a clock jump): skip to the current interval at once, not fix by fix.
+            if (t_s - self.next_fix_s) / p.fix_interval_s > 1e3 {
+                self.next_fix_s = (t_s / p.fix_interval_s).floor() * p.fix_interval_s;
+            }
             while self.next_fix_s <= t_s + 1e-9 {
                 self.next_fix_s += p.fix_interval_s;
             }

@@ -171,7 +171,7 @@ impl FarrellFlow {
                 format!("must be >= 3, got {}", params.ny),
             ));
         }
-        if params.nx * params.ny > 4_000_000 {
+        if params.nx.saturating_mul(params.ny) > 4_000_000 {
             return Err(EnvError::invalid(
                 "flow.farrell.nx",
                 "nx * ny must be at most 4,000,000",
@@ -407,7 +407,10 @@ impl FlowField for FarrellFlow {
             return Err(EnvError::Diverged {
                 time_s: t_new_s,
                 message: format!(
-                    "largest node speed {} m/s (limit {limit} m/s)",
+                    "largest node speed {:?} m/s (limit {limit:?} m/s): the meandering field is \
+                     unstable with these settings; lower sim.dt_s (mission.env_dt_s, \
+                     mission.spinup_dt_s) or flow.farrell.noise_gain, or raise \
+                     flow.farrell.noise_damping",
                     self.max_speed_mps
                 ),
             });

@@ -47,6 +47,25 @@ impl GriddedFlow {
         };
         // Columns: x, y, u, v, then t (NaN when absent: one frame at t = 0).
         let (table, _) = read_columns(path, &["x_m", "y_m", "u_mps", "v_mps"], &["t_s"])?;
+        // Ocean currents stay below 10 m/s; a larger value is a unit or typing mistake, and a
+        // huge one would move a vehicle out of any domain in one step.
+        for (k, r) in table.iter().enumerate() {
+            for (v, name) in [(r[2], "u_mps"), (r[3], "v_mps")] {
+                if v.abs() > 10.0 {
+                    return Err(file_err(format!(
+                        "line {}: {name} = {v:?} m/s; at most 10 m/s in magnitude",
+                        k + 2
+                    )));
+                }
+            }
+            if r[4].is_finite() && r[4].abs() > 1e7 {
+                return Err(file_err(format!(
+                    "line {}: t_s = {:?} s; at most 1e7 s in magnitude",
+                    k + 2,
+                    r[4]
+                )));
+            }
+        }
         let rows: Vec<[f64; 5]> = table
             .iter()
             .map(|r| {

@@ -1,0 +1,651 @@
+//! The bounds of every number and list in a scenario file, with the reason for each: one table
+//! ([`LIMITS`]) that the check uses and the README prints (`plumetrace limits --markdown`).
+//!
+//! A scenario is checked against the table before any model is made: every number in the file is
+//! matched to its key (array indices written `[]`), so a value out of range is refused with its key
+//! path and the bound, and a number whose key has no entry is refused too (a key added to the file
+//! format without a bound fails the tests). Planner keys are the planner registry's to check.
+//! Bounds that involve several keys (steps per run, positions inside the domain, stable steps)
+//! are checked when the models are built.
+
+use std::fmt::Write as _;
+
+/// What a limit bounds.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Bound {
+    /// A number in `[min, max]`; `min_open` excludes `min`.
+    Number {
+        /// Lower end.
+        min: f64,
+        /// `min` itself is not allowed.
+        min_open: bool,
+        /// Upper end (included).
+        max: f64,
+    },
+    /// A list of at most this many entries.
+    Count(usize),
+    /// Any value of its type.
+    Any,
+}
+
+/// One row of the table.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Limit {
+    /// Key path with `[]` for array indices, e.g. `vehicles[].nav.fix_interval_s`.
+    pub key: &'static str,
+    /// The bound.
+    pub bound: Bound,
+    /// Why.
+    pub why: &'static str,
+}
+
+const fn num(key: &'static str, min: f64, max: f64, why: &'static str) -> Limit {
+    Limit {
+        key,
+        bound: Bound::Number {
+            min,
+            min_open: false,
+            max,
+        },
+        why,
+    }
+}
+
+const fn pos(key: &'static str, max: f64, why: &'static str) -> Limit {
+    Limit {
+        key,
+        bound: Bound::Number {
+            min: 0.0,
+            min_open: true,
+            max,
+        },
+        why,
+    }
+}
+
+const fn count(key: &'static str, n: usize, why: &'static str) -> Limit {
+    Limit {
+        key,
+        bound: Bound::Count(n),
+        why,
+    }
+}
+
+/// Coordinates of a local tangent plane: 10,000 km is no longer local.
+const COORD: f64 = 1e7;
+/// The deepest ocean, m.
+const DEPTH: f64 = 11_000.0;
+/// A year and a third, s: longer runs are not missions.
+const LONG: f64 = 1e7;
+/// Angles may be written with any number of turns, within reason.
+const TURNS: f64 = 3600.0;
+
+const COORD_WHY: &str = "a local frame: 10,000 km is not local";
+const ANGLE_WHY: &str = "compass degrees, any number of turns up to ten";
+const TIME_WHY: &str = "115 days: longer is not a mission or a plume run";
+const DEPTH_WHY: &str = "the deepest ocean";
+
+/// Every bound of the scenario file format.
+pub const LIMITS: &[Limit] = &[
+    Limit {
+        key: "seed",
+        bound: Bound::Any,
+        why: "any whole number 0..2^64",
+    },
+    pos(
+        "sim.dt_s",
+        60.0,
+        "a step of more than a minute skips the vehicles' dynamics",
+    ),
+    pos("sim.duration_s", LONG, TIME_WHY),
+    num("domain.x_min_m", -COORD, COORD, COORD_WHY),
+    num("domain.x_max_m", -COORD, COORD, COORD_WHY),
+    num("domain.y_min_m", -COORD, COORD, COORD_WHY),
+    num("domain.y_max_m", -COORD, COORD, COORD_WHY),
+    pos("domain.depth_m", DEPTH, DEPTH_WHY),
+    num(
+        "flow.mean.speed_mps",
+        0.0,
+        10.0,
+        "ocean currents stay below 10 m/s",
+    ),
+    num("flow.mean.toward_deg", -TURNS, TURNS, ANGLE_WHY),
+    num(
+        "flow.mean.speed_min_mps",
+        0.0,
+        10.0,
+        "ocean currents stay below 10 m/s",
+    ),
+    num(
+        "flow.mean.speed_max_mps",
+        0.0,
+        10.0,
+        "ocean currents stay below 10 m/s",
+    ),
+    num("flow.mean.toward_min_deg", -TURNS, TURNS, ANGLE_WHY),
+    num("flow.mean.toward_max_deg", -TURNS, TURNS, ANGLE_WHY),
+    pos("flow.mean.period_s", LONG, TIME_WHY),
+    num("flow.mean.phase_deg", -TURNS, TURNS, ANGLE_WHY),
+    num(
+        "flow.farrell.nx",
+        3.0,
+        1000.0,
+        "a million grid nodes at most (memory and step time)",
+    ),
+    num(
+        "flow.farrell.ny",
+        3.0,
+        1000.0,
+        "a million grid nodes at most (memory and step time)",
+    ),
+    pos(
+        "flow.farrell.diffusivity_x_m2ps",
+        1e4,
+        "eddy diffusivities of the ocean are far below",
+    ),
+    pos(
+        "flow.farrell.diffusivity_y_m2ps",
+        1e4,
+        "eddy diffusivities of the ocean are far below",
+    ),
+    num(
+        "flow.farrell.noise_gain",
+        0.0,
+        100.0,
+        "meander velocities stay far below 100 m/s",
+    ),
+    pos(
+        "flow.farrell.noise_damping",
+        100.0,
+        "a damping ratio; above 100 the noise vanishes",
+    ),
+    pos(
+        "flow.farrell.noise_bandwidth_radps",
+        100.0,
+        "a meander faster than 100 rad/s is not a meander",
+    ),
+    num(
+        "plume.horizontal_diffusivity_m2ps",
+        0.0,
+        1e3,
+        "eddy diffusivities of the ocean are far below",
+    ),
+    num(
+        "plume.vertical_diffusivity_m2ps",
+        0.0,
+        1e3,
+        "eddy diffusivities of the ocean are far below",
+    ),
+    num(
+        "plume.init_radius_m",
+        1e-3,
+        1e3,
+        "a filament's peak goes as 1 / r^3: below a millimetre it overflows; a kilometre is no longer a filament",
+    ),
+    num(
+        "plume.growth_rate_m2ps",
+        0.0,
+        1e3,
+        "eddy diffusivities of the ocean are far below",
+    ),
+    num(
+        "plume.cutoff_radii",
+        1.0,
+        10.0,
+        "beyond 10 radii a Gaussian is below 1e-21 of its peak",
+    ),
+    num(
+        "plume.max_filaments",
+        1.0,
+        1e7,
+        "memory: 10 million filaments take about 0.5 GB",
+    ),
+    num(
+        "plume.initial_filaments",
+        0.0,
+        1e6,
+        "a million per source at the start at most",
+    ),
+    num(
+        "plume.pompy_diff_scale_mps",
+        0.0,
+        100.0,
+        "pompy's random-walk scale; its default is 2",
+    ),
+    count(
+        "sources",
+        1000,
+        "the step and the query time grow with the sources",
+    ),
+    num("sources[].x_m", -COORD, COORD, COORD_WHY),
+    num("sources[].y_m", -COORD, COORD, COORD_WHY),
+    num("sources[].z_m", 0.0, DEPTH, DEPTH_WHY),
+    num(
+        "sources[].mass_rate_per_s",
+        0.0,
+        1e9,
+        "concentrations must stay finite after summing many filaments",
+    ),
+    num(
+        "sources[].filament_rate_hz",
+        1e-3,
+        1e4,
+        "each filament carries mass_rate / rate: one per 1,000 s at least, 10,000 per second at most",
+    ),
+    count(
+        "obstacles",
+        10_000,
+        "the range sensors cast rays against every obstacle",
+    ),
+    count(
+        "obstacles[].vertices",
+        100_000,
+        "the range sensors cast rays against every edge",
+    ),
+    num("obstacles[].vertices[][]", -COORD, COORD, COORD_WHY),
+    num(
+        "output.nx",
+        2.0,
+        2000.0,
+        "four million grid points at most (memory)",
+    ),
+    num(
+        "output.ny",
+        2.0,
+        2000.0,
+        "four million grid points at most (memory)",
+    ),
+    num("output.z_m", 0.0, DEPTH, DEPTH_WHY),
+    pos("output.average_interval_s", LONG, TIME_WHY),
+    num("output.average_start_s", 0.0, LONG, TIME_WHY),
+    num(
+        "output.threshold",
+        0.0,
+        1e12,
+        "a concentration threshold; finite",
+    ),
+    count(
+        "vehicles",
+        100,
+        "every vehicle is stepped and sensed at every step",
+    ),
+    num("vehicles[].x_m", -COORD, COORD, COORD_WHY),
+    num("vehicles[].y_m", -COORD, COORD, COORD_WHY),
+    num("vehicles[].heading_deg", -TURNS, TURNS, ANGLE_WHY),
+    num("vehicles[].altitude_m", 0.0, DEPTH, DEPTH_WHY),
+    pos(
+        "vehicles[].dynamics.max_speed_mps",
+        20.0,
+        "marine robots stay below 20 m/s",
+    ),
+    pos(
+        "vehicles[].dynamics.max_turn_rate_deg_s",
+        360.0,
+        "a turn a second at most",
+    ),
+    pos(
+        "vehicles[].dynamics.speed_time_constant_s",
+        1e4,
+        "a response slower than hours is no response",
+    ),
+    pos(
+        "vehicles[].dynamics.vertical_time_constant_s",
+        1e4,
+        "a response slower than hours is no response",
+    ),
+    num(
+        "vehicles[].dynamics.altitude_error_sd_m",
+        0.0,
+        100.0,
+        "an altitude error of 100 m is no altitude hold",
+    ),
+    pos(
+        "vehicles[].dynamics.altitude_error_time_s",
+        1e5,
+        "a correlation time of a day at most",
+    ),
+    num(
+        "vehicles[].nav.fix_interval_s",
+        0.01,
+        LONG,
+        "fixes at 100 Hz at most (the estimate is updated at each step)",
+    ),
+    num(
+        "vehicles[].nav.fix_sigma_m",
+        0.0,
+        1e4,
+        "a fix 10 km off is no fix",
+    ),
+    num(
+        "vehicles[].nav.velocity_error_sd_mps",
+        0.0,
+        10.0,
+        "a dead-reckoning error of 10 m/s is no navigation",
+    ),
+    pos("vehicles[].nav.velocity_error_tau_s", LONG, TIME_WHY),
+    num(
+        "vehicles[].nav.heading_sd_deg",
+        0.0,
+        180.0,
+        "a compass error of half a turn is no compass",
+    ),
+    num(
+        "vehicles[].nav.speed_sd_mps",
+        0.0,
+        10.0,
+        "a speed-log error of 10 m/s is no speed log",
+    ),
+    num(
+        "vehicles[].nav.altimeter_sd_m",
+        0.0,
+        100.0,
+        "an altimeter error of 100 m is no altimeter",
+    ),
+    pos(
+        "vehicles[].chem_sensor.rate_hz",
+        1000.0,
+        "samples at 1 kHz at most (one per step is taken)",
+    ),
+    pos(
+        "vehicles[].chem_sensor.volts_per_unit",
+        1e9,
+        "readings must stay finite",
+    ),
+    pos(
+        "vehicles[].chem_sensor.full_scale_v",
+        1e6,
+        "readings must stay finite",
+    ),
+    num(
+        "vehicles[].chem_sensor.noise_sd_v",
+        0.0,
+        1e6,
+        "readings must stay finite",
+    ),
+    num(
+        "vehicles[].chem_sensor.lag_time_constant_s",
+        0.0,
+        1e5,
+        "a lag of a day at most",
+    ),
+    num(
+        "vehicles[].chem_sensor.threshold_v",
+        0.0,
+        1e6,
+        "readings must stay finite",
+    ),
+    pos(
+        "vehicles[].flow_sensor.rate_hz",
+        1000.0,
+        "samples at 1 kHz at most (one per step is taken)",
+    ),
+    num(
+        "vehicles[].flow_sensor.noise_sd_mps",
+        0.0,
+        10.0,
+        "ocean currents stay below 10 m/s",
+    ),
+    num(
+        "vehicles[].flow_sensor.bias_mps[]",
+        -10.0,
+        10.0,
+        "ocean currents stay below 10 m/s",
+    ),
+    num(
+        "vehicles[].flow_sensor.fault_start_s",
+        -LONG,
+        LONG,
+        TIME_WHY,
+    ),
+    num("vehicles[].flow_sensor.fault_end_s", -LONG, LONG, TIME_WHY),
+    pos(
+        "vehicles[].range_sensor.max_range_m",
+        1e4,
+        "sonars see kilometres at most",
+    ),
+    num(
+        "vehicles[].range_sensor.rays_per_group",
+        1.0,
+        1000.0,
+        "rays are cast at every step",
+    ),
+    pos(
+        "vehicles[].range_sensor.front_half_angle_deg",
+        180.0,
+        "half a turn at most",
+    ),
+    pos(
+        "vehicles[].range_sensor.side_outer_angle_deg",
+        180.0,
+        "half a turn at most",
+    ),
+    count(
+        "mission.op_area",
+        10_000,
+        "the cage measures every edge at every decision",
+    ),
+    num("mission.op_area[][]", -COORD, COORD, COORD_WHY),
+    count("mission.subregions", 100, "subregions are searched in turn"),
+    count(
+        "mission.subregions[]",
+        10_000,
+        "every edge is measured at every decision",
+    ),
+    num("mission.subregions[][][]", -COORD, COORD, COORD_WHY),
+    pos("mission.time_limit_s", LONG, TIME_WHY),
+    num("mission.spinup_s", 0.0, LONG, TIME_WHY),
+    pos(
+        "mission.spinup_dt_s",
+        3600.0,
+        "the plume's step; an hour at most",
+    ),
+    pos(
+        "mission.env_dt_s",
+        60.0,
+        "a step of more than a minute skips the plume's motion",
+    ),
+    num("mission.prior_flow_toward_deg", -TURNS, TURNS, ANGLE_WHY),
+    num("comms.acoustic.latency_s", 0.0, 1e5, "a day at most"),
+    pos("comms.acoustic.sound_speed_mps", 1e9, "finite"),
+    num("comms.acoustic.loss_probability", 0.0, 1.0, "a probability"),
+    pos("comms.acoustic.max_range_m", 1e8, "finite"),
+    num("comms.radio.latency_s", 0.0, 1e5, "a day at most"),
+    pos("comms.radio.sound_speed_mps", 1e9, "finite"),
+    num("comms.radio.loss_probability", 0.0, 1.0, "a probability"),
+    pos("comms.radio.max_range_m", 1e8, "finite"),
+    count("planners", 100, "planners are per vehicle"),
+];
+
+/// The most steps of a run (plume run or mission), the spin-up apart: about a day of computing.
+pub const MAX_STEPS: f64 = 1e8;
+/// The most steps of a spin-up.
+pub const MAX_SPINUP_STEPS: f64 = 1e7;
+
+/// The row for a key path (array indices written `[]`).
+pub fn limit(key: &str) -> Option<&'static Limit> {
+    LIMITS.iter().find(|l| l.key == key)
+}
+
+/// A number as it is best read in a message: `-1e-300`, `0.25`, `2.0`.
+pub fn show(v: f64) -> String {
+    format!("{v:?}")
+}
+
+impl Bound {
+    /// The bound in words.
+    pub fn describe(&self) -> String {
+        match *self {
+            Bound::Number { min, min_open, max } => format!(
+                "{} {} and <= {}",
+                if min_open { ">" } else { ">=" },
+                show(min),
+                show(max)
+            ),
+            Bound::Count(n) => format!("at most {n} entries"),
+            Bound::Any => "any".into(),
+        }
+    }
+}
+
+/// Checks every number and list of a scenario's table against [`LIMITS`]; on error returns
+/// `(key path, message)`. Tables of planners are left to the planner registry.
+pub fn check(table: &toml::Table) -> Result<(), (String, String)> {
+    walk(&toml::Value::Table(table.clone()), "", "")
+}
+
+fn join(a: &str, b: &str) -> String {
+    if a.is_empty() {
+        b.to_string()
+    } else {
+        format!("{a}.{b}")
+    }
+}
+
+fn walk(v: &toml::Value, path: &str, pattern: &str) -> Result<(), (String, String)> {
+    match v {
+        toml::Value::Table(t) => {
+            for (k, x) in t {
+                if pattern.is_empty() && (k == "planner" || k == "planners") {
+                    if let (Some(n), toml::Value::Table(p)) = (limit("planners"), x)
+                        && k == "planners"
+                        && let Bound::Count(max) = n.bound
+                        && p.len() > max
+                    {
+                        return Err((
+                            "planners".into(),
+                            format!("{} tables; {} ({})", p.len(), n.bound.describe(), n.why),
+                        ));
+                    }
+                    continue;
+                }
+                walk(x, &join(path, k), &join(pattern, k))?;
+            }
+            Ok(())
+        }
+        toml::Value::Array(a) => {
+            if let Some(l) = limit(pattern)
+                && let Bound::Count(max) = l.bound
+                && a.len() > max
+            {
+                return Err((
+                    path.to_string(),
+                    format!("{} entries; {} ({})", a.len(), l.bound.describe(), l.why),
+                ));
+            }
+            for (i, x) in a.iter().enumerate() {
+                walk(x, &format!("{path}[{i}]"), &format!("{pattern}[]"))?;
+            }
+            Ok(())
+        }
+        toml::Value::Integer(i) => number(*i as f64, path, pattern),
+        toml::Value::Float(f) => number(*f, path, pattern),
+        _ => Ok(()),
+    }
+}
+
+fn number(v: f64, path: &str, pattern: &str) -> Result<(), (String, String)> {
+    let Some(l) = limit(pattern) else {
+        return Err((
+            path.to_string(),
+            "this number has no documented bound (a key of the format without one)".into(),
+        ));
+    };
+    match l.bound {
+        Bound::Number { min, min_open, max } => {
+            let low = if min_open { v > min } else { v >= min };
+            if v.is_finite() && low && v <= max {
+                Ok(())
+            } else {
+                Err((
+                    path.to_string(),
+                    format!(
+                        "must be {} ({}), got {}",
+                        l.bound.describe(),
+                        l.why,
+                        show(v)
+                    ),
+                ))
+            }
+        }
+        Bound::Count(_) => Err((path.to_string(), "expected a list, got a number".into())),
+        Bound::Any => Ok(()),
+    }
+}
+
+/// The table as Markdown (`| key | bound | why |`).
+pub fn markdown() -> String {
+    let mut out = String::from("| key | bound | why |\n| --- | --- | --- |\n");
+    for l in LIMITS {
+        let _ = writeln!(out, "| `{}` | {} | {} |", l.key, l.bound.describe(), l.why);
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn table(s: &str) -> toml::Table {
+        s.parse().unwrap_or_default()
+    }
+
+    #[test]
+    fn numbers_and_lists_are_checked_against_their_row() {
+        assert!(check(&table("[sim]\ndt_s = 0.1\nduration_s = 10.0")).is_ok());
+        let cases = [
+            ("[sim]\ndt_s = 0.0", "sim.dt_s", "> 0.0 and <= 60.0"),
+            ("[sim]\ndt_s = nan", "sim.dt_s", "got NaN"),
+            (
+                "[mission]\ntime_limit_s = 1e300",
+                "mission.time_limit_s",
+                "got 1e300",
+            ),
+            (
+                "[[vehicles]]\nx_m = 0.0\n[vehicles.nav]\nfix_interval_s = 1e-12",
+                "vehicles[0].nav.fix_interval_s",
+                "got 1e-12",
+            ),
+            (
+                "[mission]\nop_area = [[0.0, 0.0], [1e18, 0.0], [0.0, 1.0]]",
+                "mission.op_area[1][0]",
+                "<= 10000000.0",
+            ),
+            (
+                "[plume]\nmax_filaments = 4611686018427387904",
+                "plume.max_filaments",
+                "memory",
+            ),
+            (
+                "[domain]\nwidth_m = 3.0",
+                "domain.width_m",
+                "no documented bound",
+            ),
+        ];
+        for (text, key, message) in cases {
+            let e = check(&table(text)).err().unwrap_or_default();
+            assert_eq!(e.0, key, "{text}");
+            assert!(e.1.contains(message), "{text}: {}", e.1);
+        }
+        let many = format!("vehicles = [{}]", vec!["{ x_m = 1.0 }"; 101].join(", "));
+        let e = check(&table(&many)).err().unwrap_or_default();
+        assert_eq!(e.0, "vehicles");
+        // Planner tables are the registry's.
+        assert!(
+            check(&table(
+                "[planner]\nbeta_deg = 1e300\n[planners.a]\nspeed_mps = -1.0"
+            ))
+            .is_ok()
+        );
+    }
+
+    #[test]
+    fn every_preset_number_has_a_bound_and_is_within_it() {
+        for p in crate::PRESETS {
+            let t = table(p.toml);
+            assert!(!t.is_empty());
+            assert_eq!(check(&t), Ok(()), "{}", p.name);
+        }
+        assert!(show(-1e-300).len() < 10);
+        assert!(markdown().contains("| `sim.dt_s` | > 0.0 and <= 60.0 |"));
+    }
+}
