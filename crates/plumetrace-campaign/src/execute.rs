@@ -212,6 +212,11 @@ fn run_one(c: &Campaign, key: &RunKey, out: &Path) -> RunRow {
             trajectory: example,
         };
         let run = run_mission_with(sc, options, &mut |_, _| {}).map_err(|e| e.to_string())?;
+        if let Some(at) = plumetrace_mission::output::first_non_finite(&run.summary) {
+            return Err(format!(
+                "the summary has a number that is not finite ({at})"
+            ));
+        }
         if example {
             let ex = ExampleRun::from_run(c, key, &run);
             ex.write(out).map_err(|e| e.to_string())?;

@@ -119,6 +119,27 @@ fn write_outputs(run: &MissionRun, out: &Path, name: &str, wall: f64) -> Result<
         "t_s,vehicle,true_x_m,true_y_m,true_z_m,est_x_m,est_y_m,heading_deg,speed_mps,behaviour,reading_v,detection\n",
     );
     for r in &run.trajectory {
+        let numbers = [
+            r.t_s,
+            r.true_x_m,
+            r.true_y_m,
+            r.true_z_m,
+            r.heading_deg,
+            r.speed_mps,
+            r.reading_v,
+        ];
+        if numbers
+            .iter()
+            .chain(r.est_x_m.iter())
+            .chain(r.est_y_m.iter())
+            .any(|v| !v.is_finite())
+        {
+            anyhow::bail!(
+                "vehicle {} at t = {} s has a state that is not finite; nothing written",
+                r.vehicle,
+                r.t_s
+            );
+        }
         let _ = writeln!(
             csv,
             "{:.1},{},{:.2},{:.2},{:.2},{},{},{:.1},{:.2},{},{:.3},{}",
@@ -152,6 +173,11 @@ fn write_outputs(run: &MissionRun, out: &Path, name: &str, wall: f64) -> Result<
         spinup_wall_s: run.spinup_wall_s,
         stage_times: run.stage_times,
     };
+    if let Some(at) = plumetrace_mission::output::first_non_finite(&file) {
+        anyhow::bail!(
+            "the mission's summary has a number that is not finite ({at}); nothing written"
+        );
+    }
     write_atomic(
         &out.join("summary.json"),
         serde_json::to_string_pretty(&file)?.as_bytes(),

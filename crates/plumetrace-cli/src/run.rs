@@ -192,6 +192,9 @@ fn run_plume(mut sc: BuiltScenario, args: &RunArgs) -> Result<()> {
         intermittency_threshold: spec.threshold,
         stage_times: times,
     };
+    if let Some(at) = plumetrace_mission::output::first_non_finite(&stats) {
+        bail!("the run's statistics have a number that is not finite ({at})");
+    }
     let json = serde_json::to_string_pretty(&stats)?;
     write_atomic(&args.out.join("stats.json"), json.as_bytes())?;
     if args.stats {

@@ -14,6 +14,7 @@
 
 pub mod angle;
 pub mod any_f64;
+pub mod finite;
 pub mod frame;
 pub mod message;
 pub mod names;
@@ -22,6 +23,7 @@ pub mod planner;
 pub mod vehicle;
 
 pub use angle::{Heading, wrap_deg_180, wrap_deg_360, wrap_rad_pi};
+pub use finite::first_non_finite;
 pub use frame::{Vec2, Vec3, bearing_between, heading_vector, self_intersection};
 pub use message::{Link, Message, MessageBody, Outgoing, Recipient};
 pub use names::variant_name;

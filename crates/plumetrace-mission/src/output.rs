@@ -26,3 +26,30 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
     }
     written
 }
+
+/// The key path of the first number in `value` that is not finite; outputs are checked with it
+/// before they are written.
+pub use plumetrace_core::first_non_finite;
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn temporary_files_are_unique_and_cleaned_up() {
+        let dir = std::env::temp_dir().join(format!("plumetrace-atomic-{}", std::process::id()));
+        let _ = std::fs::create_dir_all(&dir);
+        let p = dir.join("a.json");
+        assert!(write_atomic(&p, b"1").is_ok());
+        assert!(write_atomic(&dir.join("missing/b.json"), b"1").is_err());
+        let names: Vec<String> = std::fs::read_dir(&dir)
+            .map(|d| {
+                d.flatten()
+                    .map(|e| e.file_name().to_string_lossy().into_owned())
+                    .collect()
+            })
+            .unwrap_or_default();
+        assert_eq!(names, ["a.json"], "no temporary file left");
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+}
