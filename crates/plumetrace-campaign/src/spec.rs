@@ -313,6 +313,14 @@ impl Campaign {
                     "must not be empty".into(),
                 ));
             }
+            if c.name.chars().any(char::is_control) || c.name.chars().count() > 200 {
+                return Err(invalid(
+                    format!("configs[{i}].name"),
+                    "must be one line of at most 200 characters (it names the group in tables \
+                     and charts)"
+                        .into(),
+                ));
+            }
             if configs[..i].iter().any(|d| d.name == c.name) {
                 return Err(invalid(
                     format!("configs[{i}].name"),
@@ -454,14 +462,14 @@ impl Campaign {
         if let Some(p) = &c.planner {
             let path = planner_path(&t).map_err(|m| CampaignError::Invalid {
                 file: self.path.display().to_string(),
-                key: format!("configs.{}.planner", c.name),
+                key: format!("configs[{config}].planner"),
                 message: m,
             })?;
             let segments: Vec<&str> = path.split('.').collect();
             set_path(&mut t, &segments, toml::Value::Table(p.clone())).map_err(|m| {
                 CampaignError::Invalid {
                     file: self.path.display().to_string(),
-                    key: format!("configs.{}.planner", c.name),
+                    key: format!("configs[{config}].planner"),
                     message: m,
                 }
             })?;
@@ -469,7 +477,7 @@ impl Campaign {
         for (k, v) in &c.set {
             set_key(&mut t, k, v.clone()).map_err(|m| CampaignError::Invalid {
                 file: self.path.display().to_string(),
-                key: format!("configs.{}.set.{k}", c.name),
+                key: format!("configs[{config}].set.{k}"),
                 message: m,
             })?;
         }
@@ -544,7 +552,11 @@ impl Campaign {
                             s,
                             c,
                             p,
-                            "the scenario has no [mission] table: campaigns run missions".into(),
+                            format!(
+                                "scenarios[{s}]: '{}' has no [mission] table: campaigns run \
+                                 missions",
+                                self.scenarios[s].label
+                            ),
                         ));
                     }
                     // The planner registry checks every planner key (set and sweep included).

@@ -330,6 +330,26 @@ pub fn build(
                 ));
             }
             let s = sources[0];
+            for (key, k) in [
+                (
+                    "plume.horizontal_diffusivity_m2ps",
+                    p.horizontal_diffusivity_m2ps,
+                ),
+                (
+                    "plume.vertical_diffusivity_m2ps",
+                    p.vertical_diffusivity_m2ps,
+                ),
+            ] {
+                if k < 1e-6 {
+                    return Err(invalid(
+                        key,
+                        format!(
+                            "the steady plume needs at least 1e-6 m^2/s (its width goes as the \
+                             square root of it), got {k:?}"
+                        ),
+                    ));
+                }
+            }
             let g = GaussianPlume::new(
                 s.pos_m,
                 s.mass_rate_per_s,

@@ -104,8 +104,17 @@ pub fn load_preset(name: &str) -> Result<ScenarioConfig, ScenarioError> {
 /// The first date/time value in a TOML tree, with its key path.
 pub fn first_datetime(v: &toml::Value, path: &str) -> Option<(String, String)> {
     let join = |k: &str| {
-        if path.is_empty() {
+        // Keys that are not plain words are written quoted, as in TOML (`output.""`).
+        let k = if !k.is_empty()
+            && k.chars()
+                .all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '-')
+        {
             k.to_string()
+        } else {
+            format!("{k:?}")
+        };
+        if path.is_empty() {
+            k
         } else {
             format!("{path}.{k}")
         }

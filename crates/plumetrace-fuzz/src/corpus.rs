@@ -1,0 +1,117 @@
+//! The seeds of the corpus: every built-in scenario preset and every example campaign, compiled
+//! into the binary so the harness needs no files at run time.
+
+use plumetrace_scenario::{PRESETS, find_preset};
+
+/// What an input is read as.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum Target {
+    /// A scenario file, checked as `plumetrace check` does and then run briefly.
+    Scenario,
+    /// A campaign file, parsed, resolved and checked; its runs are counted, never flown.
+    Campaign,
+}
+
+impl Target {
+    /// The file name an input of this target is written to (errors must name it).
+    pub fn file_name(self) -> &'static str {
+        match self {
+            Target::Scenario => "fuzz.toml",
+            Target::Campaign => "fuzz-campaign.toml",
+        }
+    }
+
+    /// Lower-case name for reports.
+    pub fn name(self) -> &'static str {
+        match self {
+            Target::Scenario => "scenario",
+            Target::Campaign => "campaign",
+        }
+    }
+}
+
+/// One seed of the corpus.
+#[derive(Debug, Clone, Copy)]
+pub struct Seed {
+    /// Preset or campaign name.
+    pub name: &'static str,
+    /// What it is read as.
+    pub target: Target,
+    /// Its TOML text.
+    pub text: &'static str,
+}
+
+/// The example campaigns (`examples/campaigns/*.toml`; a test checks the list is complete).
+pub const CAMPAIGNS: &[(&str, &str)] = &[
+    (
+        "amp-declaration",
+        include_str!("../../../examples/campaigns/amp-declaration.toml"),
+    ),
+    (
+        "amp-vs-lawnmower",
+        include_str!("../../../examples/campaigns/amp-vs-lawnmower.toml"),
+    ),
+    (
+        "mt-lost-points",
+        include_str!("../../../examples/campaigns/mt-lost-points.toml"),
+    ),
+];
+
+/// Every seed: the presets in registry order, then the campaigns.
+pub fn seeds() -> Vec<Seed> {
+    PRESETS
+        .iter()
+        .map(|p| Seed {
+            name: p.name,
+            target: Target::Scenario,
+            text: p.toml,
+        })
+        .chain(CAMPAIGNS.iter().map(|(name, text)| Seed {
+            name,
+            target: Target::Campaign,
+            text,
+        }))
+        .collect()
+}
+
+/// Scenario files written next to every campaign input, so that campaign inputs naming
+/// `scenario.toml` (a mission) or `plume.toml` (plume only) find a real file.
+pub fn campaign_side_files() -> Vec<(&'static str, &'static str)> {
+    let text = |name: &str| find_preset(name).map_or("", |p| p.toml);
+    vec![
+        ("scenario.toml", text("demo")),
+        ("plume.toml", text("plume-demo")),
+    ]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_example_campaign_is_a_seed() {
+        let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/campaigns");
+        let mut on_disk: Vec<String> = std::fs::read_dir(&dir)
+            .map(|d| {
+                d.filter_map(Result::ok)
+                    .filter_map(|e| e.file_name().into_string().ok())
+                    .filter_map(|n| n.strip_suffix(".toml").map(str::to_string))
+                    .collect()
+            })
+            .unwrap_or_default();
+        on_disk.sort();
+        let mut embedded: Vec<String> = CAMPAIGNS.iter().map(|c| c.0.to_string()).collect();
+        embedded.sort();
+        assert_eq!(on_disk, embedded, "embed every file of {}", dir.display());
+    }
+
+    #[test]
+    fn every_seed_is_toml_and_side_files_exist() {
+        let all = seeds();
+        assert_eq!(all.len(), PRESETS.len() + CAMPAIGNS.len());
+        for s in &all {
+            assert!(s.text.parse::<toml::Table>().is_ok(), "{}", s.name);
+        }
+        assert!(campaign_side_files().iter().all(|(_, t)| !t.is_empty()));
+    }
+}

@@ -1,0 +1,217 @@
+//! Inputs from (pass seed, index): a seed of the corpus and one to three mutations, all drawn
+//! from the input's own random stream, so the same seed and index always give the same bytes.
+
+use crate::corpus::{Seed, Target, seeds};
+use crate::mutate::{Applied, Kind, MAX_INPUT_BYTES, apply_raw, apply_tree, float_literals};
+use crate::rng::input_rng;
+use rand::Rng;
+use std::borrow::Cow;
+
+/// One generated input.
+#[derive(Debug, Clone)]
+pub struct Input {
+    /// Its index in the pass.
+    pub index: u64,
+    /// The pass seed.
+    pub seed: u64,
+    /// The corpus seed it was made from.
+    pub corpus: &'static str,
+    /// What it is read as.
+    pub target: Target,
+    /// The mutations, in the order applied (tree ones first, then raw ones).
+    pub mutations: Vec<Applied>,
+    /// The file's bytes.
+    pub bytes: Vec<u8>,
+}
+
+impl Input {
+    /// Whether the bytes are UTF-8.
+    pub fn is_utf8(&self) -> bool {
+        std::str::from_utf8(&self.bytes).is_ok()
+    }
+
+    /// The text, invalid UTF-8 replaced.
+    pub fn text_lossy(&self) -> Cow<'_, str> {
+        String::from_utf8_lossy(&self.bytes)
+    }
+
+    /// A few lines on where the input came from.
+    pub fn describe(&self) -> String {
+        let mut s = format!(
+            "input {} of seed {}: {} file from '{}' ({} bytes{})\n",
+            self.index,
+            self.seed,
+            self.target.name(),
+            self.corpus,
+            self.bytes.len(),
+            if self.is_utf8() { "" } else { ", not UTF-8" }
+        );
+        for m in &self.mutations {
+            s.push_str(&format!("  {}: {}\n", m.kind.name(), m.detail));
+        }
+        s
+    }
+}
+
+/// Share of campaign mutations among the mutations of a campaign input.
+const CAMPAIGN_SHARE: f64 = 0.5;
+/// Share of raw mutations among the others.
+const RAW_SHARE: f64 = 0.2;
+
+/// The input at `index` of the pass seeded with `seed`.
+pub fn generate(seed: u64, index: u64) -> Input {
+    let mut rng = input_rng(seed, index);
+    let all = seeds();
+    // About 70 % scenarios, 30 % campaigns.
+    let scenarios: Vec<&Seed> = all
+        .iter()
+        .filter(|s| s.target == Target::Scenario)
+        .collect();
+    let campaigns: Vec<&Seed> = all
+        .iter()
+        .filter(|s| s.target == Target::Campaign)
+        .collect();
+    let pool = if rng.random_bool(0.3) && !campaigns.is_empty() {
+        &campaigns
+    } else {
+        &scenarios
+    };
+    let Some(corpus) = pool.get(rng.random_range(0..pool.len().max(1))).copied() else {
+        return Input {
+            index,
+            seed,
+            corpus: "(none)",
+            target: Target::Scenario,
+            mutations: Vec::new(),
+            bytes: Vec::new(),
+        };
+    };
+    let choose = |rng: &mut rand_pcg::Pcg64Mcg, keep: &dyn Fn(Kind) -> bool| {
+        let ks: Vec<Kind> = Kind::ALL.into_iter().filter(|k| keep(*k)).collect();
+        ks[rng.random_range(0..ks.len())]
+    };
+    let n = rng.random_range(1..=3);
+    let mut kinds = Vec::with_capacity(n);
+    for _ in 0..n {
+        let k = if corpus.target == Target::Campaign && rng.random_bool(CAMPAIGN_SHARE) {
+            choose(&mut rng, &|k| k.campaign_only())
+        } else if rng.random_bool(RAW_SHARE) {
+            choose(&mut rng, &|k| k.is_raw())
+        } else {
+            choose(&mut rng, &|k| !k.is_raw() && !k.campaign_only())
+        };
+        kinds.push(k);
+    }
+    // Tree mutations first (on the parsed text), raw ones on the final text.
+    kinds.sort_by_key(|k| k.is_raw());
+    let mut mutations = Vec::new();
+    let mut table: toml::Table = corpus.text.parse().unwrap_or_default();
+    let mut tree_changed = false;
+    for &k in kinds.iter().filter(|k| !k.is_raw()) {
+        // A mutation with nothing to act on falls back to a type change, then to an unknown key
+        // (always possible), so every input has as many mutations as drawn.
+        for kind in [k, Kind::ChangeType, Kind::InsertUnknownKey] {
+            if let Some(detail) = apply_tree(kind, &mut table, corpus.target, &mut rng) {
+                mutations.push(Applied { kind, detail });
+                tree_changed = true;
+                break;
+            }
+        }
+    }
+    let mut bytes = if tree_changed {
+        match toml::to_string(&table) {
+            Ok(text) => float_literals(&text).into_bytes(),
+            Err(e) => {
+                mutations.push(Applied {
+                    kind: Kind::ChangeType,
+                    detail: format!("(the mutated tree did not serialise: {e}; seed text kept)"),
+                });
+                corpus.text.as_bytes().to_vec()
+            }
+        }
+    } else {
+        corpus.text.as_bytes().to_vec()
+    };
+    for &kind in kinds.iter().filter(|k| k.is_raw()) {
+        let detail = apply_raw(kind, &mut bytes, &mut rng);
+        mutations.push(Applied { kind, detail });
+    }
+    if bytes.len() > MAX_INPUT_BYTES {
+        bytes.truncate(MAX_INPUT_BYTES);
+        mutations.push(Applied {
+            kind: Kind::Truncate,
+            detail: format!("cut to the {MAX_INPUT_BYTES}-byte cap"),
+        });
+    }
+    Input {
+        index,
+        seed,
+        corpus: corpus.name,
+        target: corpus.target,
+        mutations,
+        bytes,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::collections::BTreeSet;
+
+    #[test]
+    fn same_seed_and_index_give_the_same_bytes() {
+        for index in [0, 1, 17, 999, 123_456] {
+            let a = generate(5, index);
+            let b = generate(5, index);
+            assert_eq!(a.bytes, b.bytes, "index {index}");
+            assert_eq!(a.mutations, b.mutations, "index {index}");
+            assert_eq!(a.corpus, b.corpus);
+        }
+        let differ = (0..20).filter(|i| generate(5, *i).bytes != generate(6, *i).bytes);
+        assert!(differ.count() > 15, "other seeds give other inputs");
+    }
+
+    #[test]
+    fn extreme_floats_are_written_in_exponent_form() {
+        let mut exponents = 0;
+        for index in 0..1_000 {
+            let text = generate(2, index).text_lossy().into_owned();
+            assert!(!text.contains("plumetrace-fuzz-float"), "index {index}");
+            if ["e300", "e-300", "e18", "e308", "e-324"]
+                .iter()
+                .any(|e| text.contains(e))
+            {
+                exponents += 1;
+                // Still TOML (unless a raw mutation broke it on purpose).
+                let input = generate(2, index);
+                if input.mutations.iter().all(|m| !m.kind.is_raw()) {
+                    assert!(text.parse::<toml::Table>().is_ok(), "index {index}");
+                }
+            }
+        }
+        assert!(exponents > 10, "{exponents}");
+    }
+
+    #[test]
+    fn every_mutation_kind_is_produced() {
+        let mut seen = BTreeSet::new();
+        let mut targets = BTreeSet::new();
+        for index in 0..3_000 {
+            let input = generate(1, index);
+            assert!(input.bytes.len() <= MAX_INPUT_BYTES);
+            assert!(!input.mutations.is_empty());
+            targets.insert(input.target);
+            seen.extend(input.mutations.iter().map(|m| m.kind));
+            if seen.len() == Kind::ALL.len() && targets.len() == 2 {
+                break;
+            }
+        }
+        let missing: Vec<&str> = Kind::ALL
+            .iter()
+            .filter(|k| !seen.contains(k))
+            .map(|k| k.name())
+            .collect();
+        assert!(missing.is_empty(), "never produced: {missing:?}");
+        assert_eq!(targets.len(), 2);
+    }
+}

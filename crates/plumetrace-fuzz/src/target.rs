@@ -1,0 +1,460 @@
+//! Running one input in-process, as the CLI would, and classifying what happened.
+//!
+//! - Scenario inputs are written to `fuzz.toml` in a temporary directory and go through
+//!   `plumetrace check`'s path: parse (or, for bytes that are not UTF-8, the CLI's own loader
+//!   `load_file`), build, and for missions `MissionSetup::new`. An accepted scenario is then
+//!   run briefly. Missions: the parsed config's `mission.spinup_s` is capped at
+//!   [`SPINUP_CAP_S`] and `mission.time_limit_s` at [`TIME_LIMIT_CAP_S`] (only values above the
+//!   caps are lowered, so a NaN that `check` let through still reaches the run), the scenario
+//!   is built again and flown without the mean-plume grid, every number of the summary and
+//!   every trajectory row is checked, and the figure is drawn. Plume-only scenarios step the
+//!   environment at most [`PLUME_STEP_CAP`] times and query the output grid.
+//! - Campaign inputs are written to `fuzz-campaign.toml` next to `scenario.toml` (the `demo`
+//!   preset) and `plume.toml` (`plume-demo`), parsed, resolved (scenario files read), checked
+//!   group by group, and their runs counted; no mission is flown.
+//!
+//! The loops the harness drives (mission steps, plume steps) stop at the per-input deadline
+//! and report a hang themselves; anything else that runs past it is left to the batch's
+//! watchdog.
+
+use crate::classify::{Class, classify_rejection};
+use crate::corpus::{Target, campaign_side_files};
+use crate::generate::Input;
+use plumetrace_campaign::spec::{Campaign, parse_campaign};
+use plumetrace_env::ConcentrationField;
+use plumetrace_mission::{Mission, MissionOptions, MissionRun, MissionSetup};
+use plumetrace_scenario::{BuiltScenario, Origin};
+use std::panic::AssertUnwindSafe;
+use std::path::{Path, PathBuf};
+use std::sync::Mutex;
+use std::time::{Duration, Instant};
+
+/// Spin-up of the short run at most, s.
+pub const SPINUP_CAP_S: f64 = 60.0;
+/// Mission time of the short run at most, s.
+pub const TIME_LIMIT_CAP_S: f64 = 30.0;
+/// Environment steps of a plume-only short run at most.
+pub const PLUME_STEP_CAP: u64 = 200;
+/// An input that takes longer than this (but finishes) is reported as slow, s.
+pub const SLOW_S: f64 = 1.0;
+
+/// Summary fields that may be JSON null (the `Option` fields of
+/// `plumetrace_mission::summary`; array indices written `[]`). Any other null is a number
+/// that was not finite.
+const NULLABLE: &[&str] = &[
+    "first_declaration",
+    "first_detection_s",
+    "trace_length_m",
+    "detection_to_source_m",
+    "sources[].nearest_error_m",
+    "vehicles[].planner",
+    "vehicles[].first_detection_s",
+];
+
+/// What happened to one input.
+#[derive(Debug, Clone)]
+pub struct Outcome {
+    /// Its class.
+    pub class: Class,
+    /// The error, panic or check message (for accepted inputs: what ran).
+    pub message: String,
+    /// Wall time, s.
+    pub secs: f64,
+}
+
+impl Outcome {
+    /// Finished, but took longer than [`SLOW_S`].
+    pub fn slow(&self) -> bool {
+        self.secs > SLOW_S
+    }
+}
+
+/// The temporary directory inputs are written to.
+pub struct Workdir {
+    dir: tempfile::TempDir,
+    scenario: PathBuf,
+    campaign: PathBuf,
+}
+
+impl Workdir {
+    /// A fresh directory with the campaign side files.
+    pub fn new() -> anyhow::Result<Self> {
+        let dir = tempfile::Builder::new()
+            .prefix("plumetrace-fuzz-")
+            .tempdir()?;
+        let scenario = dir.path().join("scenario");
+        let campaign = dir.path().join("campaign");
+        std::fs::create_dir_all(&scenario)?;
+        std::fs::create_dir_all(&campaign)?;
+        for (name, text) in campaign_side_files() {
+            std::fs::write(campaign.join(name), text)?;
+        }
+        Ok(Workdir {
+            dir,
+            scenario,
+            campaign,
+        })
+    }
+
+    /// Where an input of `target` is written.
+    pub fn path(&self, target: Target) -> PathBuf {
+        match target {
+            Target::Scenario => self.scenario.join(target.file_name()),
+            Target::Campaign => self.campaign.join(target.file_name()),
+        }
+    }
+
+    /// `message` with the directory replaced by `<tmp>`, so messages compare across runs.
+    pub fn normalise(&self, message: &str) -> String {
+        message.replace(&self.dir.path().display().to_string(), "<tmp>")
+    }
+}
+
+/// Why a run stopped short of acceptance.
+enum Stop {
+    /// An error message (classified by the location rule).
+    Rejected(String),
+    /// A number that should be finite is not.
+    Nonfinite(String),
+    /// The deadline passed.
+    Deadline(String),
+}
+
+fn rejected(e: impl std::fmt::Display) -> Stop {
+    Stop::Rejected(e.to_string())
+}
+
+fn check_deadline(deadline: Instant, what: impl FnOnce() -> String) -> Result<(), Stop> {
+    if Instant::now() > deadline {
+        Err(Stop::Deadline(format!("past the time limit {}", what())))
+    } else {
+        Ok(())
+    }
+}
+
+/// The message of the last panic (set by the hook, taken by [`run`]).
+static LAST_PANIC: Mutex<Option<String>> = Mutex::new(None);
+
+/// Installs a panic hook that records the message and location instead of printing them (a
+/// panic is a finding, reported by the pass).
+pub fn install_panic_hook() {
+    std::panic::set_hook(Box::new(|info| {
+        let p = info.payload();
+        let msg = p
+            .downcast_ref::<&str>()
+            .map(|s| (*s).to_string())
+            .or_else(|| p.downcast_ref::<String>().cloned())
+            .unwrap_or_else(|| "(a panic without a message)".into());
+        let at = info
+            .location()
+            .map(|l| format!(" at {}:{}:{}", l.file(), l.line(), l.column()))
+            .unwrap_or_default();
+        if let Ok(mut g) = LAST_PANIC.lock() {
+            *g = Some(format!("panicked: {msg}{at}"));
+        }
+    }));
+}
+
+/// Runs `input` in-process with a deadline `timeout_s` from now; `Err` only when the harness
+/// itself fails (the input file cannot be written).
+pub fn run(input: &Input, wd: &Workdir, timeout_s: f64) -> anyhow::Result<Outcome> {
+    let path = wd.path(input.target);
+    std::fs::write(&path, &input.bytes)?;
+    if let Ok(mut g) = LAST_PANIC.lock() {
+        *g = None;
+    }
+    let start = Instant::now();
+    let deadline =
+        start + Duration::try_from_secs_f64(timeout_s).unwrap_or(Duration::from_secs(30));
+    let result = std::panic::catch_unwind(AssertUnwindSafe(|| match input.target {
+        Target::Scenario => scenario(input, &path, deadline),
+        Target::Campaign => campaign(input, &path, deadline),
+    }));
+    let secs = start.elapsed().as_secs_f64();
+    let (class, message) = match result {
+        Ok(Ok(m)) => (Class::Accepted, m),
+        Ok(Err(Stop::Rejected(m))) => {
+            let m = wd.normalise(&m);
+            let class = classify_rejection(&m, input.target.file_name(), &input.text_lossy());
+            (class, m)
+        }
+        Ok(Err(Stop::Nonfinite(m))) => (Class::NonfiniteOutput, m),
+        Ok(Err(Stop::Deadline(m))) => (Class::Hang, m),
+        Err(payload) => {
+            let recorded = LAST_PANIC.lock().ok().and_then(|mut g| g.take());
+            let m = recorded.unwrap_or_else(|| {
+                payload
+                    .downcast_ref::<String>()
+                    .cloned()
+                    .or_else(|| payload.downcast_ref::<&str>().map(|s| (*s).to_string()))
+                    .unwrap_or_else(|| "panicked".into())
+            });
+            (Class::Panic, m)
+        }
+    };
+    Ok(Outcome {
+        class,
+        message: wd.normalise(&message),
+        secs,
+    })
+}
+
+/// `check`, then a short run.
+fn scenario(input: &Input, path: &Path, deadline: Instant) -> Result<String, Stop> {
+    let origin = Origin::File(path.to_path_buf());
+    let cfg = match std::str::from_utf8(&input.bytes) {
+        Ok(text) => plumetrace_scenario::parse(text, &origin).map_err(rejected)?,
+        Err(_) => plumetrace_scenario::load_file(path).map_err(rejected)?,
+    };
+    let built = plumetrace_scenario::build(&cfg, &origin, None).map_err(rejected)?;
+    check_deadline(deadline, || "building the scenario".into())?;
+    if built.mission.is_none() {
+        return plume_run(built, deadline);
+    }
+    MissionSetup::new(built).map_err(rejected)?;
+    check_deadline(deadline, || "checking the mission".into())?;
+
+    // The short run.
+    let mut short = cfg;
+    if let Some(m) = short.mission.as_mut() {
+        if m.spinup_s > SPINUP_CAP_S {
+            m.spinup_s = SPINUP_CAP_S;
+        }
+        if m.time_limit_s > TIME_LIMIT_CAP_S {
+            m.time_limit_s = TIME_LIMIT_CAP_S;
+        }
+    }
+    let in_run = |e: &dyn std::fmt::Display| Stop::Rejected(format!("short run: {e}"));
+    let built = plumetrace_scenario::build(&short, &origin, None).map_err(|e| in_run(&e))?;
+    let setup = MissionSetup::new(built).map_err(|e| in_run(&e))?;
+    let options = MissionOptions {
+        mean_plume: false,
+        trajectory: true,
+    };
+    let mut mission = Mission::new(setup, options).map_err(|e| in_run(&e))?;
+    check_deadline(deadline, || "in the spin-up".into())?;
+    while mission.step().map_err(|e| in_run(&e))?.is_none() {
+        check_deadline(deadline, || {
+            format!(
+                "flying the mission (t = {} s of {} s)",
+                mission.time_s(),
+                mission.time_limit_s()
+            )
+        })?;
+    }
+    let run = mission.finish().map_err(|e| in_run(&e))?;
+    check_summary(&run)?;
+    check_trajectory(&run)?;
+    let t0 = Instant::now();
+    let svg = plumetrace_mission::plot::mission_figure(&run, "fuzz")
+        .map_err(|e| Stop::Rejected(format!("short run: drawing the figure: {e}")))?;
+    check_deadline(deadline, || "drawing the figure".into())?;
+    Ok(format!(
+        "mission: {} at t = {} s, {} trajectory rows, figure of {} bytes in {:.2} s",
+        run.outcome.name(),
+        run.summary.sim_time_s,
+        run.trajectory.len(),
+        svg.len(),
+        t0.elapsed().as_secs_f64()
+    ))
+}
+
+/// Plume only: a few steps, then the output grid.
+fn plume_run(mut built: BuiltScenario, deadline: Instant) -> Result<String, Stop> {
+    let steps = built.steps.min(PLUME_STEP_CAP);
+    for step in 1..=steps {
+        // As `plumetrace run` reports it.
+        built
+            .env
+            .step()
+            .map_err(|e| Stop::Rejected(format!("step {step}: {e}")))?;
+        check_deadline(deadline, || format!("at plume step {step} of {steps}"))?;
+    }
+    let grid = built.output.grid;
+    let points = grid.points();
+    let mut out = vec![0.0; points.len()];
+    built.env.plume().concentrations(&points, &mut out);
+    check_deadline(deadline, || "querying the output grid".into())?;
+    if let Some(k) = out.iter().position(|c| !c.is_finite()) {
+        return Err(Stop::Nonfinite(format!(
+            "concentration {} at output grid point {k} ({}, {}, {}) after {steps} steps",
+            out[k], points[k].x, points[k].y, points[k].z
+        )));
+    }
+    let max = out.iter().copied().fold(0.0, f64::max);
+    Ok(format!(
+        "plume: {steps} steps, {} grid points, max concentration {max:.3e}",
+        out.len()
+    ))
+}
+
+/// Every number of the summary is finite: serde_json writes a non-finite number as null, so
+/// any null outside [`NULLABLE`] is one.
+fn check_summary(run: &MissionRun) -> Result<(), Stop> {
+    let v = serde_json::to_value(&run.summary)
+        .map_err(|e| Stop::Nonfinite(format!("the summary does not serialise: {e}")))?;
+    let mut bad = Vec::new();
+    null_paths(&v, &mut String::new(), &mut String::new(), &mut bad);
+    if bad.is_empty() {
+        Ok(())
+    } else {
+        Err(Stop::Nonfinite(format!(
+            "summary fields not finite (null in JSON): {}",
+            bad.join(", ")
+        )))
+    }
+}
+
+/// Collects the paths of unexpected nulls; `pattern` is `path` with indices written `[]`.
+fn null_paths(
+    v: &serde_json::Value,
+    path: &mut String,
+    pattern: &mut String,
+    out: &mut Vec<String>,
+) {
+    match v {
+        serde_json::Value::Null if !NULLABLE.contains(&pattern.as_str()) => {
+            out.push(path.clone());
+        }
+        serde_json::Value::Object(m) => {
+            for (k, c) in m {
+                let (pl, ql) = (path.len(), pattern.len());
+                if !path.is_empty() {
+                    path.push('.');
+                    pattern.push('.');
+                }
+                path.push_str(k);
+                pattern.push_str(k);
+                null_paths(c, path, pattern, out);
+                path.truncate(pl);
+                pattern.truncate(ql);
+            }
+        }
+        serde_json::Value::Array(a) => {
+            for (i, c) in a.iter().enumerate() {
+                let (pl, ql) = (path.len(), pattern.len());
+                path.push_str(&format!("[{i}]"));
+                pattern.push_str("[]");
+                null_paths(c, path, pattern, out);
+                path.truncate(pl);
+                pattern.truncate(ql);
+            }
+        }
+        _ => {}
+    }
+}
+
+/// Every number of every trajectory row is finite.
+fn check_trajectory(run: &MissionRun) -> Result<(), Stop> {
+    for (k, r) in run.trajectory.iter().enumerate() {
+        let fields = [
+            ("t_s", Some(r.t_s)),
+            ("true_x_m", Some(r.true_x_m)),
+            ("true_y_m", Some(r.true_y_m)),
+            ("true_z_m", Some(r.true_z_m)),
+            ("est_x_m", r.est_x_m),
+            ("est_y_m", r.est_y_m),
+            ("heading_deg", Some(r.heading_deg)),
+            ("speed_mps", Some(r.speed_mps)),
+            ("reading_v", Some(r.reading_v)),
+        ];
+        let bad: Vec<String> = fields
+            .iter()
+            .filter_map(|(name, v)| {
+                v.filter(|x| !x.is_finite())
+                    .map(|x| format!("{name} = {x}"))
+            })
+            .collect();
+        if !bad.is_empty() {
+            return Err(Stop::Nonfinite(format!(
+                "trajectory row {k} (vehicle {}, t = {} s): {}",
+                r.vehicle,
+                r.t_s,
+                bad.join(", ")
+            )));
+        }
+    }
+    Ok(())
+}
+
+/// Parse, resolve, check the groups, count the runs.
+fn campaign(input: &Input, path: &Path, deadline: Instant) -> Result<String, Stop> {
+    let c = match std::str::from_utf8(&input.bytes) {
+        Ok(text) => {
+            let file = parse_campaign(text, path).map_err(rejected)?;
+            let c = Campaign::resolve(file, path, text.to_string(), true).map_err(rejected)?;
+            c.check_groups().map_err(rejected)?;
+            c
+        }
+        // As `plumetrace campaign` reads a file.
+        Err(_) => Campaign::load(path, None).map_err(rejected)?,
+    };
+    check_deadline(deadline, || "checking the campaign".into())?;
+    let runs = c.runs().len();
+    Ok(format!(
+        "campaign: {} scenarios x {} configs x {} sweep points x {} seeds = {runs} runs",
+        c.scenarios.len(),
+        c.configs.len(),
+        c.points.len(),
+        c.file.seeds
+    ))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::generate::generate;
+
+    fn unmutated(target: Target, text: &str) -> Input {
+        let mut i = generate(1, 0);
+        i.target = target;
+        i.corpus = "test";
+        i.mutations.clear();
+        i.bytes = text.as_bytes().to_vec();
+        i
+    }
+
+    #[test]
+    fn presets_and_campaigns_are_accepted() -> anyhow::Result<()> {
+        install_panic_hook();
+        let wd = Workdir::new()?;
+        for p in ["demo", "plume-demo", "freshwater"] {
+            let text = plumetrace_scenario::find_preset(p).map_or("", |p| p.toml);
+            let o = run(&unmutated(Target::Scenario, text), &wd, 60.0)?;
+            assert_eq!(o.class, Class::Accepted, "{p}: {}", o.message);
+        }
+        let o = run(
+            &unmutated(Target::Campaign, crate::corpus::CAMPAIGNS[1].1),
+            &wd,
+            60.0,
+        )?;
+        assert_eq!(o.class, Class::Accepted, "{}", o.message);
+        assert!(o.message.contains("= 80 runs"), "{}", o.message);
+        Ok(())
+    }
+
+    #[test]
+    fn a_syntax_error_is_located_and_paths_are_normalised() -> anyhow::Result<()> {
+        let wd = Workdir::new()?;
+        let o = run(&unmutated(Target::Scenario, "name = \n"), &wd, 10.0)?;
+        assert_eq!(o.class, Class::RejectedLocated, "{}", o.message);
+        assert!(
+            o.message.starts_with("<tmp>/scenario/fuzz.toml"),
+            "{}",
+            o.message
+        );
+        Ok(())
+    }
+
+    #[test]
+    fn unexpected_nulls_are_found() {
+        let v = serde_json::json!({
+            "first_detection_s": null,
+            "path_length_m": null,
+            "sources": [{"nearest_error_m": null, "x_m": null}],
+        });
+        let mut bad = Vec::new();
+        null_paths(&v, &mut String::new(), &mut String::new(), &mut bad);
+        assert_eq!(bad, ["path_length_m", "sources[0].x_m"]);
+    }
+}
