@@ -337,7 +337,7 @@ impl Campaign {
             for (i, v) in values.iter().enumerate() {
                 if values[..i].iter().any(|w| value_text(w) == value_text(v)) {
                     return Err(invalid(
-                        format!("sweep.{key}[{i}]"),
+                        format!("sweep.{}[{i}]", quoted(key)),
                         format!("{} is listed twice", value_text(v)),
                     ));
                 }
@@ -371,12 +371,15 @@ impl Campaign {
         for (key, values) in &file.sweep {
             let toml::Value::Array(values) = values else {
                 return Err(invalid(
-                    format!("sweep.{key}"),
+                    format!("sweep.{}", quoted(key)),
                     "must be an array of values".into(),
                 ));
             };
             if values.is_empty() {
-                return Err(invalid(format!("sweep.{key}"), "must not be empty".into()));
+                return Err(invalid(
+                    format!("sweep.{}", quoted(key)),
+                    "must not be empty".into(),
+                ));
             }
             let mut next = Vec::new();
             for p in &points {
@@ -477,14 +480,14 @@ impl Campaign {
         for (k, v) in &c.set {
             set_key(&mut t, k, v.clone()).map_err(|m| CampaignError::Invalid {
                 file: self.path.display().to_string(),
-                key: format!("configs[{config}].set.{k}"),
+                key: format!("configs[{config}].set.{}", quoted(k)),
                 message: m,
             })?;
         }
         for (k, v) in &self.points[point].values {
             set_key(&mut t, k, v.clone()).map_err(|m| CampaignError::Invalid {
                 file: self.path.display().to_string(),
-                key: format!("sweep.{k}"),
+                key: format!("sweep.{}", quoted(k)),
                 message: m,
             })?;
         }
@@ -593,6 +596,19 @@ impl Campaign {
         };
         let text = serde_json::to_string(&canon).unwrap_or_default();
         format!("{:016x}", fnv1a(text.as_bytes()))
+    }
+}
+
+/// A key as written in a key path: plain words as they are, others quoted (`""`, `"a b"`).
+fn quoted(key: &str) -> String {
+    if !key.is_empty()
+        && key
+            .chars()
+            .all(|c| c.is_ascii_alphanumeric() || "_-.".contains(c))
+    {
+        key.to_string()
+    } else {
+        format!("{key:?}")
     }
 }
 

@@ -449,3 +449,78 @@ fn check_warns_about_missions_that_cannot_succeed() {
         "{w}"
     );
 }
+
+#[test]
+fn problems_the_fuzzer_found_stay_fixed() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    // A date under an empty key: the key is written quoted, so the path still says where.
+    let e = check_error(
+        d,
+        "empty.toml",
+        &demo_with("[output]", "[output]\n\"\" = 1979-05-27"),
+        "output.\"\"",
+    );
+    assert!(e.contains("date/time"), "{e}");
+    // A steady plume with a vanishing diffusivity once gave NaN concentrations after one step.
+    let fresh = plumetrace_scenario::find_preset("freshwater").unwrap().toml;
+    let (from, _) = fresh
+        .lines()
+        .find_map(|l| {
+            l.strip_prefix("horizontal_diffusivity_m2ps = ")
+                .map(|v| (l, v))
+        })
+        .unwrap();
+    check_error(
+        d,
+        "fresh.toml",
+        &fresh.replacen(from, "horizontal_diffusivity_m2ps = 5e-324", 1),
+        "plume.horizontal_diffusivity_m2ps",
+    );
+    // A campaign naming a plume-only scenario: the error names the scenario's entry.
+    let c = d.join("plume.toml");
+    std::fs::write(
+        &c,
+        "name = \"c\"\nseed = 1\nseeds = 1\nscenarios = [\"demo\", \"pompy\"]\n",
+    )
+    .unwrap();
+    let e = fails(&[
+        "campaign",
+        c.to_str().unwrap(),
+        "--out",
+        d.join("o").to_str().unwrap(),
+    ]);
+    assert!(
+        e.contains("plume.toml") && e.contains("scenarios[1]") && e.contains("no [mission]"),
+        "{e}"
+    );
+    // A configuration name over two lines: refused at its index.
+    std::fs::write(
+        &c,
+        "name = \"c\"\nseed = 1\nseeds = 1\nscenarios = [\"demo\"]\n[[configs]]\nname = \"a\\nb\"\n",
+    )
+    .unwrap();
+    let e = fails(&[
+        "campaign",
+        c.to_str().unwrap(),
+        "--out",
+        d.join("o").to_str().unwrap(),
+    ]);
+    assert!(
+        e.contains("configs[0].name") && e.contains("one line"),
+        "{e}"
+    );
+    // An empty key in a sweep: its path is written quoted.
+    std::fs::write(
+        &c,
+        "name = \"c\"\nseed = 1\nseeds = 1\nscenarios = [\"demo\"]\n[sweep]\n\"\" = \"nope\"\n",
+    )
+    .unwrap();
+    let e = fails(&[
+        "campaign",
+        c.to_str().unwrap(),
+        "--out",
+        d.join("o").to_str().unwrap(),
+    ]);
+    assert!(e.contains("sweep.\"\"") && e.contains("array"), "{e}");
+}

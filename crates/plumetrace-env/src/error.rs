@@ -22,7 +22,7 @@ pub enum EnvError {
         message: String,
     },
     /// The flow field produced a non-finite or runaway velocity.
-    #[error("flow field diverged at t = {time_s} s: {message}")]
+    #[error("flow.farrell: the field diverged at t = {time_s:?} s: {message}")]
     Diverged {
         /// Simulation time of the failure, s.
         time_s: f64,
