@@ -250,10 +250,18 @@ impl FarrellFlow {
             .min(self.noise_limit())
     }
 
-    /// Explicit Euler on the corner oscillator (eigenvalues `w (-z +- i sqrt(1 - z^2))`) is stable
-    /// only while `|1 + lambda dt| < 1`, i.e. `dt < 2 z / w`.
+    /// Explicit Euler on the corner oscillator is stable only while `|1 + lambda dt| < 1` for both
+    /// eigenvalues: underdamped (`z < 1`, `lambda = w (-z +- i sqrt(1 - z^2))`) that is
+    /// `dt < 2 z / w`; overdamped (`z >= 1`, real `lambda = w (-z +- sqrt(z^2 - 1))`) it is
+    /// `dt < 2 / (w (z + sqrt(z^2 - 1)))`, set by the faster mode (a damping of 21 with the
+    /// default bandwidth once passed the first bound and diverged).
     fn noise_limit(&self) -> f64 {
-        2.0 * self.params.noise_damping / self.params.noise_bandwidth_radps
+        let (z, w) = (self.params.noise_damping, self.params.noise_bandwidth_radps);
+        if z < 1.0 {
+            2.0 * z / w
+        } else {
+            2.0 / (w * (z + (z * z - 1.0).sqrt()))
+        }
     }
 
     /// The model parameters.
@@ -547,6 +555,44 @@ mod tests {
             }
         }
         assert!(diverged, "explicit Euler beyond 2 z / w should diverge");
+    }
+
+    #[test]
+    fn an_overdamped_oscillator_is_limited_by_its_fast_mode() {
+        // Damping 21, bandwidth 0.05 rad/s: 2 z / w = 840 s would allow any step, but the fast
+        // real eigenvalue w (z + sqrt(z^2 - 1)) = 2.0988 rad/s limits dt to about 0.953 s.
+        let region = Rect {
+            x_min_m: 0.0,
+            x_max_m: 1000.0,
+            y_min_m: 0.0,
+            y_max_m: 1000.0,
+        };
+        let params = FarrellParams {
+            noise_gain: 0.1,
+            noise_damping: 21.0,
+            noise_bandwidth_radps: 0.05,
+            ..FarrellParams::default()
+        };
+        let want = 2.0 / (0.05 * (21.0 + (21.0_f64 * 21.0 - 1.0).sqrt()));
+        assert!((want - 0.953).abs() < 1e-3, "{want}");
+        let err = FarrellFlow::new(region, steady(0.1, 90.0), params, 2.0)
+            .err()
+            .map(|e| e.to_string())
+            .unwrap_or_default();
+        assert!(err.contains("sim.dt_s"), "{err}");
+        let f = FarrellFlow::new(region, steady(0.1, 90.0), params, 0.5).unwrap();
+        assert!((f.max_stable_dt_s().unwrap() - want).abs() < 1e-12);
+        // Stepping at 2 s with these parameters diverges, at 0.5 s it stays bounded.
+        let run = |dt: f64| {
+            let mut g = FarrellFlow::new(region, steady(0.1, 90.0), params, 0.5).unwrap();
+            let mut rng = stream_rng(1, StreamId::Flow);
+            (1..=2_000u32).all(|k| g.advance(f64::from(k) * dt, dt, &mut rng).is_ok())
+        };
+        assert!(
+            !run(2.0),
+            "explicit Euler beyond the fast mode's limit should diverge"
+        );
+        assert!(run(0.5));
     }
 
     #[test]
