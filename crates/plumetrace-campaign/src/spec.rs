@@ -599,17 +599,9 @@ impl Campaign {
     }
 }
 
-/// A key as written in a key path: plain words as they are, others quoted (`""`, `"a b"`).
+/// A key as written in a key path.
 fn quoted(key: &str) -> String {
-    if !key.is_empty()
-        && key
-            .chars()
-            .all(|c| c.is_ascii_alphanumeric() || "_-.".contains(c))
-    {
-        key.to_string()
-    } else {
-        format!("{key:?}")
-    }
+    plumetrace_core::params::quoted_key(key)
 }
 
 /// FNV-1a, 64 bits: a stable digest (std's hasher may change between releases).
@@ -632,7 +624,7 @@ pub fn planner_path(table: &toml::Table) -> Result<String, String> {
         .unwrap_or_default();
     match (table.contains_key("planner"), named.as_slice()) {
         (true, []) => Ok("planner".into()),
-        (false, [one]) => Ok(format!("planners.{one}")),
+        (false, [one]) => Ok(format!("planners.{}", quoted(one))),
         (false, []) => Err("the scenario has no planner table".into()),
         _ => Err(format!(
             "the scenario has several planners ({}): name one with a dotted key \
@@ -641,7 +633,7 @@ pub fn planner_path(table: &toml::Table) -> Result<String, String> {
                 .contains_key("planner")
                 .then_some("planner".to_string())
                 .into_iter()
-                .chain(named.iter().map(|n| format!("planners.{n}")))
+                .chain(named.iter().map(|n| format!("planners.{}", quoted(n))))
                 .collect::<Vec<_>>()
                 .join(", ")
         )),

@@ -209,6 +209,20 @@ impl ParamError {
     }
 }
 
+/// A key as written in a key path: plain words (ASCII letters, digits, `_`, `-`) as they are,
+/// others quoted as TOML would (`""`, `"a b"`, `"a.b"`), so that the path reads back unambiguously.
+pub fn quoted_key(key: &str) -> String {
+    if !key.is_empty()
+        && key
+            .chars()
+            .all(|c| c.is_ascii_alphanumeric() || "_-".contains(c))
+    {
+        key.to_string()
+    } else {
+        format!("{key:?}")
+    }
+}
+
 /// `prefix.name`, or `name` when the prefix is empty.
 pub fn key_path(prefix: &str, name: &str) -> String {
     if prefix.is_empty() {

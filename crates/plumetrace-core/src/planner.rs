@@ -31,13 +31,16 @@ pub enum BehaviourKind {
     Survey,
     /// A pattern over a declared source (e.g. sidescan lines).
     Mapping,
+    /// Go around an obstacle towards a reference target (the interrupted behaviour resumes
+    /// after it).
+    Avoid,
     /// Mission over: no more commands.
     Done,
 }
 
 impl BehaviourKind {
     /// Every behaviour, in the order above.
-    pub const ALL: [BehaviourKind; 9] = [
+    pub const ALL: [BehaviourKind; 10] = [
         BehaviourKind::GoTo,
         BehaviourKind::Transit,
         BehaviourKind::Find,
@@ -46,6 +49,7 @@ impl BehaviourKind {
         BehaviourKind::Reacquire,
         BehaviourKind::Survey,
         BehaviourKind::Mapping,
+        BehaviourKind::Avoid,
         BehaviourKind::Done,
     ];
 }
@@ -102,6 +106,24 @@ pub enum PlannerEvent {
     CageAbort {
         /// How far outside the op-area the estimate was, m.
         distance_outside_m: f64,
+    },
+    /// An obstacle was sensed: obstacle avoidance took over, with a virtual path through
+    /// `pos_m` along the course the vehicle had.
+    AvoidStart {
+        /// Estimated position, m: the virtual path's origin.
+        pos_m: Vec2,
+        /// The vehicle's course then, the path's direction, deg (compass).
+        course_deg: f64,
+    },
+    /// A dynamic reference target was placed on the virtual path.
+    ReferenceTarget {
+        /// The target, m.
+        pos_m: Vec2,
+    },
+    /// The obstacle was passed: the interrupted behaviour resumed.
+    AvoidEnd {
+        /// Estimated position, m.
+        pos_m: Vec2,
     },
 }
 
@@ -195,6 +217,14 @@ pub trait Planner: Send {
     /// vehicle keeps its last command and samples accumulate for the next snapshot.
     fn decision_period_s(&self) -> f64 {
         0.0
+    }
+
+    /// Control comes back after a detour this planner did not fly (obstacle avoidance took the
+    /// vehicle around an obstacle), with the vehicle at `pos_m`, off the planner's own path. A
+    /// planner that lost the plume meanwhile may search around this point; the default does
+    /// nothing.
+    fn detour_ended(&mut self, pos_m: Vec2) {
+        let _ = pos_m;
     }
 }
 

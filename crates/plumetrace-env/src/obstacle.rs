@@ -100,6 +100,22 @@ impl ObstacleSet {
     /// Distance along a ray from `origin` on `heading` to the first obstacle edge within
     /// `max_range_m`, as a range sensor's beam would see it.
     pub fn ray_range_m(&self, origin: Vec2, heading: Heading, max_range_m: f64) -> Option<f64> {
+        let mut best: Option<f64> = None;
+        self.ray_hits(origin, heading, max_range_m, |_, d| {
+            best = Some(best.map_or(d, |b: f64| b.min(d)));
+        });
+        best
+    }
+
+    /// Calls `hit(k, d)` for every obstacle `k` the ray from `origin` on `heading` meets within
+    /// `max_range_m`, with `d` the distance to its nearest edge on the ray (obstacles in order).
+    pub fn ray_hits(
+        &self,
+        origin: Vec2,
+        heading: Heading,
+        max_range_m: f64,
+        mut hit: impl FnMut(usize, f64),
+    ) {
         let end = origin + heading.unit() * max_range_m;
         let beam = Line::new(
             Coord {
@@ -108,16 +124,18 @@ impl ObstacleSet {
             },
             Coord { x: end.x, y: end.y },
         );
-        let mut best: Option<f64> = None;
-        for o in &self.obstacles {
-            for edge in o.polygon.exterior().lines() {
-                if let Some(hit) = segment_hit(&beam, &edge) {
-                    let d = (Vec2::new(hit.x, hit.y) - origin).norm();
-                    best = Some(best.map_or(d, |b| b.min(d)));
-                }
+        for (k, o) in self.obstacles.iter().enumerate() {
+            let nearest = o
+                .polygon
+                .exterior()
+                .lines()
+                .filter_map(|edge| segment_hit(&beam, &edge))
+                .map(|h| (Vec2::new(h.x, h.y) - origin).norm())
+                .min_by(f64::total_cmp);
+            if let Some(d) = nearest {
+                hit(k, d);
             }
         }
-        best
     }
 }
 

@@ -52,6 +52,10 @@ pub const CAMPAIGNS: &[(&str, &str)] = &[
         include_str!("../../../examples/campaigns/amp-vs-lawnmower.toml"),
     ),
     (
+        "moth-comparison",
+        include_str!("../../../examples/campaigns/moth-comparison.toml"),
+    ),
+    (
         "mt-lost-points",
         include_str!("../../../examples/campaigns/mt-lost-points.toml"),
     ),

@@ -73,6 +73,8 @@ pub struct MissionRun {
     pub op_area: Vec<Vec2>,
     /// Subregions.
     pub subregions: Vec<Vec<Vec2>>,
+    /// Obstacle outlines.
+    pub obstacles: Vec<Vec<Vec2>>,
     /// Mean flow at the first source over the mission, m/s.
     pub mean_flow_mps: Vec2,
     /// The vehicles, by index.
@@ -422,6 +424,19 @@ impl Mission {
             sources: self.sources,
             op_area: self.op_area,
             subregions: self.subregions,
+            obstacles: self
+                .world
+                .env()
+                .obstacles()
+                .iter()
+                .map(|o| {
+                    o.polygon
+                        .exterior()
+                        .coords()
+                        .map(|c| Vec2::new(c.x, c.y))
+                        .collect()
+                })
+                .collect(),
             mean_flow_mps: mean_flow,
             vehicles,
         })

@@ -1,14 +1,17 @@
 //! The mission figure, drawn from the recorded run (like the field-test figures): op-area and
-//! subregions dashed, each vehicle's estimated track as it logged it in a colour of its own (the
-//! true tracks thin and grey), detections as x, lost points as open circles, declared sources as
-//! filled dots, true sources as triangles, and the time-averaged plume at the first vehicle's
-//! altitude as a light heat map. The legend lists only what is drawn.
+//! subregions dashed, obstacles (kelp) as filled green patches, each vehicle's estimated track as
+//! it logged it coloured by the behaviour in control (a vehicle without a planner in a colour of
+//! its own; the true tracks thin and grey; with several vehicles each track's start is labelled
+//! with the vehicle's name), detections as x, lost points as open circles, obstacle avoidance's
+//! virtual paths dotted with their reference targets as diamonds, declared sources as filled
+//! dots, true sources as triangles, and the time-averaged plume at the first vehicle's altitude as
+//! a light heat map. The legend lists only what is drawn.
 
 use crate::mission::MissionRun;
 use crate::record::{EventKind, MeanPlumeRecorder};
 use plotters::coord::types::RangedCoordf64;
 use plotters::prelude::*;
-use plumetrace_core::{PlannerEvent, Vec2};
+use plumetrace_core::{BehaviourKind, Heading, PlannerEvent, Vec2};
 
 fn err<E: std::fmt::Debug>(e: E) -> String {
     format!("drawing the figure: {e:?}")
@@ -124,6 +127,46 @@ fn legend_corner(
     best.0
 }
 
+/// A stretch of a track flown under one behaviour (`None`: no planner), as plot points.
+type BehaviourRun = (Option<BehaviourKind>, Vec<(f64, f64)>);
+
+/// The colour of a track while `b` is in control.
+fn behaviour_colour(b: BehaviourKind) -> RGBColor {
+    match b {
+        BehaviourKind::GoTo => RGBColor(0, 150, 60),
+        BehaviourKind::Transit => RGBColor(90, 90, 90),
+        BehaviourKind::Find => RGBColor(31, 100, 190),
+        BehaviourKind::TrackIn => RGBColor(215, 30, 30),
+        BehaviourKind::TrackOut => RGBColor(250, 140, 0),
+        BehaviourKind::Reacquire => RGBColor(140, 80, 190),
+        BehaviourKind::Survey => RGBColor(0, 160, 180),
+        BehaviourKind::Mapping => RGBColor(140, 86, 75),
+        BehaviourKind::Avoid => RGBColor(230, 60, 190),
+        BehaviourKind::Done => RGBColor(0, 0, 0),
+    }
+}
+
+/// How a behaviour reads in the legend.
+fn behaviour_label(b: BehaviourKind) -> &'static str {
+    match b {
+        BehaviourKind::GoTo => "go to",
+        BehaviourKind::Transit => "transit",
+        BehaviourKind::Find => "find plume",
+        BehaviourKind::TrackIn => "track in",
+        BehaviourKind::TrackOut => "track out",
+        BehaviourKind::Reacquire => "reacquire",
+        BehaviourKind::Survey => "survey",
+        BehaviourKind::Mapping => "mapping",
+        BehaviourKind::Avoid => "avoid obstacle",
+        BehaviourKind::Done => "done",
+    }
+}
+
+/// Kelp.
+const OBSTACLE_FILL: RGBColor = RGBColor(90, 160, 90);
+/// Virtual paths and reference targets.
+const AVOID_MARK: RGBColor = RGBColor(170, 0, 140);
+
 /// Track colours, one per vehicle (cycled).
 const TRACK_COLOURS: [RGBColor; 6] = [
     RGBColor(20, 60, 160),
@@ -202,6 +245,23 @@ pub fn mission_figure(run: &MissionRun, title: &str) -> Result<String, String> {
                 .draw_series(dashed(r, RGBColor(120, 120, 120), 1))
                 .map_err(err)?;
         }
+        if !run.obstacles.is_empty() {
+            chart
+                .draw_series(run.obstacles.iter().map(|o| {
+                    Polygon::new(
+                        o.iter().map(|v| (v.x, v.y)).collect::<Vec<_>>(),
+                        OBSTACLE_FILL.mix(0.55).filled(),
+                    )
+                }))
+                .map_err(err)?
+                .label("obstacle (kelp)")
+                .legend(|(x, y)| {
+                    Rectangle::new(
+                        [(x, y - 5), (x + 14, y + 5)],
+                        OBSTACLE_FILL.mix(0.55).filled(),
+                    )
+                });
+        }
 
         let vehicles: Vec<u32> = {
             let mut v: Vec<u32> = run.trajectory.iter().map(|r| r.vehicle).collect();
@@ -211,6 +271,8 @@ pub fn mission_figure(run: &MissionRun, title: &str) -> Result<String, String> {
         };
         let grey = RGBColor(150, 150, 150);
         let mut hits: Vec<(f64, f64)> = Vec::new();
+        let mut behaviours_drawn = std::collections::BTreeSet::new();
+        let mut track_labels: Vec<(String, RGBColor)> = Vec::new();
         for (n, &vid) in vehicles.iter().enumerate() {
             let rows: Vec<_> = run.trajectory.iter().filter(|r| r.vehicle == vid).collect();
             let step = (rows.len() / 20_000).max(1);
@@ -219,11 +281,23 @@ pub fn mission_figure(run: &MissionRun, title: &str) -> Result<String, String> {
                 .step_by(step)
                 .map(|r| (r.true_x_m, r.true_y_m))
                 .collect();
-            let est: Vec<(f64, f64)> = rows
-                .iter()
-                .step_by(step)
-                .filter_map(|r| r.est_x_m.zip(r.est_y_m))
-                .collect();
+            // Runs of the estimated track under one behaviour (None: no planner); each run
+            // ends on the next one's first point so that the track stays joined.
+            let mut runs: Vec<BehaviourRun> = Vec::new();
+            for r in rows.iter().step_by(step) {
+                let Some(p) = r.est_x_m.zip(r.est_y_m) else {
+                    continue;
+                };
+                match runs.last_mut() {
+                    Some((b, pts)) if *b == r.behaviour => pts.push(p),
+                    last => {
+                        if let Some((_, pts)) = last {
+                            pts.push(p);
+                        }
+                        runs.push((r.behaviour, vec![p]));
+                    }
+                }
+            }
             let true_track = chart
                 .draw_series(std::iter::once(PathElement::new(
                     truth,
@@ -243,25 +317,46 @@ pub fn mission_figure(run: &MissionRun, title: &str) -> Result<String, String> {
             }
             let colour = TRACK_COLOURS[n % TRACK_COLOURS.len()];
             let info = run.vehicles.get(vid as usize);
-            let label = match info {
-                Some(v) if vehicles.len() > 1 => format!(
-                    "{} ({}) estimated track",
-                    v.name,
-                    v.planner.map_or("no planner", |k| k.name())
-                ),
-                _ => "track (navigation estimate)".to_string(),
-            };
-            if !est.is_empty() {
+            // One vehicle: its track coloured by behaviour. Several: one colour each, named in
+            // the legend (and at each track's start), so the vehicles can be told apart.
+            let multi = vehicles.len() > 1;
+            for (b, pts) in runs.iter() {
+                let c = match b {
+                    Some(b) if !multi => behaviour_colour(*b),
+                    _ => colour,
+                };
                 chart
                     .draw_series(std::iter::once(PathElement::new(
-                        est,
-                        colour.stroke_width(2),
+                        pts.clone(),
+                        c.stroke_width(2),
                     )))
-                    .map_err(err)?
-                    .label(label)
-                    .legend(move |(x, y)| {
-                        PathElement::new(vec![(x, y), (x + 16, y)], colour.stroke_width(2))
-                    });
+                    .map_err(err)?;
+                match (b, info) {
+                    (Some(b), _) if !multi => {
+                        behaviours_drawn.insert(*b);
+                    }
+                    (_, Some(v)) if multi => track_labels.push((
+                        format!(
+                            "{} ({}) estimated track",
+                            v.name,
+                            v.planner.map_or("no planner", |k| k.name())
+                        ),
+                        colour,
+                    )),
+                    _ => track_labels.push(("track (navigation estimate)".to_string(), colour)),
+                }
+            }
+            if vehicles.len() > 1
+                && let (Some(v), Some((_, pts))) = (info, runs.first())
+            {
+                let (x, y) = pts[0];
+                chart
+                    .draw_series(std::iter::once(Text::new(
+                        v.name.clone(),
+                        (x, y),
+                        ("sans-serif", 12).into_font().color(&BLACK),
+                    )))
+                    .map_err(err)?;
             }
             hits.extend(
                 rows.iter()
@@ -269,12 +364,95 @@ pub fn mission_figure(run: &MissionRun, title: &str) -> Result<String, String> {
                     .filter_map(|r| r.est_x_m.zip(r.est_y_m)),
             );
         }
+        track_labels.dedup_by(|a, b| a.0 == b.0);
+        let n_track_labels = track_labels.len();
+        for (label, c) in track_labels {
+            chart
+                .draw_series(std::iter::empty::<PathElement<(f64, f64)>>())
+                .map_err(err)?
+                .label(label)
+                .legend(move |(x, y)| {
+                    PathElement::new(vec![(x, y), (x + 16, y)], c.stroke_width(2))
+                });
+        }
+        for b in BehaviourKind::ALL
+            .into_iter()
+            .filter(|b| behaviours_drawn.contains(b))
+        {
+            let c = behaviour_colour(b);
+            chart
+                .draw_series(std::iter::empty::<PathElement<(f64, f64)>>())
+                .map_err(err)?
+                .label(format!("track: {}", behaviour_label(b)))
+                .legend(move |(x, y)| {
+                    PathElement::new(vec![(x, y), (x + 16, y)], c.stroke_width(2))
+                });
+        }
+        // Obstacle avoidance: each virtual path from where the obstacle was sensed to its last
+        // reference target, and the targets.
+        let mut paths: Vec<(Vec2, Heading, Vec2)> = Vec::new();
+        let mut targets: Vec<(f64, f64)> = Vec::new();
+        for e in &run.events {
+            match &e.event {
+                EventKind::Planner(PlannerEvent::AvoidStart { pos_m, course_deg }) => {
+                    paths.push((*pos_m, Heading::from_deg(*course_deg), *pos_m));
+                }
+                EventKind::Planner(PlannerEvent::ReferenceTarget { pos_m }) => {
+                    targets.push((pos_m.x, pos_m.y));
+                    if let Some((_, _, end)) = paths.last_mut() {
+                        *end = *pos_m;
+                    }
+                }
+                _ => {}
+            }
+        }
+        if !paths.is_empty() {
+            let segments: Vec<PathElement<(f64, f64)>> = paths
+                .iter()
+                .flat_map(|(a, course, b)| {
+                    let len = (b - a).dot(&course.unit()).max(0.0);
+                    let n = (len / 2.0).ceil() as usize;
+                    (0..n).step_by(2).map(move |k| {
+                        let p = a + course.unit() * (2.0 * k as f64);
+                        let q = a + course.unit() * (2.0 * (k + 1) as f64).min(len);
+                        PathElement::new(vec![(p.x, p.y), (q.x, q.y)], AVOID_MARK.stroke_width(1))
+                    })
+                })
+                .collect();
+            chart
+                .draw_series(segments)
+                .map_err(err)?
+                .label("virtual path")
+                .legend(|(x, y)| {
+                    PathElement::new(vec![(x, y), (x + 5, y)], AVOID_MARK.stroke_width(1))
+                });
+        }
+        if !targets.is_empty() {
+            chart
+                .draw_series(targets.iter().map(|&(x, y)| {
+                    Polygon::new(
+                        vec![(x, y + 1.2), (x + 1.2, y), (x, y - 1.2), (x - 1.2, y)],
+                        AVOID_MARK.filled(),
+                    )
+                }))
+                .map_err(err)?
+                .label("reference target")
+                .legend(|(x, y)| {
+                    Polygon::new(
+                        vec![(x + 7, y - 5), (x + 12, y), (x + 7, y + 5), (x + 2, y)],
+                        AVOID_MARK.filled(),
+                    )
+                });
+        }
         if !hits.is_empty() {
             chart
-                .draw_series(hits.iter().map(|&p| Cross::new(p, 3, RED.stroke_width(1))))
+                .draw_series(
+                    hits.iter()
+                        .map(|&p| Cross::new(p, 3, RGBColor(110, 0, 0).stroke_width(1))),
+                )
                 .map_err(err)?
                 .label("detection")
-                .legend(|(x, y)| Cross::new((x + 8, y), 4, RED.stroke_width(2)));
+                .legend(|(x, y)| Cross::new((x + 8, y), 4, RGBColor(110, 0, 0).stroke_width(2)));
         }
         let lost: Vec<(f64, f64)> = run
             .events
@@ -329,13 +507,28 @@ pub fn mission_figure(run: &MissionRun, title: &str) -> Result<String, String> {
         marks.extend(&lost);
         marks.extend(&declared);
         marks.extend(run.sources.iter().map(|s| (s.x, s.y)));
+        // Rows of the legend: everything that may be drawn, counted as drawn.
+        let legend_rows = usize::from(run.mean_plume.is_some())
+            + 2
+            + usize::from(!run.obstacles.is_empty())
+            + behaviours_drawn.len()
+            + n_track_labels
+            + usize::from(!paths.is_empty())
+            + usize::from(!targets.is_empty())
+            + usize::from(!hits.is_empty())
+            + usize::from(!lost.is_empty())
+            + usize::from(!run.sources.is_empty())
+            + usize::from(!declared.is_empty());
         let (pw, ph) = chart.plotting_area().dim_in_pixel();
         let corner = legend_corner(
             &marks,
             x0..x1,
             y0..y1,
             (f64::from(pw), f64::from(ph)),
-            (if vehicles.len() > 1 { 330.0 } else { 250.0 }, 190.0),
+            (
+                if vehicles.len() > 1 { 330.0 } else { 250.0 },
+                20.0 * legend_rows as f64 + 10.0,
+            ),
         );
         chart
             .configure_series_labels()

@@ -384,6 +384,12 @@ mod tests {
             PlannerEvent::CageAbort {
                 distance_outside_m: 31.0,
             },
+            PlannerEvent::AvoidStart {
+                pos_m: p,
+                course_deg: 45.0,
+            },
+            PlannerEvent::ReferenceTarget { pos_m: p },
+            PlannerEvent::AvoidEnd { pos_m: p },
         ];
         for e in &planner {
             match e {
@@ -392,7 +398,10 @@ mod tests {
                 | PlannerEvent::LostPoint { .. }
                 | PlannerEvent::Declared { .. }
                 | PlannerEvent::Region { .. }
-                | PlannerEvent::CageAbort { .. } => {}
+                | PlannerEvent::CageAbort { .. }
+                | PlannerEvent::AvoidStart { .. }
+                | PlannerEvent::ReferenceTarget { .. }
+                | PlannerEvent::AvoidEnd { .. } => {}
             }
         }
         let telemetry = [Telemetry::SourceEstimate { pos_m: p }];

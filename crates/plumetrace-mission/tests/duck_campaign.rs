@@ -1,4 +1,5 @@
-//! The Duck 2003 missions over several seeds (the acceptance checks of the AMP). Slow in a
+//! Acceptance checks over several seeds: the Duck 2003 missions (the AMP) and Li and Zhang's
+//! kelp mission (the moth planner with obstacle avoidance). Slow in a
 //! debug build: run with `cargo test --release -p plumetrace-mission --test duck_campaign --
 //! --ignored` (CI does).
 
@@ -102,4 +103,34 @@ fn duck_mt_locates_the_sources_and_declares_the_southern_edges() {
         edges.iter().filter(|&&n| n == 2).count() >= 6,
         "both southern subregions end at their edge in too few missions: {edges:?}"
     );
+}
+
+#[test]
+#[ignore = "about half a minute in release mode; run with --ignored"]
+fn li_zhang_kelp_declares_without_collisions() {
+    // Seeds 1-50, not the seeds the avoidance was tuned on (campaign seeds 77-82).
+    let results = run_seeds("li-zhang-kelp", 50);
+    let collided = results
+        .iter()
+        .filter(|r| r.1.outcome == plumetrace_mission::Outcome::Collided)
+        .count();
+    let mut errors: Vec<f64> = results
+        .iter()
+        .filter_map(|r| r.1.first_declaration.as_ref().map(|d| d.error_m))
+        .collect();
+    errors.sort_by(f64::total_cmp);
+    let median = errors.get(errors.len() / 2).copied().unwrap_or(f64::NAN);
+    eprintln!(
+        "li-zhang-kelp: declared {}/50, collided {collided}, error median {median:.2} m, \
+         p90 {:.2} m, max {:.2} m",
+        errors.len(),
+        errors
+            .get(errors.len() * 9 / 10)
+            .copied()
+            .unwrap_or(f64::NAN),
+        errors.last().copied().unwrap_or(f64::NAN)
+    );
+    assert_eq!(collided, 0, "collisions in kelp");
+    assert!(errors.len() >= 45, "declared in {} of 50", errors.len());
+    assert!(median < 3.0, "error median {median} m");
 }

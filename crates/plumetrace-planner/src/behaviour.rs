@@ -251,6 +251,67 @@ impl<M: EventLog + 'static> Arbiter<M> for Sequence<M> {
     }
 }
 
+/// Subsumption: behaviours in layers of priority, the highest that has something to say wins
+/// and inhibits every layer below it for this decision. A layer's `Done` is handed to the
+/// planner's `on_done` (which may change the memory, e.g. record a declaration) and the layers
+/// are asked again, at most once per layer, so that a finished layer gives way below it.
+pub struct Subsumption<M, D> {
+    layers: Vec<Box<dyn Behaviour<M, D>>>,
+    on_done: fn(&mut M, D),
+    active: BehaviourKind,
+}
+
+impl<M: EventLog + 'static, D: 'static> Subsumption<M, D> {
+    /// Layers from the highest priority to the lowest; `on_done` receives every finished layer's
+    /// reason.
+    pub fn new(layers: Vec<Box<dyn Behaviour<M, D>>>, on_done: fn(&mut M, D)) -> Self {
+        Subsumption {
+            layers,
+            on_done,
+            active: BehaviourKind::Done,
+        }
+    }
+
+    fn switch_to(&mut self, m: &mut M, kind: BehaviourKind) {
+        if kind != self.active {
+            self.active = kind;
+            m.log(PlannerEvent::Behaviour { behaviour: kind });
+        }
+    }
+}
+
+impl<M: EventLog + 'static, D: 'static> Arbiter<M> for Subsumption<M, D> {
+    fn arbitrate(&mut self, p: &Percept, m: &mut M) -> Option<Steer> {
+        for _ in 0..=self.layers.len() {
+            let mut finished = false;
+            for k in 0..self.layers.len() {
+                match self.layers[k].propose(p, m) {
+                    Proposal::Idle => continue,
+                    Proposal::Steer(s) => {
+                        let kind = self.layers[k].kind();
+                        self.switch_to(m, kind);
+                        return Some(s);
+                    }
+                    Proposal::Done(d) => {
+                        (self.on_done)(m, d);
+                        finished = true;
+                        break;
+                    }
+                }
+            }
+            if !finished {
+                break;
+            }
+        }
+        self.switch_to(m, BehaviourKind::Done);
+        None
+    }
+
+    fn active(&self) -> BehaviourKind {
+        self.active
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -310,5 +371,90 @@ mod tests {
                 BehaviourKind::Done
             ]
         );
+    }
+
+    /// A layer that steers on `heading_deg` while `on(m)`, or finishes once with `Reached`.
+    struct Layer {
+        kind: BehaviourKind,
+        heading_deg: f64,
+        on: fn(&[PlannerEvent]) -> bool,
+        finishes: bool,
+    }
+
+    impl Behaviour<Vec<PlannerEvent>, Reached> for Layer {
+        fn kind(&self) -> BehaviourKind {
+            self.kind
+        }
+
+        fn propose(&mut self, _: &Percept, m: &mut Vec<PlannerEvent>) -> Proposal<Reached> {
+            if !(self.on)(m) {
+                return Proposal::Idle;
+            }
+            if self.finishes {
+                self.finishes = false;
+                return Proposal::Done(Reached);
+            }
+            Proposal::Steer(Steer {
+                heading: Heading::from_deg(self.heading_deg),
+                speed_mps: 1.0,
+            })
+        }
+    }
+
+    #[test]
+    fn subsumption_lets_the_highest_layer_with_a_proposal_inhibit_the_rest() {
+        // Layer 0 steers once the log holds a detection; layer 1 finishes once (its Done reaches
+        // on_done, which logs a lost point) and then steers; layer 2 always steers.
+        fn detected(m: &[PlannerEvent]) -> bool {
+            m.iter()
+                .any(|e| matches!(e, PlannerEvent::Detection { .. }))
+        }
+        fn always(_: &[PlannerEvent]) -> bool {
+            true
+        }
+        fn lost(m: &[PlannerEvent]) -> bool {
+            !m.iter()
+                .any(|e| matches!(e, PlannerEvent::LostPoint { .. }))
+        }
+        let layers: Vec<Box<dyn Behaviour<Vec<PlannerEvent>, Reached>>> = vec![
+            Box::new(Layer {
+                kind: BehaviourKind::TrackIn,
+                heading_deg: 10.0,
+                on: detected,
+                finishes: false,
+            }),
+            Box::new(Layer {
+                kind: BehaviourKind::Reacquire,
+                heading_deg: 20.0,
+                on: lost,
+                finishes: true,
+            }),
+            Box::new(Layer {
+                kind: BehaviourKind::Find,
+                heading_deg: 30.0,
+                on: always,
+                finishes: false,
+            }),
+        ];
+        let mut s = Subsumption::new(layers, |m: &mut Vec<PlannerEvent>, Reached| {
+            m.push(PlannerEvent::LostPoint {
+                pos_m: Vec2::zeros(),
+            });
+        });
+        let mut log: Vec<PlannerEvent> = Vec::new();
+        // Layer 1 finishes (on_done logs a lost point, which turns it off): the layers are asked
+        // again in the same decision and the lowest one steers.
+        let steer = s.arbitrate(&percept(0.0, 0.0, 0.0), &mut log);
+        assert_eq!(steer.map(|s| s.heading.deg().round()), Some(30.0));
+        assert_eq!(s.active(), BehaviourKind::Find);
+        // A detection switches the top layer on: it inhibits the one below.
+        log.push(PlannerEvent::Detection {
+            pos_m: Vec2::zeros(),
+        });
+        let steer = s.arbitrate(&percept(0.0, 0.0, 0.0), &mut log);
+        assert_eq!(steer.map(|s| s.heading.deg().round()), Some(10.0));
+        assert_eq!(s.active(), BehaviourKind::TrackIn);
+        let kinds: Vec<BehaviourKind> = log.iter().filter_map(PlannerEvent::behaviour).collect();
+        assert_eq!(kinds, [BehaviourKind::Find, BehaviourKind::TrackIn]);
     }
 }

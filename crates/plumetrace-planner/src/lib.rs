@@ -9,16 +9,22 @@
 //! - [`amp`]: the REMUS Adaptive Mission Planner: behaviours Go-To, Find, Track-In, Track-Out and
 //!   Reacquire switched on the time since the last detection, source declaration after Track-Out,
 //!   post-declaration mapping and multi-source (subregion) missions;
+//! - [`avoid`]: obstacle avoidance over any planner (`avoid_obstacles = true`): the fuzzy
+//!   following-obstacle layer with dynamic reference targets;
 //! - [`behaviour`]: the small behaviour and arbiter traits planners are built from, and the
 //!   behaviours any planner can use;
 //! - [`flow`]: the planner's running estimate of the current from flow measurements.
+//! - [`fuzzy`]: fuzzy navigation past obstacles (seed 001): Mamdani engine, side lock, DRTs.
 
+pub mod avoid;
 pub mod behaviour;
 pub mod flow;
+pub mod fuzzy;
 pub mod planners;
 
 pub use flow::FlowEstimate;
 pub use planners::amp::{self, Amp, AmpParams, DeclarationRule, LostPointEviction, MappingParams};
+pub use planners::moth::{self, Moth, MothParams, MothStrategy};
 pub use planners::{
     BuildContext, CommonParams, MissionGeometry, PLANNERS, PlannerConfig, PlannerEntry,
     PlannerKind, PlannerParams, PlannerSpec, registry_markdown,

@@ -3,7 +3,8 @@
 
 use crate::config::{FlowKind, MeanFlowConfig, PlumeKind, ScenarioConfig, SeabedKind};
 use crate::{Origin, ScenarioError};
-use plumetrace_core::Vec3;
+use plumetrace_core::params::quoted_key;
+use plumetrace_core::{Vec2, Vec3};
 use plumetrace_env::flow::{FarrellFlow, GriddedFlow, MeanFlow, UniformFlow};
 use plumetrace_env::plume::Dispersion;
 use plumetrace_env::steady::{GaussianPlume, GriddedConcentration};
@@ -102,6 +103,9 @@ pub struct BuiltScenario {
     /// Water depth, m.
     pub depth_m: Option<f64>,
 }
+
+/// Random stream of kelp field `k`: `StreamId::Custom(KELP_STREAM + k)`.
+const KELP_STREAM: u64 = 0x6b65_6c70_0000;
 
 /// Builds a scenario; `seed` overrides the file's seed.
 pub fn build(
@@ -392,6 +396,57 @@ pub fn build(
         };
         obstacles.push(SoftObstacle::new(name, &o.vertices, &key).map_err(env_err)?);
     }
+    let run_seed = seed.unwrap_or(cfg.seed);
+    for (k, f) in cfg.kelp.iter().enumerate() {
+        let key = format!("kelp[{k}]");
+        let name = if f.name.is_empty() {
+            key.clone()
+        } else {
+            f.name.clone()
+        };
+        let [r_lo, r_hi] = f.radius_m;
+        if !(r_lo > 0.0 && r_hi >= r_lo) {
+            return Err(invalid(
+                &format!("{key}.radius_m"),
+                format!("needs 0 < smallest <= largest, got [{r_lo}, {r_hi}]"),
+            ));
+        }
+        if !(0.0..1.0).contains(&f.roughness) {
+            return Err(invalid(
+                &format!("{key}.roughness"),
+                format!("must be in [0, 1), got {}", f.roughness),
+            ));
+        }
+        if f.vertices < 3 {
+            return Err(invalid(
+                &format!("{key}.vertices"),
+                format!("needs at least 3, got {}", f.vertices),
+            ));
+        }
+        let keep_clear: Vec<(Vec2, f64)> = cfg
+            .sources
+            .iter()
+            .map(|s| Vec2::new(s.x_m, s.y_m))
+            .chain(cfg.vehicles.iter().map(|v| Vec2::new(v.x_m, v.y_m)))
+            .map(|c| (c, f.clear_m))
+            .collect();
+        let params = plumetrace_env::KelpFieldParams {
+            region: f.region.clone(),
+            patches: f.patches,
+            radius_m: f.radius_m,
+            gap_m: f.gap_m,
+            vertices: f.vertices,
+            roughness: f.roughness,
+        };
+        let mut rng = plumetrace_env::stream_rng(
+            f.seed.unwrap_or(run_seed),
+            plumetrace_env::StreamId::Custom(KELP_STREAM + k as u64),
+        );
+        obstacles.extend(
+            plumetrace_env::kelp_field(&params, &keep_clear, &name, &key, &mut rng)
+                .map_err(env_err)?,
+        );
+    }
 
     let legacy = match &cfg.planner {
         Some(t) => Some(legacy_planner(t).map_err(|(k, m)| invalid(&k, m))?),
@@ -410,14 +465,21 @@ pub fn build(
                     invalid(
                         &format!("vehicles[{k}].planner"),
                         if known.is_empty() {
-                            format!("no [planners.{name}] table (the scenario defines none)")
+                            format!(
+                                "no [planners.{}] table (the scenario defines none)",
+                                quoted_key(name)
+                            )
                         } else {
-                            format!("no [planners.{name}] table (defined: {})", known.join(", "))
+                            format!(
+                                "no [planners.{}] table (defined: {})",
+                                quoted_key(name),
+                                known.join(", ")
+                            )
                         },
                     )
                 })?;
                 Some(PlannerRef {
-                    key: format!("planners.{name}"),
+                    key: format!("planners.{}", quoted_key(name)),
                     table: table.clone(),
                 })
             }
@@ -445,7 +507,7 @@ pub fn build(
             .any(|v| v.planner.as_deref() == Some(n.as_str()))
     }) {
         return Err(invalid(
-            &format!("planners.{name}"),
+            &format!("planners.{}", quoted_key(name)),
             "no vehicle flies it (name it in a vehicle: planner = \"NAME\")".into(),
         ));
     }
@@ -749,7 +811,24 @@ fn vehicle_setup(
                 rays_per_group: r.rays_per_group.unwrap_or(rb.rays_per_group),
                 front_half_angle_deg: r.front_half_angle_deg.unwrap_or(rb.front_half_angle_deg),
                 side_outer_angle_deg: r.side_outer_angle_deg.unwrap_or(rb.side_outer_angle_deg),
+                rate_hz: r.rate_hz.unwrap_or(rb.rate_hz),
+                noise_sd_m: r.noise_sd_m.unwrap_or(rb.noise_sd_m),
+                detection_probability: r.detection_probability.unwrap_or(rb.detection_probability),
             };
+            plumetrace_env::error::require_positive(
+                &format!("{key}.range_sensor.rate_hz"),
+                p.rate_hz,
+            )?;
+            plumetrace_env::error::require_non_negative(
+                &format!("{key}.range_sensor.noise_sd_m"),
+                p.noise_sd_m,
+            )?;
+            if !(p.detection_probability > 0.0 && p.detection_probability <= 1.0) {
+                return Err(EnvError::invalid(
+                    format!("{key}.range_sensor.detection_probability"),
+                    "must be in (0, 1]",
+                ));
+            }
             plumetrace_env::error::require_positive(
                 &format!("{key}.range_sensor.max_range_m"),
                 p.max_range_m,

@@ -32,6 +32,9 @@ pub struct ScenarioConfig {
     /// Soft obstacles (kelp).
     #[serde(default)]
     pub obstacles: Vec<ObstacleConfig>,
+    /// Kelp fields drawn at random (their patches join the obstacles).
+    #[serde(default)]
+    pub kelp: Vec<KelpConfig>,
     /// Vehicles (AUVs and surface craft) with their navigation and sensors.
     #[serde(default)]
     pub vehicles: Vec<VehicleConfig>,
@@ -243,6 +246,50 @@ pub struct ObstacleConfig {
     pub vertices: Vec<[f64; 2]>,
 }
 
+/// `[[kelp]]`: a field of kelp patches drawn at random in a region, with gaps between them.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct KelpConfig {
+    /// Name for logs and plots (patches are `NAME.patch[j]`; default `kelp[k]`).
+    #[serde(default)]
+    pub name: String,
+    /// Where the patch centres go: a polygon `[[east, north], ...]`, m.
+    #[serde(deserialize_with = "points::list")]
+    pub region: Vec<[f64; 2]>,
+    /// Number of patches.
+    pub patches: usize,
+    /// Smallest and largest patch radius, m (default `[3, 6]`).
+    #[serde(default = "kelp_radius")]
+    pub radius_m: [f64; 2],
+    /// Least distance between two patches' bounding circles, m (default 5).
+    #[serde(default = "five")]
+    pub gap_m: f64,
+    /// Vertices of each patch outline (default 12).
+    #[serde(default = "twelve")]
+    pub vertices: usize,
+    /// Raggedness: vertex radii fall between `(1 - roughness) R` and `R` (default 0.3).
+    #[serde(default = "kelp_roughness")]
+    pub roughness: f64,
+    /// Radius kept free of kelp around every source and every vehicle's start, m (default 10).
+    #[serde(default = "ten")]
+    pub clear_m: f64,
+    /// Seed of the draw (default: the run seed, so each run has its own field).
+    pub seed: Option<u64>,
+}
+
+fn kelp_radius() -> [f64; 2] {
+    [3.0, 6.0]
+}
+fn twelve() -> usize {
+    12
+}
+fn ten() -> f64 {
+    10.0
+}
+fn kelp_roughness() -> f64 {
+    0.3
+}
+
 /// `[output]`: the concentration snapshot and the time average written by `plumetrace run`.
 #[derive(Debug, Clone, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
@@ -400,6 +447,12 @@ pub struct RangeSensorConfig {
     pub front_half_angle_deg: Option<f64>,
     /// Side groups' outer angle, deg.
     pub side_outer_angle_deg: Option<f64>,
+    /// Pings per second, Hz.
+    pub rate_hz: Option<f64>,
+    /// Range noise (standard deviation), m.
+    pub noise_sd_m: Option<f64>,
+    /// Probability that a ray sees an obstacle it crosses, per ping.
+    pub detection_probability: Option<f64>,
 }
 
 /// `[mission]`

@@ -243,6 +243,54 @@ pub const LIMITS: &[Limit] = &[
         "the range sensors cast rays against every edge",
     ),
     num("obstacles[].vertices[][]", -COORD, COORD, COORD_WHY),
+    count(
+        "kelp",
+        100,
+        "each field is drawn with a bounded number of tries per patch",
+    ),
+    count(
+        "kelp[].region",
+        10_000,
+        "each drawn centre is tested against every edge",
+    ),
+    num("kelp[].region[][]", -COORD, COORD, COORD_WHY),
+    num(
+        "kelp[].patches",
+        0.0,
+        1000.0,
+        "the range sensors cast rays against every patch",
+    ),
+    num(
+        "kelp[].radius_m[]",
+        0.0,
+        1e4,
+        "kelp patches are metres to hundreds of metres across",
+    ),
+    num(
+        "kelp[].gap_m",
+        0.0,
+        1e4,
+        "kelp patches are metres to hundreds of metres apart",
+    ),
+    num(
+        "kelp[].vertices",
+        3.0,
+        64.0,
+        "an outline of 64 vertices is round enough",
+    ),
+    num(
+        "kelp[].roughness",
+        0.0,
+        0.99,
+        "vertex radii stay above 1 % of the radius",
+    ),
+    num(
+        "kelp[].clear_m",
+        0.0,
+        1e4,
+        "kelp patches are metres to hundreds of metres apart",
+    ),
+    num("kelp[].seed", 0.0, 1.8446744073709552e19, "a 64-bit seed"),
     num(
         "output.nx",
         2.0,
@@ -418,6 +466,23 @@ pub const LIMITS: &[Limit] = &[
         "vehicles[].range_sensor.side_outer_angle_deg",
         180.0,
         "half a turn at most",
+    ),
+    pos(
+        "vehicles[].range_sensor.rate_hz",
+        1000.0,
+        "pings at 1 kHz at most (one per step is taken)",
+    ),
+    num(
+        "vehicles[].range_sensor.noise_sd_m",
+        0.0,
+        1e4,
+        "sonars see kilometres at most",
+    ),
+    num(
+        "vehicles[].range_sensor.detection_probability",
+        0.0,
+        1.0,
+        "a probability (0 is refused: a sensor that never sees is no sensor)",
     ),
     count(
         "mission.op_area",

@@ -37,6 +37,16 @@ pub const PRESETS: &[Preset] = &[
         toml: include_str!("../presets/duck-2003-mt.toml"),
     },
     Preset {
+        name: "li-zhang-open",
+        summary: "moth-inspired tracing in Li and Zhang's set-up: 100 m x 100 m, Farrell flow of 1 m/s, no obstacles",
+        toml: include_str!("../presets/li-zhang-open.toml"),
+    },
+    Preset {
+        name: "li-zhang-kelp",
+        summary: "moth-inspired tracing with obstacle avoidance: Li and Zhang's set-up with a band of kelp patches across the plume",
+        toml: include_str!("../presets/li-zhang-kelp.toml"),
+    },
+    Preset {
         name: "plume-demo",
         summary: "plume only: small meandering plume from a bottom source, 200 m x 100 m, 10 min",
         toml: include_str!("../presets/plume-demo.toml"),

@@ -3,6 +3,7 @@
 use plumetrace_core::{ChemSample, FlowSample, Heading, RangeReturn, Vec2};
 use plumetrace_env::error::{require_non_negative, require_positive};
 use plumetrace_env::{EnvError, ObstacleSet, SimRng};
+use rand::Rng;
 use rand_distr::{Distribution, StandardNormal};
 use serde::{Deserialize, Serialize};
 
@@ -221,17 +222,25 @@ impl FlowSensor {
     }
 }
 
-/// Parameters of the obstacle range sensors: three groups of rays (front, left, right).
+/// Parameters of the obstacle range sensors: three groups of rays (front, left, right), pinged
+/// together at `rate_hz`. Defaults: a small forward-looking sonar; kelp is a weak, patchy target,
+/// so each ray sees each obstacle it crosses with `detection_probability` at each ping.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct RangeSensorParams {
-    /// Detection range `R`, m.
+    /// Detection range `R`, m (20: the "far" of the front group).
     pub max_range_m: f64,
-    /// Rays per group.
+    /// Rays per group (7).
     pub rays_per_group: usize,
     /// The front group covers +-this angle about the heading, deg (30).
     pub front_half_angle_deg: f64,
     /// The side groups reach this far from the heading, deg (90).
     pub side_outer_angle_deg: f64,
+    /// Pings per second, Hz (5).
+    pub rate_hz: f64,
+    /// Range noise (standard deviation), m (0.2).
+    pub noise_sd_m: f64,
+    /// Probability that one ray sees one obstacle it crosses at one ping (0.8).
+    pub detection_probability: f64,
 }
 
 impl Default for RangeSensorParams {
@@ -241,6 +250,9 @@ impl Default for RangeSensorParams {
             rays_per_group: 7,
             front_half_angle_deg: 30.0,
             side_outer_angle_deg: 90.0,
+            rate_hz: 5.0,
+            noise_sd_m: 0.2,
+            detection_probability: 0.8,
         }
     }
 }
@@ -250,32 +262,65 @@ impl Default for RangeSensorParams {
 pub struct RangeSensor {
     /// Parameters.
     pub params: RangeSensorParams,
+    schedule: Schedule,
 }
 
 impl RangeSensor {
-    /// Casts every ray from `pos_m` with the vehicle on `heading`.
-    pub fn sample(&self, obstacles: &ObstacleSet, pos_m: Vec2, heading: Heading) -> RangeReturn {
+    /// A sensor whose first ping is at t = 0.
+    pub fn new(params: RangeSensorParams) -> Self {
+        RangeSensor {
+            params,
+            schedule: Schedule::new(params.rate_hz),
+        }
+    }
+
+    /// Whether a ping is due at `t_s` (call once per step).
+    pub fn due(&mut self, t_s: f64) -> bool {
+        self.schedule.due(t_s)
+    }
+
+    /// One ping from `pos_m` with the vehicle on `heading`: along each ray, every obstacle it
+    /// crosses within range is seen with the detection probability (a draw per ray and
+    /// obstacle); a group reports its nearest seen edge plus noise (never below 0, and a range
+    /// pushed beyond `max_range_m` by the noise is reported at `max_range_m`).
+    pub fn sample(
+        &self,
+        obstacles: &ObstacleSet,
+        pos_m: Vec2,
+        heading: Heading,
+        rng: &mut SimRng,
+    ) -> RangeReturn {
         let p = self.params;
         let n = p.rays_per_group.max(1);
-        let spread = |from: f64, to: f64| -> Vec<f64> {
+        let angle = |from: f64, to: f64, k: usize| {
             if n == 1 {
-                return vec![0.5 * (from + to)];
+                0.5 * (from + to)
+            } else {
+                from + (to - from) * k as f64 / (n - 1) as f64
             }
-            (0..n)
-                .map(|k| from + (to - from) * k as f64 / (n - 1) as f64)
-                .collect()
         };
-        let nearest = |angles: Vec<f64>| -> Option<f64> {
-            angles
-                .into_iter()
-                .filter_map(|a| obstacles.ray_range_m(pos_m, heading.turned_deg(a), p.max_range_m))
-                .min_by(f64::total_cmp)
+        let nearest = |from: f64, to: f64, rng: &mut SimRng| -> Option<f64> {
+            let mut best: Option<f64> = None;
+            for k in 0..n {
+                let a = angle(from, to, k);
+                obstacles.ray_hits(pos_m, heading.turned_deg(a), p.max_range_m, |_, d| {
+                    let seen = p.detection_probability >= 1.0
+                        || rng.random::<f64>() < p.detection_probability;
+                    if seen {
+                        best = Some(best.map_or(d, |b: f64| b.min(d)));
+                    }
+                });
+            }
+            best.map(|d| {
+                let noise: f64 = StandardNormal.sample(rng);
+                (d + noise * p.noise_sd_m).clamp(0.0, p.max_range_m)
+            })
         };
         let (f, s) = (p.front_half_angle_deg, p.side_outer_angle_deg);
         RangeReturn {
-            front_m: nearest(spread(-f, f)),
-            left_m: nearest(spread(-s, -f)),
-            right_m: nearest(spread(f, s)),
+            front_m: nearest(-f, f, rng),
+            left_m: nearest(-s, -f, rng),
+            right_m: nearest(f, s, rng),
         }
     }
 }
@@ -345,19 +390,79 @@ mod tests {
         )
         .unwrap();
         let obstacles = ObstacleSet::new(vec![wall]);
-        let r = RangeSensor {
-            params: RangeSensorParams::default(),
-        };
-        let north = r.sample(&obstacles, Vec2::zeros(), Heading::NORTH);
+        // An ideal sensor (every ray sees every obstacle, no noise).
+        let r = RangeSensor::new(RangeSensorParams {
+            noise_sd_m: 0.0,
+            detection_probability: 1.0,
+            ..RangeSensorParams::default()
+        });
+        let mut rng = stream_rng(1, StreamId::Sensor(0, 4));
+        let north = r.sample(&obstacles, Vec2::zeros(), Heading::NORTH, &mut rng);
         assert_eq!(north.left_m, None);
         assert!((north.right_m.unwrap() - 10.0).abs() < 1e-9, "{north:?}");
         assert!(
             north.front_m.is_none(),
             "30 deg off the heading the wall is 20 m away: out of range"
         );
-        let east = r.sample(&obstacles, Vec2::zeros(), Heading::from_deg(90.0));
+        let east = r.sample(&obstacles, Vec2::zeros(), Heading::from_deg(90.0), &mut rng);
         assert!((east.front_m.unwrap() - 10.0).abs() < 1e-9);
-        let south = r.sample(&obstacles, Vec2::zeros(), Heading::from_deg(180.0));
+        let south = r.sample(
+            &obstacles,
+            Vec2::zeros(),
+            Heading::from_deg(180.0),
+            &mut rng,
+        );
         assert!((south.left_m.unwrap() - 10.0).abs() < 1e-9 && south.right_m.is_none());
+    }
+
+    #[test]
+    fn range_pings_are_noisy_patchy_and_at_their_rate() {
+        // A wall 10 m East; the vehicle heads East so all seven front rays cross it.
+        let wall = SoftObstacle::new(
+            "wall",
+            &[[10.0, -50.0], [12.0, -50.0], [12.0, 50.0], [10.0, 50.0]],
+            "obstacles[0]",
+        )
+        .unwrap();
+        let obstacles = ObstacleSet::new(vec![wall]);
+        let mut r = RangeSensor::new(RangeSensorParams {
+            rays_per_group: 1,
+            noise_sd_m: 0.5,
+            detection_probability: 0.3,
+            ..RangeSensorParams::default()
+        });
+        let mut rng = stream_rng(7, StreamId::Sensor(0, 4));
+        let pings: Vec<Option<f64>> = (0..4000)
+            .map(|_| {
+                r.sample(&obstacles, Vec2::zeros(), Heading::from_deg(90.0), &mut rng)
+                    .front_m
+            })
+            .collect();
+        let seen: Vec<f64> = pings.iter().flatten().copied().collect();
+        // One ray, p = 0.3: about 1,200 of 4,000 pings see the wall (sd of the count 29).
+        assert!((1050..1350).contains(&seen.len()), "{}", seen.len());
+        let mean = seen.iter().sum::<f64>() / seen.len() as f64;
+        let sd = (seen.iter().map(|d| (d - mean).powi(2)).sum::<f64>() / seen.len() as f64).sqrt();
+        assert!(
+            (mean - 10.0).abs() < 0.1 && (sd - 0.5).abs() < 0.05,
+            "{mean} {sd}"
+        );
+        // Five pings per second at a 0.1 s step.
+        let due = (0..100).filter(|k| r.due(f64::from(*k) * 0.1)).count();
+        assert_eq!(due, 50);
+        // Seven rays each with p = 0.3: the group misses the wall only with 0.7^7 = 8 %.
+        let seven = RangeSensor::new(RangeSensorParams {
+            detection_probability: 0.3,
+            ..RangeSensorParams::default()
+        });
+        let misses = (0..4000)
+            .filter(|_| {
+                seven
+                    .sample(&obstacles, Vec2::zeros(), Heading::from_deg(90.0), &mut rng)
+                    .front_m
+                    .is_none()
+            })
+            .count();
+        assert!((250..420).contains(&misses), "{misses}");
     }
 }

@@ -138,6 +138,7 @@ pub struct SimVehicle {
     rng_chem: SimRng,
     rng_flow: SimRng,
     rng_measure: SimRng,
+    rng_range: SimRng,
 }
 
 impl SimVehicle {
@@ -163,7 +164,7 @@ impl SimVehicle {
             vehicle,
             chem: ChemSensor::new(chem),
             flow_sensor: FlowSensor::new(flow),
-            range: range.map(|params| RangeSensor { params }),
+            range: range.map(RangeSensor::new),
             command,
             active: true,
             last_chem: None,
@@ -177,6 +178,7 @@ impl SimVehicle {
             rng_chem: stream_rng(seed, StreamId::Sensor(i, 1)),
             rng_flow: stream_rng(seed, StreamId::Sensor(i, 2)),
             rng_measure: stream_rng(seed, StreamId::Sensor(i, 3)),
+            rng_range: stream_rng(seed, StreamId::Sensor(i, 4)),
         }
     }
 }
@@ -454,8 +456,11 @@ impl World {
                 let truth = env.flow().velocity(s.pos_m);
                 v.last_flow = Some(v.flow_sensor.sample(truth, t, &mut v.rng_flow));
             }
-            if let Some(r) = &v.range {
-                v.last_ranges = Some(r.sample(env.obstacles(), s.pos_m, s.heading));
+            if let Some(r) = &mut v.range
+                && r.due(t)
+            {
+                v.last_ranges =
+                    Some(r.sample(env.obstacles(), s.pos_m, s.heading, &mut v.rng_range));
             }
         }
     }

@@ -17,6 +17,7 @@
 
 pub mod amp;
 pub mod lawnmower;
+pub mod moth;
 
 use plumetrace_core::params::{Bounds, KeyDoc, ParamError, Params, key_path, markdown_rows};
 use plumetrace_core::{Decision, Heading, Planner, SensorSnapshot, Vec2, VehicleId, VehicleKind};
@@ -90,6 +91,10 @@ plumetrace_core::params! {
     pub struct CommonParams {
         /// Time between decisions; 0 decides at every simulation step (the field planner decided at the sensor's 10 Hz).
         decision_period_s: f64 = 0.0, "s", Bounds::non_negative(3600.0);
+        /// Fly around obstacles seen by the range sensors: the fuzzy following-obstacle layer with dynamic reference targets takes over from the planner until the obstacle is passed.
+        avoid_obstacles: bool = false, "", Bounds::Any;
+        /// With avoid_obstacles, a front range return closer than this starts avoidance (a side return closer than 5 m does too).
+        avoid_trigger_m: f64 = 10.0, "m", Bounds::closed(1.0, 1000.0);
     }
 }
 
@@ -233,6 +238,7 @@ macro_rules! registry {
 registry! {
     Amp(amp::AmpParams),
     Lawnmower(lawnmower::LawnmowerParams),
+    Moth(moth::MothParams),
 }
 
 impl std::fmt::Display for PlannerKind {
@@ -355,6 +361,17 @@ impl PlannerConfig {
             key: key_path(prefix, &e.key),
             message: e.message,
         })?;
+        let inner: Box<dyn Planner> = if self.common.avoid_obstacles {
+            Box::new(crate::avoid::AvoidObstacles::new(
+                inner,
+                crate::avoid::AvoidParams {
+                    trigger_m: self.common.avoid_trigger_m,
+                    ..crate::avoid::AvoidParams::default()
+                },
+            ))
+        } else {
+            inner
+        };
         let period = self.common.decision_period_s;
         Ok(if period > 0.0 {
             Box::new(Periodic {
@@ -380,6 +397,10 @@ impl Planner for Periodic {
 
     fn decision_period_s(&self) -> f64 {
         self.period_s
+    }
+
+    fn detour_ended(&mut self, pos_m: Vec2) {
+        self.inner.detour_ended(pos_m);
     }
 }
 
@@ -443,7 +464,7 @@ mod tests {
             let full = c.to_table().unwrap_or_else(|e| panic!("{e}"));
             assert_eq!(
                 full.len(),
-                2 + (p.keys)().len(),
+                1 + CommonParams::keys().len() + (p.keys)().len(),
                 "kind, common and own keys"
             );
             let back = PlannerConfig::from_table(&full, "p").unwrap_or_else(|e| panic!("{e}"));
@@ -464,9 +485,9 @@ mod tests {
         let cases = [
             ("beta_deg = 3.0", "planners.a.kind", "missing"),
             (
-                "kind = \"moth\"",
+                "kind = \"butterfly\"",
                 "planners.a.kind",
-                "unknown planner 'moth'",
+                "unknown planner 'butterfly'",
             ),
             ("kind = 3", "planners.a.kind", "must be a string"),
             (
