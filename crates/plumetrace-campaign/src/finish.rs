@@ -29,7 +29,9 @@ pub fn write_results(
     let groups = summarise(c, rows);
     write("summary.csv", summary_csv(&groups).as_bytes())?;
     let expected = c.runs().len() as u64;
-    write("summary.md", summary_md(c, &groups, expected).as_bytes())?;
+    let mut md = summary_md(c, &groups, expected);
+    md.push_str(&crate::stats::sites_md(c, rows));
+    write("summary.md", md.as_bytes())?;
     crate::charts::write_charts(c, out, &groups, rows)?;
     #[cfg(feature = "parquet")]
     crate::parquet_out::write_parquet(&out.join("runs.parquet"), rows)?;

@@ -12,55 +12,90 @@ use parquet::schema::parser::parse_message_type;
 use std::path::Path;
 use std::sync::Arc;
 
-type Getter = fn(&RunRow) -> Option<f64>;
-type CountGetter = fn(&RunRow) -> u32;
+/// How a column is read from a row and stored.
+#[derive(Clone, Copy)]
+enum Col {
+    /// Text (UTF-8).
+    Text(fn(&RunRow) -> &str),
+    /// An unsigned 64-bit whole number (stored as its bit pattern in INT64).
+    U64(fn(&RunRow) -> u64),
+    /// An unsigned 32-bit count.
+    U32(fn(&RunRow) -> u32),
+    /// A yes/no.
+    Bool(fn(&RunRow) -> bool),
+    /// An optional yes/no (null when missing).
+    OptBool(fn(&RunRow) -> Option<bool>),
+    /// An optional number (null when missing).
+    Num(fn(&RunRow) -> Option<f64>),
+}
 
-/// The count columns, in `runs.csv` order after `declared`.
-const COUNTS: [(&str, CountGetter); 3] = [
-    ("declarations", |r| r.declarations),
-    ("sources", |r| r.sources),
-    ("sources_located", |r| r.sources_located),
-];
-
-/// The optional numeric columns, in `runs.csv` order after the counts.
-const NUMBERS: [(&str, Getter); 14] = [
-    ("declared_x", |r| r.declared_x),
-    ("declared_y", |r| r.declared_y),
-    ("source_x", |r| r.source_x),
-    ("source_y", |r| r.source_y),
-    ("error_m", |r| r.error_m),
-    ("error_along_m", |r| r.error_along_m),
-    ("error_cross_m", |r| r.error_cross_m),
-    ("first_detection_s", |r| r.first_detection_s),
-    ("declaration_s", |r| r.declaration_s),
-    ("path_length_m", |r| r.path_length_m),
-    ("trace_length_m", |r| r.trace_length_m),
-    ("detection_to_source_m", |r| r.detection_to_source_m),
-    ("path_ratio", |r| r.path_ratio),
-    ("sim_time_s", |r| r.sim_time_s),
+/// Every column, in `runs.csv` order (a test compares the names with the CSV header).
+const COLUMNS: &[(&str, Col)] = &[
+    ("scenario", Col::Text(|r| &r.scenario)),
+    ("config", Col::Text(|r| &r.config)),
+    ("point", Col::Text(|r| &r.point)),
+    ("seed_index", Col::U64(|r| r.seed_index)),
+    ("seed", Col::U64(|r| r.seed)),
+    ("outcome", Col::Text(|r| r.outcome.name())),
+    ("success", Col::Bool(|r| r.success)),
+    ("declared", Col::Bool(|r| r.declared)),
+    ("declarations", Col::U32(|r| r.declarations)),
+    ("sources", Col::U32(|r| r.sources)),
+    ("sources_located", Col::U32(|r| r.sources_located)),
+    ("declared_x", Col::Num(|r| r.declared_x)),
+    ("declared_y", Col::Num(|r| r.declared_y)),
+    ("source_x", Col::Num(|r| r.source_x)),
+    ("source_y", Col::Num(|r| r.source_y)),
+    ("error_m", Col::Num(|r| r.error_m)),
+    ("error_along_m", Col::Num(|r| r.error_along_m)),
+    ("error_cross_m", Col::Num(|r| r.error_cross_m)),
+    ("first_detection_s", Col::Num(|r| r.first_detection_s)),
+    ("declaration_s", Col::Num(|r| r.declaration_s)),
+    ("path_length_m", Col::Num(|r| r.path_length_m)),
+    ("trace_length_m", Col::Num(|r| r.trace_length_m)),
+    (
+        "detection_to_source_m",
+        Col::Num(|r| r.detection_to_source_m),
+    ),
+    ("path_ratio", Col::Num(|r| r.path_ratio)),
+    ("sim_time_s", Col::Num(|r| r.sim_time_s)),
+    ("source_errors_m", Col::Text(|r| &r.source_errors_m)),
+    ("longest_quiet_s", Col::Num(|r| r.longest_quiet_s)),
+    ("max_outside_m", Col::Num(|r| r.max_outside_m)),
+    ("site_flow_toward_deg", Col::Num(|r| r.site_flow_toward_deg)),
+    ("site_flow_speed_mps", Col::Num(|r| r.site_flow_speed_mps)),
+    ("site_tidal_swing_deg", Col::Num(|r| r.site_tidal_swing_deg)),
+    ("site_shape", Col::Text(|r| &r.site_shape)),
+    (
+        "site_flow_to_axis_deg",
+        Col::Num(|r| r.site_flow_to_axis_deg),
+    ),
+    ("site_length_m", Col::Num(|r| r.site_length_m)),
+    ("site_width_m", Col::Num(|r| r.site_width_m)),
+    ("site_source_edge_m", Col::Num(|r| r.site_source_edge_m)),
+    ("site_mass_rate_per_s", Col::Num(|r| r.site_mass_rate_per_s)),
+    ("site_start", Col::Text(|r| &r.site_start)),
+    ("site_fix_interval_s", Col::Num(|r| r.site_fix_interval_s)),
+    ("site_fix_sigma_m", Col::Num(|r| r.site_fix_sigma_m)),
+    ("site_flow_fault", Col::OptBool(|r| r.site_flow_fault)),
+    ("message", Col::Text(|r| &r.message)),
 ];
 
 fn schema() -> String {
-    let mut s = String::from(
-        "message runs {
-  REQUIRED BYTE_ARRAY scenario (UTF8);
-  REQUIRED BYTE_ARRAY config (UTF8);
-  REQUIRED BYTE_ARRAY point (UTF8);
-  REQUIRED INT64 seed_index (INTEGER(64,false));
-  REQUIRED INT64 seed (INTEGER(64,false));
-  REQUIRED BYTE_ARRAY outcome (UTF8);
-  REQUIRED BOOLEAN success;
-  REQUIRED BOOLEAN declared;
-",
-    );
-    for (name, _) in COUNTS {
-        s.push_str(&format!("  REQUIRED INT32 {name} (INTEGER(32,false));\n"));
+    let mut s = String::from("message runs {\n");
+    for (name, col) in COLUMNS {
+        let line = match col {
+            Col::Text(_) => format!("  REQUIRED BYTE_ARRAY {name} (UTF8);"),
+            Col::U64(_) => format!("  REQUIRED INT64 {name} (INTEGER(64,false));"),
+            Col::U32(_) => format!("  REQUIRED INT32 {name} (INTEGER(32,false));"),
+            Col::Bool(_) => format!("  REQUIRED BOOLEAN {name};"),
+            Col::OptBool(_) => format!("  OPTIONAL BOOLEAN {name};"),
+            Col::Num(_) => format!("  OPTIONAL DOUBLE {name};"),
+        };
+        s.push_str(&line);
+        s.push('\n');
     }
-    for (name, _) in NUMBERS {
-        s.push_str(&format!("  OPTIONAL DOUBLE {name};\n"));
-    }
-    s.push_str("  REQUIRED BYTE_ARRAY source_errors_m (UTF8);\n");
-    s.push_str("  REQUIRED BYTE_ARRAY message (UTF8);\n}\n");
+    s.push_str("}\n");
     s
 }
 
@@ -77,68 +112,49 @@ pub fn write_parquet(path: &Path, rows: &[(RunKey, RunRow)]) -> Result<(), Campa
     let file = std::fs::File::create(&tmp).map_err(|e| fail(&e))?;
     let mut writer = SerializedFileWriter::new(file, schema, props).map_err(|e| fail(&e))?;
     let rows: Vec<&RunRow> = rows.iter().map(|(_, r)| r).collect();
-    let text = |f: fn(&RunRow) -> &str| -> Vec<ByteArray> {
-        rows.iter().map(|r| ByteArray::from(f(r))).collect()
-    };
     let mut rg = writer.next_row_group().map_err(|e| fail(&e))?;
     let mut index = 0;
     while let Some(mut col) = rg.next_column().map_err(|e| fail(&e))? {
-        let written = match index {
-            0 => col
-                .typed::<ByteArrayType>()
-                .write_batch(&text(|r| &r.scenario), None, None),
-            1 => col
-                .typed::<ByteArrayType>()
-                .write_batch(&text(|r| &r.config), None, None),
-            2 => col
-                .typed::<ByteArrayType>()
-                .write_batch(&text(|r| &r.point), None, None),
-            3 => col.typed::<Int64Type>().write_batch(
-                &rows.iter().map(|r| r.seed_index as i64).collect::<Vec<_>>(),
+        let Some((_, kind)) = COLUMNS.get(index) else {
+            return Err(fail(&"the schema has more columns than the column list"));
+        };
+        let written = match *kind {
+            Col::Text(get) => col.typed::<ByteArrayType>().write_batch(
+                &rows
+                    .iter()
+                    .map(|r| ByteArray::from(get(r)))
+                    .collect::<Vec<_>>(),
                 None,
                 None,
             ),
             // Unsigned 64-bit values are stored as their two's-complement bit pattern.
-            4 => col.typed::<Int64Type>().write_batch(
-                &rows.iter().map(|r| r.seed as i64).collect::<Vec<_>>(),
+            Col::U64(get) => col.typed::<Int64Type>().write_batch(
+                &rows.iter().map(|r| get(r) as i64).collect::<Vec<_>>(),
                 None,
                 None,
             ),
-            5 => col
-                .typed::<ByteArrayType>()
-                .write_batch(&text(|r| r.outcome.name()), None, None),
-            6 => col.typed::<BoolType>().write_batch(
-                &rows.iter().map(|r| r.success).collect::<Vec<_>>(),
+            Col::U32(get) => col.typed::<Int32Type>().write_batch(
+                &rows.iter().map(|r| get(r) as i32).collect::<Vec<_>>(),
                 None,
                 None,
             ),
-            7 => col.typed::<BoolType>().write_batch(
-                &rows.iter().map(|r| r.declared).collect::<Vec<_>>(),
+            Col::Bool(get) => col.typed::<BoolType>().write_batch(
+                &rows.iter().map(|r| get(r)).collect::<Vec<_>>(),
                 None,
                 None,
             ),
-            i if i < 8 + COUNTS.len() => {
-                let get = COUNTS[i - 8].1;
-                col.typed::<Int32Type>().write_batch(
-                    &rows.iter().map(|r| get(r) as i32).collect::<Vec<_>>(),
-                    None,
-                    None,
-                )
+            Col::OptBool(get) => {
+                let values: Vec<bool> = rows.iter().filter_map(|r| get(r)).collect();
+                let levels: Vec<i16> = rows.iter().map(|r| i16::from(get(r).is_some())).collect();
+                col.typed::<BoolType>()
+                    .write_batch(&values, Some(&levels), None)
             }
-            i if i < 8 + COUNTS.len() + NUMBERS.len() => {
-                let get = NUMBERS[i - 8 - COUNTS.len()].1;
+            Col::Num(get) => {
                 let values: Vec<f64> = rows.iter().filter_map(|r| get(r)).collect();
                 let levels: Vec<i16> = rows.iter().map(|r| i16::from(get(r).is_some())).collect();
                 col.typed::<DoubleType>()
                     .write_batch(&values, Some(&levels), None)
             }
-            i if i == 8 + COUNTS.len() + NUMBERS.len() => {
-                col.typed::<ByteArrayType>()
-                    .write_batch(&text(|r| &r.source_errors_m), None, None)
-            }
-            _ => col
-                .typed::<ByteArrayType>()
-                .write_batch(&text(|r| &r.message), None, None),
         };
         written.map_err(|e| fail(&e))?;
         col.close().map_err(|e| fail(&e))?;
@@ -194,7 +210,10 @@ mod tests {
             path_ratio: error,
             sim_time_s: Some(7200.0),
             source_errors_m: error.map_or(String::new(), |e| format!("{e:.3}")),
-            message: String::new(),
+            site_flow_speed_mps: Some(0.25),
+            site_shape: "convex".into(),
+            site_flow_fault: error.map(|_| true),
+            ..RunRow::default()
         };
         (key, r)
     }
@@ -224,6 +243,10 @@ mod tests {
         assert_eq!(field(&read[2], "seed"), Field::ULong(u64::MAX - 2));
         assert_eq!(field(&read[0], "sources_located"), Field::UInt(1));
         assert_eq!(field(&read[1], "sources_located"), Field::UInt(0));
+        assert_eq!(field(&read[0], "site_shape"), Field::Str("convex".into()));
+        assert_eq!(field(&read[0], "site_flow_fault"), Field::Bool(true));
+        assert_eq!(field(&read[1], "site_flow_fault"), Field::Null);
+        assert_eq!(field(&read[1], "longest_quiet_s"), Field::Null);
         let names: Vec<String> = read[0].get_column_iter().map(|(n, _)| n.clone()).collect();
         assert_eq!(
             names.join(","),

@@ -116,6 +116,36 @@ pub struct RunRow {
     /// Distance from each true source to its nearest declaration, m, `;`-separated in the
     /// scenario's source order (empty entries for sources without one).
     pub source_errors_m: String,
+    /// The longest any vehicle spent in one behaviour without a detection, s.
+    pub longest_quiet_s: Option<f64>,
+    /// The farthest any vehicle went outside the op-area (true position), m.
+    pub max_outside_m: Option<f64>,
+    /// Drawn site (family scenarios; empty otherwise): flow direction, deg.
+    pub site_flow_toward_deg: Option<f64>,
+    /// Drawn site: flow speed, m/s.
+    pub site_flow_speed_mps: Option<f64>,
+    /// Drawn site: tidal swing of the flow direction, deg.
+    pub site_tidal_swing_deg: Option<f64>,
+    /// Drawn site: op-area shape.
+    pub site_shape: String,
+    /// Drawn site: flow direction from the op-area's main axis, 0-90 deg.
+    pub site_flow_to_axis_deg: Option<f64>,
+    /// Drawn site: op-area extent along its axis, m.
+    pub site_length_m: Option<f64>,
+    /// Drawn site: op-area extent across its axis, m.
+    pub site_width_m: Option<f64>,
+    /// Drawn site: the source's distance from the nearest op-area edge, m.
+    pub site_source_edge_m: Option<f64>,
+    /// Drawn site: source release rate.
+    pub site_mass_rate_per_s: Option<f64>,
+    /// Drawn site: where the vehicle started.
+    pub site_start: String,
+    /// Drawn site: navigation fix interval, s.
+    pub site_fix_interval_s: Option<f64>,
+    /// Drawn site: navigation fix error, m.
+    pub site_fix_sigma_m: Option<f64>,
+    /// Drawn site: the flow sensor had a fault window.
+    pub site_flow_fault: Option<bool>,
     /// Why a run failed (outcome `error`), else empty.
     pub message: String,
 }
@@ -168,6 +198,8 @@ impl RunRow {
             detection_to_source_m: s.detection_to_source_m,
             path_ratio: ratio,
             sim_time_s: Some(s.sim_time_s),
+            longest_quiet_s: s.longest_quiet_s,
+            max_outside_m: Some(s.max_outside_m),
             source_errors_m: s
                 .sources
                 .iter()
@@ -191,13 +223,45 @@ impl RunRow {
     }
 
     fn empty(c: &Campaign, key: &RunKey) -> Self {
-        RunRow {
+        let row = RunRow {
             scenario: c.scenarios[key.scenario].label.clone(),
             config: c.configs[key.config].name.clone(),
             point: c.points[key.point].label(),
             seed_index: key.seed_index,
             seed: c.run_seed(key),
             ..RunRow::default()
+        };
+        match c.site(key) {
+            Some(site) => row.with_site(&site),
+            None => row,
+        }
+    }
+
+    /// The row with a drawn site's columns filled in (rounded as the site file writes them).
+    fn with_site(self, s: &plumetrace_scenario::Site) -> Self {
+        let r = |v: f64, d: i32| {
+            let k = 10f64.powi(d);
+            Some((v * k).round() / k)
+        };
+        RunRow {
+            site_flow_toward_deg: r(s.flow_toward_deg, 2),
+            site_flow_speed_mps: r(s.flow_speed_mps, 4),
+            site_tidal_swing_deg: r(s.tidal_swing_deg, 2),
+            site_shape: plumetrace_core::variant_name(&s.shape)
+                .unwrap_or("?")
+                .into(),
+            site_flow_to_axis_deg: r(s.flow_to_axis_deg, 2),
+            site_length_m: r(s.length_m, 1),
+            site_width_m: r(s.width_m, 1),
+            site_source_edge_m: r(s.source_edge_m, 1),
+            site_mass_rate_per_s: s.mass_rate_per_s.and_then(|q| r(q, 4)),
+            site_start: plumetrace_core::variant_name(&s.start)
+                .unwrap_or("?")
+                .into(),
+            site_fix_interval_s: s.fix_interval_s.and_then(|q| r(q, 2)),
+            site_fix_sigma_m: s.fix_sigma_m.and_then(|q| r(q, 3)),
+            site_flow_fault: Some(s.flow_fault_s.is_some()),
+            ..self
         }
     }
 

@@ -6,7 +6,7 @@
 //! campaign seed and the seed index, so every configuration meets the same plume realisations.
 
 use crate::error::CampaignError;
-use plumetrace_scenario::{Origin, PRESETS, find_preset};
+use plumetrace_scenario::{Family, Origin, PRESETS, Site, find_preset, is_family_path};
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 
@@ -23,7 +23,8 @@ pub struct CampaignFile {
     pub seed: u64,
     /// Seeds per group (`--seeds` overrides).
     pub seeds: u64,
-    /// Preset names, or paths ending in `.toml` relative to the campaign file.
+    /// Preset names, or paths relative to the campaign file: scenarios ending in `.toml`, families
+    /// of sites ending in `.family.toml`.
     pub scenarios: Vec<String>,
     /// A run succeeds when it declares; with this set, only when it also declares within this
     /// distance of a true source, m.
@@ -72,8 +73,10 @@ pub struct ScenarioEntry {
     pub label: String,
     /// Where it came from.
     pub origin: Origin,
-    /// Its TOML.
+    /// Its TOML (a family's: its base scenario's).
     pub table: toml::Table,
+    /// A family of sites (a `.family.toml` entry): each seed index flies its own site.
+    pub family: Option<Family>,
 }
 
 /// One sweep point: the value of each swept key.
@@ -265,6 +268,26 @@ impl Campaign {
                     format!("'{s}' is listed twice"),
                 ));
             }
+            if is_family_path(s) {
+                let p = base.join(s);
+                let family = if read_scenarios {
+                    Some(
+                        Family::load(&p)
+                            .map_err(|e| invalid(format!("scenarios[{i}]"), e.to_string()))?,
+                    )
+                } else {
+                    None
+                };
+                scenarios.push(ScenarioEntry {
+                    label: s.clone(),
+                    origin: family
+                        .as_ref()
+                        .map_or(Origin::File(p), |f| f.base_origin.clone()),
+                    table: family.as_ref().map(|f| f.base.clone()).unwrap_or_default(),
+                    family,
+                });
+                continue;
+            }
             let (origin, text) = if s.ends_with(".toml") {
                 let p = base.join(s);
                 let text = if read_scenarios {
@@ -295,6 +318,7 @@ impl Campaign {
                 label: s.clone(),
                 origin,
                 table,
+                family: None,
             });
         }
         let configs = if file.configs.is_empty() {
@@ -453,14 +477,28 @@ impl Campaign {
         plumetrace_env::derive_seed(self.file.seed, key.seed_index)
     }
 
-    /// The scenario TOML of a group, with the configuration's and the sweep point's keys set.
+    /// The site a run flies, when its scenario is a family.
+    pub fn site(&self, key: &RunKey) -> Option<Site> {
+        self.scenarios[key.scenario]
+            .family
+            .as_ref()
+            .map(|f| f.draw(self.run_seed(key)))
+    }
+
+    /// The scenario TOML of a group at a seed index (a family's site differs from seed to seed),
+    /// with the configuration's and the sweep point's keys set.
     pub fn group_table(
         &self,
         scenario: usize,
         config: usize,
         point: usize,
+        seed_index: u64,
     ) -> Result<toml::Table, CampaignError> {
-        let mut t = self.scenarios[scenario].table.clone();
+        let entry = &self.scenarios[scenario];
+        let mut t = match &entry.family {
+            Some(f) => f.scenario(plumetrace_env::derive_seed(self.file.seed, seed_index)),
+            None => entry.table.clone(),
+        };
         let c = &self.configs[config];
         if let Some(p) = &c.planner {
             let path = planner_path(&t).map_err(|m| CampaignError::Invalid {
@@ -496,7 +534,7 @@ impl Campaign {
 
     /// Builds the scenario of a run.
     pub fn build(&self, key: &RunKey) -> Result<plumetrace_scenario::BuiltScenario, CampaignError> {
-        let cfg = self.group_config(key.scenario, key.config, key.point)?;
+        let cfg = self.group_config(key.scenario, key.config, key.point, key.seed_index)?;
         let origin = &self.scenarios[key.scenario].origin;
         plumetrace_scenario::build(&cfg, origin, Some(self.run_seed(key)))
             .map_err(|e| self.group_error(key.scenario, key.config, key.point, e.to_string()))
@@ -507,8 +545,9 @@ impl Campaign {
         scenario: usize,
         config: usize,
         point: usize,
+        seed_index: u64,
     ) -> Result<plumetrace_scenario::ScenarioConfig, CampaignError> {
-        let t = self.group_table(scenario, config, point)?;
+        let t = self.group_table(scenario, config, point, seed_index)?;
         let origin = &self.scenarios[scenario].origin;
         plumetrace_scenario::from_table(t, origin)
             .map_err(|e| self.group_error(scenario, config, point, e.to_string()))
@@ -546,7 +585,8 @@ impl Campaign {
         for s in 0..self.scenarios.len() {
             for c in 0..self.configs.len() {
                 for p in 0..self.points.len() {
-                    let cfg = self.group_config(s, c, p)?;
+                    // A family is checked on its first site (every site has the same keys).
+                    let cfg = self.group_config(s, c, p, 0)?;
                     let origin = &self.scenarios[s].origin;
                     let built = plumetrace_scenario::build(&cfg, origin, None)
                         .map_err(|e| self.group_error(s, c, p, e.to_string()))?;
@@ -579,6 +619,8 @@ impl Campaign {
         struct Canon<'a> {
             seed: u64,
             scenarios: Vec<(&'a str, &'a toml::Table)>,
+            #[serde(skip_serializing_if = "Vec::is_empty")]
+            families: Vec<&'a str>,
             configs: &'a [ConfigFile],
             sweep: &'a toml::Table,
             success_radius_m: Option<f64>,
@@ -589,6 +631,11 @@ impl Campaign {
                 .scenarios
                 .iter()
                 .map(|s| (s.label.as_str(), &s.table))
+                .collect(),
+            families: self
+                .scenarios
+                .iter()
+                .filter_map(|s| s.family.as_ref().map(|f| f.text.as_str()))
                 .collect(),
             configs: &self.configs,
             sweep: &self.file.sweep,
@@ -761,7 +808,7 @@ mod tests {
         let path = Path::new("c.toml");
         let file = parse_campaign(text, path).unwrap();
         let c = Campaign::resolve(file, path, text.to_string(), true).unwrap();
-        let t = c.group_table(0, 0, 0).unwrap();
+        let t = c.group_table(0, 0, 0, 0).unwrap();
         let planner = t["planner"].as_table().unwrap();
         assert_eq!(planner["kind"].as_str(), Some("lawnmower"));
         assert_eq!(planner["lane_spacing_m"].as_float(), Some(30.0));

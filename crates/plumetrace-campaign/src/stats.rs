@@ -377,6 +377,162 @@ pub fn summary_md(c: &Campaign, groups: &[GroupSummary], expected_runs: u64) -> 
     s
 }
 
+/// A labelled test that puts a run in a bin.
+type Bin = (String, Box<dyn Fn(&RunRow) -> bool>);
+
+/// One way of splitting a family's runs by what was drawn.
+struct SiteSplit {
+    title: &'static str,
+    bins: Vec<Bin>,
+}
+
+/// Bins of a drawn number at the given edges (`[a, b)`, the last closed), labelled with `unit`.
+fn number_bins(
+    get: fn(&RunRow) -> Option<f64>,
+    edges: &[f64],
+    digits: usize,
+    unit: &str,
+) -> Vec<Bin> {
+    let mut bins: Vec<Bin> = Vec::new();
+    for w in edges.windows(2) {
+        let (a, b) = (w[0], w[1]);
+        let last = b >= edges[edges.len() - 1];
+        bins.push((
+            format!("{a:.digits$}-{b:.digits$} {unit}"),
+            Box::new(move |r: &RunRow| {
+                get(r).is_some_and(|v| v >= a && (v < b || (last && v <= b)))
+            }),
+        ));
+    }
+    bins
+}
+
+/// Tercile edges of the values (min, two terciles, max), or `None` with too few distinct values.
+fn terciles(mut v: Vec<f64>) -> Option<Vec<f64>> {
+    v.sort_by(f64::total_cmp);
+    let (lo, hi) = (*v.first()?, *v.last()?);
+    (hi > lo).then(|| vec![lo, quantile(&v, 1.0 / 3.0), quantile(&v, 2.0 / 3.0), hi])
+}
+
+/// For every family scenario of the campaign: success against what was drawn (flow direction to
+/// the op-area's axis, flow speed, the source's distance from the edge, the start, a flow-sensor
+/// fault), per configuration and sweep point. Empty without families.
+pub fn sites_md(c: &Campaign, rows: &[(RunKey, RunRow)]) -> String {
+    let mut s = String::new();
+    for (si, entry) in c.scenarios.iter().enumerate() {
+        if entry.family.is_none() {
+            continue;
+        }
+        let runs: Vec<&(RunKey, RunRow)> = rows.iter().filter(|(k, _)| k.scenario == si).collect();
+        if runs.is_empty() {
+            continue;
+        }
+        let values = |get: fn(&RunRow) -> Option<f64>| -> Vec<f64> {
+            runs.iter().filter_map(|(_, r)| get(r)).collect()
+        };
+        let mut splits = vec![SiteSplit {
+            title: "flow direction from the op-area's long axis",
+            bins: number_bins(
+                |r| r.site_flow_to_axis_deg,
+                &[0.0, 30.0, 60.0, 90.0],
+                0,
+                "deg",
+            ),
+        }];
+        if let Some(e) = terciles(values(|r| r.site_flow_speed_mps)) {
+            splits.push(SiteSplit {
+                title: "flow speed (terciles)",
+                bins: number_bins(|r| r.site_flow_speed_mps, &e, 2, "m/s"),
+            });
+        }
+        if let Some(e) = terciles(values(|r| r.site_source_edge_m)) {
+            splits.push(SiteSplit {
+                title: "source's distance from the op-area's edge (terciles)",
+                bins: number_bins(|r| r.site_source_edge_m, &e, 0, "m"),
+            });
+        }
+        let mut starts: Vec<String> = runs.iter().map(|(_, r)| r.site_start.clone()).collect();
+        starts.sort();
+        starts.dedup();
+        splits.push(SiteSplit {
+            title: "start",
+            bins: starts
+                .into_iter()
+                .map(|k| {
+                    let key = k.clone();
+                    (
+                        k,
+                        Box::new(move |r: &RunRow| r.site_start == key)
+                            as Box<dyn Fn(&RunRow) -> bool>,
+                    )
+                })
+                .collect(),
+        });
+        if runs.iter().any(|(_, r)| r.site_flow_fault == Some(true)) {
+            splits.push(SiteSplit {
+                title: "flow-sensor fault",
+                bins: vec![
+                    (
+                        "no fault".into(),
+                        Box::new(|r: &RunRow| r.site_flow_fault == Some(false)),
+                    ),
+                    (
+                        "fault".into(),
+                        Box::new(|r: &RunRow| r.site_flow_fault == Some(true)),
+                    ),
+                ],
+            });
+        }
+        let _ = writeln!(
+            s,
+            "\n## Sites of `{}`\n\nSuccess (as above) by what was drawn: successes / runs (rate).\n",
+            entry.label
+        );
+        for split in &splits {
+            let _ = writeln!(s, "**{}**\n", split.title);
+            let mut head = vec!["config".to_string()];
+            if c.points.len() > 1 {
+                head.push("sweep".into());
+            }
+            head.extend(split.bins.iter().map(|b| b.0.clone()));
+            let _ = writeln!(s, "| {} |", head.join(" | "));
+            let _ = writeln!(
+                s,
+                "|{}|",
+                head.iter().map(|_| " --- ").collect::<Vec<_>>().join("|")
+            );
+            for config in 0..c.configs.len() {
+                for point in 0..c.points.len() {
+                    let group: Vec<&RunRow> = runs
+                        .iter()
+                        .filter(|(k, _)| k.config == config && k.point == point)
+                        .map(|(_, r)| r)
+                        .collect();
+                    if group.is_empty() {
+                        continue;
+                    }
+                    let mut row = vec![c.configs[config].name.clone()];
+                    if c.points.len() > 1 {
+                        row.push(c.points[point].label());
+                    }
+                    for (_, test) in &split.bins {
+                        let n = group.iter().filter(|r| test(r)).count();
+                        let k = group.iter().filter(|r| test(r) && r.success).count();
+                        row.push(if n == 0 {
+                            "-".into()
+                        } else {
+                            format!("{k}/{n} ({:.0} %)", 100.0 * k as f64 / n as f64)
+                        });
+                    }
+                    let _ = writeln!(s, "| {} |", row.join(" | "));
+                }
+            }
+            s.push('\n');
+        }
+    }
+    s
+}
+
 #[cfg(test)]
 pub(crate) mod tests {
     #![allow(clippy::unwrap_used)]

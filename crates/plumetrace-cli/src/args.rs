@@ -34,6 +34,11 @@ pub fn runs(s: &str) -> Result<u64, String> {
     whole(s, 1, 100_000)
 }
 
+/// Sites drawn by `plumetrace family`: 1 to 10,000.
+pub fn sample(s: &str) -> Result<u64, String> {
+    whole(s, 1, 10_000)
+}
+
 /// A vehicle index: 0 to 99.
 pub fn vehicle(s: &str) -> Result<u32, String> {
     whole(s, 0, 99).map(|v| v as u32)

@@ -3,7 +3,8 @@
 //! Subcommands: `run` (fly a mission, or simulate a plume, and write the outputs), `presets` (list
 //! the built-in scenarios), `planners` (the planner registry: every planner and its keys),
 //! `check` (validate a scenario file), `replay` (run a snapshot log through a planner again),
-//! `campaign` and `merge` (Monte Carlo campaigns), `bench plume` (time the plume model on pompy's
+//! `campaign` and `merge` (Monte Carlo campaigns), `family` (draw sites of a scenario family),
+//! `bench plume` (time the plume model on pompy's
 //! scenario or a field-scale one) and `bench missions` (missions per second on 1 and more
 //! threads); benchmarks print JSON.
 
@@ -77,6 +78,8 @@ enum Command {
     Campaign(campaign::CampaignArgs),
     /// Merge the output directories of a campaign's shards.
     Merge(campaign::MergeArgs),
+    /// Draw sites of a scenario family and write each as a scenario file (to fly or inspect).
+    Family(FamilyArgs),
     /// Benchmarks; print one JSON object.
     #[command(subcommand)]
     Bench(bench::BenchCommand),
@@ -136,8 +139,58 @@ fn dispatch(cli: Cli) -> Result<()> {
         }
         Command::Campaign(args) => campaign::run(&args),
         Command::Merge(args) => campaign::run_merge(&args),
+        Command::Family(args) => family(&args),
         Command::Bench(b) => bench::run(&b),
     }
+}
+
+/// `plumetrace family`.
+#[derive(Debug, clap::Args)]
+struct FamilyArgs {
+    /// The family file (`*.family.toml`).
+    file: PathBuf,
+    /// How many sites to draw (1 to 10,000).
+    #[arg(long, value_parser = args::sample)]
+    sample: u64,
+    /// Seed: site k is drawn from derive_seed(seed, k), as in a campaign with this seed.
+    #[arg(long, default_value_t = 1, value_parser = args::seed, allow_hyphen_values = true)]
+    seed: u64,
+    /// Where to write `site-K.toml` (a new or empty directory).
+    #[arg(long)]
+    out: PathBuf,
+}
+
+/// `plumetrace family FILE --sample N --out DIR`: draws N sites and writes each as a scenario
+/// file (with the drawn values in its opening comment), checked by the same build as `run`.
+fn family(a: &FamilyArgs) -> Result<()> {
+    let f = plumetrace_scenario::Family::load(&a.file)?;
+    if a.out.exists() && std::fs::read_dir(&a.out)?.next().is_some() {
+        anyhow::bail!(
+            "{}: holds files already; give a new or empty --out directory",
+            a.out.display()
+        );
+    }
+    std::fs::create_dir_all(&a.out)?;
+    let width = (a.sample.max(1) - 1).to_string().len().max(3);
+    for k in 0..a.sample {
+        let seed = plumetrace_env::derive_seed(a.seed, k);
+        let site = f.draw(seed);
+        let text = site.to_toml(&f.file, &f.base, seed);
+        let path = a.out.join(format!("site-{k:0width$}.toml"));
+        let origin = plumetrace_scenario::Origin::File(path.clone());
+        let cfg = plumetrace_scenario::parse(&text, &origin)?;
+        plumetrace_scenario::build(&cfg, &origin, Some(seed))?;
+        plumetrace_mission::output::write_atomic(&path, text.as_bytes())?;
+    }
+    crate::outln!(
+        "{}: wrote {} sites of '{}' (seed {}) to {}",
+        a.file.display(),
+        a.sample,
+        f.file.name,
+        a.seed,
+        a.out.display()
+    );
+    Ok(())
 }
 
 /// `plumetrace planners`: every planner and its keys, as plain text.

@@ -10,6 +10,8 @@ pub enum Target {
     Scenario,
     /// A campaign file, parsed, resolved and checked; its runs are counted, never flown.
     Campaign,
+    /// A scenario family, parsed; a few of its sites are drawn and checked as `check` does.
+    Family,
 }
 
 impl Target {
@@ -18,6 +20,7 @@ impl Target {
         match self {
             Target::Scenario => "fuzz.toml",
             Target::Campaign => "fuzz-campaign.toml",
+            Target::Family => "fuzz.family.toml",
         }
     }
 
@@ -26,6 +29,7 @@ impl Target {
         match self {
             Target::Scenario => "scenario",
             Target::Campaign => "campaign",
+            Target::Family => "family",
         }
     }
 }
@@ -56,12 +60,28 @@ pub const CAMPAIGNS: &[(&str, &str)] = &[
         include_str!("../../../examples/campaigns/moth-comparison.toml"),
     ),
     (
+        "amp-families",
+        include_str!("../../../examples/campaigns/amp-families.toml"),
+    ),
+    (
         "mt-lost-points",
         include_str!("../../../examples/campaigns/mt-lost-points.toml"),
     ),
 ];
 
-/// Every seed: the presets in registry order, then the campaigns.
+/// The example families (`examples/families/*.family.toml`; a test checks the list is complete).
+pub const FAMILIES: &[(&str, &str)] = &[
+    (
+        "coastal",
+        include_str!("../../../examples/families/coastal.family.toml"),
+    ),
+    (
+        "faults",
+        include_str!("../../../examples/families/faults.family.toml"),
+    ),
+];
+
+/// Every seed: the presets in registry order, then the campaigns, then the families.
 pub fn seeds() -> Vec<Seed> {
     PRESETS
         .iter()
@@ -75,6 +95,20 @@ pub fn seeds() -> Vec<Seed> {
             target: Target::Campaign,
             text,
         }))
+        .chain(FAMILIES.iter().map(|(name, text)| Seed {
+            name,
+            target: Target::Family,
+            text,
+        }))
+        .collect()
+}
+
+/// Family files written where campaign inputs look for them (`../families/NAME.family.toml`
+/// from the campaign directory, as in `examples/`).
+pub fn family_side_files() -> Vec<(String, &'static str)> {
+    FAMILIES
+        .iter()
+        .map(|(name, text)| (format!("{name}.family.toml"), *text))
         .collect()
 }
 
@@ -91,6 +125,23 @@ pub fn campaign_side_files() -> Vec<(&'static str, &'static str)> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn every_example_family_is_a_seed() {
+        let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/families");
+        let mut on_disk: Vec<String> = std::fs::read_dir(&dir)
+            .map(|d| {
+                d.filter_map(Result::ok)
+                    .filter_map(|e| e.file_name().into_string().ok())
+                    .filter_map(|n| n.strip_suffix(".family.toml").map(str::to_string))
+                    .collect()
+            })
+            .unwrap_or_default();
+        on_disk.sort();
+        let mut embedded: Vec<String> = FAMILIES.iter().map(|c| c.0.to_string()).collect();
+        embedded.sort();
+        assert_eq!(on_disk, embedded, "embed every file of {}", dir.display());
+    }
 
     #[test]
     fn every_example_campaign_is_a_seed() {
@@ -112,7 +163,7 @@ mod tests {
     #[test]
     fn every_seed_is_toml_and_side_files_exist() {
         let all = seeds();
-        assert_eq!(all.len(), PRESETS.len() + CAMPAIGNS.len());
+        assert_eq!(all.len(), PRESETS.len() + CAMPAIGNS.len() + FAMILIES.len());
         for s in &all {
             assert!(s.text.parse::<toml::Table>().is_ok(), "{}", s.name);
         }

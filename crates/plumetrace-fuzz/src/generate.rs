@@ -62,7 +62,6 @@ const RAW_SHARE: f64 = 0.2;
 pub fn generate(seed: u64, index: u64) -> Input {
     let mut rng = input_rng(seed, index);
     let all = seeds();
-    // About 70 % scenarios, 30 % campaigns.
     let scenarios: Vec<&Seed> = all
         .iter()
         .filter(|s| s.target == Target::Scenario)
@@ -71,8 +70,13 @@ pub fn generate(seed: u64, index: u64) -> Input {
         .iter()
         .filter(|s| s.target == Target::Campaign)
         .collect();
-    let pool = if rng.random_bool(0.3) && !campaigns.is_empty() {
+    let families: Vec<&Seed> = all.iter().filter(|s| s.target == Target::Family).collect();
+    // About 60 % scenarios, 30 % campaigns, 10 % families.
+    let r: f64 = rng.random();
+    let pool = if r < 0.3 && !campaigns.is_empty() {
         &campaigns
+    } else if r < 0.4 && !families.is_empty() {
+        &families
     } else {
         &scenarios
     };
@@ -202,7 +206,7 @@ mod tests {
             assert!(!input.mutations.is_empty());
             targets.insert(input.target);
             seen.extend(input.mutations.iter().map(|m| m.kind));
-            if seen.len() == Kind::ALL.len() && targets.len() == 2 {
+            if seen.len() == Kind::ALL.len() && targets.len() == 3 {
                 break;
             }
         }
@@ -212,6 +216,6 @@ mod tests {
             .map(|k| k.name())
             .collect();
         assert!(missing.is_empty(), "never produced: {missing:?}");
-        assert_eq!(targets.len(), 2);
+        assert_eq!(targets.len(), 3, "scenarios, campaigns and families");
     }
 }

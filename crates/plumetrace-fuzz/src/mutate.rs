@@ -816,6 +816,8 @@ fn polygon_target(
                 Seg::Key("mission.op_area".into()),
             ]
         }
+        // A family has no polygon of its own.
+        Target::Family => return None,
         Target::Scenario => {
             if let Some(Value::Table(m)) = root.get_mut("mission") {
                 m.insert("op_area".into(), points_value(&square));

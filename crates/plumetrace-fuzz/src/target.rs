@@ -18,7 +18,7 @@
 //! watchdog.
 
 use crate::classify::{Class, classify_rejection};
-use crate::corpus::{Target, campaign_side_files};
+use crate::corpus::{Target, campaign_side_files, family_side_files};
 use crate::generate::Input;
 use plumetrace_campaign::spec::{Campaign, parse_campaign};
 use plumetrace_env::ConcentrationField;
@@ -74,6 +74,7 @@ pub struct Workdir {
     dir: tempfile::TempDir,
     scenario: PathBuf,
     campaign: PathBuf,
+    families: PathBuf,
 }
 
 impl Workdir {
@@ -89,10 +90,16 @@ impl Workdir {
         for (name, text) in campaign_side_files() {
             std::fs::write(campaign.join(name), text)?;
         }
+        let families = dir.path().join("families");
+        std::fs::create_dir_all(&families)?;
+        for (name, text) in family_side_files() {
+            std::fs::write(families.join(name), text)?;
+        }
         Ok(Workdir {
             dir,
             scenario,
             campaign,
+            families,
         })
     }
 
@@ -101,6 +108,7 @@ impl Workdir {
         match target {
             Target::Scenario => self.scenario.join(target.file_name()),
             Target::Campaign => self.campaign.join(target.file_name()),
+            Target::Family => self.families.join(target.file_name()),
         }
     }
 
@@ -169,6 +177,7 @@ pub fn run(input: &Input, wd: &Workdir, timeout_s: f64) -> anyhow::Result<Outcom
     let result = std::panic::catch_unwind(AssertUnwindSafe(|| match input.target {
         Target::Scenario => scenario(input, &path, deadline),
         Target::Campaign => campaign(input, &path, deadline),
+        Target::Family => family(input, &path, deadline),
     }));
     let secs = start.elapsed().as_secs_f64();
     let (class, message) = match result {
@@ -198,6 +207,27 @@ pub fn run(input: &Input, wd: &Workdir, timeout_s: f64) -> anyhow::Result<Outcom
         secs,
     })
 }
+
+/// Sites drawn from a family input, each built and checked as `check` does.
+fn family(input: &Input, path: &Path, deadline: Instant) -> Result<String, Stop> {
+    let f = match std::str::from_utf8(&input.bytes) {
+        Ok(text) => plumetrace_scenario::Family::parse(text, path).map_err(rejected)?,
+        Err(_) => plumetrace_scenario::Family::load(path).map_err(rejected)?,
+    };
+    for seed in 0..FAMILY_SITES {
+        let origin = Origin::File(path.to_path_buf());
+        let cfg = plumetrace_scenario::from_table(f.scenario(seed), &origin)
+            .map_err(|e| rejected(format!("site of seed {seed}: {e}")))?;
+        let built = plumetrace_scenario::build(&cfg, &origin, Some(seed))
+            .map_err(|e| rejected(format!("site of seed {seed}: {e}")))?;
+        MissionSetup::new(built).map_err(|e| rejected(format!("site of seed {seed}: {e}")))?;
+        check_deadline(deadline, || format!("checking the site of seed {seed}"))?;
+    }
+    Ok(format!("family: {FAMILY_SITES} sites built"))
+}
+
+/// Sites drawn and checked per family input.
+const FAMILY_SITES: u64 = 3;
 
 /// `check`, then a short run.
 fn scenario(input: &Input, path: &Path, deadline: Instant) -> Result<String, Stop> {

@@ -186,7 +186,12 @@ impl Mission {
             name,
             seed,
             step_limit: (spec.time_limit_s / dt_s).round() as u64,
-            stats: TrackStats::new(setups.len(), sources.first().map(|s| s.xy()), sample_every),
+            stats: TrackStats::new(
+                thresholds.clone(),
+                &spec.op_area,
+                sources.first().map(|s| s.xy()),
+                sample_every,
+            ),
             trajectory: options
                 .trajectory
                 .then(|| TrajectoryRecorder::new(thresholds, positions)),

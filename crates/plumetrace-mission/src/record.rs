@@ -222,7 +222,14 @@ pub struct VehicleTrack {
     pub trace_length_m: f64,
     /// Declarations: time, position and rule.
     pub declarations: Vec<(f64, Vec2, plumetrace_core::DeclarationKind)>,
+    /// The longest stretch spent in one behaviour without a reading above the detection
+    /// threshold: its length, s, and the behaviour.
+    pub longest_quiet: Option<(f64, BehaviourKind)>,
+    /// The farthest the true position went outside the op-area, m (0: never outside).
+    pub max_outside_m: f64,
     last_pos: Option<Vec2>,
+    /// The behaviour in control and since when it has had no detection.
+    quiet_since: Option<(BehaviourKind, f64)>,
 }
 
 /// Records [`VehicleTrack`]s and the mean flow at the first source.
@@ -230,6 +237,8 @@ pub struct VehicleTrack {
 pub struct TrackStats {
     /// One per vehicle.
     pub tracks: Vec<VehicleTrack>,
+    thresholds: Vec<Option<f64>>,
+    op_area: Option<plumetrace_guidance::OpArea>,
     flow_sum: Vec2,
     flow_n: f64,
     flow_at: Option<Vec2>,
@@ -237,11 +246,19 @@ pub struct TrackStats {
 }
 
 impl TrackStats {
-    /// Stats for `vehicles` vehicles; the mean flow is sampled at `flow_at` every `sample_every`
-    /// steps.
-    pub fn new(vehicles: usize, flow_at: Option<Vec2>, sample_every: u64) -> Self {
+    /// Stats for vehicles whose planners threshold readings at `thresholds` (one per vehicle,
+    /// `None`: no planner or none that thresholds) in `op_area`; the mean flow is sampled at
+    /// `flow_at` every `sample_every` steps.
+    pub fn new(
+        thresholds: Vec<Option<f64>>,
+        op_area: &[Vec2],
+        flow_at: Option<Vec2>,
+        sample_every: u64,
+    ) -> Self {
         TrackStats {
-            tracks: vec![VehicleTrack::default(); vehicles],
+            tracks: vec![VehicleTrack::default(); thresholds.len()],
+            thresholds,
+            op_area: plumetrace_guidance::OpArea::new(op_area.to_vec()).ok(),
             flow_sum: Vec2::zeros(),
             flow_n: 0.0,
             flow_at,
@@ -278,11 +295,36 @@ impl Observer for TrackStats {
                 }
             }
         }
+        for (i, b) in behaviour_switches(step.report) {
+            if let Some(track) = self.tracks.get_mut(i) {
+                track.quiet_since = Some((b, t));
+            }
+        }
         for v in step.world.vehicles() {
-            let Some(track) = self.tracks.get_mut(v.vehicle.id.0 as usize) else {
+            let i = v.vehicle.id.0 as usize;
+            let threshold = self.thresholds.get(i).copied().flatten();
+            let Some(track) = self.tracks.get_mut(i) else {
                 continue;
             };
             let p = v.vehicle.state.pos_m;
+            if let Some(a) = &self.op_area {
+                let e = a.edge_info(p);
+                if !e.inside {
+                    track.max_outside_m = track.max_outside_m.max(e.distance_m);
+                }
+            }
+            if let Some((b, since)) = track.quiet_since {
+                let detected = threshold
+                    .zip(v.last_chem)
+                    .is_some_and(|(th, c)| c.reading > th);
+                if detected || !v.active {
+                    track.quiet_since = v.active.then_some((b, t));
+                } else if b != BehaviourKind::Done
+                    && track.longest_quiet.is_none_or(|(d, _)| t - since > d)
+                {
+                    track.longest_quiet = Some((t - since, b));
+                }
+            }
             if let Some(q) = track.last_pos {
                 let d = (p - q).norm();
                 track.path_length_m += d;

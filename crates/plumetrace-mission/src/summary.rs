@@ -6,7 +6,7 @@
 
 use crate::outcome::{EndReason, MissionEnd, Outcome, VehicleStatus};
 use crate::record::VehicleTrack;
-use plumetrace_core::{DeclarationKind, Heading, Vec2, Vec3, VehicleKind};
+use plumetrace_core::{BehaviourKind, DeclarationKind, Heading, Vec2, Vec3, VehicleKind};
 use plumetrace_planner::PlannerKind;
 use serde::Serialize;
 
@@ -75,6 +75,13 @@ pub struct VehicleSummary {
     pub first_detection_s: Option<f64>,
     /// Its declarations.
     pub declarations: usize,
+    /// The longest time it spent in one behaviour without a reading above its planner's
+    /// detection threshold, s.
+    pub longest_quiet_s: Option<f64>,
+    /// That behaviour.
+    pub longest_quiet_behaviour: Option<BehaviourKind>,
+    /// The farthest its true position went outside the op-area, m.
+    pub max_outside_m: f64,
 }
 
 /// The mission's key numbers.
@@ -109,6 +116,10 @@ pub struct Summary {
     pub sources_located: usize,
     /// Every true source, with its nearest declaration.
     pub sources: Vec<SourceRecord>,
+    /// The longest any vehicle with a planner spent in one behaviour without a detection, s.
+    pub longest_quiet_s: Option<f64>,
+    /// The farthest any vehicle with a planner went outside the op-area (true position), m.
+    pub max_outside_m: f64,
     /// Every vehicle.
     pub vehicles: Vec<VehicleSummary>,
 }
@@ -184,9 +195,18 @@ impl Summary {
                     path_length_m: t.path_length_m,
                     first_detection_s: t.first_detection.map(|d| d.0),
                     declarations: t.declarations.len(),
+                    longest_quiet_s: t.longest_quiet.map(|q| q.0),
+                    longest_quiet_behaviour: t.longest_quiet.map(|q| q.1),
+                    max_outside_m: t.max_outside_m,
                 }
             })
-            .collect();
+            .collect::<Vec<_>>();
+        let with_planner = vehicles.iter().filter(|v| v.planner.is_some());
+        let longest_quiet_s = with_planner
+            .clone()
+            .filter_map(|v| v.longest_quiet_s)
+            .max_by(f64::total_cmp);
+        let max_outside_m = with_planner.map(|v| v.max_outside_m).fold(0.0, f64::max);
         Summary {
             scenario: i.scenario,
             seed: i.seed,
@@ -205,6 +225,8 @@ impl Summary {
             declarations,
             sources_located: sources.iter().filter(|s| s.located).count(),
             sources,
+            longest_quiet_s,
+            max_outside_m,
             vehicles,
         }
     }

@@ -8,12 +8,14 @@
 pub mod build;
 pub mod config;
 pub mod error;
+pub mod family;
 pub mod limits;
 pub mod presets;
 
 pub use build::{BuiltScenario, MissionSpec, OutputSpec, PlannerRef, VehicleSetup, build};
 pub use config::ScenarioConfig;
 pub use error::ScenarioError;
+pub use family::{Family, Site, is_family_path};
 pub use presets::{PRESETS, Preset, find_preset};
 
 use std::path::Path;

@@ -637,11 +637,24 @@ fn number(v: f64, path: &str, pattern: &str) -> Result<(), (String, String)> {
     }
 }
 
-/// The table as Markdown (`| key | bound | why |`).
+/// The table as Markdown (`| key | bound | why |`), then the family keys' table.
 pub fn markdown() -> String {
     let mut out = String::from("| key | bound | why |\n| --- | --- | --- |\n");
     for l in LIMITS {
         let _ = writeln!(out, "| `{}` | {} | {} |", l.key, l.bound.describe(), l.why);
+    }
+    out.push_str(
+        "\nScenario families (`*.family.toml`, see [Scenario families](#scenario-families)); \
+         a range `[low, high]` needs `low <= high`, both within the bound:\n\n\
+         | key | bound | why |\n| --- | --- | --- |\n",
+    );
+    for (key, lo, hi, why) in crate::family::FAMILY_LIMITS {
+        let _ = writeln!(
+            out,
+            "| `{key}` | >= {} and <= {} | {why} |",
+            show(*lo),
+            show(*hi)
+        );
     }
     out
 }
