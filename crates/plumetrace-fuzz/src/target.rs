@@ -46,9 +46,12 @@ const NULLABLE: &[&str] = &[
     "first_detection_s",
     "trace_length_m",
     "detection_to_source_m",
+    "longest_quiet_s",
     "sources[].nearest_error_m",
     "vehicles[].planner",
     "vehicles[].first_detection_s",
+    "vehicles[].longest_quiet_s",
+    "vehicles[].longest_quiet_behaviour",
 ];
 
 /// What happened to one input.
@@ -460,6 +463,21 @@ mod tests {
         )?;
         assert_eq!(o.class, Class::Accepted, "{}", o.message);
         assert!(o.message.contains("= 80 runs"), "{}", o.message);
+        Ok(())
+    }
+
+    #[test]
+    fn a_mission_that_ends_at_once_has_only_nullable_nulls() -> anyhow::Result<()> {
+        // Starts beyond the cage and aborts on the first step: every `Option` of the summary is
+        // `None`.
+        install_panic_hook();
+        let wd = Workdir::new()?;
+        let text = plumetrace_scenario::find_preset("demo")
+            .map_or(String::new(), |p| p.toml.to_string())
+            .replace("x_m = 470.0", "x_m = 515.0");
+        assert!(text.contains("x_m = 515.0"));
+        let o = run(&unmutated(Target::Scenario, &text), &wd, 60.0)?;
+        assert_eq!(o.class, Class::Accepted, "{}", o.message);
         Ok(())
     }
 
