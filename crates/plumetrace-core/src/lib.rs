@@ -15,6 +15,7 @@
 pub mod angle;
 pub mod any_f64;
 pub mod finite;
+pub mod flow_gate;
 pub mod frame;
 pub mod message;
 pub mod names;
@@ -24,6 +25,7 @@ pub mod vehicle;
 
 pub use angle::{Heading, wrap_deg_180, wrap_deg_360, wrap_rad_pi};
 pub use finite::first_non_finite;
+pub use flow_gate::{FlowGate, FlowGateParams};
 pub use frame::{Vec2, Vec3, bearing_between, heading_vector, self_intersection};
 pub use message::{Link, Message, MessageBody, Outgoing, Recipient};
 pub use names::variant_name;

@@ -15,6 +15,11 @@ pub struct AutopilotParams {
     pub max_turn_rate_deg_s: f64,
     /// The vertical command sent with every heading.
     pub vertical: VerticalCommand,
+    /// How fast the navigation error may grow between fixes, m/s: [`Autopilot::command_nav`]
+    /// shrinks the cage's area by this times the time since the last fix (0: never).
+    pub nav_drift_mps: f64,
+    /// The most the area is shrunk by, m.
+    pub max_inset_m: f64,
 }
 
 /// The cage aborted: the vehicle is too far outside the op-area.
@@ -37,6 +42,9 @@ pub struct CageAbort {
 #[derive(Debug, Clone, PartialEq)]
 pub struct Autopilot {
     cage: Cage,
+    nav_drift_mps: f64,
+    max_inset_m: f64,
+    inset_m: f64,
     flow_compensation: bool,
     filter: RateFilter,
     vertical: VerticalCommand,
@@ -48,6 +56,9 @@ impl Autopilot {
     pub fn new(p: AutopilotParams) -> Self {
         Autopilot {
             cage: Cage::new(p.op_area),
+            nav_drift_mps: p.nav_drift_mps,
+            max_inset_m: p.max_inset_m,
+            inset_m: 0.0,
             flow_compensation: p.flow_compensation,
             filter: RateFilter::new(p.max_turn_rate_deg_s),
             vertical: p.vertical,
@@ -79,7 +90,7 @@ impl Autopilot {
             }
         };
         self.last_t_s = Some(t_s);
-        let caged = match pos_m.map(|p| self.cage.apply(p, steer.heading)) {
+        let caged = match pos_m.map(|p| self.cage.apply_inset(p, steer.heading, self.inset_m)) {
             Some(CageAction::Abort { distance_outside_m }) => {
                 return Err(CageAbort {
                     distance_outside_m,
@@ -99,6 +110,28 @@ impl Autopilot {
             speed_mps: steer.speed_mps,
             vertical: self.vertical,
         })
+    }
+
+    /// [`Autopilot::command`] from a navigation estimate, with the cage's area shrunk by the
+    /// navigation's possible error: `nav_drift_mps` times the time since the last fix (since the
+    /// start before the first), at most `max_inset_m`.
+    pub fn command_nav(
+        &mut self,
+        t_s: f64,
+        nav: &plumetrace_core::NavEstimate,
+        steer: Steer,
+        flow_mps: Vec2,
+    ) -> Result<Command, CageAbort> {
+        let since = (t_s - nav.last_fix_s.unwrap_or(0.0)).max(0.0);
+        let inset = (self.nav_drift_mps * since).min(self.max_inset_m);
+        self.inset_m = if inset.is_finite() {
+            inset.max(0.0)
+        } else {
+            0.0
+        };
+        let out = self.command(t_s, nav.pos_m, nav.heading, steer, flow_mps);
+        self.inset_m = 0.0;
+        out
     }
 
     /// Hold `heading` at zero speed.
@@ -121,6 +154,8 @@ mod tests {
             flow_compensation,
             max_turn_rate_deg_s: 10.0,
             vertical: VerticalCommand::Altitude(2.0),
+            nav_drift_mps: 0.0,
+            max_inset_m: 0.0,
         })
     }
 

@@ -70,6 +70,18 @@ impl Cage {
 
     /// Applies the cage to `command` at estimated position `pos_m`.
     pub fn apply(&self, pos_m: Vec2, command: Heading) -> CageAction {
+        self.apply_inset(pos_m, command, 0.0)
+    }
+
+    /// [`Cage::apply`] on the op-area shrunk by `inset_m` (the navigation's uncertainty: the
+    /// vehicle may be that far from its estimate, so the cage acts that much earlier). The abort
+    /// distance is still measured from the op-area itself.
+    pub fn apply_inset(&self, pos_m: Vec2, command: Heading, inset_m: f64) -> CageAction {
+        let inset = if inset_m.is_finite() {
+            inset_m.max(0.0)
+        } else {
+            0.0
+        };
         let e = self.area.edge_info(pos_m);
         let n = e.outward_normal;
         if !e.inside {
@@ -80,13 +92,18 @@ impl Cage {
             }
             return CageAction::ReturnInside(Heading::of_vector(-n).unwrap_or(command));
         }
-        if e.distance_m >= self.band_m {
+        if e.distance_m < inset {
+            // Outside the shrunk area: back in along the inward normal.
+            return CageAction::ReturnInside(Heading::of_vector(-n).unwrap_or(command));
+        }
+        if e.distance_m >= self.band_m + inset {
             return CageAction::Pass(command);
         }
         let v = command.unit();
         let mut t = v;
         let mut inward = Vec2::zeros();
-        for (delta, n) in self.area.edges_within(pos_m, self.band_m) {
+        for (delta, n) in self.area.edges_within(pos_m, self.band_m + inset) {
+            let delta = (delta - inset).max(0.0);
             let outward = t.dot(&n);
             if outward > 0.0 {
                 t -= n * ((1.0 - delta / self.band_m) * outward);

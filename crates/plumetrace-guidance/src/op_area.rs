@@ -195,6 +195,51 @@ impl OpArea {
         out
     }
 
+    /// The longest part of the segment `a`-`b` that lies inside the area at least `margin_m` from
+    /// every edge, found on a grid of at most 1 m steps (2,000 at most); `None` when that part is
+    /// shorter than `min_length_m`. A pattern leg that reaches out of the area is flown as this
+    /// part, so that the vehicle never aims at a point the cage keeps it from.
+    pub fn clip_segment(
+        &self,
+        a: Vec2,
+        b: Vec2,
+        margin_m: f64,
+        min_length_m: f64,
+    ) -> Option<(Vec2, Vec2)> {
+        let len = (b - a).norm();
+        if !len.is_finite() {
+            return None;
+        }
+        let n = (len.ceil() as usize).clamp(1, 2000);
+        let ok = |k: usize| {
+            let p = a + (b - a) * (k as f64 / n as f64);
+            let e = self.edge_info(p);
+            e.inside && e.distance_m >= margin_m
+        };
+        let (mut best, mut run_start) = (None::<(usize, usize)>, None::<usize>);
+        for k in 0..=n {
+            match (ok(k), run_start) {
+                (true, None) => run_start = Some(k),
+                (false, Some(s)) => {
+                    if best.is_none_or(|(bs, be)| k - 1 - s > be - bs) {
+                        best = Some((s, k - 1));
+                    }
+                    run_start = None;
+                }
+                _ => {}
+            }
+        }
+        if let Some(s) = run_start
+            && best.is_none_or(|(bs, be)| n - s > be - bs)
+        {
+            best = Some((s, n));
+        }
+        let (s, e) = best?;
+        let at = |k: usize| a + (b - a) * (k as f64 / n as f64);
+        let (p, q) = (at(s), at(e));
+        ((q - p).norm() >= min_length_m).then_some((p, q))
+    }
+
     /// The vertex furthest along `direction` (e.g. the most downflow corner).
     pub fn furthest_vertex_along(&self, direction: Vec2) -> Vec2 {
         let mut best = self.vertices[0];

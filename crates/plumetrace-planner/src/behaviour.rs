@@ -140,6 +140,9 @@ pub struct Legs {
     line: Option<Box<FollowLine>>,
     params: LineParams,
     kind: BehaviourKind,
+    /// Longest time the pattern is flown, s, and when it started.
+    timeout_s: Option<f64>,
+    started_s: Option<f64>,
 }
 
 impl Legs {
@@ -152,7 +155,15 @@ impl Legs {
             line,
             params,
             kind,
+            timeout_s: None,
+            started_s: None,
         }
+    }
+
+    /// The pattern, given up `timeout_s` after its first decision (done as if flown).
+    pub fn with_timeout(mut self, timeout_s: f64) -> Self {
+        self.timeout_s = Some(timeout_s);
+        self
     }
 
     /// The legs.
@@ -172,6 +183,11 @@ impl<M, D: From<Reached>> Behaviour<M, D> for Legs {
     }
 
     fn propose(&mut self, p: &Percept, _: &mut M) -> Proposal<D> {
+        let started = *self.started_s.get_or_insert(p.t_s);
+        if self.timeout_s.is_some_and(|t| p.t_s - started > t) {
+            self.line = None;
+            return Proposal::Done(Reached.into());
+        }
         // Several legs may end at one decision (short legs, a fix that jumps past them).
         while let Some(line) = self.line.as_mut() {
             match line.update(p.pose()) {

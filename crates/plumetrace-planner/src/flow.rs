@@ -1,15 +1,17 @@
 //! The planner's estimate of the current.
 
-use plumetrace_core::{Heading, Vec2};
+use plumetrace_core::{FlowGate, FlowGateParams, Heading, Vec2};
 
 /// A running average of measured flow vectors (exponential, with a time constant), so that single
-/// noisy ADCP samples do not swing the upflow direction.
+/// noisy ADCP samples do not swing the upflow direction; optionally behind a [`FlowGate`] that
+/// holds back readings implausible against the recent ones (a reversed, wrong-layer reading).
 #[derive(Debug, Clone, PartialEq)]
 pub struct FlowEstimate {
     time_constant_s: f64,
     mean_mps: Option<Vec2>,
     last_t_s: f64,
     fallback: Heading,
+    gate: Option<FlowGate>,
 }
 
 impl FlowEstimate {
@@ -21,12 +23,30 @@ impl FlowEstimate {
             mean_mps: None,
             last_t_s: 0.0,
             fallback,
+            gate: None,
         }
     }
 
-    /// Adds a measurement taken at `t_s` (non-finite ones are ignored).
+    /// The same estimate with readings checked by a [`FlowGate`] first.
+    pub fn with_gate(mut self, gate: FlowGateParams) -> Self {
+        self.gate = Some(FlowGate::new(gate));
+        self
+    }
+
+    /// Whether the gate is holding readings back now.
+    pub fn doubting(&self) -> bool {
+        self.gate.as_ref().is_some_and(FlowGate::doubting)
+    }
+
+    /// Adds a measurement taken at `t_s` (non-finite ones, and those the gate holds back, are
+    /// ignored).
     pub fn add(&mut self, t_s: f64, v_mps: Vec2) {
         if !(v_mps.x.is_finite() && v_mps.y.is_finite() && t_s.is_finite()) {
+            return;
+        }
+        if let Some(g) = self.gate.as_mut()
+            && !g.accept(t_s, v_mps)
+        {
             return;
         }
         self.mean_mps = Some(match self.mean_mps {

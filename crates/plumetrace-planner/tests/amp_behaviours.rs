@@ -7,6 +7,7 @@ use plumetrace_core::{
     Planner, PlannerEvent, SensorSnapshot, Vec2, VehicleId, bearing_between,
 };
 use plumetrace_guidance::OpArea;
+use plumetrace_planner::amp::{FindPattern, LhsUpdate};
 use plumetrace_planner::{Amp, AmpParams, LostPointEviction};
 
 /// Flow towards North at 0.1 m/s: upflow is South.
@@ -37,8 +38,28 @@ fn snap(t: f64, pos: (f64, f64), heading_deg: f64, detection: bool) -> SensorSna
 }
 
 fn amp() -> Amp {
+    amp_with(AmpParams::default())
+}
+
+fn amp_with(p: AmpParams) -> Amp {
     let area = OpArea::rectangle(0.0, 400.0, 0.0, 1000.0).unwrap();
-    Amp::new(AmpParams::default(), area, vec![], Heading::NORTH)
+    Amp::new(p, area, vec![], Heading::NORTH)
+}
+
+/// The paper's behaviour where the defaults depart from it.
+fn paper() -> AmpParams {
+    AmpParams {
+        track_in_lhs: LhsUpdate::EveryDetection,
+        find_pattern: FindPattern::Billiard,
+        lost_point_max_age_s: 0.0,
+        lost_point_max_turn_deg: 180.0,
+        reacquire_timeout_s: 0.0,
+        clip_patterns: false,
+        mapping_timeout_s: 0.0,
+        flow_gate_deg: 180.0,
+        nav_drift_mps: 0.0,
+        ..AmpParams::default()
+    }
 }
 
 fn behaviours(events: &[PlannerEvent]) -> Vec<BehaviourKind> {
@@ -83,7 +104,8 @@ fn starts_by_going_to_the_most_downflow_corner_then_finds() {
 
 #[test]
 fn track_in_flips_lhs_on_the_wrapped_heading_difference() {
-    let mut a = amp();
+    // Table 1 as printed (LHS from the heading at every detection).
+    let mut a = amp_with(paper());
     a.decide(&snap(0.0, (200.0, 500.0), 0.0, false));
     // Heading 170: psi_v - psi_f = 170 < 180, so LHS = +1 after the detection.
     a.decide(&snap(1.0, (200.0, 500.0), 170.0, true));
@@ -371,4 +393,358 @@ fn multi_source_tracing_to_the_upflow_edge_declares_there() {
             && declared[0].1 == DeclarationKind::UpflowEdge
     );
     assert_eq!(a.behaviour(), BehaviourKind::Transit);
+}
+
+/// Flies the planner's commands with a point vehicle: the heading follows the command (the
+/// autopilot rate-limits it already), the position moves 2 m/s along the heading in still water
+/// plus the flow (0.1 m/s North); `detect(t, pos)` says when the sensor detects.
+fn fly(
+    a: &mut Amp,
+    from: (f64, f64),
+    heading_deg: f64,
+    seconds: f64,
+    detect: impl Fn(f64, Vec2) -> bool,
+) -> Vec<(f64, Vec2, f64)> {
+    fly_in(a, from, heading_deg, (0.0, seconds), detect, |_| {
+        Vec2::new(0.0, 0.1)
+    })
+}
+
+/// [`fly`] from `t0` to `t1`, with the measured flow `flow(t)` (the vehicle drifts with the
+/// true 0.1 m/s northward flow whatever is measured), and the behaviour at each step.
+fn fly_in(
+    a: &mut Amp,
+    from: (f64, f64),
+    heading_deg: f64,
+    (t0, t1): (f64, f64),
+    detect: impl Fn(f64, Vec2) -> bool,
+    flow: impl Fn(f64) -> Vec2,
+) -> Vec<(f64, Vec2, f64)> {
+    let (mut pos, mut h) = (Vec2::new(from.0, from.1), heading_deg);
+    let mut track = Vec::new();
+    let steps = ((t1 - t0) / 0.1).round() as usize;
+    for k in 0..steps {
+        let t = t0 + k as f64 * 0.1;
+        let mut sn = snap(t, (pos.x, pos.y), h, detect(t, pos));
+        sn.flow = Some(FlowSample {
+            time_s: t,
+            velocity_mps: flow(t),
+        });
+        let d = a.decide(&sn);
+        if d.status != PlanStatus::Running {
+            break;
+        }
+        h = d.command.heading.deg();
+        pos += Heading::from_deg(h).unit() * (d.command.speed_mps * 0.1) + Vec2::new(0.0, 0.01);
+        track.push((t, pos, h));
+    }
+    track
+}
+
+/// Seconds from `t0` until the behaviour is no longer `b` (or the end of the flight).
+fn time_in(a_behaviours: &[(f64, BehaviourKind)], b: BehaviourKind, t0: f64) -> f64 {
+    a_behaviours
+        .iter()
+        .find(|(t, k)| *t >= t0 && *k != b)
+        .map_or(f64::INFINITY, |(t, _)| t - t0)
+}
+
+#[test]
+fn track_in_locks_onto_the_downflow_heading() {
+    // Track-In starts heading downflow (North, with the flow) and keeps detecting. Table 1 as
+    // printed flips LHS as the heading crosses the flow direction and the rate filter's short
+    // turns cancel: the vehicle runs downflow. With the default it turns round and goes upflow.
+    let downflow_then = |p: AmpParams| {
+        let mut a = amp_with(p);
+        let track = fly(&mut a, (200.0, 500.0), 0.0, 60.0, |t, _| t > 1.0);
+        let (_, _, h) = *track.last().unwrap();
+        (
+            Heading::from_deg(h)
+                .diff_deg(Heading::from_deg(180.0))
+                .abs(),
+            a.behaviour(),
+        )
+    };
+    let (off_upflow, b) = downflow_then(paper());
+    assert_eq!(b, BehaviourKind::TrackIn);
+    assert!(
+        off_upflow > 150.0,
+        "the paper's LHS holds downflow: {off_upflow}"
+    );
+    let (off_upflow, b) = downflow_then(AmpParams::default());
+    assert_eq!(b, BehaviourKind::TrackIn);
+    assert!(
+        off_upflow <= 20.0 + 1e-6,
+        "turned round to upflow +- beta: {off_upflow}"
+    );
+}
+
+/// Flies `a` from `from` for `(t0, t1)` without detections, recording the behaviour each step.
+fn behaviours_flying(
+    a: &mut Amp,
+    from: (f64, f64),
+    heading_deg: f64,
+    (t0, t1): (f64, f64),
+) -> Vec<(f64, BehaviourKind)> {
+    let (mut pos, mut h) = (Vec2::new(from.0, from.1), heading_deg);
+    let mut out = Vec::new();
+    let steps = ((t1 - t0) / 0.1).round() as usize;
+    for k in 0..steps {
+        let t = t0 + k as f64 * 0.1;
+        let d = a.decide(&snap(t, (pos.x, pos.y), h, false));
+        out.push((t, a.behaviour()));
+        if d.status != PlanStatus::Running {
+            break;
+        }
+        h = d.command.heading.deg();
+        pos += Heading::from_deg(h).unit() * (d.command.speed_mps * 0.1) + Vec2::new(0.0, 0.01);
+    }
+    out
+}
+
+#[test]
+fn reacquire_never_ends_at_an_op_area_edge() {
+    // A lost point 20 m inside the upflow (South) edge: the first Bowtie's centre 10 m upflow of
+    // it, its lines reach 48 m further upflow, outside the op-area.
+    let run = |p: AmpParams| {
+        let mut a = amp_with(p);
+        a.decide(&snap(0.0, (200.0, 500.0), 0.0, false));
+        lose_at(&mut a, &[(200.0, 20.0)]);
+        assert_eq!(a.behaviour(), BehaviourKind::Reacquire);
+        let goal = a.track_out_goal().unwrap();
+        let b = behaviours_flying(&mut a, (goal.x, goal.y), 180.0, (30.0, 3630.0));
+        time_in(&b, BehaviourKind::Reacquire, 30.0)
+    };
+    let paper = run(paper());
+    assert!(
+        paper.is_infinite(),
+        "the paper's Reacquire circles at the edge: {paper}"
+    );
+    let now = run(AmpParams::default());
+    assert!(now < 900.0 + 1.0, "Reacquire ends: {now} s");
+}
+
+#[test]
+fn mapping_never_ends_near_an_edge() {
+    // A declaration 5 m inside the East edge: the mapping lines 10 m and 30 m further East lie
+    // outside, beyond the cage's reach.
+    let run = |p: AmpParams| {
+        let mut a = amp_with(p);
+        a.decide(&snap(0.0, (200.0, 500.0), 0.0, false));
+        lose_at(&mut a, &[(395.0, 300.0), (396.0, 298.0), (394.0, 296.5)]);
+        assert_eq!(a.behaviour(), BehaviourKind::Mapping);
+        let b = behaviours_flying(&mut a, (394.0, 296.5), 180.0, (100.0, 3700.0));
+        time_in(&b, BehaviourKind::Mapping, 100.0)
+    };
+    let paper = run(paper());
+    assert!(
+        paper.is_infinite(),
+        "the paper's mapping never ends: {paper}"
+    );
+    let now = run(AmpParams::default());
+    assert!(now < 1800.0 + 1.0, "mapping ends: {now} s");
+}
+
+#[test]
+fn a_reversed_flow_reading_does_not_turn_the_search_round() {
+    // The flow goes North at 0.1 m/s; from t = 100 s to 400 s the current meter reads it
+    // reversed. The paper's planner takes the reading: its upflow turns North.
+    let run = |p: AmpParams| {
+        let mut a = amp_with(p);
+        let reversed = |t: f64| {
+            if (100.0..400.0).contains(&t) {
+                Vec2::new(0.0, -0.1)
+            } else {
+                Vec2::new(0.0, 0.1)
+            }
+        };
+        fly_in(
+            &mut a,
+            (200.0, 500.0),
+            0.0,
+            (0.0, 350.0),
+            |_, _| false,
+            reversed,
+        );
+        // Track-In's course is the upflow direction it believes, offset by beta.
+        a.decide(&snap(350.0, (200.0, 500.0), 180.0, true));
+        a.last_course().diff_deg(Heading::from_deg(180.0)).abs()
+    };
+    assert!(
+        run(paper()) > 90.0,
+        "the paper's upflow follows the faulty reading"
+    );
+    assert!(
+        run(AmpParams::default()) <= 20.0 + 1e-6,
+        "upflow stays South"
+    );
+}
+
+#[test]
+fn sparse_fixes_let_the_vehicle_drift_out_before_the_cage_acts() {
+    // 8 m inside the East edge, heading East, the last fix 900 s ago: with the assumed drift
+    // of 0.02 m/s the navigation may be 18 m off, so the cage turns the vehicle back already.
+    let run = |p: AmpParams| {
+        let mut a = amp_with(p);
+        let mut s = snap(0.0, (392.0, 500.0), 90.0, false);
+        a.decide(&s);
+        // Find sweeps at psi_f +- 110: heading it East keeps the course East-South-East.
+        s.time_s = 900.0;
+        s.nav.last_fix_s = Some(0.0);
+        for k in 0..20 {
+            s.time_s = 900.0 + f64::from(k) * 0.1;
+            a.decide(&s);
+        }
+        let d = a.decide(&s);
+        d.command.heading.unit().x
+    };
+    assert!(run(paper()) > 0.0, "the paper's cage lets the course out");
+    assert!(run(AmpParams::default()) < 0.0, "turned back inside");
+}
+
+#[test]
+fn stale_lost_points_are_searched_after_the_tide_turns() {
+    // Lost points set with the flow going North; then the tide turns the flow East over five
+    // minutes, and it stays East.
+    let run = |p: AmpParams| {
+        let mut a = amp_with(p);
+        a.decide(&snap(0.0, (200.0, 500.0), 0.0, false));
+        lose_at(&mut a, &[(200.0, 300.0), (205.0, 280.0)]);
+        assert_eq!(a.behaviour(), BehaviourKind::Reacquire);
+        let east = |t: f64| {
+            let turned = ((t - 40.0) / 300.0).clamp(0.0, 1.0) * std::f64::consts::FRAC_PI_2;
+            Vec2::new(turned.sin(), turned.cos()) * 0.1
+        };
+        fly_in(
+            &mut a,
+            (205.0, 280.0),
+            180.0,
+            (40.0, 500.0),
+            |_, _| false,
+            east,
+        );
+        (a.behaviour(), a.lost_points().len())
+    };
+    let (b, n) = run(paper());
+    assert!(b == BehaviourKind::Reacquire && n > 0, "{b:?} {n}");
+    let (b, n) = run(AmpParams::default());
+    assert_eq!((b, n), (BehaviourKind::Find, 0));
+}
+
+#[test]
+fn no_convergence_near_the_source_in_strong_currents() {
+    // Losses near a source in a strong current scatter along the flow. The field list (the
+    // oldest point dropped) follows the latest losses, which keep landing downflow: three points
+    // within 4 m never coexist. Keeping the most upflow points (most_downflow eviction) lets the
+    // points near the source accumulate until three agree. Flow North: upflow is South, so the
+    // points nearest the source have the smallest y.
+    let losses = [
+        (200.0, 300.0),
+        (201.0, 340.0),
+        (199.0, 302.5),
+        (200.0, 360.0),
+        (202.0, 330.0),
+        (198.0, 350.0),
+        (200.0, 345.0),
+        (201.0, 355.0),
+        (199.0, 303.5),
+    ];
+    let declared = |p: AmpParams| {
+        let mut a = amp_with(p);
+        a.decide(&snap(0.0, (200.0, 500.0), 0.0, false));
+        lose_at(&mut a, &losses).iter().find_map(|e| match e {
+            PlannerEvent::Declared { pos_m, .. } => Some(*pos_m),
+            _ => None,
+        })
+    };
+    let field = AmpParams {
+        lost_point_eviction: LostPointEviction::Oldest,
+        ..paper()
+    };
+    assert_eq!(declared(field), None, "the oldest dropped: no three agree");
+    assert_eq!(
+        declared(AmpParams::default()),
+        Some(Vec2::new(200.0, 300.0))
+    );
+}
+
+#[test]
+fn a_lost_point_that_never_agrees_ages_out() {
+    // The most-downflow list keeps an early point 30 m upflow of where the plume is lost from
+    // then on; without ageing it blocks the declaration for good.
+    let losses = [
+        (200.0, 270.0),
+        (200.0, 300.0),
+        (201.0, 301.5),
+        (199.0, 302.5),
+    ];
+    let run = |age_s: f64| {
+        let mut a = amp_with(AmpParams {
+            lost_point_max_age_s: age_s,
+            ..AmpParams::default()
+        });
+        a.decide(&snap(0.0, (200.0, 500.0), 0.0, false));
+        let mut events = lose_at(&mut a, &losses[..1]);
+        // Half an hour later the plume is lost three times 30 m downflow of the first point.
+        let mut t = 2000.0;
+        for &(x, y) in &losses[1..] {
+            events.extend(a.decide(&snap(t, (x, y), 180.0, true)).events);
+            t += 6.0;
+            events.extend(a.decide(&snap(t, (x, y - 1.0), 180.0, false)).events);
+            if let Some(goal) = a.track_out_goal() {
+                t += 10.0;
+                events.extend(a.decide(&snap(t, (goal.x, goal.y), 180.0, false)).events);
+            }
+            t += 1.0;
+        }
+        events
+            .iter()
+            .any(|e| matches!(e, PlannerEvent::Declared { .. }))
+    };
+    assert!(!run(0.0), "never aged: the upflow point blocks the rule");
+    assert!(run(1800.0), "aged out after 30 min: the three agree");
+}
+
+#[test]
+fn a_wide_area_across_the_flow_is_swept_at_the_spacing() {
+    // 720 m across the flow: the field's 20 deg crosses it gaining 262 m up-flow per leg; the
+    // zigzag's angle gives 120 m.
+    let area = OpArea::rectangle(-360.0, 360.0, -150.0, 150.0).unwrap();
+    let mut a = Amp::new(AmpParams::default(), area, vec![], Heading::NORTH);
+    let track = fly(&mut a, (350.0, 140.0), 180.0, 600.0, |_, _| false);
+    assert_eq!(a.behaviour(), BehaviourKind::Find);
+    let course = a.last_course().diff_deg(Heading::from_deg(180.0)).abs();
+    let want = 90.0 - (120.0_f64 / 720.0).atan().to_degrees();
+    assert!(
+        (course - want).abs() < 0.5,
+        "{course} from upflow, want {want}"
+    );
+    assert!(!track.is_empty());
+}
+
+#[test]
+fn the_search_start_follows_the_flow_estimate() {
+    // The prior says the flow goes North, the current meter says East: the way to the search
+    // start turns from the northern corners to the eastern ones as the estimate settles.
+    let mut a = amp();
+    let east = |_: f64| Vec2::new(0.1, 0.0);
+    let track = fly_in(
+        &mut a,
+        (200.0, 500.0),
+        0.0,
+        (0.0, 150.0),
+        |_, _| false,
+        east,
+    );
+    assert_eq!(a.behaviour(), BehaviourKind::GoTo);
+    let start = a.search_start(0);
+    assert!(start.x > 380.0, "an eastern corner: {start:?}");
+    // Still on the way, and heading for it.
+    let (_, pos, _) = *track.last().unwrap();
+    let bearing = bearing_between(pos, start).unwrap();
+    assert!(
+        a.last_course().diff_deg(bearing).abs() < 1.0,
+        "{}",
+        a.last_course().deg()
+    );
 }

@@ -768,6 +768,7 @@ fn vehicle_setup(
         position_estimate: n.position_estimate.unwrap_or(nb.position_estimate),
         speed_sd_mps: n.speed_sd_mps.unwrap_or(nb.speed_sd_mps),
         altimeter_sd_m: n.altimeter_sd_m.unwrap_or(nb.altimeter_sd_m),
+        flow_check: n.flow_check.unwrap_or(nb.flow_check),
     };
     nav.validate(&format!("{key}.nav"))?;
     let cb = ChemSensorParams::default();

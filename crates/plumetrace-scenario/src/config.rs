@@ -397,6 +397,8 @@ pub struct NavConfig {
     pub speed_sd_mps: Option<f64>,
     /// Altimeter noise, m.
     pub altimeter_sd_m: Option<f64>,
+    /// Check measured currents for plausibility before dead-reckoning with them.
+    pub flow_check: Option<bool>,
 }
 
 /// `[vehicles.chem_sensor]`

@@ -36,6 +36,10 @@ pub struct NavParams {
     pub speed_sd_mps: f64,
     /// Altimeter noise, m (standard deviation); surface craft report no altitude.
     pub altimeter_sd_m: f64,
+    /// Check each measured current against the recent ones before dead-reckoning with it
+    /// ([`plumetrace_core::FlowGate`]): a reading reversed from one sample to the next (a current
+    /// meter reading the wrong layer) is replaced by the last plausible one.
+    pub flow_check: bool,
 }
 
 impl NavParams {
@@ -52,6 +56,7 @@ impl NavParams {
             position_estimate: true,
             speed_sd_mps: 0.01,
             altimeter_sd_m: 0.05,
+            flow_check: true,
         }
     }
 
@@ -66,6 +71,7 @@ impl NavParams {
             position_estimate: true,
             speed_sd_mps: 0.02,
             altimeter_sd_m: 0.0,
+            flow_check: true,
         }
     }
 
@@ -116,6 +122,9 @@ pub struct Navigator {
     heading: Heading,
     /// Measured water-relative velocity at the previous update (for the trapezoidal step).
     last_water_velocity: Vec2,
+    /// The plausibility check of measured currents, and the last current it accepted.
+    flow_gate: Option<plumetrace_core::FlowGate>,
+    last_flow: Vec2,
 }
 
 impl Navigator {
@@ -129,6 +138,10 @@ impl Navigator {
             last_fix_s: None,
             heading: start.heading,
             last_water_velocity: start.heading.unit() * start.speed_mps,
+            flow_gate: params.flow_check.then(|| {
+                plumetrace_core::FlowGate::new(plumetrace_core::FlowGateParams::default())
+            }),
+            last_flow: Vec2::zeros(),
         }
     }
 
@@ -160,9 +173,18 @@ impl Navigator {
         let p = self.params;
         let nh: f64 = StandardNormal.sample(rng);
         self.heading = truth.heading.turned_deg(p.heading_sd_deg * nh);
-        let flow = measured_flow_mps
-            .filter(|f| f.x.is_finite() && f.y.is_finite())
-            .unwrap_or_else(Vec2::zeros);
+        let flow = match (measured_flow_mps, self.flow_gate.as_mut()) {
+            (Some(f), Some(g)) => {
+                if g.accept(t_s, f) {
+                    self.last_flow = f;
+                }
+                self.last_flow
+            }
+            (f, None) => f
+                .filter(|f| f.x.is_finite() && f.y.is_finite())
+                .unwrap_or_else(Vec2::zeros),
+            (None, Some(_)) => Vec2::zeros(),
+        };
         // Trapezoidal integration of the measured water-relative velocity, as the vehicle moves:
         // without noise the estimate then follows the truth exactly.
         let water = self.heading.unit() * truth.speed_mps;

@@ -196,6 +196,8 @@ impl Lawnmower {
             flow_compensation: p.flow_compensation,
             max_turn_rate_deg_s: p.max_turn_rate_deg_s,
             vertical: VerticalCommand::Altitude(p.altitude_m),
+            nav_drift_mps: 0.0,
+            max_inset_m: 0.0,
         });
         Lawnmower {
             flow: FlowEstimate::new(p.flow_average_s, prior_flow),

@@ -561,6 +561,8 @@ impl Moth {
             flow_compensation: p.flow_compensation,
             max_turn_rate_deg_s: p.max_turn_rate_deg_s,
             vertical: VerticalCommand::Altitude(p.altitude_m),
+            nav_drift_mps: 0.0,
+            max_inset_m: 0.0,
         });
         let centroid =
             area.vertices().iter().fold(Vec2::zeros(), |a, v| a + v) / area.vertices().len() as f64;

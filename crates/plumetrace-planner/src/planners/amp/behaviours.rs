@@ -1,7 +1,7 @@
 //! The AMP's own behaviours: Find, Track-In, Track-Out and Reacquire. (Go-To, Transit and
 //! Mapping are the shared [`GoTo`](crate::behaviour::GoTo) and [`Legs`](crate::behaviour::Legs).)
 
-use super::{AmpDone, Memory, bowtie, find};
+use super::{AmpDone, FindPattern, LhsUpdate, Memory, bowtie, find};
 use crate::behaviour::{Behaviour, Percept, Proposal};
 use plumetrace_core::{BehaviourKind, Heading, Vec2};
 use plumetrace_guidance::{FollowLine, GoToPoint, ModeStatus, Steer};
@@ -22,12 +22,20 @@ impl Behaviour<Memory, AmpDone> for Find {
         if (!e.inside || e.distance_m < m.p.find_margin_m)
             && self.heading.unit().dot(&e.outward_normal) > 0.0
         {
-            self.heading = find::reflect(
-                self.heading,
-                e.outward_normal,
-                m.flow.toward(),
-                m.p.find_offset_deg,
-            );
+            self.heading = match m.p.find_pattern {
+                FindPattern::Billiard => find::reflect(
+                    self.heading,
+                    e.outward_normal,
+                    m.flow.toward(),
+                    m.p.find_offset_deg,
+                ),
+                FindPattern::Zigzag => find::zigzag(
+                    self.heading,
+                    e.outward_normal,
+                    m.flow.toward(),
+                    m.find_offset_deg(),
+                ),
+            };
         }
         Proposal::Steer(Steer {
             heading: self.heading,
@@ -58,7 +66,14 @@ impl Behaviour<Memory, AmpDone> for TrackIn {
         if p.detected {
             // Table 1: command with the current LHS, then update LHS from the heading.
             self.heading = m.flow.upflow().turned_deg(m.lhs * m.p.beta_deg);
-            m.lhs = m.lhs_from_heading(p.heading);
+            // Heading more than 90 deg off upflow (turning round from downflow), the side is
+            // kept so that the turn completes: updated from the heading, the side flips as the
+            // heading crosses the flow direction and the rate filter's short turns cancel out,
+            // holding the vehicle on the downflow heading.
+            let heading_upflow = p.heading.diff_deg(m.flow.upflow()).abs() < 90.0;
+            if m.p.track_in_lhs == LhsUpdate::EveryDetection || heading_upflow {
+                m.lhs = m.lhs_from_heading(p.heading);
+            }
             m.last_detection = Some((p.t_s, p.pos_m));
             if let Some(at) = m.upflow_edge(p.pos_m) {
                 return Proposal::Done(AmpDone::AtEdge { at });
@@ -96,14 +111,17 @@ impl Behaviour<Memory, AmpDone> for TrackOut {
     }
 }
 
-/// `N_re` Bowties around one lost point: from `bowtie_offset_m` upflow of it down to it.
+/// `N_re` Bowties around one lost point: from `bowtie_offset_m` upflow of it down to it. With
+/// `clip_patterns` each line is flown only where it lies inside the op-area (a line with no such
+/// part is skipped), and after `reacquire_timeout_s` the point is given up.
 #[derive(Debug, Clone)]
 pub(super) struct Reacquire {
     point: Vec2,
     n: usize,
     leg: usize,
     bowtie: bowtie::Bowtie,
-    line: FollowLine,
+    line: Option<FollowLine>,
+    started_s: Option<f64>,
 }
 
 impl Reacquire {
@@ -116,17 +134,20 @@ impl Reacquire {
             leg: 0,
             bowtie,
             line,
+            started_s: None,
         }
     }
 }
 
-fn new_bowtie(m: &Memory, point: Vec2, n: usize) -> (bowtie::Bowtie, FollowLine) {
+fn new_bowtie(m: &Memory, point: Vec2, n: usize) -> (bowtie::Bowtie, Option<FollowLine>) {
     let up = m.flow.upflow();
     let n_re = (m.p.n_re as usize).max(1);
     let centres = bowtie::centres(point, up, m.p.bowtie_offset_m, n_re);
     let c = centres[n.min(centres.len() - 1)];
     let b = bowtie::Bowtie::new(c, up, m.lhs, m.p.bowtie_angle_deg, m.p.bowtie_half_width_m);
-    let line = m.p.line(b.first.0, b.first.1);
+    let line = m
+        .pattern_line(b.first.0, b.first.1)
+        .map(|(s, e)| m.p.line(s, e));
     (b, line)
 }
 
@@ -136,26 +157,47 @@ impl Behaviour<Memory, AmpDone> for Reacquire {
     }
 
     fn propose(&mut self, p: &Percept, m: &mut Memory) -> Proposal<AmpDone> {
+        let started = *self.started_s.get_or_insert(p.t_s);
+        // Given up after its time, or when the point itself was dropped (aged out, or set
+        // under a flow that has since turned).
+        let dropped = !m.lost.iter().any(|l| l.pos == self.point);
+        if dropped || (m.p.reacquire_timeout_s > 0.0 && p.t_s - started > m.p.reacquire_timeout_s) {
+            return Proposal::Done(AmpDone::Searched { point: self.point });
+        }
         // At most three legs per Bowtie and `N_re` Bowties: the loop ends.
         loop {
-            match self.line.update(p.pose()) {
+            let status = match self.line.as_mut() {
+                Some(line) => line.update(p.pose()),
+                // A leg with no part inside the op-area is skipped.
+                None => ModeStatus::Done(plumetrace_guidance::DoneReason::Arrived),
+            };
+            match status {
                 ModeStatus::Running(s) => return Proposal::Steer(s),
                 ModeStatus::Done(_) => {
                     self.leg += 1;
                     let b = self.bowtie;
                     match self.leg {
                         // The side of the Bowtie: from the end of the first line, downflow, to
-                        // the start of the second.
+                        // the start of the second (both clipped like the lines).
                         1 => {
-                            self.line = FollowLine::tracking(
-                                b.first.1,
-                                b.second.0,
-                                m.p.speed_mps,
-                                m.p.r_m,
-                                m.p.k_deg_per_m,
-                            )
+                            let second = m.pattern_line(b.second.0, b.second.1);
+                            self.line = m.pattern_line(b.first.0, b.first.1).zip(second).map(
+                                |((_, first_end), (second_start, _))| {
+                                    FollowLine::tracking(
+                                        first_end,
+                                        second_start,
+                                        m.p.speed_mps,
+                                        m.p.r_m,
+                                        m.p.k_deg_per_m,
+                                    )
+                                },
+                            );
                         }
-                        2 => self.line = m.p.line(b.second.0, b.second.1),
+                        2 => {
+                            self.line = m
+                                .pattern_line(b.second.0, b.second.1)
+                                .map(|(s, e)| m.p.line(s, e));
+                        }
                         _ => {
                             let n = self.n + 1;
                             if n >= (m.p.n_re as usize).max(1) {
@@ -168,6 +210,7 @@ impl Behaviour<Memory, AmpDone> for Reacquire {
                                 leg: 0,
                                 bowtie,
                                 line,
+                                started_s: Some(started),
                             };
                         }
                     }

@@ -1,4 +1,5 @@
-//! Find: sweep across the flow from the most downflow corner, reflecting at the boundary.
+//! Find: sweep across the flow from the most downflow corner, reflecting at the boundary (the
+//! field description's billiard, or a zigzag that always makes way up or down the flow).
 
 use plumetrace_core::{Heading, Vec2};
 use plumetrace_guidance::OpArea;
@@ -54,6 +55,52 @@ pub fn reflect(heading: Heading, normal: Vec2, flow_toward: Heading, offset_deg:
     let mirrored = h - normal * (2.0 * h.dot(&normal));
     fits.max_by(|a, b| a.unit().dot(&mirrored).total_cmp(&b.unit().dot(&mirrored)))
         .unwrap_or_else(|| Heading::of_vector(tangent * along_sign).unwrap_or(heading))
+}
+
+/// The zigzag Find's heading after meeting a boundary with outward normal `normal` while on
+/// `heading`. Going up the flow (`heading` has an upflow component): the other across-flow side
+/// at `psi_f +- (90 + offset)` if it points back inside (the sweep goes on up the flow), else the
+/// way down, `psi_f +- (90 - offset)`, that points inside most (the sweep has reached the up-flow
+/// end). Going down the flow: the same with the roles swapped. When no candidate points inside
+/// (a narrow corner), the direction along the boundary.
+pub fn zigzag(heading: Heading, normal: Vec2, flow_toward: Heading, offset_deg: f64) -> Heading {
+    let up = flow_toward.reversed().unit();
+    let going_up = heading.unit().dot(&up) > 0.0;
+    let across = flow_toward.turned_deg(90.0).unit();
+    let side = if heading.unit().dot(&across) >= 0.0 {
+        1.0
+    } else {
+        -1.0
+    };
+    let up_other = flow_toward.turned_deg(-side * (90.0 + offset_deg));
+    let down_other = flow_toward.turned_deg(-side * (90.0 - offset_deg));
+    let down_same = flow_toward.turned_deg(side * (90.0 - offset_deg));
+    let up_same = flow_toward.turned_deg(side * (90.0 + offset_deg));
+    let inward = |h: &Heading| h.unit().dot(&normal) < 0.0;
+    let order = if going_up {
+        [up_other, down_other, down_same, up_same]
+    } else {
+        [down_other, up_other, up_same, down_same]
+    };
+    // The first candidate of the order that points inside; the sweep's direction along the flow
+    // changes only when the same direction across the flow cannot go on.
+    if let Some(h) = order.iter().take(1).find(|h| inward(h)) {
+        return *h;
+    }
+    order[1..]
+        .iter()
+        .filter(|h| inward(h))
+        .max_by(|a, b| (-a.unit().dot(&normal)).total_cmp(&(-b.unit().dot(&normal))))
+        .copied()
+        .unwrap_or_else(|| {
+            let tangent = Vec2::new(-normal.y, normal.x);
+            let along = if heading.unit().dot(&tangent) >= 0.0 {
+                1.0
+            } else {
+                -1.0
+            };
+            Heading::of_vector(tangent * along).unwrap_or(heading)
+        })
 }
 
 #[cfg(test)]

@@ -1,0 +1,133 @@
+//! A plausibility check of current measurements against their recent history.
+//!
+//! A current meter that reads the wrong layer (or a sensor glitch) can report the current reversed
+//! from one sample to the next, while a real current turns slowly: a tide swings its direction
+//! over hours. [`FlowGate`] keeps a reference, the exponential mean of the samples it accepted,
+//! and holds back a sample that points more than `max_turn_deg` away from it (both faster than
+//! `min_speed_mps`, so that a slack current's noise is not judged). If such samples keep coming
+//! for `persist_s` without one plausible sample between them, the change is taken as real: the
+//! gate accepts them and restarts its reference from them. A planner steering by the current and
+//! a navigation dead-reckoning with it both use it; it has no randomness and no model of its own.
+
+use crate::Vec2;
+
+/// Settings of a [`FlowGate`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FlowGateParams {
+    /// A sample further than this from the reference direction is implausible, deg.
+    pub max_turn_deg: f64,
+    /// Samples and references slower than this are not judged, m/s.
+    pub min_speed_mps: f64,
+    /// How long implausible samples must persist to be believed, s.
+    pub persist_s: f64,
+    /// Time constant of the reference, s.
+    pub reference_s: f64,
+}
+
+impl Default for FlowGateParams {
+    fn default() -> Self {
+        FlowGateParams {
+            max_turn_deg: 90.0,
+            min_speed_mps: 0.03,
+            persist_s: 1800.0,
+            reference_s: 120.0,
+        }
+    }
+}
+
+/// The check and its state.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FlowGate {
+    p: FlowGateParams,
+    reference: Option<(f64, Vec2)>,
+    doubting_since: Option<f64>,
+}
+
+impl FlowGate {
+    /// A gate with no history (it accepts the first sample).
+    pub fn new(p: FlowGateParams) -> Self {
+        FlowGate {
+            p,
+            reference: None,
+            doubting_since: None,
+        }
+    }
+
+    /// Whether the sample `v_mps` taken at `t_s` is plausible (to be used); non-finite samples
+    /// never are.
+    pub fn accept(&mut self, t_s: f64, v_mps: Vec2) -> bool {
+        if !(v_mps.x.is_finite() && v_mps.y.is_finite() && t_s.is_finite()) {
+            return false;
+        }
+        let Some((t0, r)) = self.reference else {
+            self.reference = Some((t_s, v_mps));
+            return true;
+        };
+        let judged = v_mps.norm() > self.p.min_speed_mps && r.norm() > self.p.min_speed_mps;
+        let cos = v_mps.dot(&r) / (v_mps.norm() * r.norm()).max(1e-12);
+        let implausible = judged && cos < self.p.max_turn_deg.to_radians().cos();
+        if implausible {
+            let since = *self.doubting_since.get_or_insert(t_s);
+            if t_s - since < self.p.persist_s {
+                return false;
+            }
+            // Believed: the reference restarts from this sample.
+            self.doubting_since = None;
+            self.reference = Some((t_s, v_mps));
+            return true;
+        }
+        self.doubting_since = None;
+        let dt = (t_s - t0).max(0.0);
+        let a = if self.p.reference_s > 0.0 {
+            1.0 - (-dt / self.p.reference_s).exp()
+        } else {
+            1.0
+        };
+        self.reference = Some((t_s, r + (v_mps - r) * a));
+        true
+    }
+
+    /// Whether it is holding samples back now.
+    pub fn doubting(&self) -> bool {
+        self.doubting_since.is_some()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_reversal_is_held_back_a_slow_turn_passes_and_a_lasting_change_is_believed() {
+        let mut g = FlowGate::new(FlowGateParams {
+            persist_s: 100.0,
+            ..FlowGateParams::default()
+        });
+        let east = Vec2::new(0.2, 0.0);
+        for k in 0..60 {
+            assert!(g.accept(f64::from(k), east));
+        }
+        // Reversed for 50 s: held back; then back to normal.
+        for k in 60..110 {
+            assert!(!g.accept(f64::from(k), -east), "t = {k}");
+        }
+        assert!(g.accept(110.0, east) && !g.doubting());
+        // A tide turning 90 degrees over an hour passes sample by sample.
+        for k in 0..3600 {
+            let a = f64::from(k) / 3600.0 * std::f64::consts::FRAC_PI_2;
+            let v = Vec2::new(a.cos(), a.sin()) * 0.2;
+            assert!(g.accept(111.0 + f64::from(k), v), "turning, {k} s in");
+        }
+        // A lasting reversal is believed after 100 s.
+        let t0 = 4001.0;
+        let north = Vec2::new(0.0, 0.2);
+        for k in 0..100 {
+            assert!(!g.accept(t0 + f64::from(k), -north));
+        }
+        assert!(g.accept(t0 + 100.0, -north));
+        assert!(g.accept(t0 + 101.0, -north));
+        assert!(!g.accept(t0 + 102.0, Vec2::new(f64::NAN, 0.0)));
+        // Slack water is not judged.
+        assert!(g.accept(t0 + 103.0, Vec2::new(0.01, 0.0)));
+    }
+}
