@@ -53,6 +53,19 @@ impl FlowGate {
         }
     }
 
+    /// The gate with a prior direction `toward` as its history: the first samples are judged
+    /// against it (a current meter that reads reversed from the start is held back like one that
+    /// turns later), and the first plausible sample replaces it. A zero or non-finite `toward`
+    /// leaves the gate without history.
+    pub fn with_reference(mut self, toward: Vec2) -> Self {
+        let n = toward.norm();
+        if n.is_finite() && n > 0.0 {
+            // Only the direction is judged; the time makes the first sample replace it whole.
+            self.reference = Some((f64::NEG_INFINITY, toward / n));
+        }
+        self
+    }
+
     /// Whether the sample `v_mps` taken at `t_s` is plausible (to be used); non-finite samples
     /// never are.
     pub fn accept(&mut self, t_s: f64, v_mps: Vec2) -> bool {
@@ -96,6 +109,30 @@ impl FlowGate {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_prior_judges_the_first_samples_and_the_first_plausible_one_replaces_it() {
+        let p = FlowGateParams {
+            persist_s: 100.0,
+            ..FlowGateParams::default()
+        };
+        let east = Vec2::new(0.2, 0.0);
+        let mut g = FlowGate::new(p).with_reference(Vec2::new(1.0, 0.1));
+        for k in 0..100 {
+            assert!(
+                !g.accept(f64::from(k), -east),
+                "reversed from the start, t = {k}"
+            );
+        }
+        let mut g = FlowGate::new(p).with_reference(Vec2::new(1.0, 0.1));
+        assert!(g.accept(0.0, east));
+        // The history is now the sample: a turn of 80 deg from the prior's direction that is
+        // 90+ from the sample's is held back.
+        assert!(!g.accept(1.0, Vec2::new(-0.01, 0.2)));
+        // No prior: the first sample is believed.
+        let mut g = FlowGate::new(p).with_reference(Vec2::zeros());
+        assert!(g.accept(0.0, -east));
+    }
 
     #[test]
     fn a_reversal_is_held_back_a_slow_turn_passes_and_a_lasting_change_is_believed() {

@@ -117,6 +117,7 @@ impl MissionSetup {
                 .map(|(k, r)| area(r, format!("mission.subregions[{k}]")))
                 .collect::<Result<_, _>>()?,
             prior_flow_toward_deg: spec.prior_flow_toward_deg,
+            prior_flow_given: spec.prior_flow_given,
         };
         let mut planned = Vec::with_capacity(sc.vehicles.len());
         for (k, v) in sc.vehicles.iter().enumerate() {

@@ -180,7 +180,8 @@ fn a_sensor_threshold_in_an_older_file_reaches_the_planner() {
     );
     let origin = Origin::File("scenario.toml".into());
     let mut cfg = plumetrace_scenario::parse(&text, &origin).unwrap();
-    shorten(&mut cfg, 600.0, 400.0);
+    // The whole spin-up: the plume reaches the downflow edge, where the search starts.
+    shorten(&mut cfg, 3500.0, 400.0);
     let setup = MissionSetup::new(build(&cfg, &origin, Some(1)).unwrap()).unwrap();
     let p = setup.planners[0].as_ref().unwrap();
     assert_eq!(p.config.detection_threshold_v(), Some(4.99));
@@ -190,7 +191,7 @@ fn a_sensor_threshold_in_an_older_file_reaches_the_planner() {
     assert_eq!(run.summary.first_detection_s, None);
     assert!(run.trajectory.iter().all(|r| !r.detection));
     // The same run at the default threshold detects.
-    let run = run_mission(shortened("demo", 600.0, 400.0, 1), &mut |_, _| {}).unwrap();
+    let run = run_mission(shortened("demo", 3500.0, 400.0, 1), &mut |_, _| {}).unwrap();
     assert!(run.summary.first_detection_s.is_some());
 }
 

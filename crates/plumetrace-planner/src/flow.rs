@@ -33,6 +33,14 @@ impl FlowEstimate {
         self
     }
 
+    /// The same estimate with its gate (if any) judging the first readings against the
+    /// fallback direction (a prior that was given, not assumed).
+    pub fn trusting_fallback(mut self) -> Self {
+        let toward = self.fallback.unit();
+        self.gate = self.gate.map(|g| g.with_reference(toward));
+        self
+    }
+
     /// Whether the gate is holding readings back now.
     pub fn doubting(&self) -> bool {
         self.gate.as_ref().is_some_and(FlowGate::doubting)

@@ -525,6 +525,31 @@ fn reacquire_never_ends_at_an_op_area_edge() {
 }
 
 #[test]
+fn reacquire_around_every_lost_point_hands_over_to_find() {
+    // Four lost points far apart along the plume, and the plume gone: Reacquire moves from one
+    // to the next, at most 15 minutes in all since the last detection, then Find searches on.
+    let mut a = amp();
+    a.decide(&snap(0.0, (200.0, 500.0), 0.0, false));
+    lose_at(
+        &mut a,
+        &[
+            (200.0, 400.0),
+            (150.0, 300.0),
+            (250.0, 200.0),
+            (200.0, 100.0),
+        ],
+    );
+    assert_eq!(a.behaviour(), BehaviourKind::Reacquire);
+    // The last Track-Out arrived at t = 77 s, where Reacquire began.
+    let goal = a.track_out_goal().unwrap();
+    let b = behaviours_flying(&mut a, (goal.x, goal.y), 180.0, (77.1, 3677.1));
+    let t = time_in(&b, BehaviourKind::Reacquire, 77.1);
+    assert!(t <= 900.0, "Reacquire for {t} s");
+    let next = b.iter().find(|(_, k)| *k != BehaviourKind::Reacquire);
+    assert_eq!(next.map(|n| n.1), Some(BehaviourKind::Find));
+}
+
+#[test]
 fn mapping_never_ends_near_an_edge() {
     // A declaration 5 m inside the East edge: the mapping lines 10 m and 30 m further East lie
     // outside, beyond the cage's reach.
@@ -578,6 +603,31 @@ fn a_reversed_flow_reading_does_not_turn_the_search_round() {
         run(AmpParams::default()) <= 20.0 + 1e-6,
         "upflow stays South"
     );
+}
+
+#[test]
+fn a_flow_reading_reversed_from_the_start_is_held_back_against_a_given_prior() {
+    // The meter reads the northward flow reversed from the first sample. With no history the
+    // gate believes it; judged against the mission plan's prior (North) it is held back.
+    let run = |trust: bool| {
+        let a = amp();
+        let mut a = if trust { a.trusting_prior() } else { a };
+        fly_in(
+            &mut a,
+            (200.0, 500.0),
+            0.0,
+            (0.0, 300.0),
+            |_, _| false,
+            |_| Vec2::new(0.0, -0.1),
+        );
+        a.decide(&snap(300.0, (200.0, 500.0), 180.0, true));
+        a.last_course().diff_deg(Heading::from_deg(180.0)).abs()
+    };
+    assert!(
+        run(false) > 90.0,
+        "no prior: the reversed reading is believed"
+    );
+    assert!(run(true) <= 20.0 + 1e-6, "upflow stays South");
 }
 
 #[test]
@@ -705,21 +755,73 @@ fn a_lost_point_that_never_agrees_ages_out() {
     assert!(run(1800.0), "aged out after 30 min: the three agree");
 }
 
+/// For the sources on a 20 m grid at least 60 m inside `area`, when `track` first crosses each
+/// one's straight plume (from the source northward, the flow's direction, to the edge): the
+/// number of sources, and the time by which every plume was crossed (`None`: some never were).
+fn plumes_crossed_by(area: &OpArea, track: &[(f64, Vec2, f64)]) -> (usize, Option<f64>) {
+    let (mut sources, mut last) = (0, Some(0.0_f64));
+    for i in -30..=30 {
+        for j in -30..=30 {
+            let s = Vec2::new(20.0 * i as f64, 20.0 * j as f64);
+            let e = area.edge_info(s);
+            if !e.inside || e.distance_m < 60.0 {
+                continue;
+            }
+            sources += 1;
+            let mut exit = s.y;
+            while area.edge_info(Vec2::new(s.x, exit)).inside {
+                exit += 1.0;
+            }
+            let first = track.windows(2).find_map(|w| {
+                let (p, q) = (w[0].1, w[1].1);
+                if (p.x - s.x) * (q.x - s.x) > 0.0 || p.x == q.x {
+                    return None;
+                }
+                let y = p.y + (q.y - p.y) * (s.x - p.x) / (q.x - p.x);
+                (s.y..=exit).contains(&y).then_some(w[1].0)
+            });
+            last = last.zip(first).map(|(a, b)| a.max(b));
+        }
+    }
+    (sources, last)
+}
+
 #[test]
-fn a_wide_area_across_the_flow_is_swept_at_the_spacing() {
-    // 720 m across the flow: the field's 20 deg crosses it gaining 262 m up-flow per leg; the
-    // zigzag's angle gives 120 m.
-    let area = OpArea::rectangle(-360.0, 360.0, -150.0, 150.0).unwrap();
-    let mut a = Amp::new(AmpParams::default(), area, vec![], Heading::NORTH);
-    let track = fly(&mut a, (350.0, 140.0), 180.0, 600.0, |_, _| false);
-    assert_eq!(a.behaviour(), BehaviourKind::Find);
-    let course = a.last_course().diff_deg(Heading::from_deg(180.0)).abs();
-    let want = 90.0 - (120.0_f64 / 720.0).atan().to_degrees();
+fn find_crosses_every_plume_of_a_rotated_area() {
+    // A 760 m x 330 m area whose long axis lies 67 deg from the flow (towards North), as on the
+    // coastal site where the search before the downflow edge came first never found the plume
+    // in two hours. Along the downflow edge the vehicle crosses every plume of a source 60 m or
+    // more inside within about 11 minutes (the billiard: about 13).
+    let axis = Heading::from_deg(67.0).unit();
+    let side = Heading::from_deg(157.0).unit();
+    let corners = [(1.0, 1.0), (-1.0, 1.0), (-1.0, -1.0), (1.0, -1.0)];
+    let area = OpArea::new(
+        corners
+            .iter()
+            .map(|(a, b)| axis * (380.0 * a) + side * (165.0 * b))
+            .collect(),
+    )
+    .unwrap();
+    let run = |pattern: FindPattern| {
+        let p = AmpParams {
+            find_pattern: pattern,
+            ..AmpParams::default()
+        };
+        let mut a = Amp::new(p, area.clone(), vec![], Heading::NORTH);
+        let start = a.search_start(0);
+        let track = fly(&mut a, (start.x, start.y), 90.0, 7200.0, |_, _| false);
+        assert_eq!(a.behaviour(), BehaviourKind::Find);
+        plumes_crossed_by(&area, &track)
+    };
+    let (sources, lanes) = run(FindPattern::Lanes);
+    let (_, billiard) = run(FindPattern::Billiard);
+    assert!(sources > 200, "{sources} sources");
+    let lanes = lanes.expect("lanes: every plume crossed");
+    assert!(lanes < 900.0, "lanes: every plume crossed after {lanes} s");
     assert!(
-        (course - want).abs() < 0.5,
-        "{course} from upflow, want {want}"
+        billiard.is_none_or(|b| b > lanes),
+        "billiard {billiard:?} s, lanes {lanes} s"
     );
-    assert!(!track.is_empty());
 }
 
 #[test]

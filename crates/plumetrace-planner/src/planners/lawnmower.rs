@@ -435,6 +435,7 @@ mod tests {
                 op_area: area(),
                 subregions: vec![],
                 prior_flow_toward_deg: 90.0,
+                prior_flow_given: true,
             },
             vehicle: VehicleId(0),
             vehicle_kind: plumetrace_core::VehicleKind::Auv,

@@ -35,6 +35,10 @@ pub struct MissionGeometry {
     pub subregions: Vec<OpArea>,
     /// Flow direction assumed until the first flow measurement, compass degrees (towards).
     pub prior_flow_toward_deg: f64,
+    /// Whether that direction was given (the mission plan's), not assumed: planners may then
+    /// judge the first flow readings against it.
+    #[serde(default)]
+    pub prior_flow_given: bool,
 }
 
 impl MissionGeometry {

@@ -6,10 +6,141 @@ use crate::behaviour::{Behaviour, Percept, Proposal};
 use plumetrace_core::{BehaviourKind, Heading, Vec2};
 use plumetrace_guidance::{FollowLine, GoToPoint, ModeStatus, Steer};
 
-/// Sweep across the flow, reflecting at the subregion's boundary.
-#[derive(Debug, Clone, Copy, PartialEq)]
+/// Sweep the subregion for the plume. With lanes: first (on arriving at the search start) along
+/// the subregion's downflow edge, which every plume crosses on its way out, then on lanes across
+/// the flow, up it and back down, each pass between the lanes of the ones before (entered again
+/// after the plume was lost for good: lanes from where the vehicle is, up the flow). With the
+/// billiard (the field description, also the fallback when no lane fits the subregion): reflect
+/// at the boundary.
+#[derive(Debug, Clone)]
 pub(super) struct Find {
     pub(super) heading: Heading,
+    lanes: Option<Lanes>,
+    /// The pass laid out next (0: the downflow edge), and whether from the vehicle's position.
+    next: Option<(usize, bool)>,
+}
+
+/// The pass being flown and the flow estimate it was laid out for. Each lane is reached with
+/// a plain go-to (no heading constraint: a turn onto the lane near the edge would need room the
+/// cage may not give) and then followed; a lane not done in twice its time plus five minutes is
+/// left (a lane the vehicle cannot reach never holds the search).
+#[derive(Debug, Clone)]
+struct Lanes {
+    lanes: Vec<(Vec2, Vec2)>,
+    k: usize,
+    along: Option<FollowLine>,
+    lane_started_s: Option<f64>,
+    pass: usize,
+    flow: Heading,
+}
+
+impl Lanes {
+    /// The steer on the lanes, `None` when the pass is done.
+    fn steer(&mut self, p: &Percept, m: &Memory) -> Option<Steer> {
+        let params = m.p.line_params();
+        // Two lanes may end at one decision (a fix that moves the vehicle past one).
+        while let Some(&(a, b)) = self.lanes.get(self.k) {
+            let started = *self.lane_started_s.get_or_insert(p.t_s);
+            let budget =
+                2.0 * ((a - p.pos_m).norm() + (b - a).norm()) / params.speed_mps.max(0.1) + 300.0;
+            let status = if p.t_s - started > budget {
+                None
+            } else if let Some(line) = self.along.as_mut() {
+                match line.update(p.pose()) {
+                    ModeStatus::Running(s) => Some(s),
+                    ModeStatus::Done(_) => None,
+                }
+            } else {
+                let to_start = GoToPoint {
+                    target_m: a,
+                    speed_mps: params.speed_mps,
+                    radius_m: params.radius_m,
+                };
+                match to_start.update(p.pos_m) {
+                    ModeStatus::Running(s) => return Some(s),
+                    ModeStatus::Done(_) => {
+                        self.along = Some(FollowLine::tracking(
+                            a,
+                            b,
+                            params.speed_mps,
+                            params.radius_m,
+                            params.gain_deg_per_m,
+                        ));
+                        continue;
+                    }
+                }
+            };
+            match status {
+                Some(s) => return Some(s),
+                None => {
+                    self.k += 1;
+                    self.along = None;
+                    self.lane_started_s = None;
+                }
+            }
+        }
+        None
+    }
+}
+
+/// A flow estimate this far from the one the lanes were laid out for lays them out again, deg.
+const LANES_REPLAN_DEG: f64 = 30.0;
+
+impl Find {
+    /// Find from heading `heading` (the billiard's); `first`: the subregion's search starts.
+    pub(super) fn new(heading: Heading, first: bool) -> Self {
+        Find {
+            heading,
+            lanes: None,
+            next: Some(if first { (0, false) } else { (1, true) }),
+        }
+    }
+
+    /// Lays out pass `pass` for a vehicle at `pos`: 0 the downflow edge, then lanes (odd passes
+    /// up the flow, even ones down; `from_here`: from about the vehicle's position on). When
+    /// nothing of it is left, the next pass; `None` when no lane fits the subregion.
+    fn lay_out(m: &Memory, pos: Vec2, pass: usize, from_here: bool) -> Option<Lanes> {
+        let flow = m.flow.toward();
+        let region = &m.regions[m.region];
+        // The cage may hold the vehicle up to max_cage_inset_m inside the edge; lane ends within
+        // R of there are still reached.
+        let margin = m.p.find_margin_m.max(m.p.max_cage_inset_m - 0.5 * m.p.r_m);
+        let spacing = m.p.find_spacing_m;
+        [pass, pass + 1].into_iter().find_map(|pass| {
+            let lanes = if pass == 0 {
+                find::downflow_edge(region, flow, margin, 20.0, pos)
+            } else {
+                let all = find::lanes(region, flow, spacing, pass - 1, margin, 2.0 * m.p.r_m);
+                find::order_lanes(&all, pos, flow, spacing, pass % 2 == 1, from_here)
+            };
+            (!lanes.is_empty()).then_some(Lanes {
+                lanes,
+                k: 0,
+                along: None,
+                lane_started_s: None,
+                pass,
+                flow,
+            })
+        })
+    }
+
+    fn billiard(&mut self, p: &Percept, m: &Memory) -> Proposal<AmpDone> {
+        let e = m.regions[m.region].edge_info(p.pos_m);
+        if (!e.inside || e.distance_m < m.p.find_margin_m)
+            && self.heading.unit().dot(&e.outward_normal) > 0.0
+        {
+            self.heading = find::reflect(
+                self.heading,
+                e.outward_normal,
+                m.flow.toward(),
+                m.p.find_offset_deg,
+            );
+        }
+        Proposal::Steer(Steer {
+            heading: self.heading,
+            speed_mps: m.p.speed_mps,
+        })
+    }
 }
 
 impl Behaviour<Memory, AmpDone> for Find {
@@ -18,29 +149,37 @@ impl Behaviour<Memory, AmpDone> for Find {
     }
 
     fn propose(&mut self, p: &Percept, m: &mut Memory) -> Proposal<AmpDone> {
-        let e = m.regions[m.region].edge_info(p.pos_m);
-        if (!e.inside || e.distance_m < m.p.find_margin_m)
-            && self.heading.unit().dot(&e.outward_normal) > 0.0
-        {
-            self.heading = match m.p.find_pattern {
-                FindPattern::Billiard => find::reflect(
-                    self.heading,
-                    e.outward_normal,
-                    m.flow.toward(),
-                    m.p.find_offset_deg,
-                ),
-                FindPattern::Zigzag => find::zigzag(
-                    self.heading,
-                    e.outward_normal,
-                    m.flow.toward(),
-                    m.find_offset_deg(),
-                ),
-            };
+        if m.p.find_pattern == FindPattern::Billiard {
+            return self.billiard(p, m);
         }
-        Proposal::Steer(Steer {
-            heading: self.heading,
-            speed_mps: m.p.speed_mps,
-        })
+        // A flow estimate that has turned lays the pass out again from here.
+        if let Some(l) = &self.lanes
+            && l.flow.diff_deg(m.flow.toward()).abs() > LANES_REPLAN_DEG
+        {
+            self.next = Some((l.pass, true));
+            self.lanes = None;
+        }
+        // A pass that ends gives way to the next (two at most per decision: a pass may end at
+        // its first step when a fix has moved the vehicle past it). No lane fits: the billiard.
+        for _ in 0..2 {
+            if let Some((pass, from_here)) = self.next.take() {
+                self.lanes = Find::lay_out(m, p.pos_m, pass, from_here);
+            }
+            let Some(lanes) = self.lanes.as_mut() else {
+                break;
+            };
+            match lanes.steer(p, m) {
+                Some(s) => {
+                    self.heading = s.heading;
+                    return Proposal::Steer(s);
+                }
+                None => {
+                    self.next = Some((lanes.pass + 1, false));
+                    self.lanes = None;
+                }
+            }
+        }
+        self.billiard(p, m)
     }
 }
 
@@ -121,7 +260,6 @@ pub(super) struct Reacquire {
     leg: usize,
     bowtie: bowtie::Bowtie,
     line: Option<FollowLine>,
-    started_s: Option<f64>,
 }
 
 impl Reacquire {
@@ -134,7 +272,6 @@ impl Reacquire {
             leg: 0,
             bowtie,
             line,
-            started_s: None,
         }
     }
 }
@@ -157,11 +294,12 @@ impl Behaviour<Memory, AmpDone> for Reacquire {
     }
 
     fn propose(&mut self, p: &Percept, m: &mut Memory) -> Proposal<AmpDone> {
-        let started = *self.started_s.get_or_insert(p.t_s);
-        // Given up after its time, or when the point itself was dropped (aged out, or set
+        // Given up when Reacquire (around this point and those before it since the last
+        // detection) has taken its time, or when the point itself was dropped (aged out, or set
         // under a flow that has since turned).
+        m.reacquire_since.get_or_insert(p.t_s);
         let dropped = !m.lost.iter().any(|l| l.pos == self.point);
-        if dropped || (m.p.reacquire_timeout_s > 0.0 && p.t_s - started > m.p.reacquire_timeout_s) {
+        if dropped || m.reacquire_timed_out(p.t_s) {
             return Proposal::Done(AmpDone::Searched { point: self.point });
         }
         // At most three legs per Bowtie and `N_re` Bowties: the loop ends.
@@ -210,7 +348,6 @@ impl Behaviour<Memory, AmpDone> for Reacquire {
                                 leg: 0,
                                 bowtie,
                                 line,
-                                started_s: Some(started),
                             };
                         }
                     }

@@ -110,15 +110,15 @@ plumetrace_core::params! {
         region_timeout_s: f64 = 1800.0, "s", Bounds::positive(1e6);
         /// When Track-In updates LHS from the heading: heading_upflow (only while the heading is within 90 deg of upflow, so a turn from downflow completes) or every_detection (Table 1 as printed: a Track-In that starts heading downflow can lock onto it).
         track_in_lhs: LhsUpdate = LhsUpdate::HeadingUpflow, "", Bounds::Any;
-        /// Zigzag Find: about this far up or down the flow per crossing of the area (the angle from across-flow is the arctangent of this over the area's extent across the flow, at most find_offset_deg; wide areas are then crossed at a shallower angle); 0: always find_offset_deg.
-        find_spacing_m: f64 = 120.0, "m", Bounds::non_negative(100_000.0);
-        /// Find's pattern: zigzag (always across and up the flow, flipping across at each edge, down again from the up-flow end) or billiard (the field description: keep the sign along the boundary, flip it across; in rotated areas it can cycle without going up-flow).
-        find_pattern: FindPattern = FindPattern::Zigzag, "", Bounds::Any;
+        /// Lanes Find: spacing of the lanes across the flow (each pass after the first flies lanes between those of the passes before: half, then a quarter of this).
+        find_spacing_m: f64 = 120.0, "m", Bounds::closed(10.0, 100_000.0);
+        /// Find's pattern: lanes (first along the downflow edge, which every plume crosses on its way out, then planned lines across the flow, up it and back down, on any shape of area) or billiard (the field description: headings psi_f +- 90 +- find_offset_deg, at a boundary keep the sign along it and flip it across; in rotated areas it can miss parts of the area or cycle in a corner).
+        find_pattern: FindPattern = FindPattern::Lanes, "", Bounds::Any;
         /// Lost points older than this are dropped (0: never; a point near the source whose Bowties keep finding chemical downflow of it would otherwise stay for good).
         lost_point_max_age_s: f64 = 1800.0, "s", Bounds::non_negative(1e6);
         /// Lost points saved under a flow direction more than this from the current one are dropped (180: never; after a tide turns they no longer mark the plume).
         lost_point_max_turn_deg: f64 = 45.0, "deg", Bounds::closed(1.0, 180.0);
-        /// Longest Reacquire around one lost point before the point is given up (0: no bound).
+        /// Longest Reacquire without a detection (around one lost point and the next) before Find takes over from where the vehicle is (0: no bound).
         reacquire_timeout_s: f64 = 900.0, "s", Bounds::non_negative(1e6);
         /// Clip Bowtie and mapping lines to the op-area, pattern_margin_m inside it (a line the cage keeps the vehicle from ending is never flown to its end).
         clip_patterns: bool = true, "", Bounds::Any;
@@ -126,7 +126,7 @@ plumetrace_core::params! {
         pattern_margin_m: f64 = 10.0, "m", Bounds::non_negative(1000.0);
         /// Longest post-declaration mapping (0: no bound).
         mapping_timeout_s: f64 = 1800.0, "s", Bounds::non_negative(1e6);
-        /// A flow reading more than this from the recent mean is held back until such readings persist for flow_gate_persist_s (180: every reading used; a wrong-layer current meter reads the current reversed).
+        /// A flow reading more than this from the recent mean (before the first reading: from the prior flow direction, when the scenario gives one) is held back until such readings persist for flow_gate_persist_s (180: every reading used; a wrong-layer current meter reads the current reversed).
         flow_gate_deg: f64 = 90.0, "deg", Bounds::closed(1.0, 180.0);
         /// How long implausible flow readings must persist to be believed.
         flow_gate_persist_s: f64 = 1800.0, "s", Bounds::non_negative(1e6);
@@ -155,15 +155,14 @@ impl Choice for LhsUpdate {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum FindPattern {
-    /// Across and up the flow (`psi_f +- (90 + offset)`), the across sign flipped at each edge;
-    /// from the up-flow end across and down (`psi_f +- (90 - offset)`) back to the down-flow end.
-    Zigzag,
+    /// Lanes across the flow laid out over the subregion, flown up the flow and back down.
+    Lanes,
     /// The field description: at a boundary keep the sign along it and flip it across.
     Billiard,
 }
 
 impl Choice for FindPattern {
-    const ALL: &'static [Self] = &[FindPattern::Zigzag, FindPattern::Billiard];
+    const ALL: &'static [Self] = &[FindPattern::Lanes, FindPattern::Billiard];
 }
 
 impl AmpParams {
@@ -224,12 +223,17 @@ impl PlannerParams for AmpParams {
     }
 
     fn build(&self, ctx: &BuildContext) -> Result<Box<dyn Planner>, ParamError> {
-        Ok(Box::new(Amp::new(
+        let amp = Amp::new(
             self.clone(),
             ctx.geometry.op_area.clone(),
             ctx.geometry.subregions.clone(),
             ctx.geometry.prior_flow_toward(),
-        )))
+        );
+        Ok(Box::new(if ctx.geometry.prior_flow_given {
+            amp.trusting_prior()
+        } else {
+            amp
+        }))
     }
 }
 
@@ -299,6 +303,8 @@ struct Memory {
     declared: Vec<Vec2>,
     flow: FlowEstimate,
     events: Vec<PlannerEvent>,
+    /// When Reacquire began after the last detection.
+    reacquire_since: Option<f64>,
 }
 
 impl EventLog for Memory {
@@ -329,6 +335,14 @@ impl Memory {
             .max_by(|a, b| a.dot(&u).total_cmp(&b.dot(&u)))
     }
 
+    /// Reacquire has searched for `reacquire_timeout_s` since the last detection.
+    fn reacquire_timed_out(&self, t: f64) -> bool {
+        self.p.reacquire_timeout_s > 0.0
+            && self
+                .reacquire_since
+                .is_some_and(|t0| t - t0 > self.p.reacquire_timeout_s)
+    }
+
     /// The lost points' positions, oldest first.
     fn lost_positions(&self) -> Vec<Vec2> {
         self.lost.iter().map(|l| l.pos).collect()
@@ -343,26 +357,6 @@ impl Memory {
             (age <= 0.0 || t - l.t_s <= age)
                 && (turn >= 180.0 || l.flow.diff_deg(now).abs() <= turn)
         });
-    }
-
-    /// The Find offset from across-flow: `find_offset_deg`, or for the zigzag with a spacing the
-    /// angle that advances `find_spacing_m` along the flow per crossing of the region.
-    fn find_offset_deg(&self) -> f64 {
-        let max = self.p.find_offset_deg;
-        if self.p.find_pattern != FindPattern::Zigzag || self.p.find_spacing_m <= 0.0 {
-            return max;
-        }
-        let across = self.flow.toward().turned_deg(90.0).unit();
-        let (lo, hi) = self.regions[self.region]
-            .vertices()
-            .iter()
-            .map(|v| v.dot(&across))
-            .fold((f64::MAX, f64::MIN), |(lo, hi), d| (lo.min(d), hi.max(d)));
-        let width = (hi - lo).max(1.0);
-        (self.p.find_spacing_m / width)
-            .atan()
-            .to_degrees()
-            .clamp(3.0_f64.min(max), max)
     }
 
     /// A pattern line, clipped to the op-area `pattern_margin_m` inside it when `clip_patterns`
@@ -490,17 +484,19 @@ impl Switching {
         }
     }
 
-    fn enter_find(&mut self, m: &mut Memory, pos: Vec2) {
+    /// Find from `pos`; `first`: the subregion's search starts (else the plume was lost for good).
+    fn enter_find(&mut self, m: &mut Memory, pos: Vec2, first: bool) {
         let h = find::initial_heading(
             &m.regions[m.region],
             pos,
             m.flow.toward(),
-            m.find_offset_deg(),
+            m.p.find_offset_deg,
         );
-        self.set(m, Box::new(Find { heading: h }));
+        self.set(m, Box::new(Find::new(h, first)));
     }
 
     fn enter_track_in(&mut self, m: &mut Memory, p: &Percept) {
+        m.reacquire_since = None;
         if m.last_detection.is_none() {
             m.lhs = m.lhs_from_heading(p.heading);
         }
@@ -514,7 +510,7 @@ impl Switching {
                 let r = Reacquire::new(m, point);
                 self.set(m, Box::new(r));
             }
-            None => self.enter_find(m, pos),
+            None => self.enter_find(m, pos, false),
         }
     }
 
@@ -582,12 +578,19 @@ impl Switching {
                         let g = m.p.go_to(goal);
                         self.set(m, Box::new(TrackOut { goal: g }));
                     }
-                    None => self.enter_find(m, p.pos_m),
+                    None => self.enter_find(m, p.pos_m, false),
                 }
             }
             (_, AmpDone::Searched { point }) => {
                 m.lost.retain(|q| q.pos != point);
-                self.enter_reacquire(m, p.pos_m);
+                if m.reacquire_timed_out(p.t_s) {
+                    // The plume is not where the lost points are: search on (they are kept
+                    // for the next losses, until they age out).
+                    m.reacquire_since = None;
+                    self.enter_find(m, p.pos_m, false);
+                } else {
+                    self.enter_reacquire(m, p.pos_m);
+                }
             }
             (BehaviourKind::TrackOut, AmpDone::Reached) => {
                 if !self.try_declare(m, p.t_s) {
@@ -598,7 +601,7 @@ impl Switching {
             (_, AmpDone::Reached) => {
                 // Go-To or Transit arrived: the subregion's search starts now.
                 m.region_started_s = p.t_s;
-                self.enter_find(m, p.pos_m);
+                self.enter_find(m, p.pos_m, true);
             }
         }
     }
@@ -666,6 +669,14 @@ pub struct Amp {
 }
 
 impl Amp {
+    /// The planner with its flow gate judging the first readings against the prior flow
+    /// direction (one the mission plan gives): a current meter that reads reversed from the
+    /// start is then held back too.
+    pub fn trusting_prior(mut self) -> Self {
+        self.m.flow = self.m.flow.trusting_fallback();
+        self
+    }
+
     /// A planner for `area`, searched whole (single-source mission) or, with several `regions`,
     /// one subregion after the other. `prior_flow` is the flow direction assumed until the first
     /// flow measurement.
@@ -711,6 +722,7 @@ impl Amp {
                 lost: Vec::new(),
                 declared: Vec::new(),
                 events: Vec::new(),
+                reacquire_since: None,
             },
             switching: Switching {
                 active: Box::new(Idle),
