@@ -240,6 +240,15 @@ impl OpArea {
         ((q - p).norm() >= min_length_m).then_some((p, q))
     }
 
+    /// The smallest and largest projection of the vertices on `direction` (the area's extent
+    /// along it, for a unit `direction`).
+    pub fn extent_along(&self, direction: Vec2) -> (f64, f64) {
+        self.vertices
+            .iter()
+            .map(|v| v.dot(&direction))
+            .fold((f64::MAX, f64::MIN), |(lo, hi), x| (lo.min(x), hi.max(x)))
+    }
+
     /// The vertex furthest along `direction` (e.g. the most downflow corner).
     pub fn furthest_vertex_along(&self, direction: Vec2) -> Vec2 {
         let mut best = self.vertices[0];

@@ -76,14 +76,8 @@ pub fn lanes(
 ) -> Vec<(Vec2, Vec2)> {
     let down = flow_toward.unit();
     let right = flow_toward.turned_deg(90.0).unit();
-    let span = |d: Vec2| {
-        area.vertices()
-            .iter()
-            .map(|v| v.dot(&d))
-            .fold((f64::MAX, f64::MIN), |(lo, hi), x| (lo.min(x), hi.max(x)))
-    };
-    let (d_lo, d_hi) = span(down);
-    let (c_lo, c_hi) = span(right);
+    let (d_lo, d_hi) = area.extent_along(down);
+    let (c_lo, c_hi) = area.extent_along(right);
     let spacing = spacing_m.max(1.0);
     let first = d_hi - margin_m - PASS_OFFSETS[pass % PASS_OFFSETS.len()] * spacing;
     // Bounded by the area's extent along the flow (at most 100,000 m / 1 m lanes).
@@ -112,14 +106,8 @@ pub fn downflow_edge(
 ) -> Vec<(Vec2, Vec2)> {
     let down = flow_toward.unit();
     let right = flow_toward.turned_deg(90.0).unit();
-    let span = |d: Vec2| {
-        area.vertices()
-            .iter()
-            .map(|v| v.dot(&d))
-            .fold((f64::MAX, f64::MIN), |(lo, hi), x| (lo.min(x), hi.max(x)))
-    };
-    let (d_lo, d_hi) = span(down);
-    let (c_lo, c_hi) = span(right);
+    let (d_lo, d_hi) = area.extent_along(down);
+    let (c_lo, c_hi) = area.extent_along(right);
     // From end to end of what lies margin_m inside (half a metre more, against rounding), at
     // most 10,000 points (bounded by the area's extent across the flow).
     let (c0, c1) = (c_lo + margin_m + 0.5, c_hi - margin_m - 0.5);
