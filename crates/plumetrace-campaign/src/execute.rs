@@ -210,6 +210,7 @@ fn run_one(c: &Campaign, key: &RunKey, out: &Path) -> RunRow {
         let options = MissionOptions {
             mean_plume: false,
             trajectory: example,
+            plume_frames_every_s: example.then_some(plumetrace_mission::PLUME_FRAME_EVERY_S),
         };
         let run = run_mission_with(sc, options, &mut |_, _| {}).map_err(|e| e.to_string())?;
         if let Some(at) = plumetrace_mission::output::first_non_finite(&run.summary) {

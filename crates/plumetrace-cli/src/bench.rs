@@ -81,6 +81,7 @@ fn missions(a: &MissionBenchArgs) -> Result<MissionBench> {
     let options = plumetrace_mission::MissionOptions {
         mean_plume: false,
         trajectory: false,
+        plume_frames_every_s: None,
     };
     let mut results = Vec::new();
     let mut sim_s = 0.0;

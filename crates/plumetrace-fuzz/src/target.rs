@@ -263,6 +263,7 @@ fn scenario(input: &Input, path: &Path, deadline: Instant) -> Result<String, Sto
     let options = MissionOptions {
         mean_plume: false,
         trajectory: true,
+        plume_frames_every_s: Some(plumetrace_mission::PLUME_FRAME_EVERY_S),
     };
     let mut mission = Mission::new(setup, options).map_err(|e| in_run(&e))?;
     check_deadline(deadline, || "in the spin-up".into())?;

@@ -25,9 +25,12 @@ pub mod snapshot_log;
 pub mod summary;
 
 pub use mission::{
-    Mission, MissionOptions, MissionRun, VehicleInfo, run_mission, run_mission_with,
+    FaultWindow, Mission, MissionOptions, MissionRun, PLUME_FRAME_EVERY_S, VehicleInfo,
+    run_mission, run_mission_with,
 };
 pub use outcome::{EndReason, MissionEnd, MissionEvent, Outcome, VehicleStatus};
-pub use record::{EventKind, EventRecord, Observer, StepView, TrajectoryRow};
+pub use record::{
+    EventKind, EventRecord, Observer, PlumeFrame, PlumeFrames, StepView, TrajectoryRow,
+};
 pub use setup::{MissionError, MissionSetup, PlannedVehicle};
 pub use summary::{DeclarationRecord, LOCATED_RADIUS_M, SourceRecord, Summary, VehicleSummary};

@@ -8,7 +8,7 @@
 
 use crate::outcome::{EndReason, MissionEnd, MissionEvent, Outcome, VehicleStatus};
 use crate::record::{
-    EventRecord, EventRecorder, MeanPlumeRecorder, Observer, StepView, TrackStats,
+    EventRecord, EventRecorder, MeanPlumeRecorder, Observer, PlumeFrames, StepView, TrackStats,
     TrajectoryRecorder, TrajectoryRow, true_sources,
 };
 use crate::setup::{MissionError, MissionSetup, PlannedVehicle};
@@ -20,20 +20,27 @@ use plumetrace_sim::{SimVehicle, StageTimes, World, WorldEvent};
 use std::time::Instant;
 
 /// What a mission records besides its summary and events.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub struct MissionOptions {
     /// Accumulate the time-averaged plume over the op-area for the figure (a grid of
     /// concentration queries every 20 s).
     pub mean_plume: bool,
     /// Keep every step of every vehicle's trajectory.
     pub trajectory: bool,
+    /// Sample the plume and the flow every this many seconds for the replay page
+    /// ([`PlumeFrames`]; `None`: not at all).
+    pub plume_frames_every_s: Option<f64>,
 }
+
+/// The replay page's plume frame interval when nothing else is asked for, s.
+pub const PLUME_FRAME_EVERY_S: f64 = 60.0;
 
 impl Default for MissionOptions {
     fn default() -> Self {
         MissionOptions {
             mean_plume: true,
             trajectory: true,
+            plume_frames_every_s: Some(PLUME_FRAME_EVERY_S),
         }
     }
 }
@@ -47,6 +54,19 @@ pub struct VehicleInfo {
     pub kind: VehicleKind,
     /// Its planner's kind, if any.
     pub planner: Option<PlannerKind>,
+    /// When its sensors were faulty (from the scenario), for the figures.
+    pub faults: Vec<FaultWindow>,
+}
+
+/// A time window in which one of a vehicle's sensors was faulty.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FaultWindow {
+    /// Start, s.
+    pub start_s: f64,
+    /// End, s.
+    pub end_s: f64,
+    /// What was wrong, in words.
+    pub what: &'static str,
 }
 
 /// Everything a mission produced.
@@ -67,6 +87,8 @@ pub struct MissionRun {
     /// Time-averaged concentration at the first vehicle's altitude over the op-area (if
     /// recorded).
     pub mean_plume: Option<MeanConcentrationGrid>,
+    /// The plume and flow sampled during the run (if recorded).
+    pub plume_frames: Option<PlumeFrames>,
     /// True sources.
     pub sources: Vec<Vec3>,
     /// Op-area polygon.
@@ -96,6 +118,8 @@ pub struct Mission {
     trajectory: Option<TrajectoryRecorder>,
     stats: TrackStats,
     mean_plume: Option<MeanPlumeRecorder>,
+    plume_frames: Option<PlumeFrames>,
+    faults: Vec<Vec<FaultWindow>>,
     observers: Vec<Box<dyn Observer>>,
     sources: Vec<Vec3>,
     geometry: MissionGeometry,
@@ -182,8 +206,40 @@ impl Mission {
                 sample_every,
             )
         });
+        let plume_frames = options
+            .plume_frames_every_s
+            .filter(|s| s.is_finite() && *s > 0.0)
+            .map(|every| {
+                let (mut x0, mut x1, mut y0, mut y1) = (f64::MAX, f64::MIN, f64::MAX, f64::MIN);
+                for p in &spec.op_area {
+                    (x0, x1, y0, y1) = (x0.min(p.x), x1.max(p.x), y0.min(p.y), y1.max(p.y));
+                }
+                let pad = 0.15 * (x1 - x0).max(y1 - y0);
+                PlumeFrames::new(
+                    (x0 - pad, x1 + pad, y0 - pad, y1 + pad),
+                    world.env().domain(),
+                    z,
+                    (every / dt_s).round().max(1.0) as u64,
+                )
+            });
+        let faults = setups
+            .iter()
+            .map(|v| {
+                v.flow_sensor
+                    .fault
+                    .map(|f| FaultWindow {
+                        start_s: f.start_s,
+                        end_s: f.end_s,
+                        what: "flow sensor reads the wrong layer",
+                    })
+                    .into_iter()
+                    .collect()
+            })
+            .collect();
         Ok(Mission {
             name,
+            plume_frames,
+            faults,
             seed,
             step_limit: (spec.time_limit_s / dt_s).round() as u64,
             stats: TrackStats::new(
@@ -347,6 +403,9 @@ impl Mission {
             if let Some(m) = self.mean_plume.as_mut() {
                 m.observe(&view);
             }
+            if let Some(f) = self.plume_frames.as_mut() {
+                f.observe(&view);
+            }
             for o in &mut self.observers {
                 o.observe(&view);
             }
@@ -397,10 +456,12 @@ impl Mission {
             .vehicles()
             .iter()
             .zip(&self.planned)
-            .map(|(v, p)| VehicleInfo {
+            .zip(&self.faults)
+            .map(|((v, p), faults)| VehicleInfo {
                 name: v.name.clone(),
                 kind: v.vehicle.params.kind,
                 planner: p.as_ref().map(|p| p.config.kind()),
+                faults: faults.clone(),
             })
             .collect();
         let mean_flow = self.stats.mean_flow_mps();
@@ -426,6 +487,7 @@ impl Mission {
             stage_times: self.world.stage_times(),
             spinup_wall_s: self.spinup_wall_s,
             mean_plume: self.mean_plume.map(|m| m.grid),
+            plume_frames: self.plume_frames,
             sources: self.sources,
             op_area: self.op_area,
             subregions: self.subregions,

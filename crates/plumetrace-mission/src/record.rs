@@ -9,7 +9,7 @@
 
 use crate::outcome::{MissionEvent, VehicleStatus};
 use plumetrace_core::{BehaviourKind, PlannerEvent, Telemetry, Vec2, Vec3, VehicleId};
-use plumetrace_env::{FlowField, GridSpec, MeanConcentrationGrid};
+use plumetrace_env::{ConcentrationField, FlowField, GridSpec, MeanConcentrationGrid};
 use plumetrace_sim::{StepReport, World, WorldEvent};
 use serde::Serialize;
 
@@ -384,6 +384,119 @@ impl Observer for MeanPlumeRecorder {
     fn observe(&mut self, step: &StepView<'_>) {
         if (step.world.steps() - 1).is_multiple_of(self.sample_every) {
             self.grid.accumulate(step.world.env().plume());
+        }
+    }
+}
+
+/// One frame of the plume as the replay page shows it: the concentration over a grid and the
+/// flow over a coarser one, at one time.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PlumeFrame {
+    /// Time, s.
+    pub t_s: f64,
+    /// Concentration at every point of [`PlumeFrames::grid`], row by row from the south-west.
+    pub concentration: Vec<f32>,
+    /// Water velocity (east, north), m/s, at every point of [`PlumeFrames::flow_grid`].
+    pub flow_mps: Vec<[f32; 2]>,
+}
+
+/// Samples the plume and the flow every `every_s` seconds (the replay page's background):
+/// concentration on a grid of at most 96 x 96 points at the first vehicle's altitude, flow on
+/// one of at most 12 x 12. A mission of 2 h sampled every 60 s keeps 121 frames of about 37 kB.
+#[derive(Debug)]
+pub struct PlumeFrames {
+    /// Where the concentration is sampled.
+    pub grid: GridSpec,
+    /// Where the flow is sampled.
+    pub flow_grid: GridSpec,
+    /// The frames so far.
+    pub frames: Vec<PlumeFrame>,
+    every_steps: u64,
+    points: Vec<Vec3>,
+    flow_points: Vec<Vec2>,
+}
+
+/// Largest side of the concentration grid, points.
+pub const PLUME_FRAME_MAX_SIDE: usize = 96;
+/// Largest side of the flow grid, points.
+pub const FLOW_FRAME_MAX_SIDE: usize = 12;
+
+impl PlumeFrames {
+    /// Frames over `bounds` (x0, x1, y0, y1, m, clipped to `domain`) at height `z_m`, one every
+    /// `every_steps` steps.
+    pub fn new(
+        bounds: (f64, f64, f64, f64),
+        domain: plumetrace_env::Rect,
+        z_m: f64,
+        every_steps: u64,
+    ) -> Self {
+        let (x0, x1, y0, y1) = (
+            bounds.0.max(domain.x_min_m),
+            bounds.1.min(domain.x_max_m),
+            bounds.2.max(domain.y_min_m),
+            bounds.3.min(domain.y_max_m),
+        );
+        let sides = |max: usize| {
+            let (w, h) = ((x1 - x0).max(1e-6), (y1 - y0).max(1e-6));
+            if w >= h {
+                (
+                    max,
+                    ((max as f64) * h / w).round().clamp(2.0, max as f64) as usize,
+                )
+            } else {
+                (
+                    ((max as f64) * w / h).round().clamp(2.0, max as f64) as usize,
+                    max,
+                )
+            }
+        };
+        let grid_of = |(nx, ny): (usize, usize)| GridSpec {
+            x_min_m: x0,
+            x_max_m: x1,
+            y_min_m: y0,
+            y_max_m: y1,
+            nx,
+            ny,
+            z_m,
+        };
+        let grid = grid_of(sides(PLUME_FRAME_MAX_SIDE));
+        let flow_grid = grid_of(sides(FLOW_FRAME_MAX_SIDE));
+        PlumeFrames {
+            points: grid.points(),
+            flow_points: flow_grid.points().iter().map(|p| p.xy()).collect(),
+            grid,
+            flow_grid,
+            frames: Vec::new(),
+            every_steps: every_steps.max(1),
+        }
+    }
+
+    fn sample(&mut self, world: &World) {
+        let mut c = vec![0.0; self.points.len()];
+        world.env().plume().concentrations(&self.points, &mut c);
+        let flow = world.env().flow();
+        self.frames.push(PlumeFrame {
+            t_s: world.time_s(),
+            concentration: c
+                .iter()
+                .map(|&v| if v.is_finite() { v as f32 } else { 0.0 })
+                .collect(),
+            flow_mps: self
+                .flow_points
+                .iter()
+                .map(|&p| {
+                    let v = flow.velocity(p);
+                    [v.x as f32, v.y as f32]
+                })
+                .collect(),
+        });
+    }
+}
+
+impl Observer for PlumeFrames {
+    fn observe(&mut self, step: &StepView<'_>) {
+        if (step.world.steps() - 1).is_multiple_of(self.every_steps) {
+            self.sample(step.world);
         }
     }
 }
