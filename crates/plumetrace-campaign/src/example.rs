@@ -120,6 +120,33 @@ fn example_file(dir: &Path, scenario: &str, config: &str, point: &str) -> PathBu
         .join(format!("{}.json", slug(&[scenario, config, point])))
 }
 
+/// The replay page of a group's example run: `examples/<scenario>__<config>__<point>.html`.
+pub fn page_file(dir: &Path, scenario: &str, config: &str, point: &str) -> PathBuf {
+    example_file(dir, scenario, config, point).with_extension("html")
+}
+
+/// Writes the replay page of a group's example run (atomically).
+pub fn write_page(c: &Campaign, key: &RunKey, run: &MissionRun, dir: &Path) -> Result<(), String> {
+    let (scenario, config, point) = (
+        &c.scenarios[key.scenario].label,
+        &c.configs[key.config].name,
+        c.points[key.point].label(),
+    );
+    let group = if point.is_empty() {
+        format!("{scenario} / {config}")
+    } else {
+        format!("{scenario} / {config} / {point}")
+    };
+    let title = format!(
+        "{}: {group}, example run (seed {})",
+        c.file.name, run.summary.seed
+    );
+    let page = plumetrace_mission::replay_page::replay_page(run, &title)?;
+    let path = page_file(dir, scenario, config, &point);
+    plumetrace_mission::output::write_atomic(&path, page.as_bytes())
+        .map_err(|e| format!("writing {}: {e}", path.display()))
+}
+
 /// A file name from labels, short, safe and unique: each label's letters, digits, `-`, `.` and
 /// `_` (the rest `_`), cut to 32 characters, joined by `__`, then a digest of the labels as they
 /// are (so `a/b` and `a_b`, or two long names alike in their first 32 characters, differ).

@@ -221,6 +221,7 @@ fn run_one(c: &Campaign, key: &RunKey, out: &Path) -> RunRow {
         if example {
             let ex = ExampleRun::from_run(c, key, &run);
             ex.write(out).map_err(|e| e.to_string())?;
+            crate::example::write_page(c, key, &run, out)?;
         }
         Ok::<RunRow, String>(RunRow::from_summary(c, key, &run.summary))
     }));

@@ -18,6 +18,7 @@
 //! | `summary.csv`, `summary.md` | per group: success rate with Wilson 95 % interval, error quantiles, times, path |
 //! | `success.svg`, `errors.svg`, `trajectories.svg` | charts |
 //! | `examples/*.json` | the example run (seed index 0) of each group, for the trajectory chart |
+//! | `examples/*.html` | the replay page of each group's example run |
 //! | `campaign.json`, `campaign.toml` | the fingerprint that ties the directory to its campaign, and a copy of the file |
 //! | `runs.parquet` | with the `parquet` feature: the sorted runs as Parquet |
 

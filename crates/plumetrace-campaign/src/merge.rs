@@ -133,7 +133,12 @@ pub fn merge(dirs: &[PathBuf], out: &Path) -> Result<MergeReport, CampaignError>
         };
         for entry in entries.flatten() {
             let target = out.join(EXAMPLES_DIR).join(entry.file_name());
-            if entry.path().extension().is_some_and(|e| e == "json") && !target.exists() {
+            // The example runs and their replay pages.
+            let known = entry
+                .path()
+                .extension()
+                .is_some_and(|e| e == "json" || e == "html");
+            if known && !target.exists() {
                 std::fs::copy(entry.path(), &target).map_err(|e| CampaignError::io(&target, e))?;
             }
         }

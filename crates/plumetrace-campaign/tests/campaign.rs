@@ -130,11 +130,19 @@ fn same_campaign_same_results_whatever_the_threads_and_shards() {
     for f in ["success.svg", "errors.svg", "trajectories.svg"] {
         assert!(read(&merged.join(f)).contains("<svg"), "{f}");
     }
-    // An example per group (4 groups), whichever shard flew it.
-    assert_eq!(
-        std::fs::read_dir(merged.join("examples")).unwrap().count(),
-        4
-    );
+    // An example and its replay page per group (4 groups), whichever shard flew it.
+    let names: Vec<String> = std::fs::read_dir(merged.join("examples"))
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    assert_eq!(names.iter().filter(|n| n.ends_with(".json")).count(), 4);
+    assert_eq!(names.iter().filter(|n| n.ends_with(".html")).count(), 4);
+    for n in names.iter().filter(|n| n.ends_with(".html")) {
+        let page = read(&merged.join("examples").join(n));
+        assert!(page.contains("id=\"plumetrace-data\""), "{n}");
+        let json = n.replace(".html", ".json");
+        assert!(names.contains(&json), "{n} has no example {json}");
+    }
 }
 
 #[test]

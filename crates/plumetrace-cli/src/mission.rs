@@ -10,6 +10,9 @@ use std::fmt::Write as _;
 use std::path::Path;
 use std::time::Instant;
 
+/// The replay page's file name in a run's output directory.
+pub const REPLAY_PAGE: &str = "replay.html";
+
 /// The snapshot log's file name in a run's output directory.
 pub const SNAPSHOT_LOG: &str = "snapshots.jsonl.gz";
 
@@ -23,8 +26,8 @@ struct SummaryFile<'a> {
     stage_times: plumetrace_sim::StageTimes,
 }
 
-/// Flies the mission and writes `summary.json`, `trajectory.csv`, `events.jsonl`, `plot.svg`
-/// and (unless `snapshot_log` is false) `snapshots.jsonl.gz`.
+/// Flies the mission and writes `summary.json`, `trajectory.csv`, `events.jsonl`, `plot.svg`,
+/// `replay.html` and (unless `snapshot_log` is false) `snapshots.jsonl.gz`.
 pub fn run(sc: BuiltScenario, out: &Path, stats: bool, snapshot_log: bool) -> Result<()> {
     let name = sc.name.clone();
     let started = Instant::now();
@@ -196,5 +199,8 @@ fn write_outputs(run: &MissionRun, out: &Path, name: &str, wall: f64) -> Result<
     };
     let svg = plumetrace_mission::plot::mission_figure(run, &title).map_err(anyhow::Error::msg)?;
     write_atomic(&out.join("plot.svg"), svg.as_bytes())?;
+    let page =
+        plumetrace_mission::replay_page::replay_page(run, &title).map_err(anyhow::Error::msg)?;
+    write_atomic(&out.join(REPLAY_PAGE), page.as_bytes())?;
     Ok(())
 }

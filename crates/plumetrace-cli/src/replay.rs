@@ -20,6 +20,10 @@ pub struct ReplayArgs {
     /// the others replay their own.
     #[arg(long, requires = "planner_file", allow_hyphen_values = true, value_parser = crate::args::vehicle)]
     pub vehicle: Option<u32>,
+    /// Also write a replay page (HTML) of the replayed mission here: the logged tracks with the
+    /// replayed planners' behaviours and events.
+    #[arg(long)]
+    pub page: Option<PathBuf>,
 }
 
 /// The exit status when decisions differ.
@@ -43,10 +47,36 @@ pub fn run(args: &ReplayArgs) -> Result<bool> {
     let log = plumetrace_mission::snapshot_log::open(&args.log)
         .with_context(|| format!("opening {}", args.log.display()))?;
     let only = args.vehicle;
-    let report = plumetrace_mission::snapshot_log::replay(log, &|v| {
-        other.clone().filter(|_| only.is_none_or(|o| o == v))
-    })
+    let mut page = args
+        .page
+        .as_ref()
+        .map(|_| plumetrace_mission::replay_page::LogPageBuilder::default());
+    let report = plumetrace_mission::snapshot_log::replay_with(
+        log,
+        &|v| other.clone().filter(|_| only.is_none_or(|o| o == v)),
+        &mut |r| {
+            if let Some(p) = page.as_mut() {
+                p.add(r);
+            }
+        },
+    )
     .with_context(|| format!("{}", args.log.display()))?;
+    if let (Some(path), Some(builder)) = (&args.page, page) {
+        let planner = match &args.planner_file {
+            Some(f) => format!("replayed with {}", f.display()),
+            None => "replayed with the logged planners".into(),
+        };
+        let subtitle = format!(
+            "{planner}: {} decisions, {} differ from the log",
+            report.decisions, report.differing
+        );
+        let html = builder
+            .page(&format!("replay of {}", args.log.display()), &subtitle)
+            .html()
+            .map_err(anyhow::Error::msg)?;
+        crate::output::write_atomic(path, html.as_bytes())
+            .with_context(|| format!("writing {}", path.display()))?;
+    }
     crate::outln!(
         "{}: {} decisions replayed, {} differ",
         args.log.display(),

@@ -102,6 +102,7 @@ pub const OUTPUTS: &[&str] = &[
     "trajectory.csv",
     "events.jsonl",
     "plot.svg",
+    crate::mission::REPLAY_PAGE,
     crate::mission::SNAPSHOT_LOG,
     "stats.json",
     "snapshot.csv",

@@ -283,12 +283,17 @@ fn scenario(input: &Input, path: &Path, deadline: Instant) -> Result<String, Sto
     let svg = plumetrace_mission::plot::mission_figure(&run, "fuzz")
         .map_err(|e| Stop::Rejected(format!("short run: drawing the figure: {e}")))?;
     check_deadline(deadline, || "drawing the figure".into())?;
+    // The replay page refuses data that is not finite: a flown mission must always have one.
+    let page =
+        plumetrace_mission::replay_page::replay_page(&run, "fuzz").map_err(Stop::Nonfinite)?;
+    check_deadline(deadline, || "writing the replay page".into())?;
     Ok(format!(
-        "mission: {} at t = {} s, {} trajectory rows, figure of {} bytes in {:.2} s",
+        "mission: {} at t = {} s, {} trajectory rows, figure of {} bytes and replay page of {} bytes in {:.2} s",
         run.outcome.name(),
         run.summary.sim_time_s,
         run.trajectory.len(),
         svg.len(),
+        page.len(),
         t0.elapsed().as_secs_f64()
     ))
 }

@@ -13,13 +13,15 @@
 //! - [`record`]: the observer trait and the mission's own recorders;
 //! - [`summary`]: the key numbers written as `summary.json`;
 //! - [`snapshot_log`]: the replayable log of snapshots and decisions;
-//! - [`plot`]: the mission figure; [`output`]: atomic file writing.
+//! - [`plot`]: the mission figure; [`replay_page`]: the self-contained replay page;
+//!   [`output`]: atomic file writing.
 
 pub mod mission;
 pub mod outcome;
 pub mod output;
 pub mod plot;
 pub mod record;
+pub mod replay_page;
 pub mod setup;
 pub mod snapshot_log;
 pub mod summary;

@@ -131,7 +131,7 @@ fn legend_corner(
 type BehaviourRun = (Option<BehaviourKind>, Vec<(f64, f64)>);
 
 /// The colour of a track while `b` is in control.
-fn behaviour_colour(b: BehaviourKind) -> RGBColor {
+pub(crate) fn behaviour_colour(b: BehaviourKind) -> RGBColor {
     match b {
         BehaviourKind::GoTo => RGBColor(0, 150, 60),
         BehaviourKind::Transit => RGBColor(90, 90, 90),
@@ -147,7 +147,7 @@ fn behaviour_colour(b: BehaviourKind) -> RGBColor {
 }
 
 /// How a behaviour reads in the legend.
-fn behaviour_label(b: BehaviourKind) -> &'static str {
+pub(crate) fn behaviour_label(b: BehaviourKind) -> &'static str {
     match b {
         BehaviourKind::GoTo => "go to",
         BehaviourKind::Transit => "transit",

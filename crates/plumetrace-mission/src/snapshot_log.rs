@@ -291,11 +291,32 @@ pub fn read_header(line: &str) -> Result<Header, ReplayError> {
     Ok(header)
 }
 
+/// One replayed decision, as [`replay_with`] shows it.
+pub struct Replayed<'a> {
+    /// The log's header.
+    pub header: &'a Header,
+    /// The logged line (snapshot and logged decision).
+    pub line: &'a Line,
+    /// The replayed planner's decision.
+    pub replayed: &'a Decision,
+    /// The replayed planner's detection threshold, if it has one.
+    pub threshold_v: Option<f64>,
+}
+
 /// Replays a log: each vehicle's planner is rebuilt from the header, or from `tables` where it
 /// gives one for the vehicle (another configuration), and fed the logged snapshots in order.
 pub fn replay(
     log: impl BufRead,
     tables: &dyn Fn(u32) -> Option<toml::Table>,
+) -> Result<ReplayReport, ReplayError> {
+    replay_with(log, tables, &mut |_| {})
+}
+
+/// [`replay`], showing every replayed decision to `on` (e.g. to draw the replay page).
+pub fn replay_with(
+    log: impl BufRead,
+    tables: &dyn Fn(u32) -> Option<toml::Table>,
+    on: &mut dyn FnMut(Replayed<'_>),
 ) -> Result<ReplayReport, ReplayError> {
     let mut lines = log.lines();
     let first = lines
@@ -310,6 +331,7 @@ pub fn replay(
         })?;
     let header = read_header(&first)?;
     let mut planners: BTreeMap<u32, Box<dyn Planner>> = BTreeMap::new();
+    let mut thresholds: BTreeMap<u32, Option<f64>> = BTreeMap::new();
     for v in &header.vehicles {
         if planners.contains_key(&v.id) {
             return Err(ReplayError::Line {
@@ -331,7 +353,10 @@ pub fn replay(
             })?,
         };
         let planner = PlannerConfig::from_table(&table, &v.planner_key)
-            .and_then(|c| c.build(&v.context, &v.planner_key))
+            .and_then(|c| {
+                thresholds.insert(v.id, c.detection_threshold_v());
+                c.build(&v.context, &v.planner_key)
+            })
             .map_err(|e| ReplayError::Planner {
                 vehicle: v.id,
                 message: e.to_string(),
@@ -357,6 +382,12 @@ pub fn replay(
             message: format!("vehicle {} has no planner in the header", l.vehicle),
         })?;
         let replayed = planner.decide(&l.snapshot);
+        on(Replayed {
+            header: &header,
+            line: &l,
+            replayed: &replayed,
+            threshold_v: thresholds.get(&l.vehicle).copied().flatten(),
+        });
         report.decisions += 1;
         if !same(&replayed, &l.decision) {
             report.differing += 1;
