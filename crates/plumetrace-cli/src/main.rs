@@ -30,14 +30,18 @@ mod args;
 mod bench;
 mod campaign;
 mod mission;
+#[cfg(feature = "netcdf")]
+mod netcdf;
 mod output;
 mod plot;
 mod progress;
 mod replay;
 mod run;
+mod series;
 
 use anyhow::Result;
 use clap::{Parser, Subcommand};
+use std::fmt::Write as _;
 use std::path::PathBuf;
 
 /// Chemical plume tracing with marine robots: plume simulation, planners, campaigns.
@@ -234,8 +238,26 @@ fn check(file: &std::path::Path) -> Result<()> {
     let built = plumetrace_scenario::build(&cfg, &origin, None)?;
     let (steps, dt) = (built.steps, built.dt_s);
     if built.mission.is_none() {
+        let o = &built.output;
+        let d = series::time_decimals(dt);
+        let mut series = String::new();
+        if !o.probes.is_empty() {
+            let _ = write!(
+                series,
+                "; {} probes sampled every {:.d$} s",
+                o.probes.len(),
+                o.probe_every_steps as f64 * dt
+            );
+        }
+        if let Some(every) = o.filaments_every_steps {
+            let _ = write!(
+                series,
+                "; filament snapshots every {:.d$} s",
+                every as f64 * dt
+            );
+        }
         crate::outln!(
-            "{}: ok (plume run, {steps} steps of {dt} s)",
+            "{}: ok (plume run, {steps} steps of {dt} s{series})",
             file.display()
         );
         return Ok(());

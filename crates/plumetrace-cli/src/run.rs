@@ -2,10 +2,13 @@
 //!
 //! A mission scenario is flown ([`crate::mission`]); a scenario without vehicles simulates the
 //! environment alone and writes a concentration snapshot, the time-averaged concentration and
-//! intermittency, the final filaments, statistics and a figure.
+//! intermittency, the final filaments, statistics and a figure, and when `[output]` asks for them
+//! the probe series and filament snapshots ([`crate::series`]; with the `netcdf` feature also
+//! `plume.nc`, [`crate::netcdf`]).
 
 use crate::output::write_atomic;
 use crate::plot;
+use crate::series::{FilamentSeries, ProbeSeries, time_decimals};
 use anyhow::{Context, Result, bail};
 use plumetrace_env::{ConcentrationField, FlowField, MeanConcentrationGrid, Plume};
 use plumetrace_scenario::{BuiltScenario, Origin};
@@ -76,8 +79,18 @@ struct RunStats {
     max_concentration: f64,
     max_mean_concentration: f64,
     intermittency_threshold: f64,
-    /// The plume run's stages: advance environment, sense (sampling the time average), record
-    /// (writing the outputs).
+    /// Probe samples written to `probes.csv` (0 without probes).
+    probe_samples: usize,
+    /// Probes per sample.
+    probes: usize,
+    /// Filament snapshots written to `filament_series.csv`.
+    filament_snapshots: u32,
+    /// Filament snapshots not written because the file reached its row limit.
+    filament_snapshots_skipped: u32,
+    /// Rows of `filament_series.csv`.
+    filament_series_rows: u64,
+    /// The plume run's stages: advance environment, sense (sampling the time average and the
+    /// probes), record (filament snapshots and writing the outputs).
     stage_times: plumetrace_sim::StageTimes,
 }
 
@@ -108,29 +121,49 @@ pub const OUTPUTS: &[&str] = &[
     "snapshot.csv",
     "filaments.csv",
     "plume.svg",
+    "probes.csv",
+    "filament_series.csv",
+    "plume.nc",
 ];
 
-/// Runs the plume alone and writes `stats.json`, `snapshot.csv`, `filaments.csv` and `plume.svg`.
+/// Runs the plume alone and writes `stats.json`, `snapshot.csv`, `filaments.csv` and `plume.svg`,
+/// and with `[output]` series `probes.csv`, `filament_series.csv` and (feature `netcdf`)
+/// `plume.nc`.
 fn run_plume(mut sc: BuiltScenario, args: &RunArgs) -> Result<()> {
     let started = Instant::now();
     let mut times = plumetrace_sim::StageTimes::default();
-    let spec = sc.output;
+    let spec = sc.output.clone();
     let mut mean = MeanConcentrationGrid::new(spec.grid, spec.threshold);
     let steady = matches!(sc.env.plume(), Plume::Steady(_));
+    let t_decimals = time_decimals(sc.env.dt_s());
+    let mut probes = ProbeSeries::new(spec.probes.clone(), spec.probe_every_steps);
+    let mut filament_series = spec
+        .filaments_every_steps
+        .map(|every| FilamentSeries::new(every, t_decimals));
     let progress = crate::progress::Progress::new(sc.steps, "steps");
     for step in 1..=sc.steps {
         let t0 = Instant::now();
         sc.env.step().with_context(|| format!("step {step}"))?;
         let t1 = Instant::now();
         if step >= spec.average_start_step
-            && step % spec.average_every_steps == 0
+            && step.is_multiple_of(spec.average_every_steps)
             && !(steady && mean.samples() > 0)
         {
             mean.accumulate(sc.env.plume());
         }
+        if probes.is_due(step) {
+            probes.sample(sc.env.time_s(), sc.env.plume())?;
+        }
         let t2 = Instant::now();
+        if let Some(series) = &mut filament_series
+            && series.is_due(step)
+            && let Some(f) = sc.env.plume().filaments()
+        {
+            series.record(sc.env.time_s(), f)?;
+        }
         times.advance_environment_s += (t1 - t0).as_secs_f64();
         times.sense_s += (t2 - t1).as_secs_f64();
+        times.record_s += t2.elapsed().as_secs_f64();
         progress.tick(step);
     }
     progress.finish();
@@ -168,6 +201,40 @@ fn run_plume(mut sc: BuiltScenario, args: &RunArgs) -> Result<()> {
         }
         write_atomic(&args.out.join("filaments.csv"), csv.as_bytes())?;
     }
+    if !probes.is_empty() {
+        write_atomic(
+            &args.out.join("probes.csv"),
+            probes.csv(t_decimals).as_bytes(),
+        )?;
+        #[cfg(feature = "netcdf")]
+        {
+            let nc = crate::netcdf::plume_file(&crate::netcdf::PlumeFile {
+                scenario: &sc.name,
+                seed: sc.seed,
+                probes: &probes,
+                grid: &spec.grid,
+                mean: &mean_c,
+                mean_samples: mean.samples(),
+            })
+            .context("encoding plume.nc")?;
+            write_atomic(&args.out.join("plume.nc"), &nc)?;
+        }
+    }
+    if let Some(series) = &filament_series {
+        write_atomic(
+            &args.out.join("filament_series.csv"),
+            series.csv().as_bytes(),
+        )?;
+        if series.skipped() > 0 {
+            eprintln!(
+                "filament_series.csv: the last {} of {} snapshots are not written (the file \
+                 would pass {} rows); lengthen output.filaments_interval_s",
+                series.skipped(),
+                series.skipped() + series.snapshots(),
+                plumetrace_scenario::limits::MAX_FILAMENT_ROWS
+            );
+        }
+    }
     let svg = plot::plume_figure(&sc, &snapshot, &mean_c, mean.samples())?;
     write_atomic(&args.out.join("plume.svg"), svg.as_bytes())?;
     times.record_s += t_rec.elapsed().as_secs_f64();
@@ -191,6 +258,13 @@ fn run_plume(mut sc: BuiltScenario, args: &RunArgs) -> Result<()> {
         max_concentration: snapshot.iter().copied().fold(0.0, f64::max),
         max_mean_concentration: mean_c.iter().copied().fold(0.0, f64::max),
         intermittency_threshold: spec.threshold,
+        probe_samples: probes.times_s().len(),
+        probes: probes.points().len(),
+        filament_snapshots: filament_series
+            .as_ref()
+            .map_or(0, FilamentSeries::snapshots),
+        filament_snapshots_skipped: filament_series.as_ref().map_or(0, FilamentSeries::skipped),
+        filament_series_rows: filament_series.as_ref().map_or(0, FilamentSeries::rows),
         stage_times: times,
     };
     if let Some(at) = plumetrace_mission::output::first_non_finite(&stats) {
@@ -200,7 +274,8 @@ fn run_plume(mut sc: BuiltScenario, args: &RunArgs) -> Result<()> {
     write_atomic(&args.out.join("stats.json"), json.as_bytes())?;
     if args.stats {
         eprintln!(
-            "stage times: advance environment {:.3} s, sense (time average) {:.3} s, record {:.3} s",
+            "stage times: advance environment {:.3} s, sense (time average, probes) {:.3} s, \
+             record {:.3} s",
             stats.stage_times.advance_environment_s,
             stats.stage_times.sense_s,
             stats.stage_times.record_s

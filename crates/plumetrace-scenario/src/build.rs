@@ -2,6 +2,7 @@
 //! naming the key path of anything wrong.
 
 use crate::config::{FlowKind, MeanFlowConfig, PlumeKind, ScenarioConfig, SeabedKind};
+use crate::limits::show;
 use crate::{Origin, ScenarioError};
 use plumetrace_core::params::quoted_key;
 use plumetrace_core::{Vec2, Vec3};
@@ -15,7 +16,7 @@ use plumetrace_env::{
 use std::path::{Path, PathBuf};
 
 /// What a plume run writes and how often it samples.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct OutputSpec {
     /// The snapshot / time-average grid.
     pub grid: GridSpec,
@@ -25,6 +26,12 @@ pub struct OutputSpec {
     pub average_start_step: u64,
     /// Intermittency threshold.
     pub threshold: f64,
+    /// Probe points (z above the seabed), each inside the domain; empty: no probe series.
+    pub probes: Vec<Vec3>,
+    /// Steps between probe samples: every step that is a multiple of it, from the first.
+    pub probe_every_steps: u64,
+    /// Steps between filament snapshots; `None`: no filament series.
+    pub filaments_every_steps: Option<u64>,
 }
 
 /// A vehicle ready to be put in a world: the truth at t = 0 and its navigation and sensors.
@@ -606,11 +613,15 @@ pub fn build(
             format!("must be a finite number >= 0, got {:?}", o.threshold),
         ));
     }
+    let series = series_spec(cfg, &domain, dt_s, steps).map_err(|(k, m)| invalid(&k, m))?;
     let output = OutputSpec {
         grid,
         average_every_steps: ((o.average_interval_s / dt_s).round() as u64).max(1),
         average_start_step: (o.average_start_s / dt_s).round() as u64,
         threshold: o.threshold,
+        probes: series.probes,
+        probe_every_steps: series.probe_every_steps,
+        filaments_every_steps: series.filaments_every_steps,
     };
     Ok(BuiltScenario {
         name: cfg.name.clone(),
@@ -624,6 +635,168 @@ pub fn build(
         comms,
         dt_s,
         depth_m: d.depth_m,
+    })
+}
+
+/// The probe and filament series of `[output]`, checked.
+struct SeriesSpec {
+    probes: Vec<Vec3>,
+    probe_every_steps: u64,
+    filaments_every_steps: Option<u64>,
+}
+
+/// Checks `output.probes`, `output.probe_interval_s` and `output.filaments_interval_s` of a
+/// scenario that has passed [`crate::limits`] and whose time average has been checked; `steps`
+/// of `dt_s` make the run. On error returns `(key, message)`.
+fn series_spec(
+    cfg: &ScenarioConfig,
+    domain: &Rect,
+    dt_s: f64,
+    steps: u64,
+) -> Result<SeriesSpec, (String, String)> {
+    let o = &cfg.output;
+    let depth_m = cfg.domain.depth_m;
+    let duration_s = cfg.sim.duration_s;
+    let to_steps = |s: f64| ((s / dt_s).round() as u64).max(1);
+    if cfg.mission.is_some() {
+        let given = [
+            ("output.probes", !o.probes.is_empty()),
+            ("output.probe_interval_s", o.probe_interval_s.is_some()),
+            (
+                "output.filaments_interval_s",
+                o.filaments_interval_s.is_some_and(|s| s != 0.0),
+            ),
+        ];
+        if let Some((key, _)) = given.iter().find(|(_, g)| *g) {
+            return Err((
+                (*key).into(),
+                "probe and filament series are written by plume runs only (a scenario without \
+                 [mission]); a mission records its own outputs"
+                    .into(),
+            ));
+        }
+    }
+
+    let mut probes = Vec::with_capacity(o.probes.len());
+    for (k, &[x, y, z]) in o.probes.iter().enumerate() {
+        let key = format!("output.probes[{k}]");
+        let at = format!("[{}, {}, {}]", show(x), show(y), show(z));
+        if !(x.is_finite() && y.is_finite() && z.is_finite()) {
+            return Err((
+                key,
+                format!("{at} is not a point (every coordinate finite)"),
+            ));
+        }
+        if !domain.contains_xy(x, y) {
+            return Err((
+                key,
+                format!(
+                    "{at} is outside the domain ({}..{} East, {}..{} North)",
+                    show(domain.x_min_m),
+                    show(domain.x_max_m),
+                    show(domain.y_min_m),
+                    show(domain.y_max_m)
+                ),
+            ));
+        }
+        if z < 0.0 || depth_m.is_some_and(|h| z > h) {
+            return Err((
+                key,
+                match depth_m {
+                    Some(h) => format!(
+                        "{at}: z_m (height above the seabed) must be in [0, domain.depth_m = {}]",
+                        show(h)
+                    ),
+                    None => format!("{at}: z_m (height above the seabed) must be >= 0"),
+                },
+            ));
+        }
+        probes.push(Vec3::new(x, y, z));
+    }
+
+    let probe_interval_s = o.probe_interval_s.unwrap_or(o.average_interval_s);
+    let probe_every_steps = to_steps(probe_interval_s);
+    if o.probe_interval_s.is_some() || !probes.is_empty() {
+        let default = if o.probe_interval_s.is_none() {
+            " (its default, output.average_interval_s)".to_string()
+        } else {
+            String::new()
+        };
+        if !(probe_interval_s.is_finite()
+            && probe_interval_s >= dt_s
+            && probe_interval_s <= duration_s)
+        {
+            return Err((
+                "output.probe_interval_s".into(),
+                format!(
+                    "must be in [sim.dt_s, sim.duration_s] = [{}, {}] so that the probes are \
+                     sampled at least once, got {}{default}",
+                    show(dt_s),
+                    show(duration_s),
+                    show(probe_interval_s)
+                ),
+            ));
+        }
+        let rows = (steps / probe_every_steps).saturating_mul(probes.len() as u64);
+        if rows > crate::limits::MAX_PROBE_ROWS {
+            return Err((
+                "output.probe_interval_s".into(),
+                format!(
+                    "{} samples x {} probes = {rows} rows of probes.csv; at most {}: lengthen \
+                     the interval{default} or use fewer probes",
+                    steps / probe_every_steps,
+                    probes.len(),
+                    crate::limits::MAX_PROBE_ROWS
+                ),
+            ));
+        }
+    }
+
+    // 0 is the same as absent: no snapshots.
+    let filaments_every_steps = match o.filaments_interval_s.filter(|&s| s != 0.0) {
+        None => None,
+        Some(s) => {
+            let key = "output.filaments_interval_s";
+            if !(s.is_finite() && s >= dt_s && s <= duration_s) {
+                return Err((
+                    key.into(),
+                    format!(
+                        "must be 0 (no snapshots) or in [sim.dt_s, sim.duration_s] = [{}, {}], \
+                         got {}",
+                        show(dt_s),
+                        show(duration_s),
+                        show(s)
+                    ),
+                ));
+            }
+            if cfg.plume.model != PlumeKind::Filaments {
+                return Err((
+                    key.into(),
+                    "a steady plume (plume.model = \"gaussian\" or \"gridded\") has no \
+                     filaments; remove it or use plume.model = \"filaments\""
+                        .into(),
+                ));
+            }
+            let every = to_steps(s);
+            let snapshots = steps / every;
+            if snapshots > crate::limits::MAX_FILAMENT_SNAPSHOTS {
+                return Err((
+                    key.into(),
+                    format!(
+                        "sim.duration_s / {} = {snapshots} snapshots of every filament; at most \
+                         {}: lengthen the interval",
+                        show(s),
+                        crate::limits::MAX_FILAMENT_SNAPSHOTS
+                    ),
+                ));
+            }
+            Some(every)
+        }
+    };
+    Ok(SeriesSpec {
+        probes,
+        probe_every_steps,
+        filaments_every_steps,
     })
 }
 

@@ -290,7 +290,8 @@ fn kelp_roughness() -> f64 {
     0.3
 }
 
-/// `[output]`: the concentration snapshot and the time average written by `plumetrace run`.
+/// `[output]`: the concentration snapshot, the time average, the probe series and the filament
+/// snapshots written by a plume run (`plumetrace run` on a scenario without a mission).
 #[derive(Debug, Clone, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct OutputConfig {
@@ -306,6 +307,14 @@ pub struct OutputConfig {
     pub average_start_s: f64,
     /// Threshold for the intermittency map (fraction of samples above it).
     pub threshold: f64,
+    /// Probe points `[x_m, y_m, z_m]` (z above the seabed) whose concentrations a plume run
+    /// writes at every probe sample (`probes.csv`).
+    pub probes: Vec<[f64; 3]>,
+    /// Time between probe samples, s, from the start of the run (default: `average_interval_s`,
+    /// so that from `average_start_s` on the probes are sampled at the time average's steps).
+    pub probe_interval_s: Option<f64>,
+    /// Time between snapshots of every filament (`filament_series.csv`), s; absent or 0: none.
+    pub filaments_interval_s: Option<f64>,
 }
 
 impl Default for OutputConfig {
@@ -317,6 +326,9 @@ impl Default for OutputConfig {
             average_interval_s: 1.0,
             average_start_s: 0.0,
             threshold: 0.1,
+            probes: Vec::new(),
+            probe_interval_s: None,
+            filaments_interval_s: None,
         }
     }
 }

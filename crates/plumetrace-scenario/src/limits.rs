@@ -313,6 +313,23 @@ pub const LIMITS: &[Limit] = &[
         "a concentration threshold; finite",
     ),
     count(
+        "output.probes",
+        1000,
+        "every probe is queried at every probe sample",
+    ),
+    num("output.probes[][]", -COORD, COORD, COORD_WHY),
+    pos(
+        "output.probe_interval_s",
+        LONG,
+        "115 days; probes.csv holds at most 5,000,000 rows (samples x probes)",
+    ),
+    num(
+        "output.filaments_interval_s",
+        0.0,
+        LONG,
+        "0 writes no filament snapshots; at most 1,000 snapshots per run",
+    ),
+    count(
         "vehicles",
         100,
         "every vehicle is stepped and sensed at every step",
@@ -525,6 +542,14 @@ pub const LIMITS: &[Limit] = &[
 pub const MAX_STEPS: f64 = 1e8;
 /// The most steps of a spin-up.
 pub const MAX_SPINUP_STEPS: f64 = 1e7;
+/// The most rows of a plume run's `probes.csv` (samples times probes): about 250 MB of text,
+/// held in memory until the run ends.
+pub const MAX_PROBE_ROWS: u64 = 5_000_000;
+/// The most filament snapshots of a plume run (`output.filaments_interval_s`).
+pub const MAX_FILAMENT_SNAPSHOTS: u64 = 1000;
+/// The most rows of a plume run's `filament_series.csv`: snapshots that would go beyond are not
+/// written (the run says so), since the live filaments are only known as the run goes.
+pub const MAX_FILAMENT_ROWS: u64 = 5_000_000;
 
 /// The row for a key path (array indices written `[]`).
 pub fn limit(key: &str) -> Option<&'static Limit> {
@@ -725,5 +750,14 @@ mod tests {
         }
         assert!(show(-1e-300).len() < 10);
         assert!(markdown().contains("| `sim.dt_s` | > 0.0 and <= 60.0 |"));
+    }
+
+    #[test]
+    fn series_bounds_say_the_limits_the_build_checks() {
+        let why = |k: &str| limit(k).map(|l| l.why).unwrap_or_default();
+        assert_eq!(MAX_PROBE_ROWS, 5_000_000);
+        assert!(why("output.probe_interval_s").contains("5,000,000 rows"));
+        assert_eq!(MAX_FILAMENT_SNAPSHOTS, 1000);
+        assert!(why("output.filaments_interval_s").contains("1,000 snapshots"));
     }
 }

@@ -297,3 +297,165 @@ fn planner_tables_are_wired_to_vehicles_with_key_paths() {
     let ok = error_of(&named("[planners.tracer]\nkind = \"amp\""));
     assert_eq!(ok, "accepted");
 }
+
+/// `plume-demo` (600 s at 0.1 s, 200 m x 100 m, 10 m deep) with `keys` added to `[output]`.
+fn demo_output(keys: &str) -> String {
+    demo_with(|t| t.replacen("threshold = 0.05", &format!("threshold = 0.05\n{keys}"), 1))
+}
+
+#[test]
+fn bad_probe_and_series_keys_are_rejected_with_their_key_path() {
+    let many = |n: usize| format!("probes = [{}]", vec!["[50.0, 0.0, 2.0]"; n].join(", "));
+    let cases: Vec<(String, &str, &str)> = vec![
+        (
+            "probes = [[500.0, 0.0, 2.0]]".into(),
+            "output.probes[0]",
+            "outside the domain (0.0..200.0 East, -50.0..50.0 North)",
+        ),
+        (
+            "probes = [[50.0, 0.0, 2.0], [50.0, 0.0, 20.0]]".into(),
+            "output.probes[1]",
+            "domain.depth_m = 10.0",
+        ),
+        (
+            "probes = [[50.0, 0.0, -1.0]]".into(),
+            "output.probes[0]",
+            "height above the seabed",
+        ),
+        (
+            "probes = [[50.0, 0.0]]".into(),
+            "output.probes[0]",
+            "length 3",
+        ),
+        (
+            "probes = [[1.0, 0.0, 1.0], [1e18, 0.0, 0.0]]".into(),
+            "output.probes[1][0]",
+            "<= 10000000.0",
+        ),
+        (many(1001), "output.probes", "at most 1000 entries"),
+        (
+            "probes = [[50.0, 0.0, 2.0]]\nprobe_interval_s = 0.01".into(),
+            "output.probe_interval_s",
+            "[sim.dt_s, sim.duration_s] = [0.1, 600.0]",
+        ),
+        (
+            "probe_interval_s = 601.0".into(),
+            "output.probe_interval_s",
+            "got 601.0",
+        ),
+        (
+            "probe_interval_s = -1.0".into(),
+            "output.probe_interval_s",
+            "> 0.0",
+        ),
+        (
+            format!("{}\nprobe_interval_s = 0.1", many(1000)),
+            "output.probe_interval_s",
+            "6000 samples x 1000 probes = 6000000 rows of probes.csv; at most 5000000",
+        ),
+        (
+            "filaments_interval_s = 0.5".into(),
+            "output.filaments_interval_s",
+            "1200 snapshots of every filament; at most 1000",
+        ),
+        (
+            "filaments_interval_s = 0.01".into(),
+            "output.filaments_interval_s",
+            "must be 0 (no snapshots) or in [sim.dt_s, sim.duration_s]",
+        ),
+        (
+            "filaments_interval_s = -1.0".into(),
+            "output.filaments_interval_s",
+            ">= 0.0",
+        ),
+        (
+            "filaments_interval_s = nan".into(),
+            "output.filaments_interval_s",
+            "got NaN",
+        ),
+        (
+            "probs = [[50.0, 0.0, 2.0]]".into(),
+            "output.probs",
+            "unknown field `probs`",
+        ),
+    ];
+    for (keys, key, message) in &cases {
+        let e = error_of(&demo_output(keys));
+        assert!(
+            e.starts_with("scenario.toml: ")
+                && e.contains(&format!("{key}: "))
+                && e.contains(message),
+            "{keys}: error {e:?} does not name {key} with {message:?}"
+        );
+    }
+    // The default interval is the time average's; an error says so.
+    let text = demo_output("probes = [[50.0, 0.0, 2.0]]").replacen(
+        "average_interval_s = 1.0",
+        "average_interval_s = 700.0",
+        1,
+    );
+    let e = error_of(&text);
+    assert!(
+        e.contains("output.probe_interval_s: ")
+            && e.contains("(its default, output.average_interval_s)"),
+        "{e}"
+    );
+    // A steady plume has no filaments.
+    let steady = format!(
+        "{}filaments_interval_s = 1.0\n",
+        find_preset("freshwater").unwrap().toml
+    );
+    let e = error_of(&steady);
+    assert!(
+        e.contains("output.filaments_interval_s: ") && e.contains("steady plume"),
+        "{e}"
+    );
+    // A mission writes no series.
+    let mission = format!(
+        "{}probes = [[100.0, 0.0, 2.0]]\n",
+        find_preset("demo").unwrap().toml
+    );
+    let e = error_of(&mission);
+    assert!(
+        e.contains("output.probes: ") && e.contains("plume runs only"),
+        "{e}"
+    );
+}
+
+#[test]
+fn probe_and_series_keys_are_built_into_steps() {
+    let origin = Origin::File("scenario.toml".into());
+    let built = |keys: &str| {
+        let cfg = parse(&demo_output(keys), &origin).unwrap();
+        build(&cfg, &origin, None).unwrap().output
+    };
+    let o = built("probes = [[50.0, 0.0, 2.0], [200, 50, 10]]");
+    assert_eq!(o.probes.len(), 2);
+    assert_eq!(
+        (o.probes[1].x, o.probes[1].y, o.probes[1].z),
+        (200.0, 50.0, 10.0)
+    );
+    assert_eq!(
+        o.probe_every_steps, o.average_every_steps,
+        "default: the average's"
+    );
+    assert_eq!(o.probe_every_steps, 10);
+    assert_eq!(o.filaments_every_steps, None);
+    let o = built("probes = [[50.0, 0.0, 2.0]]\nprobe_interval_s = 2.5\nfilaments_interval_s = 60");
+    assert_eq!(o.probe_every_steps, 25);
+    assert_eq!(o.filaments_every_steps, Some(600));
+    let o = built("filaments_interval_s = 0.0");
+    assert!(o.probes.is_empty());
+    assert_eq!(o.filaments_every_steps, None);
+    // Every preset keeps its outputs: no series unless asked for.
+    for p in plumetrace_scenario::PRESETS {
+        let origin = Origin::Preset(p.name.into());
+        let cfg = parse(p.toml, &origin).unwrap();
+        let o = build(&cfg, &origin, None).unwrap().output;
+        assert!(
+            o.probes.is_empty() && o.filaments_every_steps.is_none(),
+            "{}",
+            p.name
+        );
+    }
+}
