@@ -210,10 +210,7 @@ impl Mission {
             .plume_frames_every_s
             .filter(|s| s.is_finite() && *s > 0.0)
             .map(|every| {
-                let (mut x0, mut x1, mut y0, mut y1) = (f64::MAX, f64::MIN, f64::MAX, f64::MIN);
-                for p in &spec.op_area {
-                    (x0, x1, y0, y1) = (x0.min(p.x), x1.max(p.x), y0.min(p.y), y1.max(p.y));
-                }
+                let (x0, x1, y0, y1) = crate::record::bounds_of(&spec.op_area);
                 let pad = 0.15 * (x1 - x0).max(y1 - y0);
                 PlumeFrames::new(
                     (x0 - pad, x1 + pad, y0 - pad, y1 + pad),

@@ -116,16 +116,7 @@ fn emptiest_corner(
     let fy = (px.1 / panel_px.1).min(1.0) * (y.end - y.start);
     let mut best = (Corner::LowerRight, usize::MAX);
     for corner in Corner::ALL.into_iter().filter(|c| !taken.contains(c)) {
-        let cx = if corner.right() {
-            x.end - fx..x.end
-        } else {
-            x.start..x.start + fx
-        };
-        let cy = if corner.upper() {
-            y.end - fy..y.end
-        } else {
-            y.start..y.start + fy
-        };
+        let (cx, cy) = corner.box_in(&x, &y, fx, fy);
         let n = points
             .iter()
             .filter(|(px, py)| cx.contains(px) && cy.contains(py))
@@ -161,6 +152,21 @@ impl Corner {
 
     fn upper(self) -> bool {
         matches!(self, Corner::UpperRight | Corner::UpperLeft)
+    }
+
+    /// The box `fx` x `fy` (data units) in this corner of `x` x `y`.
+    fn box_in(self, x: &Range<f64>, y: &Range<f64>, fx: f64, fy: f64) -> (Range<f64>, Range<f64>) {
+        let cx = if self.right() {
+            x.end - fx..x.end
+        } else {
+            x.start..x.start + fx
+        };
+        let cy = if self.upper() {
+            y.end - fy..y.end
+        } else {
+            y.start..y.start + fy
+        };
+        (cx, cy)
     }
 
     fn position(self) -> SeriesLabelPosition {
@@ -1335,16 +1341,7 @@ fn map_layout(
         lh / f64::from(plot_h) * (y.end - y.start),
     );
     let inside = Corner::ALL.into_iter().find(|c| {
-        let cx = if c.right() {
-            x.end - fx..x.end
-        } else {
-            x.start..x.start + fx
-        };
-        let cy = if c.upper() {
-            y.end - fy..y.end
-        } else {
-            y.start..y.start + fy
-        };
+        let (cx, cy) = c.box_in(&x, &y, fx, fy);
         !legend.is_empty()
             && !marked
                 .iter()

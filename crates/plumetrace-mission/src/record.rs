@@ -343,6 +343,14 @@ impl Observer for TrackStats {
     }
 }
 
+/// The bounding box of `points`: west, east, south, north, m.
+pub fn bounds_of(points: &[Vec2]) -> (f64, f64, f64, f64) {
+    points.iter().fold(
+        (f64::MAX, f64::MIN, f64::MAX, f64::MIN),
+        |(x0, x1, y0, y1), p| (x0.min(p.x), x1.max(p.x), y0.min(p.y), y1.max(p.y)),
+    )
+}
+
 /// Accumulates the time-averaged concentration over a grid every `sample_every` steps (the
 /// figure's plume).
 #[derive(Debug)]
@@ -363,10 +371,7 @@ impl MeanPlumeRecorder {
 
     /// The grid covering `vertices` with a 5 % margin, inside the domain, at height `z_m`.
     pub fn grid_over(vertices: &[Vec2], domain: plumetrace_env::Rect, z_m: f64) -> GridSpec {
-        let (mut x0, mut x1, mut y0, mut y1) = (f64::MAX, f64::MIN, f64::MAX, f64::MIN);
-        for p in vertices {
-            (x0, x1, y0, y1) = (x0.min(p.x), x1.max(p.x), y0.min(p.y), y1.max(p.y));
-        }
+        let (x0, x1, y0, y1) = bounds_of(vertices);
         let pad = 0.05 * (x1 - x0).max(y1 - y0);
         GridSpec {
             x_min_m: (x0 - pad).max(domain.x_min_m),

@@ -262,9 +262,8 @@ impl PageTrack {
     }
 }
 
-/// Builds tracks from rows `(vehicle, t, truth, estimate, behaviour, reading, detection)`
-/// in time order, keeping a point at least every `interval_s` (and never more than
-/// [`MAX_TRACK_POINTS`] per vehicle over `t_end`).
+/// One row for [`tracks`]: vehicle, time (s), true and estimated position (m, if known),
+/// behaviour, reading (V), detection.
 pub type TrackRow = (
     u32,
     f64,
@@ -275,7 +274,9 @@ pub type TrackRow = (
     bool,
 );
 
-/// Tracks of `n` vehicles from rows in time order (see [`TrackRow`]).
+/// Tracks of `n` vehicles from rows in time order (see [`TrackRow`]), keeping a point at least
+/// every `interval_s` (and never more than [`MAX_TRACK_POINTS`] per vehicle over `t_end`) and at
+/// every behaviour switch.
 pub fn tracks(
     n: usize,
     rows: impl Iterator<Item = TrackRow>,
