@@ -75,6 +75,20 @@ const RULES: &[(&str, Side, &[&str])] = &[
         ],
     ),
     (
+        "plumetrace-py",
+        Side::App,
+        &[
+            "plumetrace-core",
+            "plumetrace-env",
+            "plumetrace-sim",
+            "plumetrace-scenario",
+            "plumetrace-guidance",
+            "plumetrace-planner",
+            "plumetrace-mission",
+            "plumetrace-campaign",
+        ],
+    ),
+    (
         "plumetrace-fuzz",
         Side::App,
         &[

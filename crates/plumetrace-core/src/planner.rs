@@ -66,6 +66,8 @@ pub enum DeclarationKind {
     UpflowEdge,
     /// The position of the strongest reading of a survey.
     StrongestReading,
+    /// A rule of a planner outside the registry (a Python planner, say), which names none.
+    Custom,
 }
 
 /// Something a planner reports for the event stream (written to logs, never read back by the

@@ -300,6 +300,42 @@ impl Mission {
         &self.world
     }
 
+    /// Flies `planner` for vehicle `vehicle` instead of the one its planner table builds: a
+    /// planner outside the registry (written in Python, or an agent being trained) behind the
+    /// same [`Planner`] seam. Only before the first step, and only for a vehicle with a planner
+    /// table: the table still gives the detection threshold the trajectory and statistics mark
+    /// detections with, and the snapshot log's header still names it.
+    pub fn replace_planner(
+        &mut self,
+        vehicle: usize,
+        planner: Box<dyn Planner>,
+    ) -> Result<(), MissionError> {
+        let invalid = |message: String| MissionError::Output {
+            what: "a replacement planner".into(),
+            message,
+        };
+        if self.world.steps() > 0 {
+            return Err(invalid(format!(
+                "planners can only be replaced before the first step, not at step {}",
+                self.world.steps()
+            )));
+        }
+        match self.planners.get_mut(vehicle) {
+            Some(slot @ Some(_)) => {
+                *slot = Some(planner);
+                Ok(())
+            }
+            Some(None) => Err(invalid(format!(
+                "vehicle {vehicle} ({}) has no planner table to replace",
+                self.world.vehicles()[vehicle].name
+            ))),
+            None => Err(invalid(format!(
+                "there is no vehicle {vehicle} (the mission has {})",
+                self.planners.len()
+            ))),
+        }
+    }
+
     /// Each vehicle's planner as configured.
     pub fn planned(&self) -> &[Option<PlannedVehicle>] {
         &self.planned
