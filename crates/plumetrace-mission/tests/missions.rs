@@ -604,3 +604,71 @@ fn a_replayed_log_makes_a_page_of_the_logged_track_and_the_replayed_behaviours()
     assert_eq!(page.op_area, from_run.op_area);
     assert!(page.html().is_ok());
 }
+
+/// A planner from outside the registry: due east at 1 m/s, 3 m up, every second.
+struct DueEast {
+    asked: std::sync::Arc<std::sync::atomic::AtomicU64>,
+}
+
+impl plumetrace_core::Planner for DueEast {
+    fn decide(&mut self, _: &plumetrace_core::SensorSnapshot) -> plumetrace_core::Decision {
+        self.asked
+            .fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+        plumetrace_core::Decision::new(
+            plumetrace_core::Command {
+                heading: plumetrace_core::Heading::from_deg(90.0),
+                speed_mps: 1.0,
+                vertical: plumetrace_core::VerticalCommand::Altitude(3.0),
+            },
+            plumetrace_core::PlanStatus::Running,
+        )
+    }
+    fn decision_period_s(&self) -> f64 {
+        1.0
+    }
+}
+
+#[test]
+fn a_replaced_planner_flies_the_vehicle_and_only_before_the_first_step() {
+    let asked = std::sync::Arc::new(std::sync::atomic::AtomicU64::new(0));
+    let setup = MissionSetup::new(shortened("demo", 0.0, 60.0, 1)).unwrap();
+    let mut m = Mission::new(setup, MissionOptions::default()).unwrap();
+    m.replace_planner(
+        0,
+        Box::new(DueEast {
+            asked: asked.clone(),
+        }),
+    )
+    .unwrap();
+    let missing = m.replace_planner(
+        5,
+        Box::new(DueEast {
+            asked: asked.clone(),
+        }),
+    );
+    assert!(missing.unwrap_err().to_string().contains("no vehicle 5"));
+    m.step().unwrap();
+    let late = m.replace_planner(
+        0,
+        Box::new(DueEast {
+            asked: asked.clone(),
+        }),
+    );
+    assert!(late.unwrap_err().to_string().contains("before the first step"));
+    let run = {
+        m.run(&mut |_, _| {}).unwrap();
+        m.finish().unwrap()
+    };
+    // Asked about once a second for 60 s, and it flew where it said: it starts at x = 470 m heading
+    // west and ends east of its start.
+    let n = asked.load(std::sync::atomic::Ordering::Relaxed);
+    assert!((50..=61).contains(&n), "asked {n} times");
+    let last = run.trajectory.last().unwrap();
+    assert!(last.true_x_m > 470.0, "x = {}", last.true_x_m);
+    assert!(
+        run.events
+            .iter()
+            .all(|e| !matches!(e.event, EventKind::Planner(_))),
+        "the replacement reported nothing, so no planner events"
+    );
+}

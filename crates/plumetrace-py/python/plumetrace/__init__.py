@@ -4,9 +4,12 @@ The simulation runs in Rust (the same code as the ``plumetrace`` command line); 
 release the interpreter. Errors are raised as :class:`PlumetraceError` with the command line's
 messages, naming the file and the key.
 
->>> import plumetrace
->>> r = plumetrace.run("demo", seed=1)
->>> r.summary["outcome"]
+Example::
+
+    import plumetrace
+
+    r = plumetrace.run("demo", seed=1)
+    print(r.outcome, r.summary["first_declaration"]["error_m"])
 """
 
 from __future__ import annotations

@@ -1,0 +1,102 @@
+"""Type hints of the extension module (the Rust side of the package)."""
+
+from typing import Any, Callable, Dict, List, Optional, Sequence, Tuple, Union
+
+import numpy as np
+import numpy.typing as npt
+
+__version__: str
+
+class PlumetraceError(Exception):
+    """A scenario, campaign or planner error; the message names the file and the key."""
+
+def run(
+    scenario: str,
+    seed: Optional[int] = None,
+    set: Optional[Dict[str, Any]] = None,
+    planner: Any = None,
+    vehicle: int = 0,
+    trajectory: bool = True,
+    progress: Optional[Callable[[int], Any]] = None,
+    **kwargs: Any,
+) -> Dict[str, Any]: ...
+def presets() -> List[Tuple[str, str]]: ...
+def planners() -> List[Tuple[str, str]]: ...
+def campaign(
+    file: str,
+    out: str,
+    jobs: Optional[int] = None,
+    shard: Union[None, str, Tuple[int, int]] = None,
+    seeds: Optional[int] = None,
+    progress: Optional[Callable[[int, int], Any]] = None,
+) -> Dict[str, Any]: ...
+def merge(dirs: Sequence[str], out: str) -> Dict[str, Any]: ...
+
+class Plume:
+    """The flow and plume of a scenario, stepped on the scenario's `dt_s`."""
+
+    def __init__(
+        self,
+        scenario: str,
+        seed: Optional[int] = None,
+        set: Optional[Dict[str, Any]] = None,
+        **kwargs: Any,
+    ) -> None: ...
+    @property
+    def name(self) -> str: ...
+    @property
+    def seed(self) -> int: ...
+    @property
+    def time_s(self) -> float: ...
+    @property
+    def dt_s(self) -> float: ...
+    @property
+    def domain(self) -> Tuple[float, float, float, float]: ...
+    def step(self, n: int = 1) -> None: ...
+    def spin_up(self, duration_s: float, dt_s: Optional[float] = None) -> None: ...
+    def concentrations(self, points: npt.NDArray[np.float64]) -> npt.NDArray[np.float64]: ...
+    def concentration_grid(
+        self, x: npt.NDArray[np.float64], y: npt.NDArray[np.float64], z: float
+    ) -> npt.NDArray[np.float64]: ...
+    def filaments(self) -> npt.NDArray[np.float64]: ...
+    def flow(self, points: npt.NDArray[np.float64]) -> npt.NDArray[np.float64]: ...
+    def mean_maps(
+        self,
+        x: npt.NDArray[np.float64],
+        y: npt.NDArray[np.float64],
+        z: float,
+        duration_s: float,
+        every_s: float,
+        threshold: Optional[float] = None,
+    ) -> Tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]: ...
+    def stats(self) -> Dict[str, float]: ...
+
+class EnvCore:
+    def __init__(self, scenario: str, set: Optional[Dict[str, Any]] = None, **kwargs: Any) -> None: ...
+    @staticmethod
+    def obs_names() -> List[str]: ...
+    @staticmethod
+    def obs_bounds() -> Tuple[List[float], List[float]]: ...
+    @property
+    def decision_period_s(self) -> float: ...
+    def reset(self, seed: int) -> npt.NDArray[np.float32]: ...
+    def step(
+        self, action: npt.NDArray[np.float64]
+    ) -> Tuple[npt.NDArray[np.float32], float, bool, bool, Dict[str, Any]]: ...
+
+class VecEnvCore:
+    def __init__(
+        self, scenario: str, n: int, set: Optional[Dict[str, Any]] = None, **kwargs: Any
+    ) -> None: ...
+    @property
+    def num_envs(self) -> int: ...
+    def reset(self, seed: int) -> npt.NDArray[np.float32]: ...
+    def step(
+        self, actions: npt.NDArray[np.float64]
+    ) -> Tuple[
+        npt.NDArray[np.float32],
+        npt.NDArray[np.float64],
+        npt.NDArray[np.bool_],
+        npt.NDArray[np.bool_],
+        npt.NDArray[np.bool_],
+    ]: ...
