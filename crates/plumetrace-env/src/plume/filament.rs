@@ -230,6 +230,28 @@ impl FilamentPlume {
         })
     }
 
+    /// A copy of the plume's state (filaments, clock, statistics, release rates); the query
+    /// caches are rebuilt by the copy's first query.
+    pub fn copy_state(&self) -> Self {
+        FilamentPlume {
+            params: self.params,
+            domain: self.domain,
+            sources: self.sources.clone(),
+            release: self.release.clone(),
+            release_dt_s: self.release_dt_s,
+            x: self.x.clone(),
+            y: self.y.clone(),
+            z: self.z.clone(),
+            birth_s: self.birth_s.clone(),
+            mass: self.mass.clone(),
+            source: self.source.clone(),
+            time_s: self.time_s,
+            stats: self.stats,
+            index: OnceLock::new(),
+            boxes: OnceLock::new(),
+        }
+    }
+
     /// The sources.
     pub fn sources(&self) -> &[Source] {
         &self.sources
