@@ -5,10 +5,11 @@ use crate::error::CampaignError;
 use crate::example::{EXAMPLES_DIR, ExampleRun};
 use crate::runs::{Appender, RUNS_FILE, RunRow, row_key};
 use crate::spec::{Campaign, RunKey, Shard};
-use plumetrace_mission::{MissionOptions, run_mission_with};
+use plumetrace_env::Environment;
+use plumetrace_mission::{Mission, MissionOptions, MissionSetup};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
-use std::collections::BTreeSet;
+use std::collections::{BTreeMap, BTreeSet};
 use std::path::Path;
 use std::sync::Mutex;
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
@@ -36,6 +37,9 @@ pub struct RunOptions {
     pub jobs: Option<usize>,
     /// Only this shard's runs.
     pub shard: Option<Shard>,
+    /// Spin every run's plume up on its own, even where runs of the same seed could share one
+    /// (the results are the same bits either way; this is for checking that).
+    pub separate_spinups: bool,
 }
 
 /// What a campaign call did.
@@ -161,27 +165,36 @@ pub fn run_campaign(
     let finished = AtomicU64::new(0);
     let failed = AtomicU64::new(0);
     let total = todo.len() as u64;
+    let groups = if opts.separate_spinups {
+        todo.iter().map(|k| vec![*k]).collect()
+    } else {
+        spinup_groups(c, &todo)
+    };
     let work = || {
-        todo.par_iter().for_each(|key| {
-            if stop.load(Ordering::Relaxed) {
-                return;
-            }
-            let row = run_one(c, key, out);
-            if row.outcome == crate::runs::RunOutcome::ERROR {
-                failed.fetch_add(1, Ordering::Relaxed);
-            }
-            let written = appender
-                .lock()
-                .map_err(|_| CampaignError::io(&runs_path, "a worker panicked while writing"))
-                .and_then(|mut a| a.append(&row));
-            if let Err(e) = written {
-                stop.store(true, Ordering::Relaxed);
-                if let Ok(mut slot) = first_error.lock() {
-                    slot.get_or_insert(e);
+        groups.par_iter().for_each(|group| {
+            let mut shared: Option<Environment> = None;
+            for (i, key) in group.iter().enumerate() {
+                if stop.load(Ordering::Relaxed) {
+                    return;
                 }
-                return;
+                let more = i + 1 < group.len();
+                let row = run_one(c, key, out, &mut shared, more);
+                if row.outcome == crate::runs::RunOutcome::ERROR {
+                    failed.fetch_add(1, Ordering::Relaxed);
+                }
+                let written = appender
+                    .lock()
+                    .map_err(|_| CampaignError::io(&runs_path, "a worker panicked while writing"))
+                    .and_then(|mut a| a.append(&row));
+                if let Err(e) = written {
+                    stop.store(true, Ordering::Relaxed);
+                    if let Ok(mut slot) = first_error.lock() {
+                        slot.get_or_insert(e);
+                    }
+                    return;
+                }
+                progress(finished.fetch_add(1, Ordering::Relaxed) + 1, total);
             }
-            progress(finished.fetch_add(1, Ordering::Relaxed) + 1, total);
         });
     };
     match opts.jobs {
@@ -202,8 +215,58 @@ pub fn run_campaign(
     Ok(report)
 }
 
+/// The runs that can share one spin-up: runs of the same scenario and seed whose scenario
+/// tables differ only in what the environment is not built from (planner tables, outputs, the
+/// mission's geometry and time limit). Everything else (domain, flow, plume, sources, obstacles,
+/// kelp, vehicles, whose start positions keep kelp clear, the simulation and spin-up steps)
+/// must be equal, so a shared spin-up gives the same bits as separate ones. Groups come in run
+/// order.
+pub fn spinup_groups(c: &Campaign, todo: &[RunKey]) -> Vec<Vec<RunKey>> {
+    let mut groups: BTreeMap<(usize, u64, String), Vec<RunKey>> = BTreeMap::new();
+    let mut alone = Vec::new();
+    for k in todo {
+        match c.group_table(k.scenario, k.config, k.point, k.seed_index) {
+            Ok(t) => groups
+                .entry((k.scenario, k.seed_index, env_fingerprint(t)))
+                .or_default()
+                .push(*k),
+            // A table that cannot be made fails in its run, alone.
+            Err(_) => alone.push(vec![*k]),
+        }
+    }
+    let mut out: Vec<Vec<RunKey>> = groups.into_values().chain(alone).collect();
+    out.sort_by_key(|g| g[0]);
+    out
+}
+
+/// What a scenario table builds its environment from, as text.
+fn env_fingerprint(mut t: toml::Table) -> String {
+    for k in [
+        "name",
+        "description",
+        "planner",
+        "planners",
+        "output",
+        "comms",
+    ] {
+        t.remove(k);
+    }
+    if let Some(toml::Value::Table(m)) = t.get_mut("mission") {
+        m.retain(|k, _| ["spinup_s", "spinup_dt_s", "env_dt_s"].contains(&k));
+    }
+    toml::to_string(&t).unwrap_or_default()
+}
+
 /// Flies one run and makes its row; never panics (a panic inside becomes outcome `error`).
-fn run_one(c: &Campaign, key: &RunKey, out: &Path) -> RunRow {
+/// `shared` holds a spun-up environment of an earlier run of the same spin-up group, or
+/// receives this run's when `more` runs of the group follow.
+fn run_one(
+    c: &Campaign,
+    key: &RunKey,
+    out: &Path,
+    shared: &mut Option<Environment>,
+    more: bool,
+) -> RunRow {
     let attempt = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
         let sc = c.build(key).map_err(|e| e.to_string())?;
         let example = key.seed_index == 0;
@@ -212,7 +275,19 @@ fn run_one(c: &Campaign, key: &RunKey, out: &Path) -> RunRow {
             trajectory: example,
             plume_frames_every_s: example.then_some(plumetrace_mission::PLUME_FRAME_EVERY_S),
         };
-        let run = run_mission_with(sc, options, &mut |_, _| {}).map_err(|e| e.to_string())?;
+        let mut setup = MissionSetup::new(sc).map_err(|e| e.to_string())?;
+        match shared.as_ref().and_then(Environment::try_clone) {
+            Some(env) => setup.use_spun_up(env),
+            None => {
+                setup.spin_up().map_err(|e| e.to_string())?;
+                if more {
+                    *shared = setup.env.try_clone();
+                }
+            }
+        }
+        let mut mission = Mission::new(setup, options).map_err(|e| e.to_string())?;
+        mission.run(&mut |_, _| {}).map_err(|e| e.to_string())?;
+        let run = mission.finish().map_err(|e| e.to_string())?;
         if let Some(at) = plumetrace_mission::output::first_non_finite(&run.summary) {
             return Err(format!(
                 "the summary has a number that is not finite ({at})"

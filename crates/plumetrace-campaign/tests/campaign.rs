@@ -59,6 +59,7 @@ fn same_campaign_same_results_whatever_the_threads_and_shards() {
         RunOptions {
             jobs: Some(1),
             shard: None,
+            ..RunOptions::default()
         },
         None,
     );
@@ -68,6 +69,7 @@ fn same_campaign_same_results_whatever_the_threads_and_shards() {
         RunOptions {
             jobs: Some(2),
             shard: None,
+            ..RunOptions::default()
         },
         None,
     );
@@ -106,6 +108,7 @@ fn same_campaign_same_results_whatever_the_threads_and_shards() {
             RunOptions {
                 jobs: Some(2),
                 shard,
+                ..RunOptions::default()
             },
             None,
         );
@@ -283,4 +286,44 @@ fn every_shipped_example_campaign_loads_and_builds_every_group() {
         }
     }
     assert!(n >= 3, "found {n} example campaigns");
+}
+
+#[test]
+fn runs_sharing_a_spin_up_give_the_bits_of_separate_spin_ups() {
+    // Three configurations: two differ in planner keys and the mission's time limit only (they
+    // share the plume's spin-up at each seed), one in its source (it spins up its own).
+    let text = CAMPAIGN.replace(
+        "[sweep]\nbeta_deg = [20.0, 30.0]\n",
+        "[[configs]]\nname = \"stronger\"\n[configs.set]\nmapping = false\n\
+         \"mission.time_limit_s\" = 1200.0\n\"mission.spinup_s\" = 1500.0\n\
+         \"sources.0.mass_rate_per_s\" = 30.0\n",
+    );
+    let tmp = tempfile::tempdir().unwrap();
+    let file = campaign_file(tmp.path(), &text);
+    let c = Campaign::load(&file, None).unwrap();
+    let groups = plumetrace_campaign::execute::spinup_groups(&c, &c.runs());
+    // Per seed: {paper, cross} together, {stronger} alone.
+    assert_eq!(groups.len(), 2 * 2, "{groups:?}");
+    assert_eq!(groups.iter().filter(|g| g.len() == 2).count(), 2);
+    for g in &groups {
+        assert!(g.iter().all(|k| k.seed_index == g[0].seed_index));
+        if g.len() == 2 {
+            assert!(g.iter().all(|k| k.config < 2), "{g:?}");
+        }
+    }
+    let (shared, separate) = (tmp.path().join("shared"), tmp.path().join("separate"));
+    run(&file, &shared, RunOptions::default(), None);
+    run(
+        &file,
+        &separate,
+        RunOptions {
+            separate_spinups: true,
+            ..RunOptions::default()
+        },
+        None,
+    );
+    let runs = read(&shared.join("runs.csv"));
+    assert_eq!(runs.lines().count(), 1 + 3 * 2, "{runs}");
+    assert_eq!(runs, read(&separate.join("runs.csv")));
+    assert!(runs.contains("declared"), "{runs}");
 }

@@ -187,6 +187,11 @@ struct PlumeBench {
     point_query_ns: f64,
     point_query_ns_min: f64,
     point_query_uniform_ns: f64,
+    /// The vehicles' sensor query (a scan that skips blocks of filaments out of reach), at the
+    /// in-plume points, ns per query.
+    sensor_scan_ns: f64,
+    /// The same points by a scan of every filament (bit for bit the same results), ns.
+    sensor_full_scan_ns: f64,
     crossflow_spread_m: BTreeMap<String, f64>,
     crossflow_mean_m: BTreeMap<String, f64>,
     crossflow_samples: BTreeMap<String, u64>,
@@ -350,14 +355,33 @@ fn plume(a: &PlumeBenchArgs) -> Result<PlumeBench> {
         let ns = c0.elapsed().as_secs_f64() * 1e9 / pts.len() as f64;
         (ns, sink)
     };
+    let time_scans = |pts: &[Vec3], full: bool| {
+        let c0 = ProcessTime::now();
+        let mut sink = 0.0;
+        for p in pts {
+            sink += if full {
+                f.concentration_full_scan(*p)
+            } else {
+                f.concentration_scan(*p)
+            };
+        }
+        (c0.elapsed().as_secs_f64() * 1e9 / pts.len() as f64, sink)
+    };
+    // Scans cost thousands of times an indexed query: a slice of the points is enough.
+    let scan_pts = &in_plume[..in_plume.len().min(2_000)];
     let mut in_plume_ns = Vec::new();
     let mut uniform_ns = Vec::new();
+    let (mut scan_ns, mut full_ns) = (Vec::new(), Vec::new());
     for _ in 0..blocks {
         let (ns, s1) = time_queries(&in_plume);
         let (ns_u, s2) = time_queries(&uniform);
-        std::hint::black_box(s1 + s2);
+        let (ns_s, s3) = time_scans(scan_pts, false);
+        let (ns_f, s4) = time_scans(scan_pts, true);
+        std::hint::black_box(s1 + s2 + s3 + s4);
         in_plume_ns.push(ns);
         uniform_ns.push(ns_u);
+        scan_ns.push(ns_s);
+        full_ns.push(ns_f);
     }
     let mut spread = BTreeMap::new();
     let mut centre = BTreeMap::new();
@@ -395,6 +419,8 @@ fn plume(a: &PlumeBenchArgs) -> Result<PlumeBench> {
         point_query_ns: median(&in_plume_ns),
         point_query_ns_min: in_plume_ns.iter().copied().fold(f64::INFINITY, f64::min),
         point_query_uniform_ns: median(&uniform_ns),
+        sensor_scan_ns: median(&scan_ns),
+        sensor_full_scan_ns: median(&full_ns),
         crossflow_spread_m: spread,
         crossflow_mean_m: centre,
         crossflow_samples: samples,

@@ -22,6 +22,11 @@ pub struct CampaignArgs {
     /// Seeds per group, 1 to 1,000,000 (overrides the file's `seeds`).
     #[arg(long, allow_hyphen_values = true, value_parser = crate::args::seeds)]
     pub seeds: Option<u64>,
+    /// Spin every run's plume up on its own. By default runs of the same seed whose scenarios
+    /// differ only in planner keys, outputs or mission geometry share one spin-up (the same
+    /// bits as separate ones, less CPU).
+    #[arg(long)]
+    pub separate_spinups: bool,
 }
 
 /// Runs (or resumes) a campaign and prints where the results are.
@@ -36,6 +41,7 @@ pub fn run(args: &CampaignArgs) -> Result<()> {
         RunOptions {
             jobs: args.jobs,
             shard: args.shard,
+            separate_spinups: args.separate_spinups,
         },
         &|done, _| progress.tick(done),
     )

@@ -127,6 +127,32 @@ impl Environment {
         Ok(())
     }
 
+    /// Simulated time spent in spin-up, s.
+    pub fn spun_up_s(&self) -> f64 {
+        self.spinup_s
+    }
+
+    /// A copy of the whole state (flow, filaments, clocks and random streams), so that stepping
+    /// the copy gives the same bits as stepping the original; `None` for a steady plume (its
+    /// field is shared, not copied, and a steady plume needs no spin-up worth sharing).
+    pub fn try_clone(&self) -> Option<Self> {
+        let plume = match &self.plume {
+            Plume::Filaments(p) => Plume::Filaments(Box::new(p.copy_state())),
+            Plume::Steady(_) => return None,
+        };
+        Some(Environment {
+            domain: self.domain,
+            flow: self.flow.clone(),
+            plume,
+            obstacles: self.obstacles.clone(),
+            dt_s: self.dt_s,
+            step: self.step,
+            spinup_s: self.spinup_s,
+            flow_rng: self.flow_rng.clone(),
+            plume_rng: self.plume_rng.clone(),
+        })
+    }
+
     /// Simulated time including any spin-up, s (the flow and plume clocks).
     pub fn elapsed_s(&self) -> f64 {
         self.spinup_s + self.step as f64 * self.dt_s

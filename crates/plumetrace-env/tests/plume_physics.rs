@@ -620,3 +620,54 @@ fn scanned_and_indexed_queries_agree() {
     }
     assert!(nonzero > 50);
 }
+
+#[test]
+fn the_pruned_sensor_scan_is_bit_for_bit_the_full_scan() {
+    let domain = rect(0.0, 200.0, -60.0, 60.0);
+    let src = Source {
+        pos_m: Vec3::new(10.0, 0.0, 0.5),
+        mass_rate_per_s: 5.0,
+        filament_rate_hz: 20.0,
+    };
+    for (vertical, z_probe) in [
+        (VerticalBoundary::Reflecting { depth_m: Some(6.0) }, 5.9),
+        (VerticalBoundary::Reflecting { depth_m: None }, 0.2),
+        (VerticalBoundary::Unbounded, 0.5),
+    ] {
+        let params = FilamentParams {
+            vertical,
+            growth_rate_m2ps: 0.02,
+            ..FilamentParams::default()
+        };
+        let mut env = filament_env(domain, pompy_farrell(domain, 0.1), src, params, 0.1, 3);
+        env.spin_up(120.0, 0.2).unwrap();
+        let mut checked = 0u32;
+        let mut nonzero = 0u32;
+        for round in 0..4 {
+            run(&mut env, 5.0);
+            let f = filaments(&env);
+            assert!(f.len() > 1000, "{} filaments", f.len());
+            let centres: Vec<Vec3> = f.filaments().map(|(c, _)| c).collect();
+            // Points on filaments, just beside them, between the plume and the edges, on the
+            // boxes' corners (offsets of whole and half metres), and far away.
+            for (k, c) in centres.iter().enumerate().step_by(13) {
+                let o = f64::from((k % 7) as u32) - 3.0;
+                for q in [
+                    *c,
+                    Vec3::new(c.x + 0.5 * o, c.y - 0.25 * o, z_probe),
+                    Vec3::new(c.x, c.y + 4.0 * o, c.z),
+                    Vec3::new(f64::from(round * 40 + (k % 40) as u32), 30.0 * o / 3.0, 1.0),
+                ] {
+                    let (a, b) = (f.concentration_scan(q), f.concentration_full_scan(q));
+                    assert_eq!(a.to_bits(), b.to_bits(), "{a} vs {b} at {q:?}");
+                    checked += 1;
+                    nonzero += u32::from(a > 0.0);
+                }
+            }
+        }
+        assert!(
+            checked > 1000 && nonzero > 300,
+            "{checked} points, {nonzero} in the plume"
+        );
+    }
+}

@@ -147,11 +147,14 @@ impl Mission {
             dt_s,
             depth_m,
             comms,
+            spun_up,
             ..
         } = setup;
         let started = Instant::now();
-        env.spin_up(spec.spinup_s, spec.spinup_dt_s)
-            .map_err(env_error)?;
+        if !spun_up {
+            env.spin_up(spec.spinup_s, spec.spinup_dt_s)
+                .map_err(env_error)?;
+        }
         let spinup_wall_s = started.elapsed().as_secs_f64();
         let mut vehicles = Vec::with_capacity(setups.len());
         let mut planners: Vec<Option<Box<dyn Planner>>> = Vec::with_capacity(setups.len());

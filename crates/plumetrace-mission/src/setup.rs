@@ -86,6 +86,9 @@ pub struct MissionSetup {
     pub comms: CommsParams,
     /// What `check` should tell the user: missions that cannot succeed, defaults that matter.
     pub warnings: Vec<String>,
+    /// Whether `env` has had its spin-up already ([`MissionSetup::spin_up`],
+    /// [`MissionSetup::use_spun_up`]); [`crate::Mission::new`] then starts at once.
+    pub spun_up: bool,
 }
 
 impl MissionSetup {
@@ -179,7 +182,31 @@ impl MissionSetup {
             depth_m: sc.depth_m,
             comms: sc.comms,
             warnings,
+            spun_up: false,
         })
+    }
+
+    /// Develops the plume now (the mission's `spinup_s` in steps of `spinup_dt_s`), so that the
+    /// spun-up environment can be copied into other setups of the same scenario and seed.
+    pub fn spin_up(&mut self) -> Result<(), MissionError> {
+        if !self.spun_up {
+            self.env
+                .spin_up(self.spec.spinup_s, self.spec.spinup_dt_s)
+                .map_err(|error| MissionError::Env {
+                    origin: self.origin.to_string(),
+                    error,
+                })?;
+            self.spun_up = true;
+        }
+        Ok(())
+    }
+
+    /// Takes `env`, a copy of a spun-up environment of the same scenario and seed (the
+    /// caller's promise: a campaign checks that the two scenarios differ in nothing the
+    /// environment is built from), instead of spinning up its own.
+    pub fn use_spun_up(&mut self, env: Environment) {
+        self.env = env;
+        self.spun_up = true;
     }
 }
 

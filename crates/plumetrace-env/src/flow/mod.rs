@@ -56,7 +56,7 @@ pub trait FlowField: Send + Sync + std::fmt::Debug {
 }
 
 /// The flow models known to plumetrace, for static dispatch and for the model registry.
-#[derive(Debug)]
+#[derive(Debug, Clone)]
 pub enum FlowModel {
     /// Uniform in space, steady or varying in time.
     Uniform(UniformFlow),
