@@ -53,13 +53,22 @@ pub fn campaign<'py>(
     let progress = progress.map(|p| p.clone().unbind());
     let report = py
         .detach(|| {
-            run_campaign(&c, &out, RunOptions { jobs, shard }, &|done, total| {
-                if let Some(p) = &progress {
-                    Python::attach(|py| {
-                        let _ = p.bind(py).call1((done, total));
-                    });
-                }
-            })
+            run_campaign(
+                &c,
+                &out,
+                RunOptions {
+                    jobs,
+                    shard,
+                    ..RunOptions::default()
+                },
+                &|done, total| {
+                    if let Some(p) = &progress {
+                        Python::attach(|py| {
+                            let _ = p.bind(py).call1((done, total));
+                        });
+                    }
+                },
+            )
         })
         .map_err(|e| {
             msg(format!(
