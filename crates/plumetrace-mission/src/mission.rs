@@ -156,7 +156,7 @@ impl Mission {
         let mut vehicles = Vec::with_capacity(setups.len());
         let mut planners: Vec<Option<Box<dyn Planner>>> = Vec::with_capacity(setups.len());
         for (v, p) in setups.iter().zip(&planned) {
-            vehicles.push(SimVehicle::new(
+            let mut sim = SimVehicle::new(
                 v.name.clone(),
                 v.vehicle.clone(),
                 v.nav,
@@ -164,7 +164,9 @@ impl Mission {
                 v.flow_sensor,
                 v.range_sensor,
                 seed,
-            ));
+            );
+            sim.deaf_window_s = v.deaf_window_s;
+            vehicles.push(sim);
             planners.push(match p {
                 Some(p) => Some(p.config.build(&p.context, &p.key).map_err(|error| {
                     MissionError::Invalid {
