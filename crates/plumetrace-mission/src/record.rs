@@ -564,10 +564,18 @@ mod tests {
                 | PlannerEvent::AvoidEnd { .. } => {}
             }
         }
-        let telemetry = [Telemetry::SourceEstimate { pos_m: p }];
+        let telemetry = [
+            Telemetry::SourceEstimate { pos_m: p },
+            Telemetry::Formation {
+                scale_cw: Some(1.0),
+                ranges_m: Some([1.0, 2.0]),
+                setpoint_m: Some(1.5),
+                reading: 0.5,
+            },
+        ];
         for e in &telemetry {
             match e {
-                Telemetry::SourceEstimate { .. } => {}
+                Telemetry::SourceEstimate { .. } | Telemetry::Formation { .. } => {}
             }
         }
         let world = [
