@@ -513,7 +513,10 @@ pub fn true_sources(world: &World) -> Vec<Vec3> {
         .plume()
         .filaments()
         .map(|f| f.sources().iter().map(|s| s.pos_m).collect())
-        .unwrap_or_default()
+        .unwrap_or_else(|| match world.env().plume() {
+            plumetrace_env::Plume::Steady(field) => field.source_positions(),
+            plumetrace_env::Plume::Filaments(_) => Vec::new(),
+        })
 }
 
 #[cfg(test)]

@@ -78,6 +78,9 @@ use plumetrace_guidance::{Autopilot, AutopilotParams, OpArea, Steer};
 use serde::{Deserialize, Serialize};
 use std::collections::VecDeque;
 
+/// Time between the telemetry records of a formation member, s.
+const TELEMETRY_PERIOD_S: f64 = 1.0;
+
 /// Which side of the formation a leader flies, looking up-flow.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
@@ -118,7 +121,7 @@ plumetrace_core::params! {
         /// Logistic response k_l of the centring (10).
         k_l: f64 = 0.02, "unit", Bounds::positive(1e6);
         /// Largest cross-flow centring velocity u_c^max (10).
-        uc_max: f64 = 0.2, "m/s", Bounds::non_negative(10.0);
+        uc_max: f64 = 0.1, "m/s", Bounds::non_negative(10.0);
         /// Base up-flow urge u_0 of (9) (the paper's 1, here a speed).
         urge_mps: f64 = 0.25, "m/s", Bounds::non_negative(10.0);
         /// Weight k_f of the formation feedback in (11).
@@ -152,7 +155,7 @@ plumetrace_core::params! {
         /// Window of the sliding max filter.
         filter_window_s: f64 = 4.0, "s", Bounds::non_negative(600.0);
         /// Time between radio broadcasts of position, reading and scale.
-        radio_period_s: f64 = 1.0, "s", Bounds::closed(0.01, 600.0);
+        radio_period_s: f64 = 0.1, "s", Bounds::closed(0.01, 600.0);
         /// Information older than this is not used.
         stale_s: f64 = 10.0, "s", Bounds::positive(3600.0);
         /// Declare a source and finish (the rule in the module docs).
@@ -407,6 +410,7 @@ pub struct FormationLeader {
     follower_reading: Option<Heard<f64>>,
     last_t_s: Option<f64>,
     next_radio_s: f64,
+    next_telemetry_s: f64,
     declarer: Declarer,
     declared: bool,
 }
@@ -431,6 +435,7 @@ impl FormationLeader {
             follower_reading: None,
             last_t_s: None,
             next_radio_s: 0.0,
+            next_telemetry_s: 0.0,
             declarer: Declarer {
                 peaks: [0.0; 3],
                 strong: None,
@@ -648,12 +653,17 @@ impl Planner for FormationLeader {
         }
         let mut events = Vec::new();
         let mut status = PlanStatus::Running;
-        let telemetry = vec![Telemetry::Formation {
-            scale_cw: Some(self.scale),
-            ranges_m: None,
-            setpoint_m: None,
-            reading: c_own,
-        }];
+        let telemetry = if t + 1e-9 >= self.next_telemetry_s {
+            self.next_telemetry_s = t + TELEMETRY_PERIOD_S;
+            vec![Telemetry::Formation {
+                scale_cw: Some(self.scale),
+                ranges_m: None,
+                setpoint_m: None,
+                reading: c_own,
+            }]
+        } else {
+            Vec::new()
+        };
         if self.p.declare
             && !self.declared
             && let Some(pos_m) = self.check_declaration(t, me_pos, own, partner, follower)
@@ -747,6 +757,7 @@ pub struct FormationFollower {
     next_request_s: f64,
     ask_left: bool,
     last_reply_s: f64,
+    next_telemetry_s: f64,
     rate: plumetrace_guidance::RateFilter,
 }
 
@@ -763,6 +774,7 @@ impl FormationFollower {
             next_request_s: 0.0,
             ask_left: true,
             last_reply_s: 0.0,
+            next_telemetry_s: 0.0,
             rate: plumetrace_guidance::RateFilter::new(p.max_turn_rate_deg_s),
             p,
         }
@@ -880,6 +892,10 @@ impl Planner for FormationFollower {
         } else {
             PlanStatus::Running
         };
+        let report = t + 1e-9 >= self.next_telemetry_s;
+        if report {
+            self.next_telemetry_s = t + TELEMETRY_PERIOD_S;
+        }
         let ranges_m = match self.ranges {
             [Some(l), Some(r)] => Some([l.value, r.value]),
             _ => None,
@@ -896,12 +912,16 @@ impl Planner for FormationFollower {
             },
             outbox,
             events: Vec::new(),
-            telemetry: vec![Telemetry::Formation {
-                scale_cw: self.scale,
-                ranges_m,
-                setpoint_m: Some(d_f),
-                reading,
-            }],
+            telemetry: if report {
+                vec![Telemetry::Formation {
+                    scale_cw: self.scale,
+                    ranges_m,
+                    setpoint_m: Some(d_f),
+                    reading,
+                }]
+            } else {
+                Vec::new()
+            },
             status,
         }
     }
