@@ -172,6 +172,9 @@ pub enum Telemetry {
         /// Latest measured ranges to the left and right leader, m (follower only).
         #[serde(default, skip_serializing_if = "Option::is_none")]
         ranges_m: Option<[f64; 2]>,
+        /// The vehicles those ranges are to: left and right leader (follower only).
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        ranges_to: Option<[crate::VehicleId; 2]>,
         /// The range set-point, m (follower only).
         #[serde(default, skip_serializing_if = "Option::is_none")]
         setpoint_m: Option<f64>,

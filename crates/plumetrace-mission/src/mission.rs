@@ -117,6 +117,7 @@ pub struct Mission {
     events: EventRecorder,
     trajectory: Option<TrajectoryRecorder>,
     stats: TrackStats,
+    team: crate::team::TeamStats,
     mean_plume: Option<MeanPlumeRecorder>,
     plume_frames: Option<PlumeFrames>,
     faults: Vec<Vec<FaultWindow>>,
@@ -246,6 +247,10 @@ impl Mission {
                 &spec.op_area,
                 sources.first().map(|s| s.xy()),
                 sample_every,
+            ),
+            team: crate::team::TeamStats::new(
+                planned.iter().map(Option::is_some).collect(),
+                sources.first().copied(),
             ),
             trajectory: options
                 .trajectory
@@ -396,6 +401,7 @@ impl Mission {
             };
             self.events.observe(&view);
             self.stats.observe(&view);
+            self.team.observe(&view);
             if let Some(t) = self.trajectory.as_mut() {
                 t.observe(&view);
             }
@@ -477,6 +483,7 @@ impl Mission {
                 .collect(),
             sources: &self.sources,
             mean_flow_mps: mean_flow,
+            team: self.team.summary(),
         });
         Ok(MissionRun {
             outcome: summary.outcome,

@@ -572,6 +572,7 @@ mod tests {
             Telemetry::Formation {
                 scale_cw: Some(1.0),
                 ranges_m: Some([1.0, 2.0]),
+                ranges_to: Some([VehicleId(1), VehicleId(2)]),
                 setpoint_m: Some(1.5),
                 reading: 0.5,
             },

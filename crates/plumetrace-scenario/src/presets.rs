@@ -71,6 +71,11 @@ pub const PRESETS: &[Preset] = &[
         summary: "formation tracing: two surface leaders and an AUV follower on acoustic ranges trace the steady freshwater plume to its surface outlet",
         toml: include_str!("../presets/soares-freshwater.toml"),
     },
+    Preset {
+        name: "soares-filaments",
+        summary: "the formation team on a meandering, intermittent filament plume from the same surface outlet (the harder case)",
+        toml: include_str!("../presets/soares-filaments.toml"),
+    },
 ];
 
 /// The preset called `name`.

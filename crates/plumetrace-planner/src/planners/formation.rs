@@ -658,6 +658,7 @@ impl Planner for FormationLeader {
             vec![Telemetry::Formation {
                 scale_cw: Some(self.scale),
                 ranges_m: None,
+                ranges_to: None,
                 setpoint_m: None,
                 reading: c_own,
             }]
@@ -916,6 +917,10 @@ impl Planner for FormationFollower {
                 vec![Telemetry::Formation {
                     scale_cw: self.scale,
                     ranges_m,
+                    ranges_to: Some([
+                        VehicleId(self.p.left_leader),
+                        VehicleId(self.p.right_leader),
+                    ]),
                     setpoint_m: Some(d_f),
                     reading,
                 }]
