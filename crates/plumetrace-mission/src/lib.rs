@@ -14,7 +14,8 @@
 //! - [`summary`]: the key numbers written as `summary.json`; [`team`]: what a team of vehicles
 //!   did together (formation error, centroid against the centre line, overhead, losses);
 //! - [`snapshot_log`]: the replayable log of snapshots and decisions;
-//! - [`plot`]: the mission figure; [`replay_page`]: the self-contained replay page;
+//! - [`plot`]: the mission figure; [`team_plot`]: the team figure (readings, speeds, headings,
+//!   scale and centroid against time); [`replay_page`]: the self-contained replay page;
 //!   [`output`]: atomic file writing.
 
 pub mod mission;
@@ -27,6 +28,7 @@ pub mod setup;
 pub mod snapshot_log;
 pub mod summary;
 pub mod team;
+pub mod team_plot;
 
 pub use mission::{
     FaultWindow, Mission, MissionOptions, MissionRun, PLUME_FRAME_EVERY_S, VehicleInfo,
