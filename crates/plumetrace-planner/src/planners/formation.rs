@@ -1038,6 +1038,28 @@ mod tests {
     }
 
     #[test]
+    fn inconsistent_keys_are_refused_with_their_names() {
+        let f = FormationFollowerParams {
+            left_leader: 1,
+            right_leader: 1,
+            ..FormationFollowerParams::default()
+        };
+        let e = f.validate("planners.f").err().map(|e| e.key);
+        assert_eq!(e.as_deref(), Some("planners.f.right_leader"));
+        let l = FormationLeaderParams {
+            scale_init: 3.0,
+            ..FormationLeaderParams::default()
+        };
+        let e = l.validate("planners.l").err().map(|e| e.key);
+        assert_eq!(e.as_deref(), Some("planners.l.scale_init"));
+        let deep = FormationLeaderParams {
+            follower_depth_m: 12.0,
+            ..FormationLeaderParams::default()
+        };
+        assert!(deep.validate("p").is_err(), "(16) has no solution");
+    }
+
+    #[test]
     fn the_max_filter_keeps_the_largest_reading_of_its_window() {
         let mut f = MaxFilter::new(4.0);
         for (t, c) in [(0.0, 1.0), (1.0, 3.0), (2.0, 2.0), (5.0, 0.5)] {
