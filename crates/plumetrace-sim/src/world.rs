@@ -358,19 +358,22 @@ impl World {
             .map_or(Vec2::zeros(), |v| v.vehicle.state.pos_m);
         // A range echo reaches its requester as a measured range, or not at all.
         let measured;
+        let unsolicited = |to: VehicleId| {
+            (
+                to,
+                WorldEvent::MessageLost {
+                    from: m.from,
+                    link: m.link,
+                    sent_s: m.sent_s,
+                    reason: LossReason::Unsolicited,
+                },
+            )
+        };
         let m = if is_range_echo(&m.body) {
             let (Recipient::Vehicle(to), MessageBody::RangeEcho { heading, scale_cw }) =
                 (m.to, &m.body)
             else {
-                events.push((
-                    m.from,
-                    WorldEvent::MessageLost {
-                        from: m.from,
-                        link: m.link,
-                        sent_s: m.sent_s,
-                        reason: LossReason::Unsolicited,
-                    },
-                ));
+                events.push(unsolicited(m.from));
                 return;
             };
             let range = match (
@@ -381,15 +384,7 @@ impl World {
                 _ => None,
             };
             let Some(range_m) = range else {
-                events.push((
-                    to,
-                    WorldEvent::MessageLost {
-                        from: m.from,
-                        link: m.link,
-                        sent_s: m.sent_s,
-                        reason: LossReason::Unsolicited,
-                    },
-                ));
+                events.push(unsolicited(to));
                 return;
             };
             measured = Message {

@@ -393,15 +393,20 @@ fn message_losses_are_the_same_for_the_same_seed() {
     assert_ne!(a, losses(6));
 }
 
-#[test]
-fn a_message_to_a_stopped_or_missing_vehicle_is_reported_lost() {
-    let mut w = World::new(
+/// Two AUVs 10 m apart with ideal channels.
+fn pair() -> World {
+    World::new(
         env(vec![]),
         vec![auv(0, (50.0, 50.0), 0.0), auv(1, (60.0, 50.0), 0.0)],
         DT,
         Some(10.0),
     )
-    .unwrap();
+    .unwrap()
+}
+
+#[test]
+fn a_message_to_a_stopped_or_missing_vehicle_is_reported_lost() {
+    let mut w = pair();
     w.stop(VehicleId(1));
     let to = |id| plumetrace_core::Message {
         from: VehicleId(0),
@@ -659,13 +664,7 @@ fn ranging_measures_the_slant_range_with_the_timing_noise_and_one_packet_in_flig
 
 #[test]
 fn an_unsolicited_echo_is_lost_and_a_deaf_modem_hears_nothing() {
-    let mut w = World::new(
-        env(vec![]),
-        vec![auv(0, (50.0, 50.0), 0.0), auv(1, (60.0, 50.0), 0.0)],
-        DT,
-        Some(10.0),
-    )
-    .unwrap();
+    let mut w = pair();
     let e = w.send(plumetrace_core::Message {
         from: VehicleId(1),
         to: Recipient::Vehicle(VehicleId(0)),
