@@ -462,7 +462,9 @@ pub fn error_chart(
     Ok(svg)
 }
 
-/// `trajectories.svg`: each group's example run (seed index 0) on a small map.
+/// `trajectories.svg`: each group's example run (seed index 0) on a small map, with a team's
+/// other members' tracks (for formation runs: the team from each start offset, as in the
+/// formation paper's Fig. 4).
 pub fn trajectory_chart(c: &Campaign, examples: &[ExampleRun]) -> Result<String, CampaignError> {
     let e = err("trajectories.svg");
     let shown = &examples[..examples.len().min(12)];
@@ -497,8 +499,8 @@ pub fn trajectory_chart(c: &Campaign, examples: &[ExampleRun]) -> Result<String,
         title
             .draw(&Text::new(
                 format!(
-                    "{}: one example run per group (seed index 0){more}; track as logged, \
-                     ○ lost points, ● declared, ▲ true source",
+                    "{}: one example run per group (seed index 0){more}; track as logged \
+                     (a team's other members green, true), ○ lost points, ● declared, ▲ true source",
                     c.file.name
                 ),
                 (12, 12),
@@ -545,6 +547,14 @@ pub fn trajectory_chart(c: &Campaign, examples: &[ExampleRun]) -> Result<String,
                         RGBColor(150, 150, 150),
                         1,
                     ))
+                    .map_err(&e)?;
+            }
+            for other in &ex.others {
+                chart
+                    .draw_series([PathElement::new(
+                        other.iter().map(|p| (p[0], p[1])).collect::<Vec<_>>(),
+                        RGBColor(60, 150, 80).stroke_width(1),
+                    )])
                     .map_err(&e)?;
             }
             chart

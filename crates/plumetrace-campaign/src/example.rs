@@ -40,6 +40,10 @@ pub struct ExampleRun {
     /// The lead vehicle's track as it logged it (navigation estimate), thinned: the vehicle of
     /// the first declaration, or the first with a planner.
     pub track: Vec<[f64; 2]>,
+    /// The other vehicles with planners (a team's members), true tracks, thinned alike (some
+    /// have no position estimate to log).
+    #[serde(default)]
+    pub others: Vec<Vec<[f64; 2]>>,
 }
 
 impl ExampleRun {
@@ -96,6 +100,20 @@ impl ExampleRun {
                 .iter()
                 .step_by(step)
                 .filter_map(|r| Some([r.est_x_m?, r.est_y_m?]))
+                .collect(),
+            others: run
+                .vehicles
+                .iter()
+                .enumerate()
+                .filter(|(k, v)| v.planner.is_some() && *k as u32 != lead)
+                .map(|(k, _)| {
+                    run.trajectory
+                        .iter()
+                        .filter(|r| r.vehicle == k as u32)
+                        .step_by(step)
+                        .map(|r| [r.true_x_m, r.true_y_m])
+                        .collect()
+                })
                 .collect(),
         }
     }

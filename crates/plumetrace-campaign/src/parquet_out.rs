@@ -62,6 +62,41 @@ const COLUMNS: &[(&str, Col)] = &[
     ("source_errors_m", Col::Text(|r| &r.source_errors_m)),
     ("longest_quiet_s", Col::Num(|r| r.longest_quiet_s)),
     ("max_outside_m", Col::Num(|r| r.max_outside_m)),
+    ("team_converged_s", Col::Num(|r| r.team_converged_s)),
+    (
+        "team_range_error_median_m",
+        Col::Num(|r| r.team_range_error_median_m),
+    ),
+    (
+        "team_range_error_p90_m",
+        Col::Num(|r| r.team_range_error_p90_m),
+    ),
+    (
+        "team_range_setpoint_m",
+        Col::Num(|r| r.team_range_setpoint_m),
+    ),
+    (
+        "team_centroid_cross_median_m",
+        Col::Num(|r| r.team_centroid_cross_median_m),
+    ),
+    (
+        "team_distance_overhead",
+        Col::Num(|r| r.team_distance_overhead),
+    ),
+    ("team_scale_max", Col::Num(|r| r.team_scale_max)),
+    ("team_scale_final", Col::Num(|r| r.team_scale_final)),
+    (
+        "team_acoustic_lost",
+        Col::Num(|r| r.team_acoustic_lost.map(|v| v as f64)),
+    ),
+    (
+        "team_acoustic_delivered",
+        Col::Num(|r| r.team_acoustic_delivered.map(|v| v as f64)),
+    ),
+    (
+        "team_non_finite_commands",
+        Col::Num(|r| r.team_non_finite_commands.map(|v| v as f64)),
+    ),
     ("site_flow_toward_deg", Col::Num(|r| r.site_flow_toward_deg)),
     ("site_flow_speed_mps", Col::Num(|r| r.site_flow_speed_mps)),
     ("site_tidal_swing_deg", Col::Num(|r| r.site_tidal_swing_deg)),

@@ -120,6 +120,28 @@ pub struct RunRow {
     pub longest_quiet_s: Option<f64>,
     /// The farthest any vehicle went outside the op-area (true position), m.
     pub max_outside_m: Option<f64>,
+    /// Team (two or more planners): when the formation first held its ranges within 20 %, s.
+    pub team_converged_s: Option<f64>,
+    /// Team: median absolute range error after convergence, m.
+    pub team_range_error_median_m: Option<f64>,
+    /// Team: 90th percentile of the absolute range error after convergence, m.
+    pub team_range_error_p90_m: Option<f64>,
+    /// Team: the range set-point, m.
+    pub team_range_setpoint_m: Option<f64>,
+    /// Team: median cross-flow distance of the centroid from the plume's centre line, m.
+    pub team_centroid_cross_median_m: Option<f64>,
+    /// Team: path to the first declaration over the straight line from start to source.
+    pub team_distance_overhead: Option<f64>,
+    /// Team: largest cross-flow scale reported.
+    pub team_scale_max: Option<f64>,
+    /// Team: last cross-flow scale reported.
+    pub team_scale_final: Option<f64>,
+    /// Team: acoustic messages lost (per recipient).
+    pub team_acoustic_lost: Option<u64>,
+    /// Team: acoustic messages delivered.
+    pub team_acoustic_delivered: Option<u64>,
+    /// Team: commands refused for a non-finite number.
+    pub team_non_finite_commands: Option<u64>,
     /// Drawn site (family scenarios; empty otherwise): flow direction, deg.
     pub site_flow_toward_deg: Option<f64>,
     /// Drawn site: flow speed, m/s.
@@ -209,6 +231,17 @@ impl RunRow {
                 })
                 .collect::<Vec<_>>()
                 .join(";"),
+            team_converged_s: s.team.as_ref().and_then(|t| t.converged_s),
+            team_range_error_median_m: s.team.as_ref().and_then(|t| t.range_error_median_m),
+            team_range_error_p90_m: s.team.as_ref().and_then(|t| t.range_error_p90_m),
+            team_range_setpoint_m: s.team.as_ref().and_then(|t| t.range_setpoint_m),
+            team_centroid_cross_median_m: s.team.as_ref().and_then(|t| t.centroid_cross_median_m),
+            team_distance_overhead: s.team.as_ref().and_then(|t| t.distance_overhead),
+            team_scale_max: s.team.as_ref().and_then(|t| t.scale_max),
+            team_scale_final: s.team.as_ref().and_then(|t| t.scale_final),
+            team_acoustic_lost: s.team.as_ref().map(|t| t.acoustic_lost),
+            team_acoustic_delivered: s.team.as_ref().map(|t| t.acoustic_delivered),
+            team_non_finite_commands: s.team.as_ref().map(|t| t.non_finite_commands),
             ..RunRow::empty(c, key)
         }
     }

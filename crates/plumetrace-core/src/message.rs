@@ -32,12 +32,45 @@ pub enum Link {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case", tag = "kind")]
 pub enum MessageBody {
-    /// An acoustic range measurement to the sender, with the sender's heading piggybacked.
+    /// An acoustic range measurement to the sender, with the sender's heading piggybacked: what
+    /// the requester's modem makes of a [`MessageBody::RangeEcho`] answering its
+    /// [`MessageBody::RangeRequest`] (the round-trip time less the known turnaround, times half
+    /// the sound speed).
     RangeReply {
         /// Measured slant range, m.
         range_m: f64,
         /// Sender's compass heading at transmission.
         sender_heading: Heading,
+        /// The sender's cross-flow formation scale, when it sends one.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        scale_cw: Option<f64>,
+    },
+    /// An acoustic ranging request (broadcast: every modem in range hears it); only `target`
+    /// answers, with a [`MessageBody::RangeEcho`] at once. The requester's filtered chemical
+    /// reading is piggybacked.
+    RangeRequest {
+        /// The vehicle asked to answer.
+        target: crate::VehicleId,
+        /// The requester's filtered chemical reading (sensor units).
+        reading: f64,
+    },
+    /// The answer to a [`MessageBody::RangeRequest`] as its target sends it: the payload only.
+    /// The requester receives it as a [`MessageBody::RangeReply`] with the measured range.
+    RangeEcho {
+        /// The sender's compass heading.
+        heading: Heading,
+        /// The sender's cross-flow formation scale, when it shares it.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        scale_cw: Option<f64>,
+    },
+    /// A formation member's state for its neighbours (surface craft, over the radio).
+    FormationState {
+        /// Position `(east, north)`, m (GPS).
+        pos_m: Vec2,
+        /// Filtered chemical reading (sensor units).
+        reading: f64,
+        /// Cross-flow formation scale.
+        scale_cw: f64,
     },
     /// A position report (e.g. a surface vehicle's GPS fix).
     Position {

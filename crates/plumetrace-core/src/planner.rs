@@ -66,6 +66,9 @@ pub enum DeclarationKind {
     UpflowEdge,
     /// The position of the strongest reading of a survey.
     StrongestReading,
+    /// A formation moved up-flow past its strongest readings and every member's reading faded:
+    /// declared at the most up-flow strong reading, on the formation's centre line.
+    FormationPassedPeak,
     /// A rule of a planner outside the registry (a Python planner, say), which names none.
     Custom,
 }
@@ -161,6 +164,24 @@ pub enum Telemetry {
     SourceEstimate {
         /// Estimated source position, m.
         pos_m: Vec2,
+    },
+    /// A formation member's state: its cross-flow scale and, for a follower, the ranges it
+    /// measured to its left and right leaders against their set-point.
+    Formation {
+        /// Cross-flow scale `s_cw` (a follower's: the latest it heard, if any).
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        scale_cw: Option<f64>,
+        /// Latest measured ranges to the left and right leader, m (follower only).
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        ranges_m: Option<[f64; 2]>,
+        /// The vehicles those ranges are to: left and right leader (follower only).
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        ranges_to: Option<[crate::VehicleId; 2]>,
+        /// The range set-point, m (follower only).
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        setpoint_m: Option<f64>,
+        /// The member's filtered chemical reading.
+        reading: f64,
     },
 }
 

@@ -11,6 +11,12 @@ pub trait ConcentrationField: Send + Sync {
     /// Concentration at `p` (`z` = height above the seabed).
     fn concentration(&self, p: Vec3) -> f64;
 
+    /// The positions of the field's sources, where the field knows them (a model's; a field read
+    /// from a file does not).
+    fn source_positions(&self) -> Vec<Vec3> {
+        Vec::new()
+    }
+
     /// Concentrations at many points, evaluated in parallel; the result does not depend on the
     /// number of threads (each point is computed alone).
     fn concentrations(&self, points: &[Vec3], out: &mut [f64]) {

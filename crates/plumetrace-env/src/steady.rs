@@ -95,6 +95,10 @@ impl GaussianPlume {
 }
 
 impl ConcentrationField for GaussianPlume {
+    fn source_positions(&self) -> Vec<Vec3> {
+        vec![self.source_m]
+    }
+
     fn concentration(&self, p: Vec3) -> f64 {
         let (x, y) = self.plume_coords(p.xy());
         if x <= 0.0 {

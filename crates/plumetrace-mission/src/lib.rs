@@ -11,9 +11,11 @@
 //! - [`mission`]: the stepper ([`Mission::new`], [`Mission::step`], [`Mission::finish`]);
 //! - [`outcome`]: how a mission ends and what it comes to;
 //! - [`record`]: the observer trait and the mission's own recorders;
-//! - [`summary`]: the key numbers written as `summary.json`;
+//! - [`summary`]: the key numbers written as `summary.json`; [`team`]: what a team of vehicles
+//!   did together (formation error, centroid against the centre line, overhead, losses);
 //! - [`snapshot_log`]: the replayable log of snapshots and decisions;
-//! - [`plot`]: the mission figure; [`replay_page`]: the self-contained replay page;
+//! - [`plot`]: the mission figure; [`team_plot`]: the team figure (readings, speeds, headings,
+//!   scale and centroid against time); [`replay_page`]: the self-contained replay page;
 //!   [`output`]: atomic file writing.
 
 pub mod mission;
@@ -25,6 +27,8 @@ pub mod replay_page;
 pub mod setup;
 pub mod snapshot_log;
 pub mod summary;
+pub mod team;
+pub mod team_plot;
 
 pub use mission::{
     FaultWindow, Mission, MissionOptions, MissionRun, PLUME_FRAME_EVERY_S, VehicleInfo,
@@ -36,3 +40,4 @@ pub use record::{
 };
 pub use setup::{MissionError, MissionSetup, PlannedVehicle};
 pub use summary::{DeclarationRecord, LOCATED_RADIUS_M, SourceRecord, Summary, VehicleSummary};
+pub use team::{TeamStats, TeamSummary};

@@ -117,6 +117,7 @@ pub struct Mission {
     events: EventRecorder,
     trajectory: Option<TrajectoryRecorder>,
     stats: TrackStats,
+    team: crate::team::TeamStats,
     mean_plume: Option<MeanPlumeRecorder>,
     plume_frames: Option<PlumeFrames>,
     faults: Vec<Vec<FaultWindow>>,
@@ -159,7 +160,7 @@ impl Mission {
         let mut vehicles = Vec::with_capacity(setups.len());
         let mut planners: Vec<Option<Box<dyn Planner>>> = Vec::with_capacity(setups.len());
         for (v, p) in setups.iter().zip(&planned) {
-            vehicles.push(SimVehicle::new(
+            let mut sim = SimVehicle::new(
                 v.name.clone(),
                 v.vehicle.clone(),
                 v.nav,
@@ -167,7 +168,9 @@ impl Mission {
                 v.flow_sensor,
                 v.range_sensor,
                 seed,
-            ));
+            );
+            sim.deaf_window_s = v.deaf_window_s;
+            vehicles.push(sim);
             planners.push(match p {
                 Some(p) => Some(p.config.build(&p.context, &p.key).map_err(|error| {
                     MissionError::Invalid {
@@ -247,6 +250,10 @@ impl Mission {
                 &spec.op_area,
                 sources.first().map(|s| s.xy()),
                 sample_every,
+            ),
+            team: crate::team::TeamStats::new(
+                planned.iter().map(Option::is_some).collect(),
+                sources.first().copied(),
             ),
             trajectory: options
                 .trajectory
@@ -433,6 +440,7 @@ impl Mission {
             };
             self.events.observe(&view);
             self.stats.observe(&view);
+            self.team.observe(&view);
             if let Some(t) = self.trajectory.as_mut() {
                 t.observe(&view);
             }
@@ -514,6 +522,7 @@ impl Mission {
                 .collect(),
             sources: &self.sources,
             mean_flow_mps: mean_flow,
+            team: self.team.summary(),
         });
         Ok(MissionRun {
             outcome: summary.outcome,

@@ -513,7 +513,10 @@ pub fn true_sources(world: &World) -> Vec<Vec3> {
         .plume()
         .filaments()
         .map(|f| f.sources().iter().map(|s| s.pos_m).collect())
-        .unwrap_or_default()
+        .unwrap_or_else(|| match world.env().plume() {
+            plumetrace_env::Plume::Steady(field) => field.source_positions(),
+            plumetrace_env::Plume::Filaments(_) => Vec::new(),
+        })
 }
 
 #[cfg(test)]
@@ -564,10 +567,19 @@ mod tests {
                 | PlannerEvent::AvoidEnd { .. } => {}
             }
         }
-        let telemetry = [Telemetry::SourceEstimate { pos_m: p }];
+        let telemetry = [
+            Telemetry::SourceEstimate { pos_m: p },
+            Telemetry::Formation {
+                scale_cw: Some(1.0),
+                ranges_m: Some([1.0, 2.0]),
+                ranges_to: Some([VehicleId(1), VehicleId(2)]),
+                setpoint_m: Some(1.5),
+                reading: 0.5,
+            },
+        ];
         for e in &telemetry {
             match e {
-                Telemetry::SourceEstimate { .. } => {}
+                Telemetry::SourceEstimate { .. } | Telemetry::Formation { .. } => {}
             }
         }
         let world = [

@@ -122,6 +122,9 @@ pub struct Summary {
     pub max_outside_m: f64,
     /// Every vehicle.
     pub vehicles: Vec<VehicleSummary>,
+    /// What the team did together (missions with two or more planners).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub team: Option<crate::team::TeamSummary>,
 }
 
 /// What the summary is made from.
@@ -135,6 +138,7 @@ pub(crate) struct SummaryInput<'a> {
     pub vehicles: Vec<(String, VehicleKind, Option<PlannerKind>)>,
     pub sources: &'a [Vec3],
     pub mean_flow_mps: Vec2,
+    pub team: Option<crate::team::TeamSummary>,
 }
 
 impl Summary {
@@ -228,6 +232,7 @@ impl Summary {
             longest_quiet_s,
             max_outside_m,
             vehicles,
+            team: i.team,
         }
     }
 

@@ -14,6 +14,8 @@
 //! - [`behaviour`]: the small behaviour and arbiter traits planners are built from, and the
 //!   behaviours any planner can use;
 //! - [`flow`]: the planner's running estimate of the current from flow measurements.
+//! - [`formation`]: formation tracing (seed 004): surface leaders and an underwater follower on
+//!   acoustic ranges.
 //! - [`fuzzy`]: fuzzy navigation past obstacles (seed 001): Mamdani engine, side lock, DRTs.
 
 pub mod avoid;
@@ -24,6 +26,9 @@ pub mod planners;
 
 pub use flow::FlowEstimate;
 pub use planners::amp::{self, Amp, AmpParams, DeclarationRule, LostPointEviction, MappingParams};
+pub use planners::formation::{
+    self, FormationFollower, FormationFollowerParams, FormationLeader, FormationLeaderParams,
+};
 pub use planners::moth::{self, Moth, MothParams, MothStrategy};
 pub use planners::{
     BuildContext, CommonParams, MissionGeometry, PLANNERS, PlannerConfig, PlannerEntry,

@@ -54,6 +54,8 @@ pub struct VehicleSetup {
     pub planner: Option<PlannerRef>,
     /// `[vehicles.chem_sensor] threshold_v`, if given: the detection threshold its planner gets.
     pub detection_threshold_v: Option<f64>,
+    /// Mission time `[start, end)` in which its modem hears nothing, s.
+    pub deaf_window_s: Option<(f64, f64)>,
 }
 
 /// A vehicle's planner table as written in the scenario.
@@ -521,11 +523,22 @@ pub fn build(
     let comms = plumetrace_sim::CommsParams {
         acoustic: channel(cfg.comms.acoustic.as_ref()),
         radio: channel(cfg.comms.radio.as_ref()),
+        ranging: {
+            let d = plumetrace_sim::RangingParams::default();
+            cfg.comms
+                .ranging
+                .as_ref()
+                .map_or(d, |r| plumetrace_sim::RangingParams {
+                    timing_noise_sd_s: r.timing_noise_sd_s.unwrap_or(d.timing_noise_sd_s),
+                    sound_speed_mps: r.sound_speed_mps.unwrap_or(d.sound_speed_mps),
+                })
+        },
     };
     comms
         .acoustic
         .validate("comms.acoustic")
         .and_then(|()| comms.radio.validate("comms.radio"))
+        .and_then(|()| comms.ranging.validate("comms.ranging"))
         .map_err(env_err)?;
 
     let seed = seed.unwrap_or(cfg.seed);
@@ -952,8 +965,28 @@ fn vehicle_setup(
         full_scale_v: c.full_scale_v.unwrap_or(cb.full_scale_v),
         noise_sd_v: c.noise_sd_v.unwrap_or(cb.noise_sd_v),
         lag_time_constant_s: c.lag_time_constant_s.unwrap_or(cb.lag_time_constant_s),
+        salinity: salinity(c, &key)?,
     };
     chem_sensor.validate(&format!("{key}.chem_sensor"))?;
+    let deaf_window_s = match (v.modem.deaf_start_s, v.modem.deaf_end_s) {
+        (None, None) => None,
+        (Some(a), Some(b)) => {
+            plumetrace_env::error::require_non_negative(&format!("{key}.modem.deaf_start_s"), a)?;
+            if !(b.is_finite() && b >= a) {
+                return Err(EnvError::invalid(
+                    format!("{key}.modem.deaf_end_s"),
+                    format!("must be at or after deaf_start_s ({a}), got {b}"),
+                ));
+            }
+            Some((a, b))
+        }
+        _ => {
+            return Err(EnvError::invalid(
+                format!("{key}.modem.deaf_end_s"),
+                "give both deaf_start_s and deaf_end_s",
+            ));
+        }
+    };
     if let Some(t) = c.threshold_v {
         plumetrace_env::error::require_non_negative(&format!("{key}.chem_sensor.threshold_v"), t)?;
     }
@@ -1046,7 +1079,39 @@ fn vehicle_setup(
         range_sensor,
         planner: None,
         detection_threshold_v: c.threshold_v,
+        deaf_window_s,
     })
+}
+
+/// The salinity probe of a `[vehicles.chem_sensor]` table, if its model is "salinity"; the
+/// salinity keys without it are an error (they would be ignored).
+fn salinity(
+    c: &crate::config::ChemSensorConfig,
+    key: &str,
+) -> Result<Option<plumetrace_sim::sensors::SalinityParams>, EnvError> {
+    use crate::config::ChemModel;
+    let d = plumetrace_sim::sensors::SalinityParams::default();
+    match c.model.unwrap_or(ChemModel::Voltage) {
+        ChemModel::Salinity => Ok(Some(plumetrace_sim::sensors::SalinityParams {
+            medium_ppt: c.medium_salinity_ppt.unwrap_or(d.medium_ppt),
+            fresh_density_kgpm3: c.fresh_density_kgpm3.unwrap_or(d.fresh_density_kgpm3),
+            noise_sd_ppt: c.noise_sd_ppt.unwrap_or(d.noise_sd_ppt),
+        })),
+        ChemModel::Voltage => {
+            let given = [
+                ("medium_salinity_ppt", c.medium_salinity_ppt),
+                ("fresh_density_kgpm3", c.fresh_density_kgpm3),
+                ("noise_sd_ppt", c.noise_sd_ppt),
+            ];
+            match given.iter().find(|(_, v)| v.is_some()) {
+                Some((name, _)) => Err(EnvError::invalid(
+                    format!("{key}.chem_sensor.{name}"),
+                    "only a salinity sensor has it (set model = \"salinity\")",
+                )),
+                None => Ok(None),
+            }
+        }
+    }
 }
 
 /// The legacy `[planner]` table (flown by every AUV that names no planner): `strategy` is read
@@ -1076,6 +1141,7 @@ fn channel(c: Option<&crate::config::ChannelConfig>) -> plumetrace_sim::ChannelP
         sound_speed_mps: c.sound_speed_mps,
         loss_probability: c.loss_probability.unwrap_or(ideal.loss_probability),
         max_range_m: c.max_range_m,
+        one_in_flight: c.one_in_flight.unwrap_or(ideal.one_in_flight),
     })
 }
 

@@ -369,6 +369,29 @@ pub struct VehicleConfig {
     pub flow_sensor: FlowSensorConfig,
     /// Obstacle range sensors (absent: none).
     pub range_sensor: Option<RangeSensorConfig>,
+    /// Its modem's faults.
+    #[serde(default)]
+    pub modem: ModemConfig,
+}
+
+/// `[vehicles.modem]`: a window in which the vehicle's modem hears nothing.
+#[derive(Debug, Clone, Default, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ModemConfig {
+    /// Start of the deaf window, s of mission time.
+    pub deaf_start_s: Option<f64>,
+    /// End of the deaf window, s.
+    pub deaf_end_s: Option<f64>,
+}
+
+/// What a chemical sensor measures.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ChemModel {
+    /// An analog reading proportional to the concentration (volts).
+    Voltage,
+    /// Salinity over a freshwater plume (ppt), with half-normal noise.
+    Salinity,
 }
 
 /// `[vehicles.dynamics]`
@@ -430,6 +453,14 @@ pub struct ChemSensorConfig {
     /// Detection threshold, V: passed to the vehicle's planner as its `threshold_v` (the
     /// threshold belongs to the planner; this key is kept for older scenario files).
     pub threshold_v: Option<f64>,
+    /// What it measures: "voltage" (default) or "salinity".
+    pub model: Option<ChemModel>,
+    /// Salinity: the medium's salinity, ppt (35).
+    pub medium_salinity_ppt: Option<f64>,
+    /// Salinity: density of the fresh water, kg/m^3 (998.2).
+    pub fresh_density_kgpm3: Option<f64>,
+    /// Salinity: scale of the half-normal noise, ppt (0.1).
+    pub noise_sd_ppt: Option<f64>,
 }
 
 /// `[vehicles.flow_sensor]`
@@ -502,6 +533,18 @@ pub struct CommsConfig {
     pub acoustic: Option<ChannelConfig>,
     /// Radio between surface craft.
     pub radio: Option<ChannelConfig>,
+    /// Acoustic ranging.
+    pub ranging: Option<RangingConfig>,
+}
+
+/// `[comms.ranging]`
+#[derive(Debug, Clone, Default, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RangingConfig {
+    /// Standard deviation of the round-trip time, s (0).
+    pub timing_noise_sd_s: Option<f64>,
+    /// Sound speed the modem assumes, m/s (1500).
+    pub sound_speed_mps: Option<f64>,
 }
 
 /// `[comms.acoustic]`, `[comms.radio]`
@@ -516,6 +559,9 @@ pub struct ChannelConfig {
     pub loss_probability: Option<f64>,
     /// Longest distance a message carries, m (none: any).
     pub max_range_m: Option<f64>,
+    /// One packet per sender on the water at a time (false): a message sent while the
+    /// previous one travels is lost.
+    pub one_in_flight: Option<bool>,
 }
 
 /// Pairs of numbers (`[east, north]`) read strictly: exactly two numbers each, so that a third

@@ -440,6 +440,24 @@ pub const LIMITS: &[Limit] = &[
         "readings must stay finite",
     ),
     pos(
+        "vehicles[].chem_sensor.medium_salinity_ppt",
+        1000.0,
+        "parts per thousand",
+    ),
+    pos(
+        "vehicles[].chem_sensor.fresh_density_kgpm3",
+        1e5,
+        "a density of water",
+    ),
+    num(
+        "vehicles[].chem_sensor.noise_sd_ppt",
+        0.0,
+        1000.0,
+        "parts per thousand",
+    ),
+    num("vehicles[].modem.deaf_start_s", 0.0, LONG, "mission time"),
+    num("vehicles[].modem.deaf_end_s", 0.0, LONG, "mission time"),
+    pos(
         "vehicles[].flow_sensor.rate_hz",
         1000.0,
         "samples at 1 kHz at most (one per step is taken)",
@@ -535,6 +553,13 @@ pub const LIMITS: &[Limit] = &[
     pos("comms.radio.sound_speed_mps", 1e9, "finite"),
     num("comms.radio.loss_probability", 0.0, 1.0, "a probability"),
     pos("comms.radio.max_range_m", 1e8, "finite"),
+    num(
+        "comms.ranging.timing_noise_sd_s",
+        0.0,
+        10.0,
+        "ten seconds of timing error is no ranging",
+    ),
+    pos("comms.ranging.sound_speed_mps", 1e9, "finite"),
     count("planners", 100, "planners are per vehicle"),
 ];
 

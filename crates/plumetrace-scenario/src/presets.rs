@@ -66,6 +66,16 @@ pub const PRESETS: &[Preset] = &[
         summary: "steady freshwater plume of the formation-tracing experiment (108 m x 40 m x 4 m)",
         toml: include_str!("../presets/freshwater.toml"),
     },
+    Preset {
+        name: "soares-freshwater",
+        summary: "formation tracing: two surface leaders and an AUV follower on acoustic ranges trace the steady freshwater plume to its surface outlet",
+        toml: include_str!("../presets/soares-freshwater.toml"),
+    },
+    Preset {
+        name: "soares-filaments",
+        summary: "the formation team on a meandering, intermittent filament plume from the same surface outlet (the harder case)",
+        toml: include_str!("../presets/soares-filaments.toml"),
+    },
 ];
 
 /// The preset called `name`.

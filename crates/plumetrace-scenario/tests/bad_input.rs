@@ -459,3 +459,43 @@ fn probe_and_series_keys_are_built_into_steps() {
         );
     }
 }
+
+#[test]
+fn bad_salinity_modem_and_ranging_keys_name_themselves() {
+    let base = find_preset("soares-freshwater").unwrap().toml;
+    let cases = [
+        // Salinity keys on a voltage sensor would be ignored.
+        (
+            base.replacen(
+                "[vehicles.chem_sensor]\nmodel = \"salinity\"",
+                "[vehicles.chem_sensor]\nnoise_sd_ppt = 0.2",
+                1,
+            ),
+            "vehicles[0].chem_sensor.noise_sd_ppt",
+        ),
+        (
+            base.replacen(
+                "[vehicles.nav]\nposition_estimate = false",
+                "[vehicles.nav]\nposition_estimate = false\n\n[vehicles.modem]\ndeaf_start_s = 10.0",
+                1,
+            ),
+            "vehicles[0].modem.deaf_end_s",
+        ),
+        (
+            base.replacen(
+                "[vehicles.nav]\nposition_estimate = false",
+                "[vehicles.nav]\nposition_estimate = false\n\n[vehicles.modem]\ndeaf_start_s = 10.0\ndeaf_end_s = 5.0",
+                1,
+            ),
+            "vehicles[0].modem.deaf_end_s",
+        ),
+        (
+            base.replace("timing_noise_sd_s = 0.0005", "timing_noise_sd_s = -1.0"),
+            "comms.ranging.timing_noise_sd_s",
+        ),
+    ];
+    for (text, key) in cases {
+        let e = error_of(&text);
+        assert!(e.contains(key), "{key}: {e}");
+    }
+}

@@ -11,8 +11,22 @@
 //! in arrival order (ties in sending order), so a message sent with no delay reaches its recipient
 //! at the next decision. The ideal channel (the default for both links) has no delay, no loss and
 //! no range limit.
+//!
+//! A channel with `one_in_flight` (an acoustic modem) carries one packet per sender at a time:
+//! a message sent while the sender's previous packet is still on its way to its farthest
+//! recipient is lost (`modem_busy`). Each link kind draws its losses from its own random stream,
+//! so radio traffic does not change which acoustic packets are lost.
+//!
+//! **Acoustic ranging.** A [`MessageBody::RangeRequest`] is heard by every vehicle in range;
+//! its target answers with a [`MessageBody::RangeEcho`]. The world measures the range for the
+//! requester, as its modem would from the round-trip time: the mean of the true slant distances
+//! at the request's and the echo's sending (the two legs' travel times times the sound speed over
+//! two; the target's known turnaround is taken off), plus the timing noise
+//! `ranging.timing_noise_sd_s` times half the sound speed. The requester receives a
+//! [`MessageBody::RangeReply`] with that range; the truth stays in the simulator. An echo
+//! without a request on record is lost (`unsolicited`). The timing noise has its own stream.
 
-use plumetrace_core::{Link, Message, Vec2, VehicleId};
+use plumetrace_core::{Link, Message, MessageBody, Vec2, VehicleId};
 use plumetrace_env::error::{require_non_negative, require_positive};
 use plumetrace_env::{EnvError, SimRng};
 use rand::Rng;
@@ -29,6 +43,10 @@ pub struct ChannelParams {
     pub loss_probability: f64,
     /// Longest distance a message carries, m; `None`: any.
     pub max_range_m: Option<f64>,
+    /// One packet per sender on the water at a time (an acoustic modem): what is sent while
+    /// the previous packet travels is lost.
+    #[serde(default)]
+    pub one_in_flight: bool,
 }
 
 impl ChannelParams {
@@ -38,6 +56,7 @@ impl ChannelParams {
         sound_speed_mps: None,
         loss_probability: 0.0,
         max_range_m: None,
+        one_in_flight: false,
     };
 
     /// Checks every parameter; `key` prefixes the names in errors.
@@ -65,6 +84,37 @@ impl Default for ChannelParams {
     }
 }
 
+/// How acoustic ranging measures a range.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct RangingParams {
+    /// Standard deviation of the round-trip time measurement, s.
+    pub timing_noise_sd_s: f64,
+    /// Sound speed the modem assumes to turn time into range, m/s.
+    pub sound_speed_mps: f64,
+}
+
+impl Default for RangingParams {
+    fn default() -> Self {
+        RangingParams {
+            timing_noise_sd_s: 0.0,
+            sound_speed_mps: 1500.0,
+        }
+    }
+}
+
+impl RangingParams {
+    /// Checks every parameter; `key` prefixes the names in errors.
+    pub fn validate(&self, key: &str) -> Result<(), EnvError> {
+        require_non_negative(&format!("{key}.timing_noise_sd_s"), self.timing_noise_sd_s)?;
+        require_positive(&format!("{key}.sound_speed_mps"), self.sound_speed_mps)
+    }
+
+    /// Standard deviation of a measured range, m.
+    pub fn range_sd_m(&self) -> f64 {
+        0.5 * self.sound_speed_mps * self.timing_noise_sd_s
+    }
+}
+
 /// The channel models of a world.
 #[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
 pub struct CommsParams {
@@ -72,6 +122,9 @@ pub struct CommsParams {
     pub acoustic: ChannelParams,
     /// Radio between surface craft.
     pub radio: ChannelParams,
+    /// Acoustic ranging.
+    #[serde(default)]
+    pub ranging: RangingParams,
 }
 
 impl CommsParams {
@@ -96,6 +149,12 @@ pub enum LossReason {
     RecipientStopped,
     /// No vehicle has the recipient's index (the event is the sender's).
     NoSuchRecipient,
+    /// The sender's modem was still carrying its previous packet.
+    ModemBusy,
+    /// The recipient could not hear (a deaf window of its modem).
+    Deaf,
+    /// A range echo answered no request on record.
+    Unsolicited,
 }
 
 /// What became of one message for one recipient.
@@ -123,24 +182,101 @@ pub struct InFlight {
     pub message: Message,
 }
 
-/// The messages on their way and the channel models' random stream.
+/// A ranging request on its way to (or answered by) its target.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct PendingRange {
+    requester: VehicleId,
+    target: VehicleId,
+    distance_m: f64,
+}
+
+/// The messages on their way and the channel models' random streams.
 #[derive(Debug, Clone)]
 pub struct Comms {
     params: CommsParams,
-    rng: SimRng,
+    rng_acoustic: SimRng,
+    rng_radio: SimRng,
+    rng_ranging: SimRng,
     in_flight: Vec<InFlight>,
     seq: u64,
+    busy_until_s: Vec<(VehicleId, Link, f64)>,
+    pending: Vec<PendingRange>,
 }
 
 impl Comms {
-    /// Channels with `params` drawing from `rng`.
-    pub fn new(params: CommsParams, rng: SimRng) -> Self {
+    /// Channels with `params`, their random streams derived from `seed` (one per link kind, one
+    /// for the ranging noise).
+    pub fn new(params: CommsParams, seed: u64) -> Self {
+        use plumetrace_env::{StreamId, stream_rng};
         Comms {
             params,
-            rng,
+            rng_acoustic: stream_rng(seed, StreamId::Custom(STREAM_ACOUSTIC)),
+            rng_radio: stream_rng(seed, StreamId::Custom(STREAM_RADIO)),
+            rng_ranging: stream_rng(seed, StreamId::Custom(STREAM_RANGING)),
             in_flight: Vec::new(),
             seq: 0,
+            busy_until_s: Vec::new(),
+            pending: Vec::new(),
         }
+    }
+
+    /// Whether `from`'s modem on `link` is still carrying a packet at `t_s` (only channels with
+    /// `one_in_flight` are ever busy).
+    pub fn busy(&self, from: VehicleId, link: Link, t_s: f64) -> bool {
+        self.busy_until_s
+            .iter()
+            .any(|&(v, l, until)| v == from && l == link && t_s + 1e-9 < until)
+    }
+
+    fn occupy(&mut self, from: VehicleId, link: Link, until_s: f64) {
+        match self
+            .busy_until_s
+            .iter_mut()
+            .find(|(v, l, _)| *v == from && *l == link)
+        {
+            Some(e) => e.2 = e.2.max(until_s),
+            None => self.busy_until_s.push((from, link, until_s)),
+        }
+    }
+
+    /// Records that `requester`'s ranging request reached `target` from `distance_m` (true
+    /// slant distance at sending); a later request to the same target replaces it.
+    pub fn record_request(&mut self, requester: VehicleId, target: VehicleId, distance_m: f64) {
+        self.pending
+            .retain(|p| !(p.requester == requester && p.target == target));
+        self.pending.push(PendingRange {
+            requester,
+            target,
+            distance_m,
+        });
+    }
+
+    /// The range `requester` measures from `target`'s echo sent from `distance_m` (true slant
+    /// distance at the echo's sending): the mean of the two legs plus timing noise. `None` when
+    /// no request of `requester` to `target` is on record (the record is used up).
+    pub fn measure_range(
+        &mut self,
+        requester: VehicleId,
+        target: VehicleId,
+        distance_m: f64,
+    ) -> Option<f64> {
+        let k = self
+            .pending
+            .iter()
+            .position(|p| p.requester == requester && p.target == target)?;
+        let p = self.pending.swap_remove(k);
+        let sd = self.params.ranging.range_sd_m();
+        let noise = if sd > 0.0 {
+            let n: f64 = rand_distr::Distribution::sample(
+                &rand_distr::StandardNormal,
+                &mut self.rng_ranging,
+            );
+            sd * n
+        } else {
+            0.0
+        };
+        let r = 0.5 * (p.distance_m + distance_m) + noise;
+        Some(if r.is_finite() { r.max(0.0) } else { 0.0 })
     }
 
     /// The channel models.
@@ -163,11 +299,19 @@ impl Comms {
         {
             return Transmission::Lost(LossReason::OutOfRange);
         }
-        if c.loss_probability > 0.0 && self.rng.random::<f64>() < c.loss_probability {
-            return Transmission::Lost(LossReason::Dropped);
-        }
         let travel = c.sound_speed_mps.map_or(0.0, |s| distance / s);
         let arrival_s = message.sent_s + c.latency_s + travel;
+        if c.one_in_flight {
+            // The packet is on the water until it reaches its farthest recipient, heard or not.
+            self.occupy(message.from, message.link, arrival_s);
+        }
+        let rng = match message.link {
+            Link::Acoustic => &mut self.rng_acoustic,
+            Link::Radio => &mut self.rng_radio,
+        };
+        if c.loss_probability > 0.0 && rng.random::<f64>() < c.loss_probability {
+            return Transmission::Lost(LossReason::Dropped);
+        }
         self.in_flight.push(InFlight {
             arrival_s,
             seq: self.seq,
@@ -194,11 +338,20 @@ impl Comms {
     }
 }
 
+/// Whether a message body is a ranging echo (the world turns it into a measured range).
+pub fn is_range_echo(body: &MessageBody) -> bool {
+    matches!(body, MessageBody::RangeEcho { .. })
+}
+
+/// The `StreamId::Custom` numbers of the channels' streams.
+const STREAM_ACOUSTIC: u64 = 0xC0_4441;
+const STREAM_RADIO: u64 = 0xC0_4452;
+const STREAM_RANGING: u64 = 0xC0_4447;
+
 #[cfg(test)]
 mod tests {
     use super::*;
-    use plumetrace_core::{MessageBody, Recipient};
-    use plumetrace_env::{StreamId, stream_rng};
+    use plumetrace_core::Recipient;
 
     fn message(link: Link, sent_s: f64) -> Message {
         Message {
@@ -218,10 +371,12 @@ mod tests {
                 sound_speed_mps: Some(1500.0),
                 loss_probability: 0.0,
                 max_range_m: Some(2000.0),
+                one_in_flight: false,
             },
             radio: ChannelParams::IDEAL,
+            ranging: RangingParams::default(),
         };
-        let mut c = Comms::new(params, stream_rng(1, StreamId::Custom(9)));
+        let mut c = Comms::new(params, 1);
         let m = message(Link::Acoustic, 10.0);
         let t = c.transmit(&m, Vec2::zeros(), VehicleId(1), Vec2::new(1500.0, 0.0));
         assert_eq!(t, Transmission::InFlight { arrival_s: 11.5 });
@@ -252,9 +407,10 @@ mod tests {
                 ..ChannelParams::IDEAL
             },
             radio: ChannelParams::IDEAL,
+            ranging: RangingParams::default(),
         };
         let count = |seed| {
-            let mut c = Comms::new(params, stream_rng(seed, StreamId::Custom(9)));
+            let mut c = Comms::new(params, seed);
             (0..20_000)
                 .filter(|_| {
                     matches!(

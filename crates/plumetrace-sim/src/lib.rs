@@ -16,10 +16,8 @@
 //!   with bias and a wrong-layer fault, and three-group obstacle range sensors.
 //!
 //! - [`comms`]: messages between vehicles through a channel model per link (acoustic modem,
-//!   radio): delay, loss and range, seeded.
-//!
-//! Acoustic ranging between vehicles arrives with formation tracing; its messages already have
-//! a type in `plumetrace_core::MessageBody::RangeReply`.
+//!   radio): delay, loss, range and one packet in flight per modem, seeded per link kind; and
+//!   acoustic ranging (requests, echoes, ranges measured by the simulator with timing noise).
 
 pub mod comms;
 pub mod nav;
@@ -27,7 +25,7 @@ pub mod sensors;
 pub mod vehicle;
 pub mod world;
 
-pub use comms::{ChannelParams, CommsParams, LossReason};
+pub use comms::{ChannelParams, CommsParams, LossReason, RangingParams};
 pub use nav::{FixEvent, NavParams, Navigator};
 pub use sensors::{
     ChemSensor, ChemSensorParams, FlowFault, FlowSensor, FlowSensorParams, RangeSensor,

@@ -1,4 +1,5 @@
-//! Sensors: chemical, flow and obstacle range.
+//! Sensors: chemical (an analog reading, or salinity over a freshwater plume), flow and obstacle
+//! range.
 
 use plumetrace_core::{ChemSample, FlowSample, Heading, RangeReturn, Vec2};
 use plumetrace_env::error::{require_non_negative, require_positive};
@@ -47,6 +48,37 @@ pub struct ChemSensorParams {
     pub noise_sd_v: f64,
     /// First-order lag of the sensor, s (0 = none).
     pub lag_time_constant_s: f64,
+    /// A salinity probe instead of the analog chemical sensor (the volts keys then do not
+    /// apply).
+    #[serde(default)]
+    pub salinity: Option<SalinityParams>,
+}
+
+/// A conductivity-temperature salinity probe over a freshwater plume.
+///
+/// The field's concentration is fresh water in kg per m^3; the fresh fraction `f = c / rho_f`
+/// dilutes the medium, `S = S_medium (1 - f)`, and the probe reports `S + |n|` with `n` normal
+/// of standard deviation `noise_sd_ppt` (half-normal noise), saturated at `S_medium`: fresh
+/// water never raises the salinity, so no reading exceeds the medium's.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct SalinityParams {
+    /// Salinity of the medium, ppt.
+    pub medium_ppt: f64,
+    /// Density of the fresh water, kg/m^3.
+    pub fresh_density_kgpm3: f64,
+    /// Noise (the scale of the half-normal), ppt.
+    pub noise_sd_ppt: f64,
+}
+
+impl Default for SalinityParams {
+    /// The formation-tracing case: 35 ppt sea water, 998.2 kg/m^3 fresh water, sigma 0.1 ppt.
+    fn default() -> Self {
+        SalinityParams {
+            medium_ppt: 35.0,
+            fresh_density_kgpm3: 998.2,
+            noise_sd_ppt: 0.1,
+        }
+    }
 }
 
 impl Default for ChemSensorParams {
@@ -57,6 +89,7 @@ impl Default for ChemSensorParams {
             full_scale_v: 5.0,
             noise_sd_v: 0.02,
             lag_time_constant_s: 0.0,
+            salinity: None,
         }
     }
 }
@@ -71,7 +104,13 @@ impl ChemSensorParams {
         require_non_negative(
             &format!("{key}.lag_time_constant_s"),
             self.lag_time_constant_s,
-        )
+        )?;
+        if let Some(s) = &self.salinity {
+            require_positive(&format!("{key}.medium_salinity_ppt"), s.medium_ppt)?;
+            require_positive(&format!("{key}.fresh_density_kgpm3"), s.fresh_density_kgpm3)?;
+            require_non_negative(&format!("{key}.noise_sd_ppt"), s.noise_sd_ppt)?;
+        }
+        Ok(())
     }
 }
 
@@ -108,6 +147,20 @@ impl ChemSensor {
     /// A sample of `concentration` (taken at the sensor's true position) at `t_s`.
     pub fn sample(&mut self, concentration: f64, t_s: f64, rng: &mut SimRng) -> ChemSample {
         let p = self.params;
+        if let Some(s) = p.salinity {
+            let fresh = (concentration / s.fresh_density_kgpm3).clamp(0.0, 1.0);
+            let n: f64 = StandardNormal.sample(rng);
+            let reading =
+                (s.medium_ppt * (1.0 - fresh) + s.noise_sd_ppt * n.abs()).clamp(0.0, s.medium_ppt);
+            return ChemSample {
+                time_s: t_s,
+                reading: if reading.is_finite() {
+                    reading
+                } else {
+                    s.medium_ppt
+                },
+            };
+        }
         let raw = p.volts_per_unit * concentration.max(0.0);
         self.lagged_v = match (self.last_t_s, p.lag_time_constant_s > 0.0) {
             (Some(t0), true) => {
@@ -353,6 +406,32 @@ mod tests {
         lag.sample(0.0, 0.0, &mut rng);
         let r = lag.sample(1.0, 1.0, &mut rng).reading;
         assert!((r - (1.0 - (-1.0f64).exp())).abs() < 1e-12, "{r}");
+    }
+
+    #[test]
+    fn salinity_is_diluted_by_fresh_water_with_half_normal_noise_saturated_at_the_medium() {
+        let mut rng = stream_rng(2, StreamId::Sensor(0, 1));
+        let mut s = ChemSensor::new(ChemSensorParams {
+            salinity: Some(SalinityParams::default()),
+            ..ChemSensorParams::default()
+        });
+        // Outside the plume every reading is the medium's: the noise only raises salinity.
+        assert!((0..100).all(|k| s.sample(0.0, f64::from(k), &mut rng).reading == 35.0));
+        // 2.852 kg/m^3 of fresh water: 35 (1 - 2.852 / 998.2) = 34.9 ppt. The half-normal mean
+        // is sigma sqrt(2 / pi) = 0.0798; readings above 35 are cut back to 35.
+        let n = 20_000;
+        let r: Vec<f64> = (0..n)
+            .map(|k| s.sample(2.852, f64::from(k), &mut rng).reading)
+            .collect();
+        assert!(r.iter().all(|x| (34.9 - 1e-9..=35.0).contains(x)));
+        let saturated = r.iter().filter(|x| **x == 35.0).count() as f64 / f64::from(n);
+        // P(|n| > 0.1 ppt) = P(|z| > 1) = 0.3173.
+        assert!((saturated - 0.3173).abs() < 0.015, "{saturated}");
+        let mean_below: f64 = r.iter().map(|x| x.min(35.0)).sum::<f64>() / f64::from(n);
+        // E[min(34.9 + |n|, 35)] = 34.9 + 0.1 (E[|z|; |z| < 1] + P(|z| > 1)).
+        let want =
+            34.9 + 0.1 * ((2.0 / std::f64::consts::PI).sqrt() * (1.0 - (-0.5f64).exp()) + 0.3173);
+        assert!((mean_below - want).abs() < 0.002, "{mean_below} vs {want}");
     }
 
     #[test]

@@ -10,7 +10,8 @@
 //!    `decision_period_s`) gets its [`SensorSnapshot`] (navigation estimate, samples since its
 //!    last decision, messages) and returns a [`Decision`]; its outgoing messages go through their
 //!    link's channel model ([`crate::comms`]: delay from the distance between sender and
-//!    recipient at sending, loss, range) and are on their way;
+//!    recipient at sending, loss, range, one packet in flight per modem) and are on their way;
+//!    a range echo is turned into the requester's measured range here (acoustic ranging);
 //! 5. **control**: a command that is not finite is recorded as an event and replaced by the
 //!    vehicle's previous command (the safe one: finite, and what the vehicle is already doing);
 //! 6. **integrate**: vehicle dynamics in the local current, then navigation (fixes jump here);
@@ -20,14 +21,14 @@
 //!
 //! Each stage is a function, and its wall time is summed in [`StageTimes`].
 
-use crate::comms::{Comms, CommsParams, LossReason, Transmission};
+use crate::comms::{Comms, CommsParams, LossReason, Transmission, is_range_echo};
 use crate::{
     ChemSensor, ChemSensorParams, FlowSensor, FlowSensorParams, NavParams, Navigator, RangeSensor,
     RangeSensorParams, Vehicle,
 };
 use plumetrace_core::{
-    ChemSample, Command, Decision, FlowSample, Link, Message, Planner, RangeReturn, Recipient,
-    SensorSnapshot, Vec2, Vec3, VehicleId, VerticalCommand,
+    ChemSample, Command, Decision, FlowSample, Link, Message, MessageBody, Planner, RangeReturn,
+    Recipient, SensorSnapshot, Vec2, Vec3, VehicleId, VerticalCommand,
 };
 use plumetrace_env::{EnvError, Environment, FlowField, SimRng, StreamId, stream_rng};
 use serde::{Deserialize, Serialize};
@@ -128,6 +129,9 @@ pub struct SimVehicle {
     pub active: bool,
     /// The latest chemical sample (for logs).
     pub last_chem: Option<ChemSample>,
+    /// A window `[start, end)` of mission time, s, during which the vehicle's modem hears
+    /// nothing (messages arriving then are lost as `deaf`).
+    pub deaf_window_s: Option<(f64, f64)>,
     next_decision_s: f64,
     pending_chem: Vec<ChemSample>,
     last_flow: Option<FlowSample>,
@@ -168,6 +172,7 @@ impl SimVehicle {
             command,
             active: true,
             last_chem: None,
+            deaf_window_s: None,
             next_decision_s: 0.0,
             pending_chem: Vec::new(),
             last_flow: None,
@@ -269,6 +274,7 @@ impl World {
         }
         comms.acoustic.validate("comms.acoustic")?;
         comms.radio.validate("comms.radio")?;
+        comms.ranging.validate("comms.ranging")?;
         Ok(World {
             env,
             vehicles,
@@ -276,7 +282,7 @@ impl World {
             env_every: ratio.round() as u64,
             step: 0,
             water_depth_m,
-            comms: Comms::new(comms, stream_rng(seed, StreamId::Custom(COMMS_STREAM))),
+            comms: Comms::new(comms, seed),
             record_snapshots: false,
             times: StageTimes::default(),
         })
@@ -350,6 +356,49 @@ impl World {
             .vehicles
             .get(m.from.0 as usize)
             .map_or(Vec2::zeros(), |v| v.vehicle.state.pos_m);
+        // A range echo reaches its requester as a measured range, or not at all.
+        let measured;
+        let unsolicited = |to: VehicleId| {
+            (
+                to,
+                WorldEvent::MessageLost {
+                    from: m.from,
+                    link: m.link,
+                    sent_s: m.sent_s,
+                    reason: LossReason::Unsolicited,
+                },
+            )
+        };
+        let m = if is_range_echo(&m.body) {
+            let (Recipient::Vehicle(to), MessageBody::RangeEcho { heading, scale_cw }) =
+                (m.to, &m.body)
+            else {
+                events.push(unsolicited(m.from));
+                return;
+            };
+            let range = match (
+                self.vehicles.get(m.from.0 as usize),
+                self.vehicles.get(to.0 as usize),
+            ) {
+                (Some(a), Some(b)) => self.comms.measure_range(to, m.from, slant_m(a, b)),
+                _ => None,
+            };
+            let Some(range_m) = range else {
+                events.push(unsolicited(to));
+                return;
+            };
+            measured = Message {
+                body: MessageBody::RangeReply {
+                    range_m,
+                    sender_heading: *heading,
+                    scale_cw: *scale_cw,
+                },
+                ..m.clone()
+            };
+            &measured
+        } else {
+            m
+        };
         let lost = |to: VehicleId, reason| {
             (
                 to,
@@ -367,7 +416,9 @@ impl World {
             events.push(lost(m.from, LossReason::NoSuchRecipient));
             return;
         }
-        for v in &self.vehicles {
+        let busy = self.comms.busy(m.from, m.link, m.sent_s);
+        let sender = m.from.0 as usize;
+        for (k, v) in self.vehicles.iter().enumerate() {
             let id = v.vehicle.id;
             let addressed = match m.to {
                 Recipient::Broadcast => id != m.from,
@@ -383,10 +434,21 @@ impl World {
                 }
                 continue;
             }
-            if let Transmission::Lost(reason) =
-                self.comms.transmit(m, from_m, id, v.vehicle.state.pos_m)
-            {
-                events.push(lost(id, reason));
+            if busy {
+                events.push(lost(id, LossReason::ModemBusy));
+                continue;
+            }
+            match self.comms.transmit(m, from_m, id, v.vehicle.state.pos_m) {
+                Transmission::Lost(reason) => events.push(lost(id, reason)),
+                Transmission::InFlight { .. } => {
+                    if let MessageBody::RangeRequest { target, .. } = m.body
+                        && target == id
+                        && let Some(s) = self.vehicles.get(sender)
+                    {
+                        let d = slant_m(s, &self.vehicles[k]);
+                        self.comms.record_request(m.from, id, d);
+                    }
+                }
             }
         }
     }
@@ -471,14 +533,21 @@ impl World {
             let Some(v) = self.vehicles.get_mut(arrived.to.0 as usize) else {
                 continue;
             };
-            if !v.active {
+            let deaf = v
+                .deaf_window_s
+                .is_some_and(|(a, b)| t + 1e-9 >= a && t + 1e-9 < b);
+            if !v.active || deaf {
                 events.push((
                     arrived.to,
                     WorldEvent::MessageLost {
                         from: m.from,
                         link: m.link,
                         sent_s: m.sent_s,
-                        reason: LossReason::RecipientStopped,
+                        reason: if deaf {
+                            LossReason::Deaf
+                        } else {
+                            LossReason::RecipientStopped
+                        },
                     },
                 ));
                 continue;
@@ -619,5 +688,8 @@ impl World {
     }
 }
 
-/// The `StreamId::Custom` number of the message channels' stream.
-const COMMS_STREAM: u64 = 0xC0_4445;
+/// True slant distance between two vehicles (horizontal and vertical), m.
+fn slant_m(a: &SimVehicle, b: &SimVehicle) -> f64 {
+    let (p, q) = (&a.vehicle.state, &b.vehicle.state);
+    ((p.pos_m - q.pos_m).norm_squared() + (p.z_m - q.z_m).powi(2)).sqrt()
+}

@@ -12,7 +12,7 @@ use plumetrace_env::steady::GaussianPlume;
 use plumetrace_env::{Environment, FlowModel, ObstacleSet, Plume, Rect, SoftObstacle};
 use plumetrace_sim::{
     ChannelParams, ChemSensorParams, CommsParams, FlowSensorParams, Incident, LossReason,
-    NavParams, SimVehicle, Vehicle, VehicleParams, World, WorldEvent,
+    NavParams, RangingParams, SimVehicle, Vehicle, VehicleParams, World, WorldEvent,
 };
 
 const DT: f64 = 0.1;
@@ -294,10 +294,12 @@ fn messages_arrive_after_the_channels_delay_or_are_lost() {
         sound_speed_mps: Some(1500.0),
         loss_probability: 0.2,
         max_range_m: None,
+        one_in_flight: false,
     };
     let comms = CommsParams {
         acoustic,
         radio: ChannelParams::IDEAL,
+        ranging: RangingParams::default(),
     };
     let (mut w, mut p, heard) = talkers(comms, Link::Acoustic, 150.0);
     let mut lost = 0;
@@ -338,6 +340,7 @@ fn messages_arrive_after_the_channels_delay_or_are_lost() {
             ..ChannelParams::IDEAL
         },
         radio: ChannelParams::IDEAL,
+        ranging: RangingParams::default(),
     };
     let (mut w, mut p, heard) = talkers(short, Link::Acoustic, 150.0);
     let r = w.step(&mut p).unwrap();
@@ -359,6 +362,7 @@ fn message_losses_are_the_same_for_the_same_seed() {
             ..ChannelParams::IDEAL
         },
         radio: ChannelParams::IDEAL,
+        ranging: RangingParams::default(),
     };
     let losses = |seed: u64| {
         let (w, mut p, _) = talkers(lossy, Link::Acoustic, 150.0);
@@ -389,15 +393,20 @@ fn message_losses_are_the_same_for_the_same_seed() {
     assert_ne!(a, losses(6));
 }
 
-#[test]
-fn a_message_to_a_stopped_or_missing_vehicle_is_reported_lost() {
-    let mut w = World::new(
+/// Two AUVs 10 m apart with ideal channels.
+fn pair() -> World {
+    World::new(
         env(vec![]),
         vec![auv(0, (50.0, 50.0), 0.0), auv(1, (60.0, 50.0), 0.0)],
         DT,
         Some(10.0),
     )
-    .unwrap();
+    .unwrap()
+}
+
+#[test]
+fn a_message_to_a_stopped_or_missing_vehicle_is_reported_lost() {
+    let mut w = pair();
     w.stop(VehicleId(1));
     let to = |id| plumetrace_core::Message {
         from: VehicleId(0),
@@ -504,5 +513,213 @@ fn vehicles_with_different_planners_decide_at_their_own_periods() {
         (v[2].vehicle.state.pos_m - Vec2::new(151.0, 50.0)).norm() < 0.1,
         "{:?}",
         v[2].vehicle.state.pos_m
+    );
+}
+
+/// Sends a ranging request to vehicle 1 at every decision; records the ranges it gets back.
+struct Ranger {
+    ranges: std::sync::Arc<std::sync::Mutex<Vec<f64>>>,
+}
+
+impl Planner for Ranger {
+    fn decide(&mut self, s: &SensorSnapshot) -> Decision {
+        if let Ok(mut r) = self.ranges.lock() {
+            for m in &s.inbox {
+                if let MessageBody::RangeReply { range_m, .. } = m.body {
+                    r.push(range_m);
+                }
+            }
+        }
+        let mut d = Decision::new(command(0.0, 0.0), PlanStatus::Running);
+        d.outbox.push(Outgoing {
+            to: Recipient::Broadcast,
+            link: Link::Acoustic,
+            body: MessageBody::RangeRequest {
+                target: VehicleId(1),
+                reading: 0.0,
+            },
+        });
+        d
+    }
+}
+
+/// Answers every ranging request addressed to it at once; counts the requests it hears.
+struct Echoer {
+    me: VehicleId,
+    heard: std::sync::Arc<std::sync::Mutex<u32>>,
+}
+
+impl Planner for Echoer {
+    fn decide(&mut self, s: &SensorSnapshot) -> Decision {
+        let mut d = Decision::new(command(0.0, 0.0), PlanStatus::Running);
+        for m in &s.inbox {
+            if let MessageBody::RangeRequest { target, .. } = m.body {
+                if let Ok(mut h) = self.heard.lock() {
+                    *h += 1;
+                }
+                if target == self.me {
+                    d.outbox.push(Outgoing {
+                        to: Recipient::Vehicle(m.from),
+                        link: Link::Acoustic,
+                        body: MessageBody::RangeEcho {
+                            heading: Heading::from_deg(45.0),
+                            scale_cw: Some(1.5),
+                        },
+                    });
+                }
+            }
+        }
+        d
+    }
+}
+
+#[test]
+fn ranging_measures_the_slant_range_with_the_timing_noise_and_one_packet_in_flight() {
+    let comms = CommsParams {
+        acoustic: ChannelParams {
+            latency_s: 0.25,
+            sound_speed_mps: Some(1500.0),
+            loss_probability: 0.0,
+            max_range_m: None,
+            one_in_flight: true,
+        },
+        radio: ChannelParams::IDEAL,
+        ranging: RangingParams {
+            timing_noise_sd_s: 0.002,
+            sound_speed_mps: 1500.0,
+        },
+    };
+    let ranges = std::sync::Arc::new(std::sync::Mutex::new(Vec::new()));
+    let heard = std::sync::Arc::new(std::sync::Mutex::new(0));
+    let heard2 = std::sync::Arc::new(std::sync::Mutex::new(0));
+    let follower = auv(0, (50.0, 100.0), 0.0);
+    let mut w = World::with_comms(
+        env(vec![]),
+        vec![
+            follower,
+            auv(1, (50.0, 130.0), 0.0),
+            auv(2, (80.0, 100.0), 0.0),
+        ],
+        DT,
+        Some(10.0),
+        comms,
+        3,
+    )
+    .unwrap();
+    // Every vehicle 2 m above the seabed: the slant range is the horizontal one.
+    let truth = 30.0;
+    let mut p: Vec<Option<Box<dyn Planner>>> = vec![
+        Some(Box::new(Ranger {
+            ranges: ranges.clone(),
+        })),
+        Some(Box::new(Echoer {
+            me: VehicleId(1),
+            heard: heard.clone(),
+        })),
+        Some(Box::new(Echoer {
+            me: VehicleId(2),
+            heard: heard2.clone(),
+        })),
+    ];
+    let mut busy = 0;
+    // 1000 s: the current (0.1 m/s East) carries the three together, all inside the domain.
+    for _ in 0..10_000 {
+        let r = w.step(&mut p).unwrap();
+        busy += r
+            .events
+            .iter()
+            .filter(|(_, e)| {
+                matches!(
+                    e,
+                    WorldEvent::MessageLost {
+                        reason: LossReason::ModemBusy,
+                        ..
+                    }
+                )
+            })
+            .count();
+    }
+    let r = ranges.lock().unwrap().clone();
+    let n = r.len() as f64;
+    let mean = r.iter().sum::<f64>() / n;
+    let sd = (r.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (n - 1.0)).sqrt();
+    // A request every step would be 10,000; the modem carries one at a time (0.25 s turnaround
+    // plus 20 ms of travel: at most one request in three steps of 0.1 s goes out).
+    assert!(n > 2000.0 && n <= 10_000.0 / 3.0, "{n}");
+    assert!(
+        busy > 0,
+        "requests sent while the previous one travels are lost"
+    );
+    // Timing noise 2 ms: range sd 1.5 m.
+    assert!(
+        (mean - truth).abs() < 4.0 * 1.5 / n.sqrt(),
+        "{mean} vs {truth}"
+    );
+    assert!((sd - 1.5).abs() < 0.1, "{sd}");
+    // Both hear every request that was sent; only the target answered.
+    let (h1, h2) = (*heard.lock().unwrap(), *heard2.lock().unwrap());
+    assert_eq!(h1, h2, "busy {busy}");
+    assert!(h1 as f64 >= n);
+}
+
+#[test]
+fn an_unsolicited_echo_is_lost_and_a_deaf_modem_hears_nothing() {
+    let mut w = pair();
+    let e = w.send(plumetrace_core::Message {
+        from: VehicleId(1),
+        to: Recipient::Vehicle(VehicleId(0)),
+        link: Link::Acoustic,
+        sent_s: 0.0,
+        body: MessageBody::RangeEcho {
+            heading: Heading::from_deg(0.0),
+            scale_cw: None,
+        },
+    });
+    assert!(
+        matches!(
+            &e[..],
+            [(
+                VehicleId(0),
+                WorldEvent::MessageLost {
+                    reason: LossReason::Unsolicited,
+                    ..
+                }
+            )]
+        ),
+        "{e:?}"
+    );
+    w.vehicles_mut()[1].deaf_window_s = Some((0.0, 1.0));
+    let text = plumetrace_core::Message {
+        from: VehicleId(0),
+        to: Recipient::Vehicle(VehicleId(1)),
+        link: Link::Acoustic,
+        sent_s: 0.0,
+        body: MessageBody::Text { text: "x".into() },
+    };
+    assert!(w.send(text.clone()).is_empty(), "on its way");
+    let mut p: Vec<Option<Box<dyn Planner>>> = vec![None, None];
+    let r = w.step(&mut p).unwrap();
+    assert!(r.events.iter().any(|(id, e)| *id == VehicleId(1)
+        && matches!(
+            e,
+            WorldEvent::MessageLost {
+                reason: LossReason::Deaf,
+                ..
+            }
+        )));
+    for _ in 0..10 {
+        w.step(&mut p).unwrap();
+    }
+    w.send(plumetrace_core::Message {
+        sent_s: w.time_s(),
+        ..text
+    });
+    let r = w.step(&mut p).unwrap();
+    assert!(
+        r.events
+            .iter()
+            .any(|(id, e)| *id == VehicleId(1) && matches!(e, WorldEvent::MessageDelivered { .. })),
+        "heard after the window: {:?}",
+        r.events
     );
 }

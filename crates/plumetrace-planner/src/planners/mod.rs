@@ -16,6 +16,7 @@
 //! planner without the simulator.
 
 pub mod amp;
+pub mod formation;
 pub mod lawnmower;
 pub mod moth;
 
@@ -243,6 +244,8 @@ registry! {
     Amp(amp::AmpParams),
     Lawnmower(lawnmower::LawnmowerParams),
     Moth(moth::MothParams),
+    FormationLeader(formation::FormationLeaderParams),
+    FormationFollower(formation::FormationFollowerParams),
 }
 
 impl std::fmt::Display for PlannerKind {

@@ -1,0 +1,67 @@
+//! Formation tracing end to end on `soares-freshwater`: the team declares near the outlet, the
+//! follower keeps its ranges, the team's numbers reach the summary, and lossy links show up in
+//! them.
+
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
+use plumetrace_mission::{EventKind, Outcome, run_mission};
+use plumetrace_scenario::{Origin, build, load_preset};
+use plumetrace_sim::WorldEvent;
+
+fn run(seed: u64, loss: f64) -> plumetrace_mission::MissionRun {
+    let mut cfg = load_preset("soares-freshwater").unwrap();
+    if let Some(a) = cfg.comms.acoustic.as_mut() {
+        a.loss_probability = Some(loss);
+    }
+    let built = build(
+        &cfg,
+        &Origin::Preset("soares-freshwater".into()),
+        Some(seed),
+    )
+    .unwrap();
+    run_mission(built, &mut |_, _| {}).unwrap()
+}
+
+#[test]
+fn the_team_traces_the_freshwater_plume_to_its_outlet_keeping_its_ranges() {
+    let r = run(11, 0.0);
+    let s = &r.summary;
+    assert_eq!(s.outcome, Outcome::Declared, "{s:?}");
+    let d = s.first_declaration.as_ref().unwrap();
+    assert!(
+        d.error_m < 10.0,
+        "declared {:.1} m from the outlet",
+        d.error_m
+    );
+    let team = s.team.as_ref().expect("three planners make a team");
+    // d = 10 m: the follower's true ranges within 10 % of it.
+    let median = team.range_error_median_m.unwrap();
+    assert!(median < 1.0, "median range error {median}");
+    assert_eq!(team.non_finite_commands, 0);
+    assert_eq!(team.acoustic_lost, 0, "ideal links lose nothing");
+    assert!(team.acoustic_delivered > 100);
+    let smax = team.scale_max.unwrap();
+    assert!(
+        smax > 1.0 && smax <= 2.0 * (1.0f64 - 0.0025).sqrt(),
+        "{smax}"
+    );
+    assert!(team.centroid_cross_median_m.unwrap() < 2.0);
+    let overhead = team.distance_overhead.unwrap();
+    assert!(overhead > 1.0 && overhead < 1.5, "{overhead}");
+    assert!(!r.events.iter().any(|e| matches!(
+        e.event,
+        EventKind::World(WorldEvent::NonFiniteCommand { .. })
+    )));
+}
+
+#[test]
+fn with_a_fifth_of_the_acoustic_packets_lost_the_losses_are_counted_and_the_team_still_declares() {
+    let r = run(11, 0.2);
+    let team = r.summary.team.as_ref().unwrap();
+    let lost = team.acoustic_lost as f64;
+    let all = lost + team.acoustic_delivered as f64;
+    // Each packet is lost with probability 0.2 per recipient (busy modems add a few).
+    assert!(lost / all > 0.15 && lost / all < 0.3, "{lost} of {all}");
+    assert_eq!(r.summary.outcome, Outcome::Declared);
+    assert!(team.range_error_median_m.unwrap() < 1.0);
+}
