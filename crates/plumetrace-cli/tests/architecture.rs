@@ -30,6 +30,15 @@ const RULES: &[(&str, Side, &[&str])] = &[
         &["plumetrace-core", "plumetrace-guidance"],
     ),
     (
+        "plumetrace-onboard",
+        Side::Onboard,
+        &[
+            "plumetrace-core",
+            "plumetrace-guidance",
+            "plumetrace-planner",
+        ],
+    ),
+    (
         "plumetrace-sim",
         Side::Simulator,
         &["plumetrace-core", "plumetrace-env"],

@@ -1,0 +1,20 @@
+//! The planner on a vehicle.
+//!
+//! In the backseat-driver arrangement the vehicle's own computer (the front seat) keeps low-level
+//! control and safety, and a payload computer (the back seat) sends it set-points. This crate is
+//! the back seat: it reads navigation and the chemical sensor from a vehicle link, feeds any
+//! registered planner the same [`plumetrace_core::SensorSnapshot`]s the simulator would, and
+//! sends the planner's commands back, checked at one chokepoint. It depends on no simulator
+//! crate, so what flies a vehicle is exactly what flew the simulations.
+//!
+//! - [`sentence`]: the line rule (framing and checksum) and field readers shared by the codecs;
+//! - [`bluefin`]: the Bluefin standard payload interface sentences;
+//! - [`iver`]: the Iver remote-helm sentences and their unit setting;
+//! - [`chem`]: the chemical sensor's line input.
+
+pub mod bluefin;
+pub mod chem;
+pub mod iver;
+pub mod sentence;
+
+pub use sentence::{SentenceError, UtcTime};
