@@ -10,10 +10,12 @@
 //! - [`sentence`]: the line rule (framing and checksum) and field readers shared by the codecs;
 //! - [`bluefin`]: the Bluefin standard payload interface sentences;
 //! - [`iver`]: the Iver remote-helm sentences and their unit setting;
-//! - [`chem`]: the chemical sensor's line input.
+//! - [`chem`]: the chemical sensor's line input;
+//! - [`geo`]: latitude and longitude to the local frame and back (GeographicLib geodesics).
 
 pub mod bluefin;
 pub mod chem;
+pub mod geo;
 pub mod iver;
 pub mod sentence;
 
