@@ -58,6 +58,7 @@ const RULES: &[(&str, Side, &[&str])] = &[
             "plumetrace-scenario",
             "plumetrace-guidance",
             "plumetrace-planner",
+            "plumetrace-onboard",
         ],
     ),
     (

@@ -11,12 +11,14 @@
 //! - [`bluefin`]: the Bluefin standard payload interface sentences;
 //! - [`iver`]: the Iver remote-helm sentences and their unit setting;
 //! - [`chem`]: the chemical sensor's line input;
-//! - [`geo`]: latitude and longitude to the local frame and back (GeographicLib geodesics).
+//! - [`geo`]: latitude and longitude to the local frame and back (GeographicLib geodesics);
+//! - [`snapshot_log`]: the snapshot log (every snapshot and decision) and its replay.
 
 pub mod bluefin;
 pub mod chem;
 pub mod geo;
 pub mod iver;
 pub mod sentence;
+pub mod snapshot_log;
 
 pub use sentence::{SentenceError, UtcTime};
