@@ -80,6 +80,7 @@ const RULES: &[(&str, Side, &[&str])] = &[
             "plumetrace-sim",
             "plumetrace-scenario",
             "plumetrace-planner",
+            "plumetrace-onboard",
             "plumetrace-mission",
             "plumetrace-campaign",
         ],

@@ -131,7 +131,31 @@ pub struct Mission {
 impl Mission {
     /// Develops the plume (spin-up), then builds the world and every vehicle's planner.
     pub fn new(setup: MissionSetup, options: MissionOptions) -> Result<Self, MissionError> {
+        Mission::with_planners(setup, options, None)
+    }
+
+    /// [`Mission::new`], with the planners given (one slot per vehicle) instead of built from
+    /// the setup's tables: e.g. a planner that is a link to a planner elsewhere (a simulated
+    /// front seat). `None` builds them from the registry.
+    pub fn with_planners(
+        setup: MissionSetup,
+        options: MissionOptions,
+        given: Option<Vec<Option<Box<dyn Planner>>>>,
+    ) -> Result<Self, MissionError> {
         let origin = setup.origin.to_string();
+        if let Some(g) = &given
+            && g.len() != setup.vehicles.len()
+        {
+            return Err(MissionError::NotAMission {
+                origin,
+                message: format!(
+                    "{} planners given for {} vehicles",
+                    g.len(),
+                    setup.vehicles.len()
+                ),
+            });
+        }
+        let mut given = given.map(|g| g.into_iter());
         let env_error = |error| MissionError::Env {
             origin: origin.clone(),
             error,
@@ -165,6 +189,10 @@ impl Mission {
                 v.range_sensor,
                 seed,
             ));
+            if let Some(g) = given.as_mut() {
+                planners.push(g.next().flatten());
+                continue;
+            }
             planners.push(match p {
                 Some(p) => Some(p.config.build(&p.context, &p.key).map_err(|error| {
                     MissionError::Invalid {

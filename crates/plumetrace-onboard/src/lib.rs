@@ -11,14 +11,25 @@
 //! - [`bluefin`]: the Bluefin standard payload interface sentences;
 //! - [`iver`]: the Iver remote-helm sentences and their unit setting;
 //! - [`chem`]: the chemical sensor's line input;
+//! - [`config`]: the onboard file (planner, mission geometry, chemical input, link, time);
+//! - [`command`]: the chokepoint every command passes (finite, within the vehicle's limits);
+//! - [`link`]: the link trait, the Bluefin and Iver protocols on TCP or a serial line,
+//!   reconnection, keep-alives, acknowledgements and the raw traffic log;
+//! - [`runner`]: the onboard runner (snapshots in, checked commands out, pauses for safety);
+//! - [`serial`]: raw serial lines and pseudo-terminals (no system library);
 //! - [`geo`]: latitude and longitude to the local frame and back (GeographicLib geodesics);
 //! - [`snapshot_log`]: the snapshot log (every snapshot and decision) and its replay.
 
 pub mod bluefin;
 pub mod chem;
+pub mod command;
+pub mod config;
 pub mod geo;
 pub mod iver;
+pub mod link;
+pub mod runner;
 pub mod sentence;
+pub mod serial;
 pub mod snapshot_log;
 
 pub use sentence::{SentenceError, UtcTime};
