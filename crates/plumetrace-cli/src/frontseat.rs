@@ -169,6 +169,9 @@ pub struct FrontSeat {
     delay: Duration,
     silent: Option<(f64, f64)>,
     restart: Option<(f64, Duration)>,
+    polled: bool,
+    pty_heard: bool,
+    time_limit_s: f64,
     stats: Arc<Mutex<FrontSeatStats>>,
 }
 
@@ -180,6 +183,12 @@ impl FrontSeat {
         if let Ok(mut s) = self.stats.lock() {
             f(&mut s);
         }
+    }
+
+    fn gone(&self) -> bool {
+        self.stats
+            .lock()
+            .is_ok_and(|s| s.back_seat_gone || s.finished)
     }
 
     fn connected(&self) -> bool {
@@ -257,14 +266,30 @@ impl FrontSeat {
                 std::thread::sleep(wait.min(Duration::from_millis(10)));
                 Ok(0)
             }
-            Wire::Pty(p) => match p.controller.read(&mut chunk) {
-                Ok(n) => Ok(n),
-                // No back seat has the device open (yet).
-                Err(_) => {
-                    std::thread::sleep(Duration::from_millis(20));
-                    Ok(0)
+            Wire::Pty(p) => {
+                let deadline = Instant::now() + wait;
+                loop {
+                    match p.controller.read(&mut chunk) {
+                        Ok(n) if n > 0 => {
+                            self.pty_heard = true;
+                            break Ok(n);
+                        }
+                        Err(e) if e.kind() != std::io::ErrorKind::WouldBlock => {
+                            // No back seat has the device open: not yet, or no more.
+                            if self.pty_heard && self.lock_step {
+                                if let Ok(mut st) = self.stats.lock() {
+                                    st.back_seat_gone = true;
+                                }
+                                break Ok(0);
+                            }
+                            std::thread::sleep(wait.min(Duration::from_millis(20)));
+                            break Ok(0);
+                        }
+                        _ if Instant::now() >= deadline => break Ok(0),
+                        _ => std::thread::sleep(Duration::from_micros(200)),
+                    }
                 }
-            },
+            }
         };
         match n {
             Ok(n) => self.buf.extend_from_slice(&chunk[..n]),
@@ -343,6 +368,10 @@ impl FrontSeat {
                 Ok(iver::Sentence::Omstop) => {
                     self.stop();
                     true
+                }
+                Ok(iver::Sentence::Osd) => {
+                    self.polled = true;
+                    false
                 }
                 Ok(_) => false,
                 Err(_) => {
@@ -488,14 +517,12 @@ impl Planner for FrontSeat {
         let mut answered = false;
         if self.protocol == Protocol::Iver && self.lock_step && !silent {
             let deadline = Instant::now() + self.wait;
-            'poll: while Instant::now() < deadline {
+            while !self.polled && Instant::now() < deadline && !self.gone() {
                 for line in self.read_lines(Duration::from_millis(50)) {
-                    if matches!(iver::Sentence::parse(&line), Ok(iver::Sentence::Osd)) {
-                        break 'poll;
-                    }
                     answered |= self.take(&line, time);
                 }
             }
+            self.polled = false;
         }
         for c in &s.chem {
             let line = self.chem.encode(time, c.reading);
@@ -524,7 +551,7 @@ impl Planner for FrontSeat {
         }
         if self.lock_step && !silent && self.connected() {
             let deadline = Instant::now() + self.wait;
-            while !answered && Instant::now() < deadline && self.connected() {
+            while !answered && Instant::now() < deadline && self.connected() && !self.gone() {
                 for line in self.read_lines(Duration::from_millis(50)) {
                     answered |= self.take(&line, time);
                 }
@@ -543,6 +570,15 @@ impl Planner for FrontSeat {
             for line in self.read_lines(Duration::ZERO) {
                 self.take(&line, time);
             }
+        }
+        if self.protocol == Protocol::Bluefin && t + self.nav_period_s >= self.time_limit_s - 1e-9 {
+            // The last record: the clock's last tick tells the back seat the time is up.
+            let end = UtcTime::from_seconds(START_S + self.time_limit_s);
+            let tick = bluefin::Sentence::Ctl {
+                time: end,
+                accepting: false,
+            };
+            self.send(&tick.encode());
         }
         let finished = self
             .stats
@@ -735,6 +771,9 @@ pub fn run(args: &FrontseatArgs) -> Result<()> {
         restart: args
             .restart_at
             .map(|a| (a, Duration::from_secs_f64(args.restart_for))),
+        polled: false,
+        pty_heard: false,
+        time_limit_s: setup.spec.time_limit_s,
         stats: stats.clone(),
     };
     let mut planners: Vec<Option<Box<dyn Planner>>> =

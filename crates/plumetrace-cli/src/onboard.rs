@@ -17,7 +17,7 @@ pub struct OnboardArgs {
     /// The onboard file (TOML: mission geometry, planner, link, chemical input, run mode).
     pub file: PathBuf,
     /// Output directory (created if needed): `snapshots.jsonl.gz`, `link.log` (raw traffic),
-    /// `chem.log` (a separate chemical input's), `onboard.json` (the report).
+    /// `chem.log` (a separate chemical input's), `run.alog` (MOOS), `onboard.json` (the report).
     #[arg(long, default_value = "onboard-out")]
     pub out: PathBuf,
 }
@@ -100,13 +100,28 @@ pub fn run(args: &OnboardArgs) -> Result<()> {
         _ => None,
     };
     let mut chem = runner::chem_link_for(&onboard, chem_traffic);
+    let alog_path = args.out.join("run.alog");
+    let alog_file = std::fs::File::create(&alog_path)
+        .with_context(|| format!("creating {}", alog_path.display()))?;
+    let start_unix = std::time::SystemTime::now()
+        .duration_since(std::time::UNIX_EPOCH)
+        .map_or(0.0, |d| d.as_secs_f64());
+    let mut alog = plumetrace_onboard::alog::AlogWriter::new(
+        std::io::BufWriter::new(alog_file),
+        &alog_path.display().to_string(),
+        start_unix,
+        "pPlumetrace",
+    )?;
     let mut log_error = None;
     let chem_dyn: Option<&mut dyn plumetrace_onboard::link::Link> = chem.as_mut().map(|c| c as _);
     let report = runner::run(&onboard, &mut link, chem_dyn, &mut |s, d| {
-        if log_error.is_none()
-            && let Err(e) = log.write(0, s, d)
-        {
-            log_error = Some(e);
+        if log_error.is_none() {
+            let written = log
+                .write(0, s, d)
+                .and_then(|()| alog.decision(s, d).map_err(|e| format!("run.alog: {e}")));
+            if let Err(e) = written {
+                log_error = Some(e);
+            }
         }
     })
     .map_err(anyhow::Error::msg)?;
@@ -115,6 +130,8 @@ pub fn run(args: &OnboardArgs) -> Result<()> {
         anyhow::bail!("writing {}: {e}", log_path.display());
     }
     log.finish().map_err(anyhow::Error::msg)?;
+    alog.finish()
+        .with_context(|| format!("writing {}", alog_path.display()))?;
     let file = ReportFile::from(&report);
     let json = serde_json::to_string_pretty(&file)?;
     write_atomic(&args.out.join("onboard.json"), json.as_bytes())?;

@@ -13,9 +13,11 @@
 //! - [`record`]: the observer trait and the mission's own recorders;
 //! - [`summary`]: the key numbers written as `summary.json`;
 //! - [`snapshot_log`]: the replayable log of snapshots and decisions;
+//! - [`alog`]: MOOS `.alog` files, one per planned vehicle;
 //! - [`plot`]: the mission figure; [`replay_page`]: the self-contained replay page;
 //!   [`output`]: atomic file writing.
 
+pub mod alog;
 pub mod mission;
 pub mod outcome;
 pub mod output;

@@ -7,6 +7,7 @@
 //! sends the planner's commands back, checked at one chokepoint. It depends on no simulator
 //! crate, so what flies a vehicle is exactly what flew the simulations.
 //!
+//! - [`alog`]: a MOOS `.alog` writer for onboard runs and missions;
 //! - [`sentence`]: the line rule (framing and checksum) and field readers shared by the codecs;
 //! - [`bluefin`]: the Bluefin standard payload interface sentences;
 //! - [`iver`]: the Iver remote-helm sentences and their unit setting;
@@ -20,6 +21,7 @@
 //! - [`geo`]: latitude and longitude to the local frame and back (GeographicLib geodesics);
 //! - [`snapshot_log`]: the snapshot log (every snapshot and decision) and its replay.
 
+pub mod alog;
 pub mod bluefin;
 pub mod chem;
 pub mod command;

@@ -372,7 +372,7 @@ pub fn oms_of(c: &CheckedCommand, s: &IverSettings, water_depth_m: Option<f64>) 
 
 impl Protocol for Iver {
     fn hello(&mut self) -> Vec<String> {
-        self.last_poll = None;
+        self.last_poll = Some(Instant::now());
         self.last_oms = None;
         vec![iver::Sentence::Osd.encode()]
     }

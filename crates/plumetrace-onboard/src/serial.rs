@@ -20,7 +20,8 @@ pub fn set_raw(f: &impl AsFd, baud: u32) -> std::io::Result<()> {
 /// A pseudo-terminal: the controlling end (kept by whoever plays the vehicle) and the path of
 /// the other end (a device a back seat opens like a serial port).
 pub struct Pty {
-    /// The controlling end, raw, with 0.1 s reads.
+    /// The controlling end, raw and non-blocking (a read without data fails with
+    /// `WouldBlock`; the 0.1 s read timeout of raw mode applies to the device end only).
     pub controller: File,
     /// The path of the device end (`/dev/pts/N`).
     pub path: std::path::PathBuf,
@@ -35,6 +36,7 @@ impl Pty {
         unlockpt(&fd)?;
         let name = ptsname(&fd, Vec::new())?;
         let path = std::path::PathBuf::from(name.to_string_lossy().into_owned());
+        rustix::fs::fcntl_setfl(&fd, rustix::fs::OFlags::RDWR | rustix::fs::OFlags::NONBLOCK)?;
         let controller = File::from(fd);
         set_raw(&controller, 19_200)?;
         Ok(Pty { controller, path })
