@@ -98,6 +98,9 @@ pub struct FrontseatArgs {
     /// ... for this long (wall time), s.
     #[arg(long, default_value_t = 2.0)]
     pub restart_for: f64,
+    /// End the mission at this time instead of the scenario's limit, s.
+    #[arg(long)]
+    pub time_limit_s: Option<f64>,
     /// Seed of the fault draws.
     #[arg(long, default_value_t = 1)]
     pub fault_seed: u64,
@@ -703,7 +706,16 @@ pub fn run(args: &FrontseatArgs) -> Result<()> {
     let frame = LocalFrame::new(origin).map_err(anyhow::Error::msg)?;
     let sc = crate::run::load(args.scenario.as_deref(), args.preset.as_deref(), args.seed)?;
     let name = sc.name.clone();
-    let setup = MissionSetup::new(sc)?;
+    let mut setup = MissionSetup::new(sc)?;
+    if let Some(limit) = args.time_limit_s {
+        if !(limit.is_finite() && limit > 0.0 && limit <= setup.spec.time_limit_s) {
+            bail!(
+                "--time-limit-s: {limit} is outside (0, {}] (the scenario's limit)",
+                setup.spec.time_limit_s
+            );
+        }
+        setup.spec.time_limit_s = limit;
+    }
     let mut link = toml::Table::new();
     let mut origin_t = toml::Table::new();
     origin_t.insert("lat_deg".into(), origin.lat_deg.into());
@@ -738,7 +750,7 @@ pub fn run(args: &FrontseatArgs) -> Result<()> {
     };
     link.insert("origin".into(), origin_t.into());
     // A rehearsal's back seat stops soon after its front seat is gone for good.
-    link.insert("give_up_s".into(), 30.0.into());
+    link.insert("give_up_s".into(), 5.0.into());
     if let Some(path) = &args.write_onboard {
         let text = onboard_file(&setup, &link, args.lock_step, args.nav_period_s)?;
         crate::output::write_atomic(path, text.as_bytes())?;

@@ -267,3 +267,43 @@ fn thirty_seconds_without_navigation_pause_the_planner_and_send_the_stop() {
     assert!(fs["stops"].as_u64().unwrap() >= 1, "{fs}");
     no_unsafe_commands(&fs);
 }
+#[test]
+fn iver_over_a_pseudo_terminal_in_lock_step_answers_every_poll_with_checked_commands() {
+    let dir = tempfile::tempdir().unwrap();
+    let (ob, fs) = fly(
+        dir.path(),
+        &[
+            "--protocol",
+            "iver",
+            "--remote-helm-major",
+            "4",
+            "--time-limit-s",
+            "600",
+        ],
+    );
+    no_unsafe_commands(&fs);
+    assert_eq!(fs["unanswered"], 0, "{fs}");
+    assert_eq!(fs["nav_records"], ob["nav_records"], "{fs} {ob}");
+    assert_eq!(ob["nav_records"], 6000, "{ob}");
+    assert_eq!(ob["commands_rejected"], 0);
+    let log = std::fs::read_to_string(dir.path().join("ob").join("link.log")).unwrap();
+    assert!(
+        log.contains("> $OMS,") && log.contains("< $OSI,"),
+        "Iver sentences on the wire"
+    );
+    // The planner found and tracked the plume over the serial link.
+    let alog = read_alog(&dir.path().join("ob").join("run.alog"));
+    assert!(
+        alog.iter()
+            .any(|(v, x)| v == "CPT_BEHAVIOUR" && x == "track_in"),
+        "no track-in"
+    );
+    // Depths go out in feet (remote helm 4): the AMP's 2 m altitude over about 8 m of water.
+    let oms: Vec<f64> = log
+        .lines()
+        .filter_map(|l| l.split_once("> $OMS,"))
+        .map(|(_, r)| r.split(',').nth(1).unwrap().parse().unwrap())
+        .collect();
+    let mean = oms.iter().sum::<f64>() / oms.len() as f64;
+    assert!((17.0..22.0).contains(&mean), "mean $OMS depth {mean} ft");
+}

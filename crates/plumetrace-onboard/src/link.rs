@@ -568,6 +568,8 @@ pub struct LineLink {
     clock: UtcTime,
     traffic: Option<Box<dyn Write + Send>>,
     started: Instant,
+    // Events from sending (a write that failed), reported by the next poll.
+    deferred: Vec<LinkEvent>,
 }
 
 impl LineLink {
@@ -596,6 +598,7 @@ impl LineLink {
             clock: UtcTime::default(),
             traffic,
             started: now,
+            deferred: Vec::new(),
         }
     }
 
@@ -693,7 +696,7 @@ impl LineLink {
 
 impl Link for LineLink {
     fn poll(&mut self, wait: Duration) -> Vec<LinkEvent> {
-        let mut events = Vec::new();
+        let mut events = std::mem::take(&mut self.deferred);
         self.connect(&mut events);
         let deadline = Instant::now() + wait;
         let mut chunk = [0u8; 4096];
@@ -754,6 +757,7 @@ impl Link for LineLink {
         let mut events = Vec::new();
         let lines = self.protocol.write(what, time, Instant::now());
         self.send_lines(lines, &mut events);
+        self.deferred.extend(events);
         if let Some(t) = self.traffic.as_mut() {
             let _ = t.flush();
         }
