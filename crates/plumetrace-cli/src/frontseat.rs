@@ -247,23 +247,7 @@ impl FrontSeat {
         let mut chunk = [0u8; 4096];
         let n = match &mut self.wire {
             Wire::Tcp { conn: Some(c), .. } => {
-                // No wait: a non-blocking read (read timeouts are rounded up to the kernel's
-                // tick, which would slow lock-step to a crawl).
-                let _ = c.set_nonblocking(wait.is_zero());
-                let _ = c.set_read_timeout(Some(wait.max(Duration::from_millis(1))));
-                match c.read(&mut chunk) {
-                    Ok(0) => Err(()),
-                    Ok(n) => Ok(n),
-                    Err(e)
-                        if matches!(
-                            e.kind(),
-                            std::io::ErrorKind::WouldBlock | std::io::ErrorKind::TimedOut
-                        ) =>
-                    {
-                        Ok(0)
-                    }
-                    Err(_) => Err(()),
-                }
+                plumetrace_onboard::link::read_tcp(c, &mut chunk, wait).map_err(|_| ())
             }
             Wire::Tcp { conn: None, .. } => {
                 std::thread::sleep(wait.min(Duration::from_millis(10)));

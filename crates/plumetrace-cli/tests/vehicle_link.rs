@@ -98,6 +98,29 @@ fn bluefin_over_tcp_in_lock_step_declares_and_replays_exactly_and_again_the_same
     let out = common::run_ok(&["replay", log.to_str().unwrap()]);
     let text = String::from_utf8_lossy(&out.stdout);
     assert!(text.contains(" 0 differ"), "{text}");
+    // Another configuration departs from the logged decisions, and the replay says where.
+    let other = dir.path().join("other.toml");
+    std::fs::write(&other, "kind = \"amp\"\nbeta_deg = 35.0\n").unwrap();
+    let o = common::bin()
+        .args([
+            "replay",
+            log.to_str().unwrap(),
+            "--planner-file",
+            other.to_str().unwrap(),
+        ])
+        .output()
+        .unwrap();
+    assert_eq!(
+        o.status.code(),
+        Some(3),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    let text = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        text.contains("  line "),
+        "the first differences are listed: {text}"
+    );
     let alog = read_alog(&dir.path().join("ob").join("run.alog"));
     assert!(
         alog.iter().any(|(v, _)| v == "CPT_DECLARATION"),

@@ -87,14 +87,8 @@ pub trait Link {
 pub trait Protocol: Send {
     /// Lines sent on (re)connecting.
     fn hello(&mut self) -> Vec<String>;
-    /// Reads one received line into events (and possibly lines to send back).
-    fn read(
-        &mut self,
-        line: &str,
-        now: Instant,
-        events: &mut Vec<LinkEvent>,
-        replies: &mut Vec<String>,
-    ) -> Result<(), SentenceError>;
+    /// Reads one received line into events.
+    fn read(&mut self, line: &str, events: &mut Vec<LinkEvent>) -> Result<(), SentenceError>;
     /// Lines for an outgoing command.
     fn write(&mut self, what: Outgoing, time: UtcTime, now: Instant) -> Vec<String>;
     /// Lines due now (keep-alives, resends, polls); events such as a give-up.
@@ -170,13 +164,7 @@ impl Protocol for Bluefin {
             .collect()
     }
 
-    fn read(
-        &mut self,
-        line: &str,
-        _now: Instant,
-        events: &mut Vec<LinkEvent>,
-        _replies: &mut Vec<String>,
-    ) -> Result<(), SentenceError> {
+    fn read(&mut self, line: &str, events: &mut Vec<LinkEvent>) -> Result<(), SentenceError> {
         use bluefin::Sentence as S;
         match bluefin::Sentence::parse(line)? {
             S::Nvg(n) => {
@@ -292,13 +280,7 @@ impl Protocol for ChemOnly {
     fn hello(&mut self) -> Vec<String> {
         Vec::new()
     }
-    fn read(
-        &mut self,
-        line: &str,
-        _now: Instant,
-        _events: &mut Vec<LinkEvent>,
-        _replies: &mut Vec<String>,
-    ) -> Result<(), SentenceError> {
+    fn read(&mut self, line: &str, _events: &mut Vec<LinkEvent>) -> Result<(), SentenceError> {
         let id = line
             .trim()
             .trim_start_matches('$')
@@ -377,13 +359,7 @@ impl Protocol for Iver {
         vec![iver::Sentence::Osd.encode()]
     }
 
-    fn read(
-        &mut self,
-        line: &str,
-        _now: Instant,
-        events: &mut Vec<LinkEvent>,
-        _replies: &mut Vec<String>,
-    ) -> Result<(), SentenceError> {
+    fn read(&mut self, line: &str, events: &mut Vec<LinkEvent>) -> Result<(), SentenceError> {
         match iver::Sentence::parse(line)? {
             iver::Sentence::Osi(o) => {
                 self.water_depth_m = (o.altitude_ft > 0.0)
@@ -477,6 +453,30 @@ pub enum Endpoint {
     },
 }
 
+/// Reads what a TCP stream has within `wait` (`Ok(0)`: nothing came; no wait at all is a
+/// non-blocking read, since read timeouts round up to the kernel's tick); the peer closing the
+/// connection is an `UnexpectedEof` error.
+pub fn read_tcp(s: &mut TcpStream, buf: &mut [u8], wait: Duration) -> std::io::Result<usize> {
+    s.set_nonblocking(wait.is_zero())?;
+    s.set_read_timeout(Some(wait.max(Duration::from_millis(1))))?;
+    match s.read(buf) {
+        Ok(0) => Err(std::io::Error::new(
+            std::io::ErrorKind::UnexpectedEof,
+            "the other side closed the connection",
+        )),
+        Ok(n) => Ok(n),
+        Err(e)
+            if matches!(
+                e.kind(),
+                std::io::ErrorKind::WouldBlock | std::io::ErrorKind::TimedOut
+            ) =>
+        {
+            Ok(0)
+        }
+        Err(e) => Err(e),
+    }
+}
+
 enum Conn {
     Tcp(TcpStream),
     Serial(std::fs::File),
@@ -507,25 +507,7 @@ impl Conn {
     /// Reads what is there within `wait`: `Ok(0)` when nothing came.
     fn read(&mut self, buf: &mut [u8], wait: Duration) -> std::io::Result<usize> {
         match self {
-            Conn::Tcp(s) => {
-                s.set_read_timeout(Some(wait.max(Duration::from_millis(1))))?;
-                match s.read(buf) {
-                    Ok(0) => Err(std::io::Error::new(
-                        std::io::ErrorKind::UnexpectedEof,
-                        "the front seat closed the connection",
-                    )),
-                    Ok(n) => Ok(n),
-                    Err(e)
-                        if matches!(
-                            e.kind(),
-                            std::io::ErrorKind::WouldBlock | std::io::ErrorKind::TimedOut
-                        ) =>
-                    {
-                        Ok(0)
-                    }
-                    Err(e) => Err(e),
-                }
-            }
+            Conn::Tcp(s) => read_tcp(s, buf, wait),
             // Raw mode with VMIN 0 and VTIME 1: a read returns after 0.1 s without data.
             Conn::Serial(f) => match f.read(buf) {
                 Err(e) if e.kind() == std::io::ErrorKind::WouldBlock => Ok(0),
@@ -666,7 +648,6 @@ impl LineLink {
     }
 
     fn take_line(&mut self, line: &str, events: &mut Vec<LinkEvent>) {
-        let now = Instant::now();
         self.log('<', line);
         if let Some(chem) = self.chem.as_ref().filter(|c| c.claims(line)) {
             let r = chem.parse(line);
@@ -677,9 +658,8 @@ impl LineLink {
             }
             return;
         }
-        let mut replies = Vec::new();
         let before = events.len();
-        let r = self.protocol.read(line, now, events, &mut replies);
+        let r = self.protocol.read(line, events);
         self.counts.count(&r);
         if let Err(e) = r {
             events.truncate(before);
@@ -690,7 +670,6 @@ impl LineLink {
                 self.clock = *t;
             }
         }
-        self.send_lines(replies, events);
     }
 }
 
