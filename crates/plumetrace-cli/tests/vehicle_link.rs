@@ -330,3 +330,37 @@ fn iver_over_a_pseudo_terminal_in_lock_step_answers_every_poll_with_checked_comm
     let mean = oms.iter().sum::<f64>() / oms.len() as f64;
     assert!((17.0..22.0).contains(&mean), "mean $OMS depth {mean} ft");
 }
+
+#[test]
+fn bad_onboard_files_and_front_seat_flags_name_what_and_where() {
+    let dir = tempfile::tempdir().unwrap();
+    let bad = dir.path().join("bad.toml");
+    std::fs::write(
+        &bad,
+        "[mission]\nop_area = [[0.0, 0.0], [10.0, 0.0], [10.0, 10.0]]\n[planner]\nkind = \"amp\"\n[link]\nprotocol = \"bluefin\"\naddress = \"127.0.0.1:1\"\norigin = { lat_deg = 36.0, lon_deg = -75.0 }\nstale_nav_s = -2.0\n",
+    )
+    .unwrap();
+    let o = common::bin()
+        .args(["onboard", bad.to_str().unwrap()])
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(1));
+    let e = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        e.contains("bad.toml") && e.contains("link.stale_nav_s"),
+        "{e}"
+    );
+    for (flag, value) in [
+        ("--drop", "1.5"),
+        ("--nav-period-s", "0"),
+        ("--origin", "95,0"),
+    ] {
+        let o = common::bin()
+            .args(["frontseat", "--preset", "demo", flag, value])
+            .output()
+            .unwrap();
+        assert_eq!(o.status.code(), Some(1), "{flag} {value}");
+        let e = String::from_utf8_lossy(&o.stderr);
+        assert!(e.contains(flag), "{flag}: {e}");
+    }
+}

@@ -422,3 +422,114 @@ pub fn run(
     s.report.lines = link.counts().clone();
     Ok(s.report)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::link::NavFix;
+
+    /// A link that plays a script of events against the wall clock and records what is sent.
+    struct Script {
+        start: Instant,
+        events: Vec<(f64, LinkEvent)>,
+        sent: Vec<(f64, Outgoing)>,
+        counts: LineCounts,
+    }
+
+    impl Link for Script {
+        fn poll(&mut self, wait: Duration) -> Vec<LinkEvent> {
+            std::thread::sleep(wait.min(Duration::from_millis(10)));
+            let now = self.start.elapsed().as_secs_f64();
+            let due = self.events.iter().take_while(|e| e.0 <= now).count();
+            self.events.drain(..due).map(|e| e.1).collect()
+        }
+        fn send(&mut self, what: Outgoing, _time: UtcTime) {
+            self.sent.push((self.start.elapsed().as_secs_f64(), what));
+        }
+        fn counts(&self) -> &LineCounts {
+            &self.counts
+        }
+        fn connected(&self) -> bool {
+            true
+        }
+    }
+
+    fn nav(t: f64) -> (f64, LinkEvent) {
+        (
+            t,
+            LinkEvent::Nav(NavFix {
+                time: None,
+                lat_deg: 36.18,
+                lon_deg: -75.75 + 0.003,
+                heading_deg: 270.0,
+                speed_mps: 2.0,
+                altitude_m: Some(2.0),
+                depth_m: Some(6.0),
+                gps: false,
+            }),
+        )
+    }
+
+    #[test]
+    fn in_real_time_stale_navigation_pauses_the_planner_and_sends_the_safe_command() {
+        let text = r#"
+[mission]
+op_area = [[60.0, -80.0], [460.0, -80.0], [460.0, 80.0], [60.0, 80.0]]
+prior_flow_toward_deg = 90.0
+[planner]
+kind = "amp"
+[link]
+protocol = "bluefin"
+address = "127.0.0.1:1"
+origin = { lat_deg = 36.18, lon_deg = -75.75 }
+stale_nav_s = 0.3
+[run]
+time_limit_s = 1.6
+"#;
+        let onboard = Onboard::from_toml(text).unwrap_or_else(|e| panic!("{e}"));
+        let mut events = vec![(0.0, LinkEvent::Connected)];
+        events.extend([0.0, 0.1, 0.2].map(nav));
+        // Silence from 0.2 s to 1.0 s.
+        events.extend([1.0, 1.1, 1.2, 1.3].map(nav));
+        let mut link = Script {
+            start: Instant::now(),
+            events,
+            sent: Vec::new(),
+            counts: LineCounts::default(),
+        };
+        let mut decisions = 0;
+        let report = run(&onboard, &mut link, None, &mut |_, _| decisions += 1)
+            .unwrap_or_else(|e| panic!("{e}"));
+        assert_eq!(report.end, RunEnd::TimeLimit);
+        assert_eq!(report.nav_records, 7);
+        assert_eq!(decisions, 7);
+        let stale: Vec<&Pause> = report
+            .pauses
+            .iter()
+            .filter(|p| p.reason.starts_with("navigation older than 0.3 s"))
+            .collect();
+        assert_eq!(stale.len(), 1, "{:?}", report.pauses);
+        let (start, end) = (stale[0].start_s, stale[0].end_s.unwrap_or(f64::NAN));
+        assert!(start > 0.5 && start < 0.8, "paused at {start}");
+        assert!(end >= 1.0 && end < 1.2, "resumed at {end}");
+        // The safe command went out once, between the commands before and after the silence.
+        let safe: Vec<f64> = link
+            .sent
+            .iter()
+            .filter(|s| s.1 == Outgoing::Safe)
+            .map(|s| s.0)
+            .collect();
+        assert_eq!(safe.len(), 1, "{:?}", link.sent);
+        assert!(
+            !link
+                .sent
+                .iter()
+                .any(|s| matches!(s.1, Outgoing::Steer(_)) && s.0 > start && s.0 < end)
+        );
+        assert!(
+            link.sent
+                .iter()
+                .any(|s| matches!(s.1, Outgoing::Steer(_)) && s.0 >= end)
+        );
+    }
+}
