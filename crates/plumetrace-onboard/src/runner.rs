@@ -510,8 +510,8 @@ time_limit_s = 1.6
             .collect();
         assert_eq!(stale.len(), 1, "{:?}", report.pauses);
         let (start, end) = (stale[0].start_s, stale[0].end_s.unwrap_or(f64::NAN));
-        assert!(start > 0.5 && start < 0.8, "paused at {start}");
-        assert!(end >= 1.0 && end < 1.2, "resumed at {end}");
+        assert!((0.5..0.8).contains(&start), "paused at {start}");
+        assert!((1.0..1.2).contains(&end), "resumed at {end}");
         // The safe command went out once, between the commands before and after the silence.
         let safe: Vec<f64> = link
             .sent
