@@ -733,8 +733,14 @@ pub fn run(args: &FrontseatArgs) -> Result<()> {
         }
     };
     link.insert("origin".into(), origin_t.into());
-    // A rehearsal's back seat stops soon after its front seat is gone for good.
-    link.insert("give_up_s".into(), 5.0.into());
+    // A rehearsal's back seat stops soon after its front seat is gone for good; over a
+    // pseudo-terminal it must not reopen the device at all (its number may soon belong to
+    // another terminal), so it gives up before its first retry.
+    let give_up = match args.protocol {
+        Protocol::Bluefin => 5.0,
+        Protocol::Iver => 0.05,
+    };
+    link.insert("give_up_s".into(), give_up.into());
     if let Some(path) = &args.write_onboard {
         let text = onboard_file(&setup, &link, args.lock_step, args.nav_period_s)?;
         crate::output::write_atomic(path, text.as_bytes())?;
