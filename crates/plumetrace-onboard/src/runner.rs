@@ -82,6 +82,16 @@ pub struct RunReport {
     pub lines: LineCounts,
 }
 
+/// The link timing an onboard file sets.
+fn timing(l: &crate::config::LinkFile) -> LinkTiming {
+    let secs = Duration::from_secs_f64;
+    LinkTiming {
+        silence_timeout: secs(l.silence_timeout_s),
+        reconnect_min: secs(l.reconnect_min_s),
+        reconnect_max: secs(l.reconnect_max_s),
+    }
+}
+
 /// Makes the link an onboard file describes; raw traffic goes to `traffic`.
 pub fn link_for(onboard: &Onboard, traffic: Option<Box<dyn Write + Send>>) -> LineLink {
     let l = &onboard.file.link;
@@ -119,11 +129,7 @@ pub fn link_for(onboard: &Onboard, traffic: Option<Box<dyn Write + Send>>) -> Li
         endpoint,
         protocol,
         on_link.then(|| c.line_format()),
-        LinkTiming {
-            silence_timeout: secs(l.silence_timeout_s),
-            reconnect_min: secs(l.reconnect_min_s),
-            reconnect_max: secs(l.reconnect_max_s),
-        },
+        timing(l),
         traffic,
     );
     link.set_lock_step(onboard.file.run.mode == RunMode::LockStep);
@@ -146,16 +152,11 @@ pub fn chem_link_for(
         },
         (None, None) => return None,
     };
-    let secs = Duration::from_secs_f64;
     Some(LineLink::new(
         endpoint,
         Box::new(crate::link::ChemOnly),
         Some(c.line_format()),
-        LinkTiming {
-            silence_timeout: secs(l.silence_timeout_s),
-            reconnect_min: secs(l.reconnect_min_s),
-            reconnect_max: secs(l.reconnect_max_s),
-        },
+        timing(l),
         traffic,
     ))
 }
