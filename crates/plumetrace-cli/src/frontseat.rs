@@ -781,10 +781,11 @@ pub fn run(args: &FrontseatArgs) -> Result<()> {
     let mut planners: Vec<Option<Box<dyn Planner>>> =
         (0..setup.vehicles.len()).map(|_| None).collect();
     planners[k] = Some(Box::new(seat));
-    let started = Instant::now();
     let mut mission = Mission::with_planners(setup, MissionOptions::default(), Some(planners))?;
     crate::outln!("{name}: front seat {where_}");
     let pace = !args.lock_step;
+    // Real time starts when the plume has spun up.
+    let started = Instant::now();
     loop {
         let end = mission.step()?;
         if pace {
