@@ -29,9 +29,11 @@ macro_rules! outln {
 mod args;
 mod bench;
 mod campaign;
+mod frontseat;
 mod mission;
 #[cfg(feature = "netcdf")]
 mod netcdf;
+mod onboard;
 mod output;
 mod plot;
 mod progress;
@@ -78,6 +80,12 @@ enum Command {
     /// Feed a snapshot log (`snapshots.jsonl` of a run) to fresh planners and report the
     /// decisions that differ from the logged ones.
     Replay(replay::ReplayArgs),
+    /// Fly a planner on a vehicle: read navigation and the chemical sensor from a front-seat link
+    /// (Bluefin over TCP, Iver over a serial line) and send the planner's commands back.
+    Onboard(onboard::OnboardArgs),
+    /// A simulated front seat: fly a scenario's vehicle and plume and speak a front-seat
+    /// protocol (Bluefin on TCP, Iver on a pseudo-terminal) to `plumetrace onboard`.
+    Frontseat(frontseat::FrontseatArgs),
     /// Run a Monte Carlo campaign (resumable, parallel, shardable) and summarise it.
     Campaign(campaign::CampaignArgs),
     /// Merge the output directories of a campaign's shards.
@@ -141,6 +149,8 @@ fn dispatch(cli: Cli) -> Result<()> {
             }
             Ok(())
         }
+        Command::Onboard(args) => onboard::run(&args),
+        Command::Frontseat(args) => frontseat::run(&args),
         Command::Campaign(args) => campaign::run(&args),
         Command::Merge(args) => campaign::run_merge(&args),
         Command::Family(args) => family(&args),

@@ -28,7 +28,13 @@ struct SummaryFile<'a> {
 
 /// Flies the mission and writes `summary.json`, `trajectory.csv`, `events.jsonl`, `plot.svg`,
 /// `replay.html` and (unless `snapshot_log` is false) `snapshots.jsonl.gz`.
-pub fn run(sc: BuiltScenario, out: &Path, stats: bool, snapshot_log: bool) -> Result<()> {
+pub fn run(
+    sc: BuiltScenario,
+    out: &Path,
+    stats: bool,
+    snapshot_log: bool,
+    alog: bool,
+) -> Result<()> {
     let name = sc.name.clone();
     let started = Instant::now();
     let setup = MissionSetup::new(sc)?;
@@ -48,6 +54,13 @@ pub fn run(sc: BuiltScenario, out: &Path, stats: bool, snapshot_log: bool) -> Re
         let path = out.join(SNAPSHOT_LOG);
         let writer = SnapshotLogWriter::create(&path, &header)
             .with_context(|| format!("creating {}", path.display()))?;
+        mission.observe(Box::new(writer))?;
+    }
+    if alog {
+        let planned: Vec<bool> = mission.planned().iter().map(Option::is_some).collect();
+        let writer =
+            plumetrace_mission::alog::AlogObserver::create(out, &mission.vehicle_names(), &planned)
+                .with_context(|| format!("creating the .alog files in {}", out.display()))?;
         mission.observe(Box::new(writer))?;
     }
     let progress = crate::progress::Progress::new(mission.time_limit_s().round() as u64, "s");

@@ -38,6 +38,10 @@ pub struct RunArgs {
     /// planner, for `plumetrace replay`).
     #[arg(long)]
     no_snapshot_log: bool,
+    /// Also write a MOOS `.alog` per vehicle with a planner (`NAME.alog`: navigation, set-points,
+    /// behaviour, readings, detections, declarations).
+    #[arg(long)]
+    alog: bool,
 }
 
 /// Loads a scenario from a file or preset.
@@ -103,7 +107,7 @@ pub fn run(args: &RunArgs) -> Result<()> {
         crate::output::refuse_overwriting(path, &args.out, OUTPUTS)?;
     }
     if sc.mission.is_some() {
-        crate::mission::run(sc, &args.out, args.stats, !args.no_snapshot_log)
+        crate::mission::run(sc, &args.out, args.stats, !args.no_snapshot_log, args.alog)
     } else {
         run_plume(sc, args)
     }

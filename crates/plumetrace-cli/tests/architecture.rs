@@ -30,6 +30,15 @@ const RULES: &[(&str, Side, &[&str])] = &[
         &["plumetrace-core", "plumetrace-guidance"],
     ),
     (
+        "plumetrace-onboard",
+        Side::Onboard,
+        &[
+            "plumetrace-core",
+            "plumetrace-guidance",
+            "plumetrace-planner",
+        ],
+    ),
+    (
         "plumetrace-sim",
         Side::Simulator,
         &["plumetrace-core", "plumetrace-env"],
@@ -49,6 +58,7 @@ const RULES: &[(&str, Side, &[&str])] = &[
             "plumetrace-scenario",
             "plumetrace-guidance",
             "plumetrace-planner",
+            "plumetrace-onboard",
         ],
     ),
     (
@@ -70,6 +80,7 @@ const RULES: &[(&str, Side, &[&str])] = &[
             "plumetrace-sim",
             "plumetrace-scenario",
             "plumetrace-planner",
+            "plumetrace-onboard",
             "plumetrace-mission",
             "plumetrace-campaign",
         ],

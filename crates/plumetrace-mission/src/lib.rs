@@ -14,10 +14,12 @@
 //! - [`summary`]: the key numbers written as `summary.json`; [`team`]: what a team of vehicles
 //!   did together (formation error, centroid against the centre line, overhead, losses);
 //! - [`snapshot_log`]: the replayable log of snapshots and decisions;
+//! - [`alog`]: MOOS `.alog` files, one per planned vehicle;
 //! - [`plot`]: the mission figure; [`team_plot`]: the team figure (readings, speeds, headings,
 //!   scale and centroid against time); [`replay_page`]: the self-contained replay page;
 //!   [`output`]: atomic file writing.
 
+pub mod alog;
 pub mod mission;
 pub mod outcome;
 pub mod output;

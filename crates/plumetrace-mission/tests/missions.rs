@@ -655,7 +655,11 @@ fn a_replaced_planner_flies_the_vehicle_and_only_before_the_first_step() {
             asked: asked.clone(),
         }),
     );
-    assert!(late.unwrap_err().to_string().contains("before the first step"));
+    assert!(
+        late.unwrap_err()
+            .to_string()
+            .contains("before the first step")
+    );
     let run = {
         m.run(&mut |_, _| {}).unwrap();
         m.finish().unwrap()

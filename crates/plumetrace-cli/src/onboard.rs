@@ -1,0 +1,154 @@
+//! `plumetrace onboard FILE`: the planner on a vehicle. Reads an onboard file, connects to the
+//! front seat it names and flies the planner against it until the planner finishes, aborts, the
+//! time limit passes or the link gives up; writes the snapshot log, the raw link traffic and a
+//! report. Everything it runs is the onboard crate's: no simulator code is involved.
+
+use crate::output::write_atomic;
+use anyhow::{Context, Result};
+use plumetrace_onboard::config::Onboard;
+use plumetrace_onboard::runner::{self, RunReport};
+use plumetrace_onboard::snapshot_log::{Header, SnapshotLogFile};
+use serde::Serialize;
+use std::path::PathBuf;
+
+/// Arguments of `plumetrace onboard`.
+#[derive(Debug, clap::Args)]
+pub struct OnboardArgs {
+    /// The onboard file (TOML: mission geometry, planner, link, chemical input, run mode).
+    pub file: PathBuf,
+    /// Output directory (created if needed): `snapshots.jsonl.gz`, `link.log` (raw traffic),
+    /// `chem.log` (a separate chemical input's), `run.alog` (MOOS), `onboard.json` (the report).
+    #[arg(long, default_value = "onboard-out")]
+    pub out: PathBuf,
+}
+
+#[derive(Serialize)]
+struct ReportFile {
+    end: String,
+    time_s: f64,
+    nav_records: u64,
+    decisions: u64,
+    commands_sent: u64,
+    commands_rejected: u64,
+    safe_commands: u64,
+    acks_given_up: u64,
+    connections: u64,
+    pauses: Vec<(f64, Option<f64>, String)>,
+    declarations: Vec<[f64; 2]>,
+    lines_accepted: u64,
+    lines_rejected: std::collections::BTreeMap<&'static str, u64>,
+}
+
+impl From<&RunReport> for ReportFile {
+    fn from(r: &RunReport) -> Self {
+        ReportFile {
+            end: format!("{:?}", r.end).to_lowercase(),
+            time_s: r.time_s,
+            nav_records: r.nav_records,
+            decisions: r.decisions,
+            commands_sent: r.commands_sent,
+            commands_rejected: r.commands_rejected,
+            safe_commands: r.safe_commands,
+            acks_given_up: r.acks_given_up,
+            connections: r.connections,
+            pauses: r
+                .pauses
+                .iter()
+                .map(|p| (p.start_s, p.end_s, p.reason.clone()))
+                .collect(),
+            declarations: r.declarations.iter().map(|p| [p.x, p.y]).collect(),
+            lines_accepted: r.lines.accepted,
+            lines_rejected: r.lines.rejected.clone(),
+        }
+    }
+}
+
+/// Reads an onboard file, naming it in errors.
+pub fn load(path: &std::path::Path) -> Result<Onboard> {
+    let text = plumetrace_env::input::read_text(path, plumetrace_env::input::MAX_TEXT_BYTES)
+        .map_err(anyhow::Error::msg)
+        .with_context(|| format!("reading {}", path.display()))?;
+    Onboard::from_toml(&text).with_context(|| format!("{}", path.display()))
+}
+
+/// Runs the onboard process.
+pub fn run(args: &OnboardArgs) -> Result<()> {
+    let onboard = load(&args.file)?;
+    std::fs::create_dir_all(&args.out)
+        .with_context(|| format!("creating {}", args.out.display()))?;
+    let header = Header::new(
+        &onboard.file.name,
+        0,
+        std::slice::from_ref(&onboard.file.name),
+        &[Some(onboard.clone())],
+    )
+    .map_err(anyhow::Error::msg)?;
+    let log_path = args.out.join(crate::mission::SNAPSHOT_LOG);
+    let mut log = SnapshotLogFile::create(&log_path, &header)
+        .with_context(|| format!("creating {}", log_path.display()))?;
+    let traffic_path = args.out.join("link.log");
+    let traffic = std::fs::File::create(&traffic_path)
+        .with_context(|| format!("creating {}", traffic_path.display()))?;
+    let mut link = runner::link_for(&onboard, Some(Box::new(std::io::BufWriter::new(traffic))));
+    let chem_traffic = match &onboard.file.chemical {
+        c if c.address.is_some() || c.device.is_some() => {
+            let p = args.out.join("chem.log");
+            let f =
+                std::fs::File::create(&p).with_context(|| format!("creating {}", p.display()))?;
+            Some(Box::new(std::io::BufWriter::new(f)) as Box<dyn std::io::Write + Send>)
+        }
+        _ => None,
+    };
+    let mut chem = runner::chem_link_for(&onboard, chem_traffic);
+    let alog_path = args.out.join("run.alog");
+    let alog_file = std::fs::File::create(&alog_path)
+        .with_context(|| format!("creating {}", alog_path.display()))?;
+    let start_unix = std::time::SystemTime::now()
+        .duration_since(std::time::UNIX_EPOCH)
+        .map_or(0.0, |d| d.as_secs_f64());
+    let mut alog = plumetrace_onboard::alog::AlogWriter::new(
+        std::io::BufWriter::new(alog_file),
+        &alog_path.display().to_string(),
+        start_unix,
+        "pPlumetrace",
+    )?;
+    let mut log_error = None;
+    let chem_dyn: Option<&mut dyn plumetrace_onboard::link::Link> = chem.as_mut().map(|c| c as _);
+    let report = runner::run(&onboard, &mut link, chem_dyn, &mut |s, d| {
+        if log_error.is_none() {
+            let written = log
+                .write(0, s, d)
+                .and_then(|()| alog.decision(s, d).map_err(|e| format!("run.alog: {e}")));
+            if let Err(e) = written {
+                log_error = Some(e);
+            }
+        }
+    })
+    .map_err(anyhow::Error::msg)?;
+    drop(link);
+    if let Some(e) = log_error {
+        anyhow::bail!("writing {}: {e}", log_path.display());
+    }
+    log.finish().map_err(anyhow::Error::msg)?;
+    alog.finish()
+        .with_context(|| format!("writing {}", alog_path.display()))?;
+    let file = ReportFile::from(&report);
+    let json = serde_json::to_string_pretty(&file)?;
+    write_atomic(&args.out.join("onboard.json"), json.as_bytes())?;
+    crate::outln!(
+        "{}: {} after {:.1} s; {} navigation records, {} decisions, {} commands sent, {} rejected by the chokepoint, {} pauses, {} declarations; {} lines accepted, {} rejected; wrote {}",
+        args.file.display(),
+        file.end,
+        report.time_s,
+        report.nav_records,
+        report.decisions,
+        report.commands_sent,
+        report.commands_rejected,
+        report.pauses.len(),
+        report.declarations.len(),
+        report.lines.accepted,
+        report.lines.rejected_total(),
+        args.out.display()
+    );
+    Ok(())
+}

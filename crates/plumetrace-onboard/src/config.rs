@@ -1,0 +1,546 @@
+//! The onboard file: only what the vehicle process needs (the planner table, the mission
+//! geometry, the chemical input, the link and how time runs), read in two phases: a serde mirror
+//! of the TOML that rejects unknown keys, then checks of every number that name the key path
+//! and the file.
+//!
+//! ```toml
+//! name = "demo on a vehicle"
+//! [mission]
+//! op_area = [[60.0, -80.0], [460.0, -80.0], [460.0, 80.0], [60.0, 80.0]]
+//! prior_flow_toward_deg = 90.0
+//! [planner]
+//! kind = "amp"
+//! [link]
+//! protocol = "bluefin"          # or "iver"
+//! address = "127.0.0.1:29500"   # bluefin; iver: device = "/dev/ttyUSB0"
+//! origin = { lat_deg = 36.18, lon_deg = -75.75 }
+//! [chemical]
+//! format = "sentence"           # or "plain"
+//! id = "PTCHM"
+//! field = 2
+//! [run]
+//! mode = "lock_step"            # or "real_time"
+//! ```
+
+use crate::chem::ChemFormat;
+use crate::command::VehicleLimits;
+use crate::geo::Origin;
+use plumetrace_core::params::ParamError;
+use plumetrace_core::{Vec2, VehicleKind};
+use plumetrace_guidance::OpArea;
+use plumetrace_planner::{BuildContext, MissionGeometry, PlannerConfig};
+use serde::{Deserialize, Serialize};
+use std::path::PathBuf;
+
+/// The whole file, as written.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct OnboardFile {
+    /// A name for logs.
+    #[serde(default = "default_name")]
+    pub name: String,
+    /// The mission geometry.
+    pub mission: MissionFile,
+    /// The planner table (`kind` and its keys, as in a scenario).
+    pub planner: toml::Table,
+    /// The vehicle link.
+    pub link: LinkFile,
+    /// The chemical sensor.
+    #[serde(default)]
+    pub chemical: ChemicalFile,
+    /// How time runs.
+    #[serde(default)]
+    pub run: RunFile,
+}
+
+fn default_name() -> String {
+    "onboard".into()
+}
+
+/// `[mission]`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MissionFile {
+    /// The op-area polygon, local metres `[east, north]`.
+    pub op_area: Vec<[f64; 2]>,
+    /// Subregions searched in turn.
+    #[serde(default)]
+    pub subregions: Vec<Vec<[f64; 2]>>,
+    /// Flow direction assumed until the first flow measurement, deg (towards); when left out,
+    /// 0 and not "given".
+    pub prior_flow_toward_deg: Option<f64>,
+    /// The vehicle kind the planner is built for.
+    #[serde(default = "default_kind")]
+    pub vehicle_kind: VehicleKind,
+}
+
+fn default_kind() -> VehicleKind {
+    VehicleKind::Auv
+}
+
+/// The link's protocol.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ProtocolKind {
+    /// Bluefin standard payload interface over TCP.
+    Bluefin,
+    /// Iver remote helm over a serial line.
+    Iver,
+}
+
+/// What the link sends when the planner pauses (stale navigation, lost link).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum SafeAction {
+    /// The protocol's stop (`$BPRMB` stop, `$OMSTOP,0`).
+    Stop,
+    /// Nothing: the front seat's own timeout takes over.
+    None,
+}
+
+/// `[link]`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LinkFile {
+    /// `bluefin` or `iver`.
+    pub protocol: ProtocolKind,
+    /// Bluefin: the front seat's `host:port`.
+    pub address: Option<String>,
+    /// Iver: the serial device.
+    pub device: Option<PathBuf>,
+    /// Iver: baud rate (1200 to 921600).
+    #[serde(default = "default_baud")]
+    pub baud: u32,
+    /// Iver: remote-helm major version (depth in feet below 5, metres from 5), 1 to 99.
+    pub remote_helm_major: Option<u32>,
+    /// The local frame's origin.
+    pub origin: Origin,
+    /// Navigation older than this pauses the planner, s (`(0, 600]`, 5).
+    #[serde(default = "five")]
+    pub stale_nav_s: f64,
+    /// The link counts as lost after this long without a byte, s (`(0, 600]`, 10).
+    #[serde(default = "ten")]
+    pub silence_timeout_s: f64,
+    /// What to send when the planner pauses.
+    #[serde(default = "default_safe")]
+    pub safe_command: SafeAction,
+    /// Bluefin: resend an unacknowledged command after this long, s (`(0, 60]`, 5).
+    #[serde(default = "five")]
+    pub ack_timeout_s: f64,
+    /// Bluefin: tries per command (1 to 10, 3).
+    #[serde(default = "three")]
+    pub ack_tries: u32,
+    /// Bluefin: status keep-alive period, s (`(0, 60]`, 1).
+    #[serde(default = "one")]
+    pub status_period_s: f64,
+    /// Iver: navigation poll period in real time, s (`(0, 60]`, 0.5).
+    #[serde(default = "half")]
+    pub poll_period_s: f64,
+    /// Iver: the `$OMS` timeout field, s (1 to 60, 5).
+    #[serde(default = "five_u")]
+    pub oms_timeout_s: u32,
+    /// First reconnection delay, s (`(0, 60]`, 0.1), doubled after each failure.
+    #[serde(default = "tenth")]
+    pub reconnect_min_s: f64,
+    /// Longest reconnection delay, s (`[reconnect_min_s, 600]`, 5).
+    #[serde(default = "five")]
+    pub reconnect_max_s: f64,
+    /// Give up (end the run) after the link has been down this long, s (`(0, 86400]`, 600).
+    #[serde(default = "give_up")]
+    pub give_up_s: f64,
+    /// The vehicle's limits, checked at the chokepoint.
+    #[serde(default)]
+    pub limits: VehicleLimits,
+}
+
+fn default_baud() -> u32 {
+    19_200
+}
+fn five() -> f64 {
+    5.0
+}
+fn ten() -> f64 {
+    10.0
+}
+fn one() -> f64 {
+    1.0
+}
+fn half() -> f64 {
+    0.5
+}
+fn tenth() -> f64 {
+    0.1
+}
+fn three() -> u32 {
+    3
+}
+fn five_u() -> u32 {
+    5
+}
+fn give_up() -> f64 {
+    600.0
+}
+fn default_safe() -> SafeAction {
+    SafeAction::Stop
+}
+
+/// The chemical line formats, as the onboard file names them.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ChemKind {
+    /// One plain number per line.
+    Plain,
+    /// A sentence with a checksum: `id`, the reading in `field`.
+    #[default]
+    Sentence,
+}
+
+/// `[chemical]`: the sensor's line format and where its lines come from.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ChemicalFile {
+    /// `sentence` (default) or `plain`.
+    #[serde(default)]
+    pub format: ChemKind,
+    /// The sentence id (1 to 10 letters or digits; `PTCHM`).
+    #[serde(default = "default_chem_id")]
+    pub id: String,
+    /// The reading's field, 1-based after the id (1 to 40; 2).
+    #[serde(default = "default_chem_field")]
+    pub field: usize,
+    /// A separate TCP source (`host:port`); neither this nor `device`: the lines travel on the
+    /// vehicle link.
+    pub address: Option<String>,
+    /// A separate serial device.
+    pub device: Option<PathBuf>,
+}
+
+fn default_chem_id() -> String {
+    "PTCHM".into()
+}
+fn default_chem_field() -> usize {
+    2
+}
+
+impl Default for ChemicalFile {
+    fn default() -> Self {
+        ChemicalFile {
+            format: ChemKind::default(),
+            id: default_chem_id(),
+            field: default_chem_field(),
+            address: None,
+            device: None,
+        }
+    }
+}
+
+impl ChemicalFile {
+    /// The line format.
+    pub fn line_format(&self) -> ChemFormat {
+        match self.format {
+            ChemKind::Plain => ChemFormat::Plain,
+            ChemKind::Sentence => ChemFormat::Sentence {
+                id: self.id.clone(),
+                field: self.field,
+            },
+        }
+    }
+}
+
+/// How time runs.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum RunMode {
+    /// Wall-clock time; decisions at the planner's period.
+    RealTime,
+    /// The front seat's time: one decision opportunity per navigation record, one command
+    /// back for each (deterministic rehearsals and tests).
+    LockStep,
+}
+
+/// `[run]`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RunFile {
+    /// `real_time` or `lock_step`.
+    #[serde(default = "default_mode")]
+    pub mode: RunMode,
+    /// Lock-step over a protocol without times (Iver): seconds per navigation record
+    /// (`(0, 60]`, 0.5).
+    #[serde(default = "half")]
+    pub lock_step_period_s: f64,
+    /// End the run after this much mission time, s (`(0, 1e6]`, 86400).
+    #[serde(default = "day")]
+    pub time_limit_s: f64,
+}
+
+fn default_mode() -> RunMode {
+    RunMode::RealTime
+}
+fn day() -> f64 {
+    86_400.0
+}
+
+impl Default for RunFile {
+    fn default() -> Self {
+        RunFile {
+            mode: default_mode(),
+            lock_step_period_s: 0.5,
+            time_limit_s: day(),
+        }
+    }
+}
+
+/// The file checked and its planner read through the registry.
+#[derive(Debug, Clone)]
+pub struct Onboard {
+    /// What was written.
+    pub file: OnboardFile,
+    /// The planner's configuration.
+    pub planner: PlannerConfig,
+    /// What the planner is built with.
+    pub context: BuildContext,
+}
+
+fn err(key: &str, message: impl Into<String>) -> ParamError {
+    ParamError {
+        key: key.into(),
+        message: message.into(),
+    }
+}
+
+fn in_range(key: &str, v: f64, lo: f64, hi: f64, lo_open: bool) -> Result<(), ParamError> {
+    let above = if lo_open { v > lo } else { v >= lo };
+    if v.is_finite() && above && v <= hi {
+        Ok(())
+    } else {
+        let open = if lo_open { "(" } else { "[" };
+        Err(err(key, format!("{v} is outside {open}{lo}, {hi}]")))
+    }
+}
+
+fn polygon(points: &[[f64; 2]], key: &str) -> Result<OpArea, ParamError> {
+    OpArea::new(points.iter().map(|p| Vec2::new(p[0], p[1])).collect())
+        .map_err(|e| err(key, e.to_string()))
+}
+
+impl Onboard {
+    /// Reads and checks an onboard file's text; errors name the key path.
+    pub fn from_toml(text: &str) -> Result<Self, ParamError> {
+        let de = toml::Deserializer::parse(text).map_err(|e| err("", e.to_string()))?;
+        let file: OnboardFile = serde_path_to_error::deserialize(de).map_err(|e| {
+            let path = e.path().to_string();
+            err(if path == "." { "" } else { &path }, e.inner().to_string())
+        })?;
+        Onboard::check(file)
+    }
+
+    /// Checks a parsed file.
+    pub fn check(file: OnboardFile) -> Result<Self, ParamError> {
+        let m = &file.mission;
+        if let Some(d) = m.prior_flow_toward_deg {
+            in_range("mission.prior_flow_toward_deg", d, -360.0, 360.0, false)?;
+        }
+        let geometry = MissionGeometry {
+            op_area: polygon(&m.op_area, "mission.op_area")?,
+            subregions: m
+                .subregions
+                .iter()
+                .enumerate()
+                .map(|(k, r)| polygon(r, &format!("mission.subregions[{k}]")))
+                .collect::<Result<_, _>>()?,
+            prior_flow_toward_deg: m.prior_flow_toward_deg.unwrap_or(0.0),
+            prior_flow_given: m.prior_flow_toward_deg.is_some(),
+        };
+        let planner = PlannerConfig::from_table(&file.planner, "planner")?;
+        let l = &file.link;
+        match l.protocol {
+            ProtocolKind::Bluefin if l.address.is_none() => {
+                return Err(err(
+                    "link.address",
+                    "missing: the front seat's host:port (bluefin)",
+                ));
+            }
+            ProtocolKind::Iver if l.device.is_none() => {
+                return Err(err("link.device", "missing: the serial device (iver)"));
+            }
+            ProtocolKind::Iver if l.remote_helm_major.is_none() => {
+                return Err(err(
+                    "link.remote_helm_major",
+                    "missing: the vehicle's remote-helm major version (it sets the depth unit: feet below 5, metres from 5)",
+                ));
+            }
+            _ => {}
+        }
+        if let Some(v) = l.remote_helm_major {
+            in_range("link.remote_helm_major", f64::from(v), 1.0, 99.0, false)?;
+        }
+        crate::geo::LocalFrame::new(l.origin).map_err(|e| err("link.origin", e))?;
+        in_range("link.baud", f64::from(l.baud), 1200.0, 921_600.0, false)?;
+        for (key, v, hi) in [
+            ("link.stale_nav_s", l.stale_nav_s, 600.0),
+            ("link.silence_timeout_s", l.silence_timeout_s, 600.0),
+            ("link.ack_timeout_s", l.ack_timeout_s, 60.0),
+            ("link.status_period_s", l.status_period_s, 60.0),
+            ("link.poll_period_s", l.poll_period_s, 60.0),
+            ("link.reconnect_min_s", l.reconnect_min_s, 60.0),
+            ("link.give_up_s", l.give_up_s, 86_400.0),
+            ("run.lock_step_period_s", file.run.lock_step_period_s, 60.0),
+            ("run.time_limit_s", file.run.time_limit_s, 1e6),
+        ] {
+            in_range(key, v, 0.0, hi, true)?;
+        }
+        in_range(
+            "link.reconnect_max_s",
+            l.reconnect_max_s,
+            l.reconnect_min_s,
+            600.0,
+            false,
+        )?;
+        in_range("link.ack_tries", f64::from(l.ack_tries), 1.0, 10.0, false)?;
+        in_range(
+            "link.oms_timeout_s",
+            f64::from(l.oms_timeout_s),
+            1.0,
+            60.0,
+            false,
+        )?;
+        l.limits
+            .validate()
+            .map_err(|(k, m)| err(&format!("link.limits.{k}"), m))?;
+        let c = &file.chemical;
+        if c.address.is_some() && c.device.is_some() {
+            return Err(err("chemical", "give address or device, not both"));
+        }
+        if let ChemFormat::Sentence { id, field } = &c.line_format() {
+            if id.is_empty() || id.len() > 10 || !id.bytes().all(|b| b.is_ascii_alphanumeric()) {
+                return Err(err(
+                    "chemical.id",
+                    format!("'{id}' is not 1 to 10 letters or digits"),
+                ));
+            }
+            in_range("chemical.field", *field as f64, 1.0, 40.0, false)?;
+        }
+        let context = BuildContext {
+            geometry,
+            vehicle: plumetrace_core::VehicleId(0),
+            vehicle_kind: m.vehicle_kind,
+        };
+        Ok(Onboard {
+            file,
+            planner,
+            context,
+        })
+    }
+}
+
+impl crate::snapshot_log::LoggablePlanner for Onboard {
+    fn key(&self) -> &str {
+        "planner"
+    }
+    fn config(&self) -> &PlannerConfig {
+        &self.planner
+    }
+    fn context(&self) -> &BuildContext {
+        &self.context
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const GOOD: &str = r#"
+name = "t"
+[mission]
+op_area = [[60.0, -80.0], [460.0, -80.0], [460.0, 80.0], [60.0, 80.0]]
+prior_flow_toward_deg = 90.0
+[planner]
+kind = "amp"
+[link]
+protocol = "bluefin"
+address = "127.0.0.1:29500"
+origin = { lat_deg = 36.18, lon_deg = -75.75 }
+"#;
+
+    #[test]
+    fn a_good_file_reads_with_its_defaults() {
+        let o = Onboard::from_toml(GOOD).unwrap_or_else(|e| panic!("{e}"));
+        assert_eq!(o.file.link.stale_nav_s, 5.0);
+        assert_eq!(o.file.run.mode, RunMode::RealTime);
+        assert!(o.context.geometry.prior_flow_given);
+        assert_eq!(o.file.chemical.line_format(), ChemFormat::default());
+    }
+
+    #[test]
+    fn the_chemical_table_reads_both_formats() {
+        let plain =
+            format!("{GOOD}\n[chemical]\nformat = \"plain\"\naddress = \"127.0.0.1:4000\"\n");
+        let o = Onboard::from_toml(&plain).unwrap_or_else(|e| panic!("{e}"));
+        assert_eq!(o.file.chemical.line_format(), ChemFormat::Plain);
+        assert_eq!(o.file.chemical.address.as_deref(), Some("127.0.0.1:4000"));
+        let sentence =
+            format!("{GOOD}\n[chemical]\nformat = \"sentence\"\nid = \"CHEM\"\nfield = 3\n");
+        let o = Onboard::from_toml(&sentence).unwrap_or_else(|e| panic!("{e}"));
+        assert_eq!(
+            o.file.chemical.line_format(),
+            ChemFormat::Sentence {
+                id: "CHEM".into(),
+                field: 3
+            }
+        );
+        let bad = format!("{GOOD}\n[chemical]\nformat = \"sentence\"\nid = \"C H\"\nfield = 3\n");
+        assert_eq!(
+            Onboard::from_toml(&bad).err().map(|e| e.key),
+            Some("chemical.id".into())
+        );
+        let unknown = format!("{GOOD}\n[chemical]\nformat = \"plain\"\nrate = 3\n");
+        assert!(
+            Onboard::from_toml(&unknown).is_err(),
+            "unknown keys are refused"
+        );
+    }
+
+    #[test]
+    fn bad_files_name_the_key() {
+        let cases = [
+            ("protocol = \"bluefin\"", "protocl = \"bluefin\"", "link"),
+            (
+                "name = \"t\"",
+                "name = \"t\"\n[run]\nmode = \"sideways\"",
+                "run.mode",
+            ),
+            (
+                "address = \"127.0.0.1:29500\"",
+                "address = \"127.0.0.1:29500\"\nstale_nav_s = -1.0",
+                "link.stale_nav_s",
+            ),
+            (
+                "address = \"127.0.0.1:29500\"",
+                "address = \"127.0.0.1:29500\"\nlimits = { max_speed_mps = nan }",
+                "link.limits.max_speed_mps",
+            ),
+            (
+                "kind = \"amp\"",
+                "kind = \"amp\"\nbeta_deg = 1000.0",
+                "planner.beta_deg",
+            ),
+            ("lat_deg = 36.18", "lat_deg = 95.0", "link.origin"),
+            (
+                "protocol = \"bluefin\"",
+                "protocol = \"iver\"\ndevice = \"/dev/null\"",
+                "link.remote_helm_major",
+            ),
+        ];
+        for (from, to, key) in cases {
+            let text = GOOD.replacen(from, to, 1);
+            assert_ne!(text, GOOD);
+            let e = Onboard::from_toml(&text).err();
+            let got = e.as_ref().map(|e| e.key.clone());
+            assert!(
+                got.as_deref().is_some_and(|g| g.starts_with(key)),
+                "{to}: {e:?}"
+            );
+        }
+    }
+}
