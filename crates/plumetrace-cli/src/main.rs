@@ -29,6 +29,7 @@ macro_rules! outln {
 mod args;
 mod bench;
 mod campaign;
+mod gridworld;
 mod mission;
 #[cfg(feature = "netcdf")]
 mod netcdf;

@@ -13,11 +13,14 @@
 //!   following-obstacle layer with dynamic reference targets;
 //! - [`behaviour`]: the small behaviour and arbiter traits planners are built from, and the
 //!   behaviours any planner can use;
+//! - [`estimate`]: the source-likelihood map (a posterior over source cells from every sample)
+//!   and the expected-entropy move choice of infotaxis, with the windy grid world it is checked on;
 //! - [`flow`]: the planner's running estimate of the current from flow measurements.
 //! - [`fuzzy`]: fuzzy navigation past obstacles (seed 001): Mamdani engine, side lock, DRTs.
 
 pub mod avoid;
 pub mod behaviour;
+pub mod estimate;
 pub mod flow;
 pub mod fuzzy;
 pub mod planners;
