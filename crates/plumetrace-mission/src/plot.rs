@@ -245,6 +245,7 @@ pub(crate) fn behaviour_colour(b: BehaviourKind) -> RGBColor {
         BehaviourKind::Survey => RGBColor(0, 160, 180),
         BehaviourKind::Mapping => RGBColor(140, 86, 75),
         BehaviourKind::Avoid => RGBColor(230, 60, 190),
+        BehaviourKind::Infotaxis => RGBColor(110, 140, 20),
         BehaviourKind::Done => RGBColor(0, 0, 0),
     }
 }
@@ -261,6 +262,7 @@ pub(crate) fn behaviour_label(b: BehaviourKind) -> &'static str {
         BehaviourKind::Survey => "survey",
         BehaviourKind::Mapping => "mapping",
         BehaviourKind::Avoid => "avoid obstacle",
+        BehaviourKind::Infotaxis => "infotaxis",
         BehaviourKind::Done => "done",
     }
 }

@@ -564,10 +564,26 @@ mod tests {
                 | PlannerEvent::AvoidEnd { .. } => {}
             }
         }
-        let telemetry = [Telemetry::SourceEstimate { pos_m: p }];
+        let telemetry = [
+            Telemetry::SourceEstimate { pos_m: p },
+            Telemetry::SourceMap {
+                entropy_bits: 3.0,
+                peak_m: p,
+                mass: 0.5,
+            },
+            Telemetry::SourceMapRaster {
+                origin_m: p,
+                cell_m: 5.0,
+                nx: 1,
+                ny: 1,
+                log10_p: vec![0.0],
+            },
+        ];
         for e in &telemetry {
             match e {
-                Telemetry::SourceEstimate { .. } => {}
+                Telemetry::SourceEstimate { .. }
+                | Telemetry::SourceMap { .. }
+                | Telemetry::SourceMapRaster { .. } => {}
             }
         }
         let world = [

@@ -27,9 +27,14 @@
 //! vehicle's altitude, so a sample there says little about the cells just upflow of it; far
 //! downflow the factor approaches 1. `K_z = 0`, or an unknown altitude, turns the factor off.
 //!
-//! **Footprint and likelihood.** A cell's footprint value is `s(c) = max_T m(T) g_T(c)` with `g_T`
-//! the Gaussian of `e(T)` and `sigma(T)` (1 at its centre) and `m(T)` the vertical factor: how
-//! strongly the sample sees a source in `c`. With the source in `c`, a sample detects with
+//! **Dilution.** The mean concentration of a plume from a point source falls as its cross-section
+//! grows, about as one over travel time once diffusion dominates: beyond `dilution_s` the chance
+//! of a detection is scaled by `dilution_s / T`, so a detection favours sources a moderate travel
+//! time upflow over sources far upflow that would reach the vehicle only diluted.
+//!
+//! **Footprint and likelihood.** A cell's footprint value is `s(c) = max_T m(T) d(T) g_T(c)` with
+//! `g_T` the Gaussian of `e(T)` and `sigma(T)` (1 at its centre), `m(T)` the vertical factor and
+//! `d(T)` the dilution: how strongly the sample sees a source in `c`. With the source in `c`, a sample detects with
 //! probability `P(c) = p_false + (p_detect - p_false) s(c)`: `p_detect` below 1 is the plume's
 //! intermittency (inside the plume most samples still read nothing, so a non-detection there
 //! lowers a cell only by `1 - p_detect` at most), and `p_false` is the chance of a detection from
@@ -65,6 +70,9 @@ pub struct MapModel {
     pub p_false: f64,
     /// Samples closer together than this count as one, s.
     pub correlation_s: f64,
+    /// Dilution: beyond this travel time the chance of a detection falls as `dilution_s / T`
+    /// (the mean concentration of a diffusing plume falls as one over travel time; 0: off), s.
+    pub dilution_s: f64,
 }
 
 impl Default for MapModel {
@@ -74,10 +82,11 @@ impl Default for MapModel {
             window_s: 3600.0,
             spread0_m: 3.0,
             diffusivity_m2ps: 0.1,
-            vertical_diffusivity_m2ps: 0.002,
-            p_detect: 0.3,
+            vertical_diffusivity_m2ps: 0.01,
+            p_detect: 0.1,
             p_false: 0.002,
-            correlation_s: 1.0,
+            correlation_s: 10.0,
+            dilution_s: 60.0,
         }
     }
 }
@@ -318,6 +327,12 @@ impl SourceMap {
             } else {
                 1.0
             };
+            let dilution = if m.dilution_s > 0.0 && travel > m.dilution_s {
+                m.dilution_s / travel
+            } else {
+                1.0
+            };
+            let vertical = vertical * dilution;
             if vertical > 1e-3 {
                 let e = pos_m - (x_now - self.flow.at(t_s - travel));
                 self.splat(e, sigma, vertical);
@@ -440,6 +455,39 @@ impl SourceMap {
         self.footprint(pos_m, t_s, altitude_m);
         for &k in &self.touched {
             out[k] = any(pf + (pd - pf) * self.scratch[k]);
+        }
+    }
+
+    /// Back to the uniform prior (the flow history is kept).
+    pub fn reset(&mut self) {
+        let n = self.len();
+        self.log_p.fill(-(n as f64).ln());
+        self.p.fill(1.0 / n as f64);
+        self.dirty = false;
+    }
+
+    /// The posterior as telemetry: `log10 p` per grid cell, rounded to 0.01, floored at -12
+    /// (cells outside the op-area too).
+    pub fn raster(&mut self) -> plumetrace_core::Telemetry {
+        self.normalise();
+        let log10_p = self
+            .index
+            .iter()
+            .map(|&k| {
+                let l = if k == u32::MAX {
+                    -12.0
+                } else {
+                    (self.log_p[k as usize] / std::f64::consts::LN_10).max(-12.0)
+                };
+                ((l * 100.0).round() / 100.0) as f32
+            })
+            .collect();
+        plumetrace_core::Telemetry::SourceMapRaster {
+            origin_m: Vec2::new(self.x0, self.y0),
+            cell_m: self.model.resolution_m,
+            nx: self.nx,
+            ny: self.ny,
+            log10_p,
         }
     }
 
@@ -586,6 +634,7 @@ mod tests {
     fn a_bottom_source_is_not_seen_from_altitude_close_by() {
         let model = MapModel {
             vertical_diffusivity_m2ps: 0.002,
+            dilution_s: 0.0,
             ..model()
         };
         let mut m = SourceMap::new(&area(), model).unwrap_or_else(|| panic!("no map"));

@@ -10,6 +10,8 @@
 //!   finding the source, and the posterior entropy after each outcome) and the two objectives
 //!   that rank moves, infotaxis and space-aware infotaxis; the infotaxis planner and the
 //!   grid-world benchmark both choose their moves with it;
+//! - [`tracker`]: the map as a planner keeps it (fed from snapshots, read on a period, the
+//!   declaration rule: mass within a radius of the most likely cell);
 //! - [`gridworld`]: the windy grid world of the published infotaxis benchmark (mean hit rates of
 //!   an advection-diffusion model on a lattice), the model a searcher there knows.
 //!
@@ -19,6 +21,8 @@
 pub mod gridworld;
 pub mod infotaxis;
 pub mod map;
+pub mod tracker;
 
 pub use infotaxis::{MoveOutcome, Objective, entropy_bits};
 pub use map::{MapModel, SourceMap};
+pub use tracker::{MapRead, MapRule, MapTracker};

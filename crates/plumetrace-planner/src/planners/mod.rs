@@ -16,6 +16,7 @@
 //! planner without the simulator.
 
 pub mod amp;
+pub mod infotaxis;
 pub mod lawnmower;
 pub mod moth;
 
@@ -241,6 +242,7 @@ macro_rules! registry {
 
 registry! {
     Amp(amp::AmpParams),
+    Infotaxis(infotaxis::InfotaxisParams),
     Lawnmower(lawnmower::LawnmowerParams),
     Moth(moth::MothParams),
 }
