@@ -958,6 +958,69 @@ fn plume_cells(
     cells
 }
 
+/// The last source-likelihood map a planner reported (its whole raster), as cells over `x` x `y`:
+/// `log10 p` from 6 decades below the peak to the peak in 12 shades of blue (equal neighbours
+/// along a row merged into one rectangle). Drawn under the tracks, over the mean plume.
+fn posterior_cells(
+    run: &MissionRun,
+    x: &Range<f64>,
+    y: &Range<f64>,
+) -> Vec<([(f64, f64); 2], RGBColor)> {
+    let raster = run.events.iter().rev().find_map(|e| match &e.event {
+        crate::record::EventKind::Telemetry(plumetrace_core::Telemetry::SourceMapRaster {
+            origin_m,
+            cell_m,
+            nx,
+            ny,
+            log10_p,
+        }) => Some((*origin_m, *cell_m, *nx, *ny, log10_p)),
+        _ => None,
+    });
+    let Some((origin, cell, nx, ny, lp)) = raster else {
+        return Vec::new();
+    };
+    if lp.len() != nx * ny || cell.is_nan() || cell <= 0.0 {
+        return Vec::new();
+    }
+    let peak = lp.iter().copied().fold(f32::MIN, f32::max);
+    let shade = |i: usize, j: usize| -> Option<u32> {
+        let l = f64::from(lp[j * nx + i] - peak) / 6.0 + 1.0;
+        (l > 0.0).then(|| (l * 12.0).ceil().clamp(1.0, 12.0) as u32)
+    };
+    let mut cells = Vec::new();
+    for j in 0..ny {
+        let ya = (origin.y + j as f64 * cell).max(y.start);
+        let yb = (origin.y + (j + 1) as f64 * cell).min(y.end);
+        if ya >= yb {
+            continue;
+        }
+        let mut i = 0;
+        while i < nx {
+            let Some(s) = shade(i, j) else {
+                i += 1;
+                continue;
+            };
+            let mut e = i + 1;
+            while e < nx && shade(e, j) == Some(s) {
+                e += 1;
+            }
+            let xa = (origin.x + i as f64 * cell).max(x.start);
+            let xb = (origin.x + e as f64 * cell).min(x.end);
+            if xa < xb {
+                let l = f64::from(s) / 12.0;
+                let col = RGBColor(
+                    (225.0 - 190.0 * l) as u8,
+                    (235.0 - 150.0 * l) as u8,
+                    (255.0 - 70.0 * l) as u8,
+                );
+                cells.push(([(xa, ya), (xb, yb)], col));
+            }
+            i = e;
+        }
+    }
+    cells
+}
+
 /// The legend's size in pixels as plotters lays it out (12 px font, 30 px for the icons, 10 px
 /// margins).
 fn legend_px(entries: &[LegendEntry]) -> (f64, f64) {
@@ -1138,6 +1201,13 @@ fn map_layout(
             &mut legend,
             "mean plume at vehicle altitude".into(),
             Icon::Patch(RGBColor(255, 170, 100), 1.0),
+        );
+    }
+    if !posterior_cells(run, &bx, &by).is_empty() {
+        add(
+            &mut legend,
+            "source map, log10 p (6 decades)".into(),
+            Icon::Patch(RGBColor(35, 85, 185), 1.0),
         );
     }
     if run.op_area.len() > 1 {
@@ -1402,7 +1472,8 @@ fn map_layout(
             }
         }
     }
-    let plume = plume_cells(run, &x, &y);
+    let mut plume = plume_cells(run, &x, &y);
+    plume.extend(posterior_cells(run, &x, &y));
     let obstacles = run
         .obstacles
         .iter()

@@ -102,35 +102,42 @@ pub(crate) fn map_model(
     }
 }
 
+/// A planner's map tracker over `area`; the error names `map_resolution_m` when the map does
+/// not fit.
+pub(crate) fn build_tracker(
+    area: &OpArea,
+    model: MapModel,
+    rule: MapRule,
+    threshold_v: f64,
+) -> Result<MapTracker, ParamError> {
+    MapTracker::new(area, model, rule, threshold_v).ok_or_else(|| ParamError {
+        key: "map_resolution_m".into(),
+        message: format!(
+            "no source map fits the op-area at {} m cells (none inside, or more than {} cells)",
+            model.resolution_m,
+            crate::estimate::map::MAX_CELLS
+        ),
+    })
+}
+
 impl InfotaxisParams {
     fn tracker(&self, area: &OpArea) -> Result<MapTracker, ParamError> {
-        MapTracker::new(
-            area,
-            map_model(
-                self.map_resolution_m,
-                self.map_p_detect,
-                self.map_diffusivity_m2ps,
-                self.map_vertical_diffusivity_m2ps,
-                self.map_window_s,
-                self.map_correlation_s,
-                self.map_dilution_s,
-            ),
-            MapRule {
-                radius_m: self.map_radius_m,
-                mass: self.map_mass,
-                check_period_s: self.map_check_s,
-                min_detections: u64::from(self.map_min_detections),
-            },
-            self.threshold_v,
-        )
-        .ok_or_else(|| ParamError {
-            key: "map_resolution_m".into(),
-            message: format!(
-                "no source map fits the op-area at {} m cells (none inside, or more than {} cells)",
-                self.map_resolution_m,
-                crate::estimate::map::MAX_CELLS
-            ),
-        })
+        let model = map_model(
+            self.map_resolution_m,
+            self.map_p_detect,
+            self.map_diffusivity_m2ps,
+            self.map_vertical_diffusivity_m2ps,
+            self.map_window_s,
+            self.map_correlation_s,
+            self.map_dilution_s,
+        );
+        let rule = MapRule {
+            radius_m: self.map_radius_m,
+            mass: self.map_mass,
+            check_period_s: self.map_check_s,
+            min_detections: u64::from(self.map_min_detections),
+        };
+        build_tracker(area, model, rule, self.threshold_v)
     }
 }
 

@@ -236,16 +236,7 @@ impl AmpParams {
             check_period_s: self.map_check_s,
             min_detections: u64::from(self.map_min_detections),
         };
-        MapTracker::new(area, model, rule, self.threshold_v)
-            .map(Some)
-            .ok_or_else(|| ParamError {
-                key: "map_resolution_m".into(),
-                message: format!(
-                    "no source map fits the op-area at {} m cells (none inside, or more than {} cells)",
-                    self.map_resolution_m,
-                    crate::estimate::map::MAX_CELLS
-                ),
-            })
+        crate::planners::infotaxis::build_tracker(area, model, rule, self.threshold_v).map(Some)
     }
 
     /// The declaration rule the keys describe.
