@@ -33,6 +33,9 @@ use plumetrace_sim::{Incident, WorldEvent};
 use std::collections::BTreeMap;
 use std::ops::Range;
 
+/// The source map's entropy in the reading panel.
+const ENTROPY_LINE: RGBColor = RGBColor(40, 120, 60);
+
 fn err<E: std::fmt::Debug>(e: E) -> String {
     format!("drawing the figure: {e:?}")
 }
@@ -2118,6 +2121,40 @@ where
             .draw_series(std::iter::once(PathElement::new(
                 min_max_columns(&pts, t_max_min, cols),
                 colour.stroke_width(1),
+            )))
+            .map_err(err)?;
+    }
+    // The source map's entropy (a planner that keeps a map reports it), scaled to the panel's
+    // height: 0 at the bottom, the largest reported value at the top.
+    let entropy: Vec<(f64, f64)> = run
+        .events
+        .iter()
+        .filter(|e| vehicles.contains(&e.vehicle))
+        .filter_map(|e| match &e.event {
+            crate::record::EventKind::Telemetry(plumetrace_core::Telemetry::SourceMap {
+                entropy_bits,
+                ..
+            }) if entropy_bits.is_finite() => Some((e.t_s / 60.0, *entropy_bits)),
+            _ => None,
+        })
+        .collect();
+    let h_max = entropy.iter().map(|p| p.1).fold(0.0, f64::max);
+    if entropy.len() > 1 && h_max > 0.0 {
+        let scaled: Vec<(f64, f64)> = entropy
+            .iter()
+            .map(|&(t, h)| (t, h / h_max * y_hi * 0.95))
+            .collect();
+        chart
+            .draw_series(std::iter::once(PathElement::new(
+                scaled,
+                ENTROPY_LINE.stroke_width(2),
+            )))
+            .map_err(err)?;
+        chart
+            .draw_series(std::iter::once(Text::new(
+                format!("source map entropy (0-{h_max:.1} bits)"),
+                (t_max_min * 0.01, y_hi * 0.99),
+                ("sans-serif", 12).into_font().color(&ENTROPY_LINE),
             )))
             .map_err(err)?;
     }
