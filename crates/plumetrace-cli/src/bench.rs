@@ -1,5 +1,7 @@
 //! `plumetrace bench plume` times the plume model; `plumetrace bench missions` times whole
-//! missions on several thread counts. Each prints one JSON object.
+//! missions on several thread counts; `plumetrace bench infotaxis` runs the windy grid-world
+//! benchmark of infotaxis ([`crate::gridworld`]); `plumetrace bench map` times the
+//! source-likelihood map's update at the Duck op-area size. Each prints one JSON object.
 //!
 //! The pompy case is pompy's own scenario (x 0-100 m, y -50-50 m, 21 x 21 Farrell grid, 1 m/s,
 //! source at (5, 0), dt 0.01 s); the field case is the `field-scale` preset. After a warm-up the
@@ -26,6 +28,122 @@ pub enum BenchCommand {
     Plume(PlumeBenchArgs),
     /// Missions per second of a mission preset on 1, 2, ... threads (as a campaign runs them).
     Missions(MissionBenchArgs),
+    /// Infotaxis in the windy grid world of the published benchmark: steps to the source.
+    Infotaxis(crate::gridworld::InfotaxisBenchArgs),
+    /// Cost of one update of the source-likelihood map over a preset's op-area.
+    Map(MapBenchArgs),
+}
+
+/// Arguments of `plumetrace bench map`.
+#[derive(Debug, clap::Args)]
+pub struct MapBenchArgs {
+    /// Mission preset whose op-area the map covers.
+    #[arg(long, default_value = "duck-2003-st")]
+    preset: String,
+    /// Map cell size, m.
+    #[arg(long, default_value_t = 5.0, allow_hyphen_values = true, value_parser = crate::args::number)]
+    resolution: f64,
+    /// Samples to time (at 10 Hz, along a line across the area, one in five a detection).
+    #[arg(long, default_value_t = 20_000, allow_hyphen_values = true, value_parser = crate::args::runs)]
+    samples: u64,
+}
+
+#[derive(Debug, Serialize)]
+struct MapBench {
+    preset: String,
+    resolution_m: f64,
+    candidate_cells: usize,
+    samples: u64,
+    us_per_update: f64,
+    us_per_update_detection: f64,
+    us_per_update_non_detection: f64,
+    /// One candidate move's hit model (a footprint and the dense fill).
+    us_per_hit_model: f64,
+    /// One normalisation (paid by the first read after samples).
+    us_per_normalisation: f64,
+}
+
+/// Times the map's update: samples along a line through the op-area, in a 0.12 m/s current
+/// along the area's long axis, at 2 m altitude, the map's default model.
+fn map(a: &MapBenchArgs) -> Result<MapBench> {
+    use plumetrace_planner::estimate::{MapModel, SourceMap};
+    if !(a.resolution >= 0.5 && a.resolution <= 1000.0) {
+        bail!(
+            "--resolution must be >= 0.5 and <= 1000, got {}",
+            a.resolution
+        );
+    }
+    let cfg = plumetrace_scenario::load_preset(&a.preset)?;
+    let origin = plumetrace_scenario::Origin::Preset(a.preset.clone());
+    let Some(mission) = plumetrace_scenario::build(&cfg, &origin, None)?.mission else {
+        bail!("preset '{}' is not a mission", a.preset);
+    };
+    let v = mission.op_area.clone();
+    let model = MapModel {
+        resolution_m: a.resolution,
+        ..MapModel::default()
+    };
+    let Some(mut m) = SourceMap::from_vertices(&v, model) else {
+        bail!("no map cell fits the op-area at {} m", a.resolution);
+    };
+    let (p0, p1) = (v[0], v[2]);
+    let flow = (v[1] - v[0]).normalize() * 0.12;
+    let (mut t_det, mut t_non, mut n_det) = (0.0, 0.0, 0u64);
+    for k in 0..a.samples {
+        let t = k as f64 * 0.1;
+        if k % 10 == 0 {
+            m.add_flow(t, flow);
+        }
+        let f = (k as f64 / a.samples as f64) * 0.9 + 0.05;
+        let pos = p0 + (p1 - p0) * f;
+        let detected = k % 5 == 0;
+        let started = ProcessTime::now();
+        m.observe(pos, t, Some(2.0), detected);
+        let dt = started.elapsed().as_secs_f64();
+        if detected {
+            t_det += dt;
+            n_det += 1;
+        } else {
+            t_non += dt;
+        }
+    }
+    let mut out = Vec::new();
+    let reps = 200;
+    let started = ProcessTime::now();
+    for k in 0..reps {
+        let pos = p0 + (p1 - p0) * (0.3 + 0.002 * k as f64);
+        m.hit_probabilities(
+            pos,
+            a.samples as f64 * 0.1 + 15.0,
+            Some(2.0),
+            15.0,
+            &mut out,
+        );
+    }
+    let t_hit = started.elapsed().as_secs_f64();
+    // A read after each sample: the normalisation a reading of the map pays.
+    let started = ProcessTime::now();
+    let mut mass = 0.0;
+    for k in 0..reps {
+        let t = a.samples as f64 * 0.1 + 0.1 * f64::from(k);
+        m.observe(p0 + (p1 - p0) * 0.5, t, Some(2.0), false);
+        mass += m.probabilities()[0];
+    }
+    let t_norm =
+        started.elapsed().as_secs_f64() - f64::from(reps) * (t_det + t_non) / a.samples as f64;
+    std::hint::black_box(mass);
+    let n_non = a.samples - n_det;
+    Ok(MapBench {
+        preset: a.preset.clone(),
+        resolution_m: a.resolution,
+        candidate_cells: m.len(),
+        samples: a.samples,
+        us_per_update: (t_det + t_non) / a.samples as f64 * 1e6,
+        us_per_update_detection: t_det / n_det.max(1) as f64 * 1e6,
+        us_per_update_non_detection: t_non / n_non.max(1) as f64 * 1e6,
+        us_per_hit_model: t_hit / f64::from(reps) * 1e6,
+        us_per_normalisation: t_norm / f64::from(reps) * 1e6,
+    })
 }
 
 /// Arguments of `plumetrace bench missions`.
@@ -208,6 +326,16 @@ pub fn run(cmd: &BenchCommand) -> Result<()> {
         }
         BenchCommand::Missions(a) => {
             let r = missions(a)?;
+            crate::outln!("{}", serde_json::to_string_pretty(&r)?);
+            Ok(())
+        }
+        BenchCommand::Map(a) => {
+            let r = map(a)?;
+            crate::outln!("{}", serde_json::to_string_pretty(&r)?);
+            Ok(())
+        }
+        BenchCommand::Infotaxis(a) => {
+            let r = crate::gridworld::run(a)?;
             crate::outln!("{}", serde_json::to_string_pretty(&r)?);
             Ok(())
         }

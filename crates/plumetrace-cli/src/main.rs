@@ -30,6 +30,7 @@ mod args;
 mod bench;
 mod campaign;
 mod frontseat;
+mod gridworld;
 mod mission;
 #[cfg(feature = "netcdf")]
 mod netcdf;

@@ -34,13 +34,15 @@ pub enum BehaviourKind {
     /// Go around an obstacle towards a reference target (the interrupted behaviour resumes
     /// after it).
     Avoid,
+    /// Moves chosen for what they are expected to tell about the source (infotaxis).
+    Infotaxis,
     /// Mission over: no more commands.
     Done,
 }
 
 impl BehaviourKind {
     /// Every behaviour, in the order above.
-    pub const ALL: [BehaviourKind; 10] = [
+    pub const ALL: [BehaviourKind; 11] = [
         BehaviourKind::GoTo,
         BehaviourKind::Transit,
         BehaviourKind::Find,
@@ -50,6 +52,7 @@ impl BehaviourKind {
         BehaviourKind::Survey,
         BehaviourKind::Mapping,
         BehaviourKind::Avoid,
+        BehaviourKind::Infotaxis,
         BehaviourKind::Done,
     ];
 }
@@ -71,6 +74,9 @@ pub enum DeclarationKind {
     FormationPassedPeak,
     /// A rule of a planner outside the registry (a Python planner, say), which names none.
     Custom,
+    /// The most likely cell of the source-likelihood map, once the map's mass within a radius of
+    /// it passed a threshold.
+    SourceMap,
 }
 
 /// Something a planner reports for the event stream (written to logs, never read back by the
@@ -182,6 +188,30 @@ pub enum Telemetry {
         setpoint_m: Option<f64>,
         /// The member's filtered chemical reading.
         reading: f64,
+    },
+    /// The state of the planner's source-likelihood map.
+    SourceMap {
+        /// Entropy of the posterior, bits.
+        entropy_bits: f64,
+        /// Centre of the most likely cell, m.
+        peak_m: Vec2,
+        /// Posterior mass within the declaration radius of the peak.
+        mass: f64,
+    },
+    /// The whole posterior of the planner's source-likelihood map: a raster of cells over the
+    /// op-area's bounding box, `log10` of each cell's probability (rounded to 0.01; cells
+    /// outside the op-area, and those below 1e-12, at -12).
+    SourceMapRaster {
+        /// Lower-left corner of the raster, m.
+        origin_m: Vec2,
+        /// Cell size, m.
+        cell_m: f64,
+        /// Cells along x.
+        nx: usize,
+        /// Cells along y.
+        ny: usize,
+        /// `log10 p`, row by row from the south (`ny` rows of `nx`).
+        log10_p: Vec<f32>,
     },
 }
 

@@ -33,6 +33,9 @@ use plumetrace_sim::{Incident, WorldEvent};
 use std::collections::BTreeMap;
 use std::ops::Range;
 
+/// The source map's entropy in the reading panel.
+const ENTROPY_LINE: RGBColor = RGBColor(40, 120, 60);
+
 fn err<E: std::fmt::Debug>(e: E) -> String {
     format!("drawing the figure: {e:?}")
 }
@@ -245,6 +248,7 @@ pub(crate) fn behaviour_colour(b: BehaviourKind) -> RGBColor {
         BehaviourKind::Survey => RGBColor(0, 160, 180),
         BehaviourKind::Mapping => RGBColor(140, 86, 75),
         BehaviourKind::Avoid => RGBColor(230, 60, 190),
+        BehaviourKind::Infotaxis => RGBColor(110, 140, 20),
         BehaviourKind::Done => RGBColor(0, 0, 0),
     }
 }
@@ -261,6 +265,7 @@ pub(crate) fn behaviour_label(b: BehaviourKind) -> &'static str {
         BehaviourKind::Survey => "survey",
         BehaviourKind::Mapping => "mapping",
         BehaviourKind::Avoid => "avoid obstacle",
+        BehaviourKind::Infotaxis => "infotaxis",
         BehaviourKind::Done => "done",
     }
 }
@@ -956,6 +961,69 @@ fn plume_cells(
     cells
 }
 
+/// The last source-likelihood map a planner reported (its whole raster), as cells over `x` x `y`:
+/// `log10 p` from 6 decades below the peak to the peak in 12 shades of blue (equal neighbours
+/// along a row merged into one rectangle). Drawn under the tracks, over the mean plume.
+fn posterior_cells(
+    run: &MissionRun,
+    x: &Range<f64>,
+    y: &Range<f64>,
+) -> Vec<([(f64, f64); 2], RGBColor)> {
+    let raster = run.events.iter().rev().find_map(|e| match &e.event {
+        crate::record::EventKind::Telemetry(plumetrace_core::Telemetry::SourceMapRaster {
+            origin_m,
+            cell_m,
+            nx,
+            ny,
+            log10_p,
+        }) => Some((*origin_m, *cell_m, *nx, *ny, log10_p)),
+        _ => None,
+    });
+    let Some((origin, cell, nx, ny, lp)) = raster else {
+        return Vec::new();
+    };
+    if lp.len() != nx * ny || cell.is_nan() || cell <= 0.0 {
+        return Vec::new();
+    }
+    let peak = lp.iter().copied().fold(f32::MIN, f32::max);
+    let shade = |i: usize, j: usize| -> Option<u32> {
+        let l = f64::from(lp[j * nx + i] - peak) / 6.0 + 1.0;
+        (l > 0.0).then(|| (l * 12.0).ceil().clamp(1.0, 12.0) as u32)
+    };
+    let mut cells = Vec::new();
+    for j in 0..ny {
+        let ya = (origin.y + j as f64 * cell).max(y.start);
+        let yb = (origin.y + (j + 1) as f64 * cell).min(y.end);
+        if ya >= yb {
+            continue;
+        }
+        let mut i = 0;
+        while i < nx {
+            let Some(s) = shade(i, j) else {
+                i += 1;
+                continue;
+            };
+            let mut e = i + 1;
+            while e < nx && shade(e, j) == Some(s) {
+                e += 1;
+            }
+            let xa = (origin.x + i as f64 * cell).max(x.start);
+            let xb = (origin.x + e as f64 * cell).min(x.end);
+            if xa < xb {
+                let l = f64::from(s) / 12.0;
+                let col = RGBColor(
+                    (225.0 - 190.0 * l) as u8,
+                    (235.0 - 150.0 * l) as u8,
+                    (255.0 - 70.0 * l) as u8,
+                );
+                cells.push(([(xa, ya), (xb, yb)], col));
+            }
+            i = e;
+        }
+    }
+    cells
+}
+
 /// The legend's size in pixels as plotters lays it out (12 px font, 30 px for the icons, 10 px
 /// margins).
 fn legend_px(entries: &[LegendEntry]) -> (f64, f64) {
@@ -1136,6 +1204,13 @@ fn map_layout(
             &mut legend,
             "mean plume at vehicle altitude".into(),
             Icon::Patch(RGBColor(255, 170, 100), 1.0),
+        );
+    }
+    if !posterior_cells(run, &bx, &by).is_empty() {
+        add(
+            &mut legend,
+            "source map, log10 p (6 decades)".into(),
+            Icon::Patch(RGBColor(35, 85, 185), 1.0),
         );
     }
     if run.op_area.len() > 1 {
@@ -1400,7 +1475,8 @@ fn map_layout(
             }
         }
     }
-    let plume = plume_cells(run, &x, &y);
+    let mut plume = plume_cells(run, &x, &y);
+    plume.extend(posterior_cells(run, &x, &y));
     let obstacles = run
         .obstacles
         .iter()
@@ -2045,6 +2121,40 @@ where
             .draw_series(std::iter::once(PathElement::new(
                 min_max_columns(&pts, t_max_min, cols),
                 colour.stroke_width(1),
+            )))
+            .map_err(err)?;
+    }
+    // The source map's entropy (a planner that keeps a map reports it), scaled to the panel's
+    // height: 0 at the bottom, the largest reported value at the top.
+    let entropy: Vec<(f64, f64)> = run
+        .events
+        .iter()
+        .filter(|e| vehicles.contains(&e.vehicle))
+        .filter_map(|e| match &e.event {
+            crate::record::EventKind::Telemetry(plumetrace_core::Telemetry::SourceMap {
+                entropy_bits,
+                ..
+            }) if entropy_bits.is_finite() => Some((e.t_s / 60.0, *entropy_bits)),
+            _ => None,
+        })
+        .collect();
+    let h_max = entropy.iter().map(|p| p.1).fold(0.0, f64::max);
+    if entropy.len() > 1 && h_max > 0.0 {
+        let scaled: Vec<(f64, f64)> = entropy
+            .iter()
+            .map(|&(t, h)| (t, h / h_max * y_hi * 0.95))
+            .collect();
+        chart
+            .draw_series(std::iter::once(PathElement::new(
+                scaled,
+                ENTROPY_LINE.stroke_width(2),
+            )))
+            .map_err(err)?;
+        chart
+            .draw_series(std::iter::once(Text::new(
+                format!("source map entropy (0-{h_max:.1} bits)"),
+                (t_max_min * 0.01, y_hi * 0.99),
+                ("sans-serif", 12).into_font().color(&ENTROPY_LINE),
             )))
             .map_err(err)?;
     }

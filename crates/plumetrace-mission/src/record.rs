@@ -576,10 +576,25 @@ mod tests {
                 setpoint_m: Some(1.5),
                 reading: 0.5,
             },
+            Telemetry::SourceMap {
+                entropy_bits: 3.0,
+                peak_m: p,
+                mass: 0.5,
+            },
+            Telemetry::SourceMapRaster {
+                origin_m: p,
+                cell_m: 5.0,
+                nx: 1,
+                ny: 1,
+                log10_p: vec![0.0],
+            },
         ];
         for e in &telemetry {
             match e {
-                Telemetry::SourceEstimate { .. } | Telemetry::Formation { .. } => {}
+                Telemetry::SourceEstimate { .. }
+                | Telemetry::Formation { .. }
+                | Telemetry::SourceMap { .. }
+                | Telemetry::SourceMapRaster { .. } => {}
             }
         }
         let world = [

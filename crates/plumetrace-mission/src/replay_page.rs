@@ -553,10 +553,19 @@ impl LogPageBuilder {
     }
 }
 
-/// Events as JSON values, numbers rounded for size.
+/// Events as JSON values, numbers rounded for size; whole source-map rasters are left out (the
+/// page does not draw them, and each is a value per map cell).
 fn events_json(events: &[EventRecord]) -> Vec<Value> {
     events
         .iter()
+        .filter(|e| {
+            !matches!(
+                e.event,
+                crate::record::EventKind::Telemetry(
+                    plumetrace_core::Telemetry::SourceMapRaster { .. }
+                )
+            )
+        })
         .filter_map(|e| serde_json::to_value(e).ok())
         .map(|mut v| {
             if let Some(t) = v.get("t_s").and_then(Value::as_f64) {

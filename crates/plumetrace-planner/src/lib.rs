@@ -13,6 +13,8 @@
 //!   following-obstacle layer with dynamic reference targets;
 //! - [`behaviour`]: the small behaviour and arbiter traits planners are built from, and the
 //!   behaviours any planner can use;
+//! - [`estimate`]: the source-likelihood map (a posterior over source cells from every sample)
+//!   and the expected-entropy move choice of infotaxis, with the windy grid world it is checked on;
 //! - [`flow`]: the planner's running estimate of the current from flow measurements.
 //! - [`formation`]: formation tracing (seed 004): surface leaders and an underwater follower on
 //!   acoustic ranges.
@@ -20,6 +22,7 @@
 
 pub mod avoid;
 pub mod behaviour;
+pub mod estimate;
 pub mod flow;
 pub mod fuzzy;
 pub mod planners;

@@ -27,6 +27,11 @@ pub const PRESETS: &[Preset] = &[
         toml: include_str!("../presets/demo-survey.toml"),
     },
     Preset {
+        name: "demo-infotaxis",
+        summary: "the demo site searched by infotaxis on a source-likelihood map, declaring when the map concentrates",
+        toml: include_str!("../presets/demo-infotaxis.toml"),
+    },
+    Preset {
         name: "duck-2003-st",
         summary: "Duck 2003 single-source mission: 1094 m x 367 m op-area, 0.10-0.15 m/s, about 1 km of plume",
         toml: include_str!("../presets/duck-2003-st.toml"),

@@ -17,6 +17,7 @@
 
 pub mod amp;
 pub mod formation;
+pub mod infotaxis;
 pub mod lawnmower;
 pub mod moth;
 
@@ -242,6 +243,7 @@ macro_rules! registry {
 
 registry! {
     Amp(amp::AmpParams),
+    Infotaxis(infotaxis::InfotaxisParams),
     Lawnmower(lawnmower::LawnmowerParams),
     Moth(moth::MothParams),
     FormationLeader(formation::FormationLeaderParams),

@@ -13,7 +13,8 @@
 //! - **Reacquire** flies `N_re` Bowties from 10 m upflow of the most upflow lost point down to it,
 //!   then drops the point; with no point left it returns to Find.
 //!
-//! Declaration ([`DeclarationRule`]) leads to post-declaration mapping ([`MappingParams`]) and the
+//! Declaration ([`DeclarationRule`]; with `map_declaration`, also or instead the
+//! source-likelihood map's rule of [`crate::estimate::tracker`]) leads to post-declaration mapping ([`MappingParams`]) and the
 //! end of the mission. In a multi-source mission the area is split into subregions searched in
 //! turn; a subregion ends on timeout (source-free), on a declaration, or when the plume is traced
 //! to its upflow edge (declared there); no mapping is flown between subregions.
@@ -36,6 +37,7 @@ pub use mapping::MappingParams;
 
 use crate::behaviour::{Arbiter, Behaviour, EventLog, GoTo, Idle, Legs, LineParams, Percept};
 use crate::behaviour::{Proposal, Reached};
+use crate::estimate::{MapRule, MapTracker};
 use crate::flow::FlowEstimate;
 use crate::planners::{BuildContext, PlannerParams};
 use behaviours::{Find, Reacquire, TrackIn, TrackOut};
@@ -134,7 +136,55 @@ plumetrace_core::params! {
         nav_drift_mps: f64 = 0.02, "m/s", Bounds::non_negative(10.0);
         /// The most the cage's area is shrunk by for the navigation error.
         max_cage_inset_m: f64 = 20.0, "m", Bounds::non_negative(1000.0);
+        /// Declaring from the source-likelihood map: off (the lost-point rule alone), instead (the map's rule alone: its most likely cell once the mass within map_radius_m reaches map_mass), also (whichever rule declares first) or refine (the lost-point rule says when, the map where: its most likely cell if the map's rule holds then, else the lost point).
+        map_declaration: MapDeclaration = MapDeclaration::Off, "", Bounds::Any;
+        /// Map declaration: radius around the map's most likely cell.
+        map_radius_m: f64 = 10.0, "m", Bounds::closed(0.5, 10_000.0);
+        /// Map declaration: posterior mass within map_radius_m that declares.
+        map_mass: f64 = 0.5, "", Bounds::closed(0.01, 1.0);
+        /// Map declaration: detections the map must have taken in first.
+        map_min_detections: u32 = 50, "", Bounds::whole(0, 1_000_000);
+        /// Time between reads of the map for the declaration.
+        map_check_s: f64 = 5.0, "s", Bounds::closed(0.0, 3600.0);
+        /// Source map: cell size.
+        map_resolution_m: f64 = 5.0, "m", Bounds::closed(0.5, 1000.0);
+        /// Source map: probability that a sample inside the plume detects (intermittency).
+        map_p_detect: f64 = 0.1, "", Bounds::closed(0.01, 1.0);
+        /// Source map: samples closer together than this count as one look (the plume's meander keeps a vehicle in or out of it for seconds).
+        map_correlation_s: f64 = 10.0, "s", Bounds::closed(0.0, 3600.0);
+        /// Source map: growth of the back-projection spread, sigma^2 = (3 m)^2 + 2 D T.
+        map_diffusivity_m2ps: f64 = 0.1, "m^2/s", Bounds::closed(0.0, 1000.0);
+        /// Source map: vertical diffusivity that mixes a bottom source up to the vehicle's altitude (0: no vertical model).
+        map_vertical_diffusivity_m2ps: f64 = 0.01, "m^2/s", Bounds::closed(0.0, 100.0);
+        /// Source map: longest travel time a sample is back-projected over.
+        map_window_s: f64 = 3600.0, "s", Bounds::closed(1.0, 1e6);
+        /// Source map: travel time beyond which the chance of a detection falls as one over travel time (plume dilution; 0: off).
+        map_dilution_s: f64 = 60.0, "s", Bounds::closed(0.0, 1e6);
     }
+}
+
+/// The `map_declaration` key: whether the AMP declares from its source-likelihood map.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum MapDeclaration {
+    /// No map: the lost-point rule alone.
+    Off,
+    /// The map's rule alone (Track-Out ends go to Reacquire).
+    Instead,
+    /// Either rule, whichever declares first.
+    Also,
+    /// The lost-point rule decides when; the map's most likely cell is declared if the map's
+    /// rule holds then (else the lost point).
+    Refine,
+}
+
+impl Choice for MapDeclaration {
+    const ALL: &'static [Self] = &[
+        MapDeclaration::Off,
+        MapDeclaration::Instead,
+        MapDeclaration::Also,
+        MapDeclaration::Refine,
+    ];
 }
 
 /// When Track-In updates LHS from the vehicle's heading.
@@ -166,6 +216,29 @@ impl Choice for FindPattern {
 }
 
 impl AmpParams {
+    /// The source-likelihood map with its declaration rule, when `map_declaration` is on.
+    fn map_tracker(&self, area: &OpArea) -> Result<Option<MapTracker>, ParamError> {
+        if self.map_declaration == MapDeclaration::Off {
+            return Ok(None);
+        }
+        let model = crate::planners::infotaxis::map_model(
+            self.map_resolution_m,
+            self.map_p_detect,
+            self.map_diffusivity_m2ps,
+            self.map_vertical_diffusivity_m2ps,
+            self.map_window_s,
+            self.map_correlation_s,
+            self.map_dilution_s,
+        );
+        let rule = MapRule {
+            radius_m: self.map_radius_m,
+            mass: self.map_mass,
+            check_period_s: self.map_check_s,
+            min_detections: u64::from(self.map_min_detections),
+        };
+        crate::planners::infotaxis::build_tracker(area, model, rule, self.threshold_v).map(Some)
+    }
+
     /// The declaration rule the keys describe.
     pub fn declaration_rule(&self) -> DeclarationRule {
         match self.declaration {
@@ -223,12 +296,14 @@ impl PlannerParams for AmpParams {
     }
 
     fn build(&self, ctx: &BuildContext) -> Result<Box<dyn Planner>, ParamError> {
-        let amp = Amp::new(
+        let map = self.map_tracker(&ctx.geometry.op_area)?;
+        let mut amp = Amp::new(
             self.clone(),
             ctx.geometry.op_area.clone(),
             ctx.geometry.subregions.clone(),
             ctx.geometry.prior_flow_toward(),
         );
+        amp.m.map = map;
         Ok(Box::new(if ctx.geometry.prior_flow_given {
             amp.trusting_prior()
         } else {
@@ -305,6 +380,10 @@ struct Memory {
     events: Vec<PlannerEvent>,
     /// When Reacquire began after the last detection.
     reacquire_since: Option<f64>,
+    /// The source-likelihood map, when `map_declaration` is on.
+    map: Option<MapTracker>,
+    /// Map telemetry of the current decision made inside the switching logic.
+    map_telemetry: Vec<Telemetry>,
 }
 
 impl EventLog for Memory {
@@ -549,10 +628,35 @@ impl Switching {
 
     /// Runs the declaration check; true when a source was declared.
     fn try_declare(&mut self, m: &mut Memory, t: f64) -> bool {
+        if m.p.map_declaration == MapDeclaration::Instead {
+            return false;
+        }
         let rule = m.p.declaration_rule();
         match rule.check(&m.lost_positions(), m.flow.upflow()) {
             Some(at) => {
-                self.declare(m, at, rule.kind(), RegionEvent::Declared, t);
+                let refined = match (m.p.map_declaration, m.map.as_mut()) {
+                    (MapDeclaration::Refine, Some(tracker)) => {
+                        let read = tracker.read(t);
+                        let mut telemetry = Vec::new();
+                        tracker.report(t, &read, &mut telemetry, true);
+                        m.map_telemetry.extend(telemetry);
+                        if m.regions.len() > 1 {
+                            tracker.reset();
+                        }
+                        read.declares(tracker.rule()).then_some(read.peak_m)
+                    }
+                    _ => None,
+                };
+                match refined {
+                    Some(peak) => self.declare(
+                        m,
+                        peak,
+                        DeclarationKind::SourceMap,
+                        RegionEvent::Declared,
+                        t,
+                    ),
+                    None => self.declare(m, at, rule.kind(), RegionEvent::Declared, t),
+                }
                 true
             }
             None => false,
@@ -723,6 +827,8 @@ impl Amp {
                 declared: Vec::new(),
                 events: Vec::new(),
                 reacquire_since: None,
+                map: None,
+                map_telemetry: Vec::new(),
             },
             switching: Switching {
                 active: Box::new(Idle),
@@ -777,6 +883,47 @@ impl Amp {
         self.m.track_out_goal()
     }
 
+    /// Feeds the map (if any) and, with `map_declaration` `instead` or `also`, declares its most
+    /// likely cell when the map's rule holds, in a searching behaviour (not on the way to a
+    /// subregion, mapping or done).
+    fn map_declaration(&mut self, s: &SensorSnapshot, pos: Vec2, telemetry: &mut Vec<Telemetry>) {
+        let t = s.time_s;
+        let flow = self.m.flow.velocity_mps();
+        let ground = s.nav.heading.unit() * s.nav.speed_mps + flow;
+        let mode = self.m.p.map_declaration;
+        let multi = self.m.multi_region();
+        let Some(tracker) = self.m.map.as_mut() else {
+            return;
+        };
+        tracker.feed(s, pos, ground, flow);
+        let searching = matches!(
+            self.switching.active(),
+            BehaviourKind::Find
+                | BehaviourKind::TrackIn
+                | BehaviourKind::TrackOut
+                | BehaviourKind::Reacquire
+        );
+        let Some(read) = tracker.read_due(t, telemetry) else {
+            return;
+        };
+        let by_map = matches!(mode, MapDeclaration::Instead | MapDeclaration::Also);
+        if !by_map || !searching || !read.declares(tracker.rule()) {
+            return;
+        }
+        tracker.report(t, &read, telemetry, true);
+        if multi {
+            // The next subregion's search starts from the prior.
+            tracker.reset();
+        }
+        self.switching.declare(
+            &mut self.m,
+            read.peak_m,
+            DeclarationKind::SourceMap,
+            RegionEvent::Declared,
+            t,
+        );
+    }
+
     /// The source estimate: the last declaration, else the most upflow lost point.
     fn source_estimate(&self) -> Option<Vec2> {
         self.m
@@ -824,6 +971,8 @@ impl Planner for Amp {
                 .last_detection
                 .is_some_and(|(tl, _)| t - tl <= self.m.p.lambda_s)
                 && self.in_contact;
+        let mut telemetry = Vec::new();
+        self.map_declaration(s, pos, &mut telemetry);
         let percept = Percept {
             t_s: t,
             pos_m: pos,
@@ -838,7 +987,6 @@ impl Planner for Amp {
         };
         let steer = steer.unwrap_or(self.last_steer);
         self.last_steer = steer;
-        let mut telemetry = Vec::new();
         let estimate = self.source_estimate();
         if estimate.is_some() && estimate != self.reported_estimate {
             self.reported_estimate = estimate;
@@ -854,6 +1002,7 @@ impl Planner for Amp {
                 (abort.command, PlanStatus::Abort)
             }
         };
+        telemetry.append(&mut self.m.map_telemetry);
         Decision {
             command,
             outbox: Vec::new(),

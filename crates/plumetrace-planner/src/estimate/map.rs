@@ -1,0 +1,663 @@
+//! The source-likelihood map: a posterior over candidate source cells of the op-area, built from
+//! every chemical sample (after Pang and Farrell 2006).
+//!
+//! **Cells.** Square cells of `resolution_m` over the op-area's bounding box; cells whose centres
+//! lie outside the op-area are not candidates. The prior is uniform over the candidates. The
+//! posterior is kept as log-probabilities; an update touches only the cells of the sample's
+//! footprint, and the map is normalised (log-sum-exp) before it is read, so what is read always
+//! has mass 1 to rounding.
+//!
+//! **Flow history.** The current is taken as uniform over the area but varying in time, as the
+//! vehicle measures it: each flow reading is held until the next, and the cumulative displacement
+//! `X(t)` of a water parcel is kept at every reading (a ring buffer of `window_s` plus the newest
+//! reading), so the displacement over any interval costs one binary search. Before the first
+//! reading the first one is assumed; after the last, the last.
+//!
+//! **Back-projection.** A sample taken at `x_k` at time `t_k` may carry chemical released at
+//! `t_k - T` for any travel time `T` in `0..=window_s`; that chemical left
+//! `e(T) = x_k - (X(t_k) - X(t_k - T))`. The release point is uncertain by a Gaussian spread
+//! `sigma(T)^2 = spread0_m^2 + 2 diffusivity_m2ps T` (turbulent dispersion and flow error both
+//! grow with travel time). Travel times are taken at steps of one spread of flow travel (at
+//! least one second and half a cell), so successive footprints overlap.
+//!
+//! **Vertical mixing.** The source is on the bottom and the vehicle samples at altitude `z`.
+//! Chemical released at the bed spreads upwards as a reflected Gaussian with vertical diffusivity
+//! `K_z`: after travel time `T` the concentration at height `z` is `exp(-z^2 / (4 K_z T))` of the
+//! concentration at the bed. Near the source (small `T`) the chemical has not reached the
+//! vehicle's altitude, so a sample there says little about the cells just upflow of it; far
+//! downflow the factor approaches 1. `K_z = 0`, or an unknown altitude, turns the factor off.
+//!
+//! **Dilution.** The mean concentration of a plume from a point source falls as its cross-section
+//! grows, about as one over travel time once diffusion dominates: beyond `dilution_s` the chance
+//! of a detection is scaled by `dilution_s / T`, so a detection favours sources a moderate travel
+//! time upflow over sources far upflow that would reach the vehicle only diluted.
+//!
+//! **Footprint and likelihood.** A cell's footprint value is `s(c) = max_T m(T) d(T) g_T(c)` with
+//! `g_T` the Gaussian of `e(T)` and `sigma(T)` (1 at its centre), `m(T)` the vertical factor and
+//! `d(T)` the dilution: how strongly the sample sees a source in `c`. With the source in `c`, a sample detects with
+//! probability `P(c) = p_false + (p_detect - p_false) s(c)`: `p_detect` below 1 is the plume's
+//! intermittency (inside the plume most samples still read nothing, so a non-detection there
+//! lowers a cell only by `1 - p_detect` at most), and `p_false` is the chance of a detection from
+//! a source elsewhere (background, another source, a spike). A detection multiplies each cell by
+//! `P(c)`, a non-detection by `1 - P(c)`; cells outside the footprint take the same factor,
+//! which normalisation removes, so only footprint cells are touched. Samples closer together than
+//! `correlation_s` are not independent (the vehicle sees the same filament): each sample's log
+//! likelihood is weighed by the time since the previous one over `correlation_s` (at most 1).
+//!
+//! A non-detection's factor is at most that of the cells it says nothing about, so it never
+//! raises a cell relative to them; a detection's is at least theirs.
+
+use plumetrace_core::Vec2;
+use plumetrace_guidance::OpArea;
+use std::collections::VecDeque;
+
+/// The likelihood model's parameters.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct MapModel {
+    /// Cell size, m.
+    pub resolution_m: f64,
+    /// Longest travel time back-projected, s.
+    pub window_s: f64,
+    /// Spread of the release point at zero travel time, m.
+    pub spread0_m: f64,
+    /// Growth of the spread: `sigma^2 = spread0^2 + 2 diffusivity T`, m^2/s.
+    pub diffusivity_m2ps: f64,
+    /// Vertical diffusivity for the bottom source's mixing up to the vehicle (0: off), m^2/s.
+    pub vertical_diffusivity_m2ps: f64,
+    /// Probability that a sample inside the plume detects (intermittency).
+    pub p_detect: f64,
+    /// Probability that a sample detects with the source elsewhere.
+    pub p_false: f64,
+    /// Samples closer together than this count as one, s.
+    pub correlation_s: f64,
+    /// Dilution: beyond this travel time the chance of a detection falls as `dilution_s / T`
+    /// (the mean concentration of a diffusing plume falls as one over travel time; 0: off), s.
+    pub dilution_s: f64,
+}
+
+impl Default for MapModel {
+    fn default() -> Self {
+        MapModel {
+            resolution_m: 5.0,
+            window_s: 3600.0,
+            spread0_m: 3.0,
+            diffusivity_m2ps: 0.1,
+            vertical_diffusivity_m2ps: 0.01,
+            p_detect: 0.1,
+            p_false: 0.002,
+            correlation_s: 10.0,
+            dilution_s: 60.0,
+        }
+    }
+}
+
+/// Cumulative water displacement from flow readings held between samples.
+#[derive(Debug, Clone, PartialEq, Default)]
+struct FlowHistory {
+    /// `(time, displacement at that time, velocity from then on)`, oldest first.
+    samples: VecDeque<(f64, Vec2, Vec2)>,
+}
+
+impl FlowHistory {
+    fn add(&mut self, t_s: f64, v_mps: Vec2, keep_s: f64) {
+        if !(t_s.is_finite() && v_mps.x.is_finite() && v_mps.y.is_finite()) {
+            return;
+        }
+        match self.samples.back().copied() {
+            Some((t0, _, _)) if t_s <= t0 => {
+                // Same time (or out of order): the newer reading replaces the velocity.
+                if let Some(last) = self.samples.back_mut() {
+                    last.2 = v_mps;
+                }
+                return;
+            }
+            Some((t0, x0, v0)) => self.samples.push_back((t_s, x0 + v0 * (t_s - t0), v_mps)),
+            None => self.samples.push_back((t_s, Vec2::zeros(), v_mps)),
+        }
+        while self.samples.len() > 2 && self.samples[1].0 < t_s - keep_s {
+            self.samples.pop_front();
+        }
+    }
+
+    /// The displacement at `t_s` (relative to an arbitrary origin).
+    fn at(&self, t_s: f64) -> Vec2 {
+        let Some(&(t_first, x_first, v_first)) = self.samples.front() else {
+            return Vec2::zeros();
+        };
+        if t_s <= t_first {
+            return x_first + v_first * (t_s - t_first);
+        }
+        let i = self.samples.partition_point(|s| s.0 <= t_s);
+        let (t0, x0, v0) = self.samples[i - 1];
+        x0 + v0 * (t_s - t0)
+    }
+
+    fn speed_mps(&self) -> f64 {
+        self.samples.back().map_or(0.0, |s| s.2.norm())
+    }
+}
+
+/// The source-likelihood map of one vehicle (see the module docs).
+#[derive(Debug, Clone, PartialEq)]
+pub struct SourceMap {
+    model: MapModel,
+    x0: f64,
+    y0: f64,
+    nx: usize,
+    ny: usize,
+    /// Candidate index of each grid cell (`u32::MAX`: outside the op-area).
+    index: Vec<u32>,
+    /// Centre of each candidate.
+    centres: Vec<Vec2>,
+    /// Normalised log-probability of each candidate.
+    log_p: Vec<f64>,
+    /// Its probability.
+    p: Vec<f64>,
+    flow: FlowHistory,
+    last_sample_s: Option<f64>,
+    /// Scratch: footprint value per candidate (zero outside the last footprint) and the touched
+    /// candidates.
+    scratch: Vec<f64>,
+    touched: Vec<usize>,
+    /// Scratch: the Gaussian along x of one splat.
+    gx: Vec<f64>,
+    /// Updates since the last normalisation.
+    dirty: bool,
+    updates: u64,
+}
+
+/// Footprint values below this are taken as zero (the cell is left alone).
+const FOOTPRINT_FLOOR: f64 = 1e-4;
+
+/// The most grid cells a map may have.
+pub const MAX_CELLS: usize = 4_000_000;
+
+impl SourceMap {
+    /// A uniform map over `area` with the given model; `None` when no cell centre lies inside
+    /// the area or the grid would exceed [`MAX_CELLS`].
+    pub fn new(area: &OpArea, model: MapModel) -> Option<Self> {
+        let v = area.vertices();
+        let (mut x_lo, mut x_hi, mut y_lo, mut y_hi) = (f64::MAX, f64::MIN, f64::MAX, f64::MIN);
+        for p in v {
+            x_lo = x_lo.min(p.x);
+            x_hi = x_hi.max(p.x);
+            y_lo = y_lo.min(p.y);
+            y_hi = y_hi.max(p.y);
+        }
+        let r = model.resolution_m;
+        if !(r > 0.0 && x_hi > x_lo && y_hi > y_lo) {
+            return None;
+        }
+        let nx = ((x_hi - x_lo) / r).ceil().max(1.0);
+        let ny = ((y_hi - y_lo) / r).ceil().max(1.0);
+        if nx * ny > MAX_CELLS as f64 {
+            return None;
+        }
+        let (nx, ny) = (nx as usize, ny as usize);
+        let mut index = vec![u32::MAX; nx * ny];
+        let mut centres = Vec::new();
+        for j in 0..ny {
+            for i in 0..nx {
+                let c = Vec2::new(x_lo + (i as f64 + 0.5) * r, y_lo + (j as f64 + 0.5) * r);
+                if area.contains(c) {
+                    index[j * nx + i] = centres.len() as u32;
+                    centres.push(c);
+                }
+            }
+        }
+        let n = centres.len();
+        if n == 0 {
+            return None;
+        }
+        let lp = -(n as f64).ln();
+        Some(SourceMap {
+            model,
+            x0: x_lo,
+            y0: y_lo,
+            nx,
+            ny,
+            index,
+            centres,
+            log_p: vec![lp; n],
+            p: vec![1.0 / n as f64; n],
+            flow: FlowHistory::default(),
+            last_sample_s: None,
+            scratch: vec![0.0; n],
+            touched: Vec::new(),
+            gx: Vec::new(),
+            dirty: false,
+            updates: 0,
+        })
+    }
+
+    /// [`SourceMap::new`] over the polygon `vertices` (`None` also for a polygon that is not
+    /// an op-area).
+    pub fn from_vertices(vertices: &[Vec2], model: MapModel) -> Option<Self> {
+        OpArea::new(vertices.to_vec())
+            .ok()
+            .and_then(|a| Self::new(&a, model))
+    }
+
+    /// The model.
+    pub fn model(&self) -> &MapModel {
+        &self.model
+    }
+
+    /// Number of candidate cells.
+    pub fn len(&self) -> usize {
+        self.centres.len()
+    }
+
+    /// Whether there are no candidates (never, for a built map).
+    pub fn is_empty(&self) -> bool {
+        self.centres.is_empty()
+    }
+
+    /// The grid: lower-left corner, cell size and cells along x and y.
+    pub fn grid(&self) -> (Vec2, f64, usize, usize) {
+        (
+            Vec2::new(self.x0, self.y0),
+            self.model.resolution_m,
+            self.nx,
+            self.ny,
+        )
+    }
+
+    /// Centre of each candidate.
+    pub fn centres(&self) -> &[Vec2] {
+        &self.centres
+    }
+
+    /// Probability of each candidate (sums to 1).
+    pub fn probabilities(&mut self) -> &[f64] {
+        self.normalise();
+        &self.p
+    }
+
+    /// Log-probability of each candidate (normalised).
+    pub fn log_probabilities(&mut self) -> &[f64] {
+        self.normalise();
+        &self.log_p
+    }
+
+    /// Samples taken into account so far.
+    pub fn updates(&self) -> u64 {
+        self.updates
+    }
+
+    /// Adds a flow reading taken at `t_s`.
+    pub fn add_flow(&mut self, t_s: f64, velocity_mps: Vec2) {
+        self.flow.add(t_s, velocity_mps, self.model.window_s);
+    }
+
+    /// The candidate whose cell holds `p`, if any.
+    pub fn candidate_at(&self, p: Vec2) -> Option<usize> {
+        let r = self.model.resolution_m;
+        let i = ((p.x - self.x0) / r).floor();
+        let j = ((p.y - self.y0) / r).floor();
+        if !(i >= 0.0 && j >= 0.0 && (i as usize) < self.nx && (j as usize) < self.ny) {
+            return None;
+        }
+        let k = self.index[j as usize * self.nx + i as usize];
+        (k != u32::MAX).then_some(k as usize)
+    }
+
+    /// Computes the footprint of a sample at `pos_m`, time `t_s`, altitude `altitude_m` into
+    /// the scratch buffer (see the module docs); the touched candidates are in `self.touched`.
+    fn footprint(&mut self, pos_m: Vec2, t_s: f64, altitude_m: Option<f64>) {
+        for &k in &self.touched {
+            self.scratch[k] = 0.0;
+        }
+        self.touched.clear();
+        let m = self.model;
+        let r = m.resolution_m;
+        let kz = m.vertical_diffusivity_m2ps;
+        let z2 = altitude_m.filter(|z| z.is_finite()).map_or(0.0, |z| z * z);
+        let speed = self.flow.speed_mps().max(0.01);
+        let x_now = self.flow.at(t_s);
+        let mut travel = 0.0_f64;
+        while travel <= m.window_s {
+            let sigma = (m.spread0_m * m.spread0_m + 2.0 * m.diffusivity_m2ps * travel).sqrt();
+            let vertical = if kz > 0.0 && z2 > 0.0 {
+                if travel > 0.0 {
+                    (-z2 / (4.0 * kz * travel)).exp()
+                } else {
+                    0.0
+                }
+            } else {
+                1.0
+            };
+            let dilution = if m.dilution_s > 0.0 && travel > m.dilution_s {
+                m.dilution_s / travel
+            } else {
+                1.0
+            };
+            let vertical = vertical * dilution;
+            if vertical > 1e-3 {
+                let e = pos_m - (x_now - self.flow.at(t_s - travel));
+                self.splat(e, sigma, vertical);
+            }
+            travel += (sigma / speed).max(1.0).max(0.5 * r / speed);
+        }
+    }
+
+    /// Raises the footprint to `peak * exp(-d^2 / (2 sigma^2))` within 3 sigma of `centre` (the
+    /// Gaussian is separable: one exponential per row and per column).
+    fn splat(&mut self, centre: Vec2, sigma: f64, peak: f64) {
+        let r = self.model.resolution_m;
+        let reach = 3.0 * sigma + 0.5 * r;
+        let i_lo = ((centre.x - reach - self.x0) / r).floor().max(0.0);
+        let i_hi = ((centre.x + reach - self.x0) / r)
+            .ceil()
+            .min(self.nx as f64);
+        let j_lo = ((centre.y - reach - self.y0) / r).floor().max(0.0);
+        let j_hi = ((centre.y + reach - self.y0) / r)
+            .ceil()
+            .min(self.ny as f64);
+        if !(i_lo < i_hi && j_lo < j_hi) {
+            return;
+        }
+        let (i_lo, i_hi, j_lo, j_hi) = (i_lo as usize, i_hi as usize, j_lo as usize, j_hi as usize);
+        let inv = 1.0 / (2.0 * sigma * sigma);
+        let gauss = |offset: f64| (-offset * offset * inv).exp();
+        self.gx.clear();
+        self.gx
+            .extend((i_lo..i_hi).map(|i| gauss(self.x0 + (i as f64 + 0.5) * r - centre.x)));
+        for j in j_lo..j_hi {
+            let gy = peak * gauss(self.y0 + (j as f64 + 0.5) * r - centre.y);
+            if gy < FOOTPRINT_FLOOR {
+                continue;
+            }
+            let row = &self.index[j * self.nx + i_lo..j * self.nx + i_hi];
+            for (&k, &gx) in row.iter().zip(&self.gx) {
+                let v = gy * gx;
+                if k == u32::MAX || v < FOOTPRINT_FLOOR {
+                    continue;
+                }
+                let k = k as usize;
+                if v > self.scratch[k] {
+                    if self.scratch[k] == 0.0 {
+                        self.touched.push(k);
+                    }
+                    self.scratch[k] = v;
+                }
+            }
+        }
+    }
+
+    /// Takes one chemical sample into account: taken at `pos_m` (estimated), time `t_s`,
+    /// altitude `altitude_m` (if known), detection or not.
+    pub fn observe(&mut self, pos_m: Vec2, t_s: f64, altitude_m: Option<f64>, detected: bool) {
+        if !(pos_m.x.is_finite() && pos_m.y.is_finite() && t_s.is_finite()) {
+            return;
+        }
+        let weight = match self.last_sample_s {
+            Some(l) if self.model.correlation_s > 0.0 => {
+                ((t_s - l) / self.model.correlation_s).clamp(0.0, 1.0)
+            }
+            _ => 1.0,
+        };
+        self.last_sample_s = Some(t_s);
+        self.updates += 1;
+        if weight <= 0.0 {
+            return;
+        }
+        self.footprint(pos_m, t_s, altitude_m);
+        let (pd, pf) = (self.model.p_detect, self.model.p_false);
+        for &k in &self.touched {
+            let p = pf + (pd - pf) * self.scratch[k];
+            // Relative to the cells outside the footprint (factor pf or 1 - pf).
+            let l = if detected {
+                (p / pf).ln()
+            } else {
+                ((1.0 - p) / (1.0 - pf)).ln()
+            };
+            self.log_p[k] += weight * l;
+        }
+        self.dirty = true;
+    }
+
+    /// Normalises the posterior if samples came since the last time (reading the map does this,
+    /// so what is read always sums to 1).
+    fn normalise(&mut self) {
+        if !self.dirty {
+            return;
+        }
+        self.dirty = false;
+        let max = self.log_p.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+        if !max.is_finite() {
+            return;
+        }
+        let s: f64 = self.log_p.iter().map(|l| (l - max).exp()).sum();
+        let lse = max + s.ln();
+        for (l, p) in self.log_p.iter_mut().zip(self.p.iter_mut()) {
+            *l -= lse;
+            *p = l.exp();
+        }
+    }
+
+    /// For a candidate move: the probability of at least one detection among `samples`
+    /// independent samples taken at `pos_m` at time `t_s` (flow held at its last reading), for
+    /// every candidate source cell, into `out`.
+    pub fn hit_probabilities(
+        &mut self,
+        pos_m: Vec2,
+        t_s: f64,
+        altitude_m: Option<f64>,
+        samples: f64,
+        out: &mut Vec<f64>,
+    ) {
+        let (pd, pf) = (self.model.p_detect, self.model.p_false);
+        let n = samples.max(1.0);
+        let any = |p: f64| 1.0 - (1.0 - p).powf(n);
+        out.clear();
+        out.resize(self.len(), any(pf));
+        self.footprint(pos_m, t_s, altitude_m);
+        for &k in &self.touched {
+            out[k] = any(pf + (pd - pf) * self.scratch[k]);
+        }
+    }
+
+    /// Back to the uniform prior (the flow history is kept).
+    pub fn reset(&mut self) {
+        let n = self.len();
+        self.log_p.fill(-(n as f64).ln());
+        self.p.fill(1.0 / n as f64);
+        self.dirty = false;
+    }
+
+    /// The posterior as telemetry: `log10 p` per grid cell, rounded to 0.01, floored at -12
+    /// (cells outside the op-area too).
+    pub fn raster(&mut self) -> plumetrace_core::Telemetry {
+        self.normalise();
+        let log10_p = self
+            .index
+            .iter()
+            .map(|&k| {
+                let l = if k == u32::MAX {
+                    -12.0
+                } else {
+                    (self.log_p[k as usize] / std::f64::consts::LN_10).max(-12.0)
+                };
+                ((l * 100.0).round() / 100.0) as f32
+            })
+            .collect();
+        plumetrace_core::Telemetry::SourceMapRaster {
+            origin_m: Vec2::new(self.x0, self.y0),
+            cell_m: self.model.resolution_m,
+            nx: self.nx,
+            ny: self.ny,
+            log10_p,
+        }
+    }
+
+    /// The entropy of the posterior, bits.
+    pub fn entropy_bits(&mut self) -> f64 {
+        crate::estimate::entropy_bits(self.probabilities())
+    }
+
+    /// The most likely candidate: its centre and probability.
+    pub fn most_likely(&mut self) -> (Vec2, f64) {
+        self.normalise();
+        let (k, p) = self
+            .p
+            .iter()
+            .enumerate()
+            .fold((0, f64::MIN), |b, (k, &p)| if p > b.1 { (k, p) } else { b });
+        (self.centres[k], p)
+    }
+
+    /// The posterior mass within `radius_m` of `centre`.
+    pub fn mass_within(&mut self, centre: Vec2, radius_m: f64) -> f64 {
+        self.normalise();
+        let r = self.model.resolution_m;
+        let i_lo = ((centre.x - radius_m - self.x0) / r).floor().max(0.0) as usize;
+        let i_hi = ((centre.x + radius_m - self.x0) / r)
+            .ceil()
+            .clamp(0.0, self.nx as f64) as usize;
+        let j_lo = ((centre.y - radius_m - self.y0) / r).floor().max(0.0) as usize;
+        let j_hi = ((centre.y + radius_m - self.y0) / r)
+            .ceil()
+            .clamp(0.0, self.ny as f64) as usize;
+        let mut m = 0.0;
+        for j in j_lo..j_hi {
+            for i in i_lo..i_hi {
+                let k = self.index[j * self.nx + i];
+                if k != u32::MAX && (self.centres[k as usize] - centre).norm() <= radius_m {
+                    m += self.p[k as usize];
+                }
+            }
+        }
+        m
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn area() -> OpArea {
+        OpArea::rectangle(0.0, 400.0, 0.0, 200.0).unwrap_or_else(|e| panic!("{e}"))
+    }
+
+    fn model() -> MapModel {
+        MapModel {
+            resolution_m: 5.0,
+            window_s: 2000.0,
+            vertical_diffusivity_m2ps: 0.0,
+            ..MapModel::default()
+        }
+    }
+
+    /// A deterministic stream of samples from a source at (100, 100) in a uniform current of
+    /// 0.2 m/s towards East: the vehicle zigzags across the plume 100-300 m downflow; a sample
+    /// detects when it is within 10 m of the centreline, one in three of those (a fixed pattern).
+    fn detections(map: &mut SourceMap, steps: usize, check: &mut dyn FnMut(&mut SourceMap)) {
+        for k in 0..steps {
+            let t = k as f64;
+            map.add_flow(t, Vec2::new(0.2, 0.0));
+            let x = 300.0 - (k as f64 * 0.5) % 200.0;
+            let y = 100.0 + 40.0 * ((k as f64) * 0.05).sin();
+            let near = (y - 100.0).abs() < 10.0;
+            map.observe(Vec2::new(x, y), t, Some(2.0), near && k % 3 == 0);
+            check(map);
+        }
+    }
+
+    #[test]
+    fn detections_from_a_known_source_concentrate_the_map_on_it() {
+        let mut m = SourceMap::new(&area(), model()).unwrap_or_else(|| panic!("no map"));
+        let h0 = m.entropy_bits();
+        detections(&mut m, 1500, &mut |_| {});
+        let (best, _) = m.most_likely();
+        let upflow_mass = m.mass_within(Vec2::new(100.0, 100.0), 60.0);
+        assert!(m.entropy_bits() < h0 - 3.0, "{} vs {h0}", m.entropy_bits());
+        assert!((best.y - 100.0).abs() < 15.0, "across: {best:?}");
+        assert!(
+            best.x < 200.0,
+            "upflow of where the vehicle sampled: {best:?}"
+        );
+        assert!(upflow_mass > 0.3, "{upflow_mass}");
+    }
+
+    #[test]
+    fn the_mass_is_one_after_every_update() {
+        let mut m = SourceMap::new(&area(), model()).unwrap_or_else(|| panic!("no map"));
+        let mut worst: f64 = 0.0;
+        detections(&mut m, 400, &mut |m| {
+            let s: f64 = m.probabilities().iter().sum();
+            worst = worst.max((s - 1.0).abs());
+        });
+        assert!(worst < 1e-9, "{worst}");
+        assert_eq!(m.updates(), 400);
+    }
+
+    #[test]
+    fn non_detections_never_raise_a_cell_above_the_cells_they_say_nothing_about() {
+        let mut m = SourceMap::new(&area(), model()).unwrap_or_else(|| panic!("no map"));
+        // A far corner the footprints never reach (they run upflow, West, of y 100 +- 40).
+        let far = m
+            .candidate_at(Vec2::new(390.0, 5.0))
+            .unwrap_or_else(|| panic!("no cell"));
+        for k in 0..300 {
+            let t = k as f64;
+            m.add_flow(t, Vec2::new(0.2, 0.0));
+            let before = m.probabilities().to_vec();
+            let x = 300.0 - k as f64 * 0.5;
+            m.observe(Vec2::new(x, 100.0), t, Some(2.0), false);
+            let after = m.probabilities().to_vec();
+            let ratio_far = after[far] / before[far];
+            for (a, b) in after.iter().zip(&before) {
+                assert!(
+                    a / b <= ratio_far * (1.0 + 1e-12),
+                    "a cell rose: {a} from {b}"
+                );
+            }
+        }
+        let (best, _) = m.most_likely();
+        // The cells upflow of the track lost mass; the argmax is not among them.
+        assert!((best.y - 100.0).abs() > 10.0 || best.x > 300.0, "{best:?}");
+    }
+
+    #[test]
+    fn the_same_samples_give_the_same_map() {
+        let run = || {
+            let mut m = SourceMap::new(&area(), model()).unwrap_or_else(|| panic!("no map"));
+            detections(&mut m, 300, &mut |_| {});
+            m
+        };
+        let (mut a, mut b) = (run(), run());
+        assert_eq!(a.log_probabilities(), b.log_probabilities());
+    }
+
+    #[test]
+    fn a_bottom_source_is_not_seen_from_altitude_close_by() {
+        let model = MapModel {
+            vertical_diffusivity_m2ps: 0.002,
+            dilution_s: 0.0,
+            ..model()
+        };
+        let mut m = SourceMap::new(&area(), model).unwrap_or_else(|| panic!("no map"));
+        m.add_flow(0.0, Vec2::new(0.2, 0.0));
+        m.observe(Vec2::new(300.0, 100.0), 0.0, Some(2.0), true);
+        // 2 m up with K_z = 0.002: exp(-4 / (0.008 T)) is small for T < 100 s (20 m).
+        let (i_near, i_mid) = (
+            m.candidate_at(Vec2::new(290.0, 100.0)).unwrap_or(0),
+            m.candidate_at(Vec2::new(100.0, 100.0)).unwrap_or(0),
+        );
+        let p = m.probabilities();
+        let (near, mid) = (p[i_near], p[i_mid]);
+        assert!(mid > 5.0 * near, "{mid} vs {near}");
+    }
+
+    #[test]
+    fn flow_history_integrates_held_readings() {
+        let mut f = FlowHistory::default();
+        f.add(0.0, Vec2::new(1.0, 0.0), 100.0);
+        f.add(10.0, Vec2::new(0.0, 1.0), 100.0);
+        let d = f.at(15.0) - f.at(5.0);
+        assert!((d - Vec2::new(5.0, 5.0)).norm() < 1e-12, "{d:?}");
+        let before = f.at(-5.0) - f.at(0.0);
+        assert!((before - Vec2::new(-5.0, 0.0)).norm() < 1e-12);
+    }
+}
