@@ -5,7 +5,7 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 cargo build --quiet --bin plumetrace
-bin=target/debug/plumetrace
+bin="${CARGO_TARGET_DIR:-target}/debug/plumetrace"
 python3 - "$bin" <<'PY'
 import subprocess, sys
 bin = sys.argv[1]

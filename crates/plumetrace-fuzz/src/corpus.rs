@@ -67,6 +67,26 @@ pub const CAMPAIGNS: &[(&str, &str)] = &[
         "mt-lost-points",
         include_str!("../../../examples/campaigns/mt-lost-points.toml"),
     ),
+    (
+        "formation-soares",
+        include_str!("../../../examples/campaigns/formation-soares.toml"),
+    ),
+    (
+        "formation-soares-filaments",
+        include_str!("../../../examples/campaigns/formation-soares-filaments.toml"),
+    ),
+    (
+        "map-declaration-coastal",
+        include_str!("../../../examples/campaigns/map-declaration-coastal.toml"),
+    ),
+    (
+        "map-declaration-duck",
+        include_str!("../../../examples/campaigns/map-declaration-duck.toml"),
+    ),
+    (
+        "probabilistic",
+        include_str!("../../../examples/campaigns/probabilistic.toml"),
+    ),
 ];
 
 /// The example families (`examples/families/*.family.toml`; a test checks the list is complete).
