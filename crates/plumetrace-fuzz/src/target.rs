@@ -39,7 +39,8 @@ pub const PLUME_STEP_CAP: u64 = 200;
 pub const SLOW_S: f64 = 1.0;
 
 /// Summary fields that may be JSON null (the `Option` fields of
-/// `plumetrace_mission::summary`; array indices written `[]`). Any other null is a number
+/// `plumetrace_mission::summary` and of its team summary, `plumetrace_mission::team`; array
+/// indices written `[]`). Any other null is a number
 /// that was not finite.
 const NULLABLE: &[&str] = &[
     "first_declaration",
@@ -52,6 +53,17 @@ const NULLABLE: &[&str] = &[
     "vehicles[].first_detection_s",
     "vehicles[].longest_quiet_s",
     "vehicles[].longest_quiet_behaviour",
+    "team",
+    "team.converged_s",
+    "team.range_error_median_m",
+    "team.range_error_p90_m",
+    "team.range_setpoint_m",
+    "team.centroid_cross_median_m",
+    "team.centroid_cross_final_m",
+    "team.distance_overhead",
+    "team.scale_min",
+    "team.scale_max",
+    "team.scale_final",
 ];
 
 /// What happened to one input.
