@@ -44,14 +44,8 @@ impl Observer for AlogObserver {
         if self.error.is_some() {
             return;
         }
-        for (k, (s, d)) in step
-            .report
-            .snapshots
-            .iter()
-            .zip(&step.report.decisions)
-            .enumerate()
-        {
-            let (Some(s), Some(d), Some(Some((path, w)))) = (s, d, self.writers.get_mut(k)) else {
+        for (k, s, d) in step.decided() {
+            let Some(Some((path, w))) = self.writers.get_mut(k) else {
                 continue;
             };
             if let Err(e) = w.decision(s, d) {

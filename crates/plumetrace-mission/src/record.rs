@@ -26,6 +26,27 @@ pub struct StepView<'a> {
     pub statuses: &'a [VehicleStatus],
 }
 
+impl StepView<'_> {
+    /// Each vehicle that decided this step, with the snapshot it decided on (recorded only when
+    /// an observer wants snapshots) and its decision, by vehicle index.
+    pub fn decided(
+        &self,
+    ) -> impl Iterator<
+        Item = (
+            usize,
+            &plumetrace_core::SensorSnapshot,
+            &plumetrace_core::Decision,
+        ),
+    > {
+        self.report
+            .snapshots
+            .iter()
+            .zip(&self.report.decisions)
+            .enumerate()
+            .filter_map(|(k, (s, d))| Some((k, s.as_ref()?, d.as_ref()?)))
+    }
+}
+
 /// Something that records a mission as it runs.
 pub trait Observer: Send {
     /// Looks at one step.

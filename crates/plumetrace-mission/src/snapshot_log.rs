@@ -43,16 +43,7 @@ impl Observer for SnapshotLogWriter {
         if self.error.is_some() {
             return;
         }
-        for (k, (s, d)) in step
-            .report
-            .snapshots
-            .iter()
-            .zip(&step.report.decisions)
-            .enumerate()
-        {
-            let (Some(snapshot), Some(decision)) = (s, d) else {
-                continue;
-            };
+        for (k, snapshot, decision) in step.decided() {
             if let Err(e) = self.file.write(k as u32, snapshot, decision) {
                 self.error = Some(e);
                 return;

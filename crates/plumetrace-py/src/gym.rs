@@ -178,13 +178,7 @@ impl Maker {
             _ => VerticalCommand::Altitude(v.vehicle.state.z_m),
         };
         let area = setup.geometry.op_area.clone();
-        let (mut x0, mut x1, mut y0, mut y1) = (f64::MAX, f64::MIN, f64::MAX, f64::MIN);
-        for p in area.vertices() {
-            x0 = x0.min(p.x);
-            x1 = x1.max(p.x);
-            y0 = y0.min(p.y);
-            y1 = y1.max(p.y);
-        }
+        let (x0, x1, y0, y1) = plumetrace_mission::record::bounds_of(area.vertices());
         let mut mission = Mission::new(
             setup,
             MissionOptions {
