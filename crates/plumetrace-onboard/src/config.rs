@@ -48,6 +48,9 @@ pub struct OnboardFile {
     /// The chemical sensor.
     #[serde(default)]
     pub chemical: ChemicalFile,
+    /// The current meter (`None`: no measured current; the planner keeps the prior flow).
+    #[serde(default)]
+    pub flow: Option<FlowFile>,
     /// How time runs.
     #[serde(default)]
     pub run: RunFile,
@@ -247,6 +250,27 @@ impl ChemicalFile {
     }
 }
 
+/// `[flow]`: a current meter (ADCP or DVL) writing NMEA 0183 `$--CUR` sentences (see
+/// [`crate::current`]), and where its lines come from.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct FlowFile {
+    /// Only this layer's readings (0 to 99; left out: every reading).
+    pub layer: Option<u32>,
+    /// A separate TCP source (`host:port`); neither this nor `device`: the lines travel on the
+    /// vehicle link.
+    pub address: Option<String>,
+    /// A separate serial device.
+    pub device: Option<PathBuf>,
+}
+
+impl FlowFile {
+    /// The line format.
+    pub fn line_format(&self) -> crate::current::FlowFormat {
+        crate::current::FlowFormat { layer: self.layer }
+    }
+}
+
 /// How time runs.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
@@ -420,6 +444,14 @@ impl Onboard {
                 ));
             }
             in_range("chemical.field", *field as f64, 1.0, 40.0, false)?;
+        }
+        if let Some(fl) = &file.flow {
+            if fl.address.is_some() && fl.device.is_some() {
+                return Err(err("flow", "give address or device, not both"));
+            }
+            if let Some(layer) = fl.layer {
+                in_range("flow.layer", f64::from(layer), 0.0, 99.0, false)?;
+            }
         }
         let context = BuildContext {
             geometry,
