@@ -727,6 +727,11 @@ pub fn run(args: &FrontseatArgs) -> Result<()> {
             bail!("{name}: {v} is outside [0, 3600]");
         }
     }
+    if args.protocol == Protocol::Iver && args.lock_step && args.silent_at.is_some() {
+        bail!(
+            "--silent-at: Iver sentences carry no time, so in lock-step a back seat cannot see navigation missing for a span of mission time; use --restart-at (the serial line silent for a span of wall time)"
+        );
+    }
     let origin = parse_origin(&args.origin)?;
     let frame = LocalFrame::new(origin).map_err(anyhow::Error::msg)?;
     let sc = crate::run::load(args.scenario.as_deref(), args.preset.as_deref(), args.seed)?;

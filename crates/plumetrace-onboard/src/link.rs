@@ -87,6 +87,8 @@ pub trait Link {
     fn counts(&self) -> &LineCounts;
     /// Whether the link is connected.
     fn connected(&self) -> bool;
+    /// Ends the link after the last send, so that what was sent reaches the other side.
+    fn close(&mut self) {}
 }
 
 /// One protocol's side of a link: what to say on connecting, how to read a line, how to write a
@@ -791,5 +793,28 @@ impl Link for LineLink {
 
     fn connected(&self) -> bool {
         self.conn.is_some()
+    }
+
+    fn close(&mut self) {
+        if let Some(t) = self.traffic.as_mut() {
+            let _ = t.flush();
+        }
+        // Closing a TCP socket with unread data resets the connection, and the other side may
+        // then drop what it had not read yet (the final stop): end the sending side, then read
+        // what is left until the other side closes or half a second has passed.
+        if let Some(Conn::Tcp(s)) = self.conn.as_mut() {
+            let _ = s.flush();
+            let _ = s.shutdown(std::net::Shutdown::Write);
+            let deadline = Instant::now() + Duration::from_millis(500);
+            let mut chunk = [0u8; 4096];
+            while Instant::now() < deadline {
+                let left = deadline.saturating_duration_since(Instant::now());
+                match read_tcp(s, &mut chunk, left.min(Duration::from_millis(50))) {
+                    Ok(_) => {}
+                    Err(_) => break,
+                }
+            }
+        }
+        self.conn = None;
     }
 }

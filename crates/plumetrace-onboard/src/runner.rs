@@ -449,13 +449,14 @@ pub fn run_with_inputs(
                     PlanStatus::Running => {}
                     PlanStatus::Finished | PlanStatus::Abort => {
                         link.send(Outgoing::Finished, s.stamp());
+                        s.report.lines = link.counts().clone();
+                        link.close();
                         s.report.time_s = t;
                         s.report.end = if decision.status == PlanStatus::Finished {
                             RunEnd::Finished
                         } else {
                             RunEnd::Aborted
                         };
-                        s.report.lines = link.counts().clone();
                         return Ok(s.report);
                     }
                 }
@@ -499,6 +500,7 @@ pub fn run_with_inputs(
     s.report.end = end;
     s.report.time_s = s.now_s();
     s.report.lines = link.counts().clone();
+    link.close();
     Ok(s.report)
 }
 
