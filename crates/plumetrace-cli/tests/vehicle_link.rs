@@ -611,4 +611,24 @@ fn bad_onboard_files_and_front_seat_flags_name_what_and_where() {
         let e = String::from_utf8_lossy(&o.stderr);
         assert!(e.contains(flag), "{flag}: {e}");
     }
+    // Iver sentences carry no time: a silence in mission time is refused in lock-step.
+    let o = common::bin()
+        .args([
+            "frontseat",
+            "--preset",
+            "demo",
+            "--protocol",
+            "iver",
+            "--lock-step",
+            "--silent-at",
+            "300",
+        ])
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(1));
+    let e = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        e.contains("--silent-at") && e.contains("--restart-at"),
+        "{e}"
+    );
 }

@@ -534,6 +534,33 @@ origin = { lat_deg = 36.18, lon_deg = -75.75 }
     }
 
     #[test]
+    fn the_flow_table_is_optional_and_checked() {
+        let o = Onboard::from_toml(GOOD).unwrap_or_else(|e| panic!("{e}"));
+        assert_eq!(
+            o.file.flow, None,
+            "no current meter unless a [flow] table is given"
+        );
+        let on_link = format!("{GOOD}\n[flow]\n");
+        let o = Onboard::from_toml(&on_link).unwrap_or_else(|e| panic!("{e}"));
+        assert_eq!(o.file.flow, Some(FlowFile::default()));
+        let own = format!("{GOOD}\n[flow]\nlayer = 3\naddress = \"127.0.0.1:4001\"\n");
+        let o = Onboard::from_toml(&own).unwrap_or_else(|e| panic!("{e}"));
+        assert_eq!(o.file.flow.as_ref().and_then(|f| f.layer), Some(3));
+        for (bad, key) in [
+            ("layer = 100", "flow.layer"),
+            ("address = \"a:1\"\ndevice = \"/dev/ttyS1\"", "flow"),
+            ("rate = 1", "flow"),
+        ] {
+            let text = format!("{GOOD}\n[flow]\n{bad}\n");
+            let e = Onboard::from_toml(&text).err();
+            assert!(
+                e.as_ref().is_some_and(|e| e.key.starts_with(key)),
+                "{bad}: {e:?}"
+            );
+        }
+    }
+
+    #[test]
     fn bad_files_name_the_key() {
         let cases = [
             ("protocol = \"bluefin\"", "protocl = \"bluefin\"", "link"),
