@@ -3,8 +3,13 @@
 //!
 //! Safety comes first. The planner is paused, and the link sends the protocol's safe command
 //! (or nothing, as configured), when navigation is older than `link.stale_nav_s`, when the link
-//! is lost (it reconnects with back-off meanwhile) or when the front seat says it does not
-//! accept commands; it resumes with the next fresh navigation record. A command that fails the
+//! is lost (it reconnects with back-off meanwhile), when a serial line has been silent for
+//! `link.silence_timeout_s` (the device stays open) or when the front seat says it does not
+//! accept commands; it resumes with the next fresh navigation record.
+//!
+//! Current readings (the `[flow]` table: `$--CUR` sentences on the vehicle link or an input of
+//! their own) go into every snapshot as the latest [`FlowSample`], stamped on arrival, as a
+//! simulated flow sensor's do; without them the planner keeps the prior flow direction. A command that fails the
 //! chokepoint is not sent (the previous one stands) and is counted.
 //!
 //! Time is either the wall clock (`real_time`) or the front seat's (`lock_step`): mission time
