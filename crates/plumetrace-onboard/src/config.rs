@@ -611,6 +611,90 @@ origin = { lat_deg = 36.18, lon_deg = -75.75 }
         );
     }
 
+    fn moos_file(link_moos: &str, chemical: &str) -> String {
+        let link = "protocol = \"bluefin\"\naddress = \"127.0.0.1:29500\"";
+        let text = GOOD.replacen(link, "protocol = \"moos\"", 1);
+        format!("{text}{link_moos}{chemical}")
+    }
+
+    #[cfg(not(feature = "moos"))]
+    #[test]
+    fn without_the_feature_the_moos_link_says_how_to_build_it() {
+        let text = moos_file("[link.moos]\nchem_variable = \"CHEM\"\n", "");
+        let e = Onboard::from_toml(&text).err();
+        assert_eq!(e.as_ref().map(|e| e.key.as_str()), Some("link.protocol"));
+        assert!(
+            e.is_some_and(|e| e.message.contains("--features moos")),
+            "the error says how to build with it"
+        );
+    }
+
+    #[cfg(feature = "moos")]
+    #[test]
+    fn the_moos_keys_have_defaults_and_bounds() {
+        let text = moos_file("[link.moos]\nchem_variable = \"CHEM\"\n", "");
+        let o = Onboard::from_toml(&text).unwrap_or_else(|e| panic!("{e}"));
+        let m = o.file.link.moos.unwrap_or_default();
+        assert_eq!((m.host.as_str(), m.port), ("localhost", 9000));
+        assert_eq!(m.app_name, "pPlumetrace");
+        let separate = moos_file("", "[chemical]\naddress = \"127.0.0.1:4000\"\n");
+        assert!(Onboard::from_toml(&separate).is_ok());
+        let cases = [
+            (moos_file("", ""), "link.moos.chem_variable"),
+            (
+                moos_file(
+                    "[link.moos]\nchem_variable = \"C\"\n",
+                    "[chemical]\naddress = \"127.0.0.1:4000\"\n",
+                ),
+                "link.moos.chem_variable",
+            ),
+            (
+                moos_file("[link.moos]\nchem_variable = \"A B\"\n", ""),
+                "link.moos.chem_variable",
+            ),
+            (
+                moos_file("[link.moos]\nchem_variable = \"C\"\nport = 0\n", ""),
+                "link.moos.port",
+            ),
+            (
+                moos_file("[link.moos]\nchem_variable = \"C\"\nport = 70000\n", ""),
+                "link.moos.port",
+            ),
+            (
+                moos_file("[link.moos]\nchem_variable = \"C\"\napp_name = \"\"\n", ""),
+                "link.moos.app_name",
+            ),
+            (
+                moos_file("[link.moos]\nchem_variable = \"C\"\nhost = \"a b\"\n", ""),
+                "link.moos.host",
+            ),
+            (
+                moos_file("[link.moos]\nchem_variable = \"C\"\nrate = 1\n", ""),
+                "link.moos",
+            ),
+            (
+                moos_file("[link.moos]\nchem_variable = \"C\"\n", "").replacen(
+                    "protocol = \"moos\"",
+                    "protocol = \"moos\"\naddress = \"h:1\"",
+                    1,
+                ),
+                "link.address",
+            ),
+            (
+                format!("{GOOD}[link.moos]\nchem_variable = \"C\"\n"),
+                "link.moos",
+            ),
+        ];
+        for (text, key) in cases {
+            let e = Onboard::from_toml(&text).err();
+            let got = e.as_ref().map(|e| e.key.clone());
+            assert!(
+                got.as_deref().is_some_and(|g| g.starts_with(key)),
+                "{text}: {e:?}"
+            );
+        }
+    }
+
     #[test]
     fn bad_files_name_the_key() {
         let cases = [
