@@ -1,7 +1,8 @@
 //! The MOOS link against an in-process fake MOOSDB (a TCP listener thread speaking the wire
 //! format of `plumetrace_onboard::moos`): the handshake, registrations, navigation in, set-points
 //! out, a registered planner flying a simple simulated vehicle in the loop, pauses on stale
-//! navigation, reconnection after the server drops the connection or sends an unreadable stream,
+//! navigation, lock-step time from the postings, reconnection after the server drops the
+//! connection or sends an unreadable stream,
 //! and bad packets counted and never acted on.
 
 #![allow(clippy::unwrap_used, clippy::expect_used)]
@@ -296,7 +297,7 @@ fn fake_moosdb(script: Script) -> (u16, std::thread::JoinHandle<Record>) {
     (port, handle)
 }
 
-fn onboard(port: u16, time_limit_s: f64) -> Onboard {
+fn onboard(port: u16, time_limit_s: f64, mode: &str) -> Onboard {
     let text = format!(
         r#"
 [mission]
@@ -317,6 +318,7 @@ app_name = "pPlumetrace"
 chem_variable = "CHEM_READING"
 [run]
 time_limit_s = {time_limit_s}
+mode = "{mode}"
 "#
     );
     Onboard::from_toml(&text).unwrap_or_else(|e| panic!("{e}"))
@@ -325,13 +327,18 @@ time_limit_s = {time_limit_s}
 /// Flies the AMP against the fake server; returns the run's report, what the server saw and
 /// the traffic log.
 fn fly(script: Script, time_limit_s: f64) -> (RunReport, Record, String) {
+    fly_in(script, time_limit_s, "real_time")
+}
+
+/// [`fly`] with the run's `mode`.
+fn fly_in(script: Script, time_limit_s: f64, mode: &str) -> (RunReport, Record, String) {
     let (port, server) = fake_moosdb(Script {
         end_at: time_limit_s + 1.0,
         ..script
     });
     let dir = tempfile::tempdir().unwrap();
     let log = dir.path().join("link.log");
-    let o = onboard(port, time_limit_s);
+    let o = onboard(port, time_limit_s, mode);
     let traffic = std::fs::File::create(&log).unwrap();
     let mut link = runner::link_for(&o, Some(Box::new(traffic))).unwrap();
     let report = runner::run(&o, &mut *link, None, &mut |_, _| {}).unwrap();
@@ -553,4 +560,26 @@ fn a_dropped_connection_and_an_unreadable_stream_lead_to_reconnection() {
             "no set-points on connection {conn}"
         );
     }
+}
+
+/// In lock-step mission time is the MOOS time of the postings and every navigation record
+/// gets its set-points back.
+#[test]
+fn in_lock_step_mission_time_comes_from_the_postings() {
+    let (report, rec, _) = fly_in(Script::default(), 2.0, "lock_step");
+    assert_eq!(report.end, RunEnd::TimeLimit, "{report:?}");
+    // The time limit is reached on the postings' clock (they come every 0.1 s).
+    assert!((2.0..2.3).contains(&report.time_s), "{}", report.time_s);
+    assert!(report.nav_records >= 15, "{report:?}");
+    // One command per record once the first decision is made.
+    assert!(
+        report.commands_sent + 1 >= report.nav_records,
+        "{} commands for {} records",
+        report.commands_sent,
+        report.nav_records
+    );
+    assert_eq!(
+        rec.values("DESIRED_HEADING").len() as u64,
+        report.commands_sent
+    );
 }
