@@ -2,8 +2,8 @@
 //! format of `plumetrace_onboard::moos`): the handshake, registrations, navigation in, set-points
 //! out, a registered planner flying a simple simulated vehicle in the loop, pauses on stale
 //! navigation, lock-step time from the postings, reconnection after the server drops the
-//! connection or sends an unreadable stream,
-//! and bad packets counted and never acted on.
+//! connection or sends an unreadable stream, a refused name, the manual override, and bad
+//! packets counted and never acted on.
 
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
