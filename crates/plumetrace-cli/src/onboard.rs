@@ -89,7 +89,9 @@ pub fn run(args: &OnboardArgs) -> Result<()> {
     let traffic_path = args.out.join("link.log");
     let traffic = std::fs::File::create(&traffic_path)
         .with_context(|| format!("creating {}", traffic_path.display()))?;
-    let mut link = runner::link_for(&onboard, Some(Box::new(std::io::BufWriter::new(traffic))));
+    let mut link = runner::link_for(&onboard, Some(Box::new(std::io::BufWriter::new(traffic))))
+        .map_err(anyhow::Error::msg)
+        .with_context(|| format!("{}", args.file.display()))?;
     let chem_traffic = match &onboard.file.chemical {
         c if c.address.is_some() || c.device.is_some() => {
             let p = args.out.join("chem.log");
@@ -126,7 +128,7 @@ pub fn run(args: &OnboardArgs) -> Result<()> {
     let mut inputs: Vec<&mut dyn plumetrace_onboard::link::Link> = Vec::new();
     inputs.extend(chem.as_mut().map(|c| c as _));
     inputs.extend(flow.as_mut().map(|c| c as _));
-    let report = runner::run_with_inputs(&onboard, &mut link, &mut inputs, &mut |s, d| {
+    let report = runner::run_with_inputs(&onboard, &mut *link, &mut inputs, &mut |s, d| {
         if log_error.is_none() {
             let written = log
                 .write(0, s, d)

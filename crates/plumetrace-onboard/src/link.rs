@@ -89,6 +89,15 @@ pub trait Link {
     fn connected(&self) -> bool;
     /// Ends the link after the last send, so that what was sent reaches the other side.
     fn close(&mut self) {}
+    /// What the planner decided from a snapshot (before its command is sent). A link that
+    /// publishes more than set-points (MOOS: behaviour, detections, declarations) uses it;
+    /// the others ignore it.
+    fn decided(
+        &mut self,
+        _snapshot: &plumetrace_core::SensorSnapshot,
+        _decision: &plumetrace_core::Decision,
+    ) {
+    }
 }
 
 /// One protocol's side of a link: what to say on connecting, how to read a line, how to write a

@@ -97,8 +97,12 @@ fn timing(l: &crate::config::LinkFile) -> LinkTiming {
     }
 }
 
-/// Makes the link an onboard file describes; raw traffic goes to `traffic`.
-pub fn link_for(onboard: &Onboard, traffic: Option<Box<dyn Write + Send>>) -> LineLink {
+/// Makes the link an onboard file describes; raw traffic goes to `traffic`. An error when the
+/// file asks for a link this build does not have (MOOS without the `moos` feature).
+pub fn link_for(
+    onboard: &Onboard,
+    traffic: Option<Box<dyn Write + Send>>,
+) -> Result<Box<dyn Link>, String> {
     let l = &onboard.file.link;
     let secs = Duration::from_secs_f64;
     let safe_stop = l.safe_command == SafeAction::Stop;
@@ -127,6 +131,13 @@ pub fn link_for(onboard: &Onboard, traffic: Option<Box<dyn Write + Send>>) -> Li
                 safe_stop,
             })),
         ),
+        #[cfg(feature = "moos")]
+        ProtocolKind::Moos => {
+            return crate::moos::MoosLink::for_onboard(onboard, timing(l), traffic)
+                .map(|m| Box::new(m) as Box<dyn Link>);
+        }
+        #[cfg(not(feature = "moos"))]
+        ProtocolKind::Moos => return Err(crate::config::MOOS_MISSING.into()),
     };
     let c = &onboard.file.chemical;
     let on_link = c.address.is_none() && c.device.is_none();
@@ -146,7 +157,7 @@ pub fn link_for(onboard: &Onboard, traffic: Option<Box<dyn Write + Send>>) -> Li
         link = link.with_flow(f.line_format());
     }
     link.set_lock_step(onboard.file.run.mode == RunMode::LockStep);
-    link
+    Ok(Box::new(link))
 }
 
 /// Where the current meter's lines come from when not on the vehicle link.
@@ -445,6 +456,7 @@ pub fn run_with_inputs(
                 s.report.decisions += 1;
                 next_decision_s = if period > 0.0 { t + period } else { t };
                 observe(&snapshot, &decision);
+                link.decided(&snapshot, &decision);
                 for e in &decision.events {
                     if let PlannerEvent::Declared { pos_m, .. } = e {
                         s.report.declarations.push(*pos_m);
