@@ -48,6 +48,9 @@ pub struct OnboardFile {
     /// The chemical sensor.
     #[serde(default)]
     pub chemical: ChemicalFile,
+    /// The current meter (`None`: no measured current; the planner keeps the prior flow).
+    #[serde(default)]
+    pub flow: Option<FlowFile>,
     /// How time runs.
     #[serde(default)]
     pub run: RunFile,
@@ -301,6 +304,27 @@ impl ChemicalFile {
     }
 }
 
+/// `[flow]`: a current meter (ADCP or DVL) writing NMEA 0183 `$--CUR` sentences (see
+/// [`crate::current`]), and where its lines come from.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct FlowFile {
+    /// Only this layer's readings (0 to 99; left out: every reading).
+    pub layer: Option<u32>,
+    /// A separate TCP source (`host:port`); neither this nor `device`: the lines travel on the
+    /// vehicle link.
+    pub address: Option<String>,
+    /// A separate serial device.
+    pub device: Option<PathBuf>,
+}
+
+impl FlowFile {
+    /// The line format.
+    pub fn line_format(&self) -> crate::current::FlowFormat {
+        crate::current::FlowFormat { layer: self.layer }
+    }
+}
+
 /// How time runs.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
@@ -478,6 +502,14 @@ impl Onboard {
                 ));
             }
             in_range("chemical.field", *field as f64, 1.0, 40.0, false)?;
+        }
+        if let Some(fl) = &file.flow {
+            if fl.address.is_some() && fl.device.is_some() {
+                return Err(err("flow", "give address or device, not both"));
+            }
+            if let Some(layer) = fl.layer {
+                in_range("flow.layer", f64::from(layer), 0.0, 99.0, false)?;
+            }
         }
         let context = BuildContext {
             geometry,
@@ -691,6 +723,33 @@ origin = { lat_deg = 36.18, lon_deg = -75.75 }
             assert!(
                 got.as_deref().is_some_and(|g| g.starts_with(key)),
                 "{text}: {e:?}"
+            );
+        }
+    }
+
+    #[test]
+    fn the_flow_table_is_optional_and_checked() {
+        let o = Onboard::from_toml(GOOD).unwrap_or_else(|e| panic!("{e}"));
+        assert_eq!(
+            o.file.flow, None,
+            "no current meter unless a [flow] table is given"
+        );
+        let on_link = format!("{GOOD}\n[flow]\n");
+        let o = Onboard::from_toml(&on_link).unwrap_or_else(|e| panic!("{e}"));
+        assert_eq!(o.file.flow, Some(FlowFile::default()));
+        let own = format!("{GOOD}\n[flow]\nlayer = 3\naddress = \"127.0.0.1:4001\"\n");
+        let o = Onboard::from_toml(&own).unwrap_or_else(|e| panic!("{e}"));
+        assert_eq!(o.file.flow.as_ref().and_then(|f| f.layer), Some(3));
+        for (bad, key) in [
+            ("layer = 100", "flow.layer"),
+            ("address = \"a:1\"\ndevice = \"/dev/ttyS1\"", "flow"),
+            ("rate = 1", "flow"),
+        ] {
+            let text = format!("{GOOD}\n[flow]\n{bad}\n");
+            let e = Onboard::from_toml(&text).err();
+            assert!(
+                e.as_ref().is_some_and(|e| e.key.starts_with(key)),
+                "{bad}: {e:?}"
             );
         }
     }

@@ -12,6 +12,7 @@
 //! - [`bluefin`]: the Bluefin standard payload interface sentences;
 //! - [`iver`]: the Iver remote-helm sentences and their unit setting;
 //! - [`chem`]: the chemical sensor's line input;
+//! - [`current`]: the current meter's `$--CUR` sentences (measured flow);
 //! - [`config`]: the onboard file (planner, mission geometry, chemical input, link, time);
 //! - [`command`]: the chokepoint every command passes (finite, within the vehicle's limits);
 //! - [`link`]: the link trait, the Bluefin and Iver protocols on TCP or a serial line,
@@ -27,6 +28,7 @@ pub mod bluefin;
 pub mod chem;
 pub mod command;
 pub mod config;
+pub mod current;
 pub mod geo;
 pub mod iver;
 pub mod link;
