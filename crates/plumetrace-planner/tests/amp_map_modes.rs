@@ -44,6 +44,8 @@ fn amp(mode: MapDeclaration, map_can_declare: bool) -> Amp {
         map_mass: if map_can_declare { 0.01 } else { 1.0 },
         map_min_detections: if map_can_declare { 3 } else { 1_000_000 },
         map_check_s: 0.0,
+        // At once (the hold has its own tests with the map's tracker).
+        map_hold_s: 0.0,
         ..AmpParams::default()
     };
     let area = OpArea::rectangle(0.0, 400.0, 0.0, 1000.0).unwrap();
