@@ -144,7 +144,7 @@ plumetrace_core::params! {
         map_mass: f64 = 0.5, "", Bounds::closed(0.01, 1.0);
         /// Map declaration: detections the map must have taken in first.
         map_min_detections: u32 = 50, "", Bounds::whole(0, 1_000_000);
-        /// Map declaration: how long the rule must hold with the map's most likely cell staying within map_radius_m (the plume traced to its head, not a map read mid-plume; 0 and 600 s did worse on Duck-like and coastal sites).
+        /// Map declaration: how long the rule must hold with the map's most likely cell staying within map_radius_m (the plume traced to its head, not a map read mid-plume; 0 and 600 s did worse on Duck-like sites).
         map_hold_s: f64 = 300.0, "s", Bounds::closed(0.0, 1e5);
         /// Time between reads of the map for the declaration.
         map_check_s: f64 = 5.0, "s", Bounds::closed(0.0, 3600.0);
