@@ -87,6 +87,10 @@ pub const CAMPAIGNS: &[(&str, &str)] = &[
         "probabilistic",
         include_str!("../../../examples/campaigns/probabilistic.toml"),
     ),
+    (
+        "map-tuning",
+        include_str!("../../../examples/campaigns/map-tuning.toml"),
+    ),
 ];
 
 /// The example families (`examples/families/*.family.toml`; a test checks the list is complete).
@@ -94,6 +98,10 @@ pub const FAMILIES: &[(&str, &str)] = &[
     (
         "coastal",
         include_str!("../../../examples/families/coastal.family.toml"),
+    ),
+    (
+        "duck-like",
+        include_str!("../../../examples/families/duck-like.family.toml"),
     ),
     (
         "faults",

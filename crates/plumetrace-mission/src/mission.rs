@@ -56,6 +56,8 @@ pub struct VehicleInfo {
     pub planner: Option<PlannerKind>,
     /// When its sensors were faulty (from the scenario), for the figures.
     pub faults: Vec<FaultWindow>,
+    /// The unit of its chemical readings: "V" (the analog sensor) or "ppt" (a salinity probe).
+    pub reading_unit: &'static str,
 }
 
 /// A time window in which one of a vehicle's sensors was faulty.
@@ -506,6 +508,11 @@ impl Mission {
                 kind: v.vehicle.params.kind,
                 planner: p.as_ref().map(|p| p.config.kind()),
                 faults: faults.clone(),
+                reading_unit: if v.chem.params().salinity.is_some() {
+                    "ppt"
+                } else {
+                    "V"
+                },
             })
             .collect();
         let mean_flow = self.stats.mean_flow_mps();

@@ -961,30 +961,125 @@ fn plume_cells(
     cells
 }
 
-/// The last source-likelihood map a planner reported (its whole raster), as cells over `x` x `y`:
-/// `log10 p` from 6 decades below the peak to the peak in 12 shades of blue (equal neighbours
-/// along a row merged into one rectangle). Drawn under the tracks, over the mean plume.
+/// One source-likelihood map a planner reported: its time, origin, cell size, cells along x and
+/// y, and `log10 p` per cell.
+type Raster<'a> = (f64, Vec2, f64, usize, usize, &'a [f32]);
+
+/// Every whole source-likelihood map the planners reported, in time order.
+fn rasters(run: &MissionRun) -> Vec<Raster<'_>> {
+    run.events
+        .iter()
+        .filter_map(|e| match &e.event {
+            EventKind::Telemetry(plumetrace_core::Telemetry::SourceMapRaster {
+                origin_m,
+                cell_m,
+                nx,
+                ny,
+                log10_p,
+            }) => Some((e.t_s, *origin_m, *cell_m, *nx, *ny, log10_p.as_slice())),
+            _ => None,
+        })
+        .filter(|r| r.5.len() == r.3 * r.4 && r.2.is_finite() && r.2 > 0.0)
+        .collect()
+}
+
+/// The maps worth showing on their own: the one reported at (or last before) the first
+/// declaration and the last one, labelled; one map when they are the same.
+fn posterior_snapshots(run: &MissionRun) -> Vec<(String, Raster<'_>)> {
+    let all = rasters(run);
+    let Some(&last) = all.last() else {
+        return Vec::new();
+    };
+    let declared_s = run.events.iter().find_map(|e| match e.event {
+        EventKind::Planner(PlannerEvent::Declared { .. }) => Some(e.t_s),
+        _ => None,
+    });
+    let at_declaration = declared_s.and_then(|t| all.iter().rev().find(|r| r.0 <= t).copied());
+    match at_declaration {
+        Some(d) if d.0 < last.0 => vec![
+            (format!("source map at the declaration ({:.0} s)", d.0), d),
+            (format!("source map at the end ({:.0} s)", last.0), last),
+        ],
+        Some(d) => vec![(
+            format!("source map at the declaration and end ({:.0} s)", d.0),
+            d,
+        )],
+        None => vec![(format!("source map at the end ({:.0} s)", last.0), last)],
+    }
+}
+
+/// The centre of the most likely cell of a map.
+fn raster_peak(r: &Raster<'_>) -> Vec2 {
+    let (_, origin, cell, nx, _, lp) = *r;
+    let k = lp
+        .iter()
+        .enumerate()
+        .fold((0, f32::MIN), |b, (k, &l)| if l > b.1 { (k, l) } else { b })
+        .0;
+    Vec2::new(
+        origin.x + ((k % nx) as f64 + 0.5) * cell,
+        origin.y + ((k / nx) as f64 + 0.5) * cell,
+    )
+}
+
+/// Centres of the cells the legend must not hide: the mean plume above a tenth of its peak and
+/// the last source map within 3 decades of its peak.
+fn hot_points(run: &MissionRun) -> Vec<(f64, f64)> {
+    let mut out = Vec::new();
+    if let Some(mp) = &run.mean_plume {
+        let g = *mp.spec();
+        let mean = mp.mean();
+        let max = mean
+            .iter()
+            .copied()
+            .filter(|c| c.is_finite())
+            .fold(0.0, f64::max);
+        if g.nx >= 2 && g.ny >= 2 && max > 0.0 {
+            let dx = (g.x_max_m - g.x_min_m) / (g.nx - 1) as f64;
+            let dy = (g.y_max_m - g.y_min_m) / (g.ny - 1) as f64;
+            for (k, &c) in mean.iter().enumerate() {
+                if c.is_finite() && c > 0.1 * max {
+                    let (i, j) = (k % g.nx, k / g.nx);
+                    out.push((g.x_min_m + i as f64 * dx, g.y_min_m + j as f64 * dy));
+                }
+            }
+        }
+    }
+    if let Some(&(_, origin, cell, nx, _, lp)) = rasters(run).last() {
+        let peak = lp.iter().copied().fold(f32::MIN, f32::max);
+        for (k, &l) in lp.iter().enumerate() {
+            if l >= peak - 3.0 {
+                out.push((
+                    origin.x + ((k % nx) as f64 + 0.5) * cell,
+                    origin.y + ((k / nx) as f64 + 0.5) * cell,
+                ));
+            }
+        }
+    }
+    out
+}
+
+/// The last source-likelihood map a planner reported (its whole raster), as cells over `x` x `y`
+/// (see [`raster_cells`]).
 fn posterior_cells(
     run: &MissionRun,
     x: &Range<f64>,
     y: &Range<f64>,
 ) -> Vec<([(f64, f64); 2], RGBColor)> {
-    let raster = run.events.iter().rev().find_map(|e| match &e.event {
-        crate::record::EventKind::Telemetry(plumetrace_core::Telemetry::SourceMapRaster {
-            origin_m,
-            cell_m,
-            nx,
-            ny,
-            log10_p,
-        }) => Some((*origin_m, *cell_m, *nx, *ny, log10_p)),
-        _ => None,
-    });
-    let Some((origin, cell, nx, ny, lp)) = raster else {
-        return Vec::new();
-    };
-    if lp.len() != nx * ny || cell.is_nan() || cell <= 0.0 {
-        return Vec::new();
-    }
+    rasters(run)
+        .last()
+        .map_or(Vec::new(), |r| raster_cells(r, x, y))
+}
+
+/// A source-likelihood map as cells over `x` x `y`: `log10 p` from 6 decades below the peak to
+/// the peak in 12 shades of blue (equal neighbours along a row merged into one rectangle). Drawn
+/// under the tracks, over the mean plume.
+fn raster_cells(
+    r: &Raster<'_>,
+    x: &Range<f64>,
+    y: &Range<f64>,
+) -> Vec<([(f64, f64); 2], RGBColor)> {
+    let (_, origin, cell, nx, ny, lp) = *r;
     let peak = lp.iter().copied().fold(f32::MIN, f32::max);
     let shade = |i: usize, j: usize| -> Option<u32> {
         let l = f64::from(lp[j * nx + i] - peak) / 6.0 + 1.0;
@@ -1404,6 +1499,8 @@ fn map_layout(
     marked.extend(&declared);
     marked.extend(run.sources.iter().map(|s| (s.x, s.y)));
     marked.extend(marks.iter().map(|k| k.pos));
+    // Nor the plume's core or the source map's likely cells.
+    marked.extend(hot_points(run));
     let (x, y, plot_h) = fit_aspect(
         bx.clone(),
         by.clone(),
@@ -1640,21 +1737,132 @@ pub fn mission_figure(run: &MissionRun, title: &str) -> Result<String, String> {
     let lay = map_layout(run, &rows, title)?;
     let panel = panel_vehicles(run, &rows);
     let (_, _, band_h) = legend_band(&lay);
-    let height = lay.map_h_px + band_h + panel_h_px(panel.len());
+    let snaps = posterior_snapshots(run);
+    let snaps_h = if snaps.is_empty() { 0 } else { POSTERIOR_PX };
+    let height = lay.map_h_px + band_h + snaps_h + panel_h_px(panel.len());
     let mut svg = String::new();
     {
         let root = SVGBackend::with_string(&mut svg, (WIDTH_PX, height)).into_drawing_area();
         root.fill(&WHITE).map_err(err)?;
         let (top, rest) = root.split_vertically(lay.map_h_px);
-        let (band, bottom) = rest.split_vertically(band_h);
+        let (band, rest) = rest.split_vertically(band_h);
+        let (maps, bottom) = rest.split_vertically(snaps_h);
         draw_map(&top, run, &lay, title)?;
         draw_legend_band(&band, &lay)?;
+        if !snaps.is_empty() {
+            draw_posteriors(&maps, run, &rows, &snaps)?;
+        }
         if !panel.is_empty() {
             draw_panel(&bottom, run, &rows, &lay, &panel)?;
         }
         root.present().map_err(err)?;
     }
     Ok(svg)
+}
+
+/// The height of the row of source-map panels, px.
+const POSTERIOR_PX: u32 = 300;
+
+/// The source maps of `snaps` side by side, each zoomed on its most likely cell, the true
+/// sources and the first declaration, with the estimated tracks over them.
+fn draw_posteriors<DB: DrawingBackend>(
+    area: &DrawingArea<DB, plotters::coord::Shift>,
+    run: &MissionRun,
+    rows: &BTreeMap<u32, Vec<&TrajectoryRow>>,
+    snaps: &[(String, Raster<'_>)],
+) -> Result<(), String>
+where
+    DB::ErrorType: 'static,
+{
+    // Two columns: a lone map takes the left one (at the same scale as a pair would).
+    let panels = area.split_evenly((1, 2));
+    let (w_px, h_px) = panels
+        .first()
+        .map_or((WIDTH_PX, POSTERIOR_PX), |p| p.dim_in_pixel());
+    let declared = run
+        .summary
+        .declarations
+        .first()
+        .map(|d| Vec2::new(d.x_m, d.y_m));
+    for (panel, (title, r)) in panels.iter().zip(snaps) {
+        let peak = raster_peak(r);
+        let mut pts = vec![peak];
+        pts.extend(run.sources.iter().map(|s| Vec2::new(s.x, s.y)));
+        pts.extend(declared);
+        let (mut lo, mut hi) = (peak, peak);
+        for p in &pts {
+            lo = Vec2::new(lo.x.min(p.x), lo.y.min(p.y));
+            hi = Vec2::new(hi.x.max(p.x), hi.y.max(p.y));
+        }
+        // At least 150 m across, a quarter of the span around what matters, one scale.
+        let (over_w, over_h) = map_overhead_px(w_px, title)?;
+        let (pw, ph) = (
+            f64::from(w_px.saturating_sub(over_w).max(1)),
+            f64::from(h_px.saturating_sub(over_h).max(1)),
+        );
+        let span = (hi - lo) * 1.5;
+        let half_y = (0.5 * span.y).max(0.5 * span.x * ph / pw).max(75.0);
+        let half_x = half_y * pw / ph;
+        let c = (lo + hi) * 0.5;
+        let (x, y) = (c.x - half_x..c.x + half_x, c.y - half_y..c.y + half_y);
+        let mut chart = map_chart(panel, title, x.clone(), y.clone())?;
+        chart
+            .draw_series(
+                raster_cells(r, &x, &y)
+                    .into_iter()
+                    .map(|(b, col)| Rectangle::new(b, col.filled())),
+            )
+            .map_err(err)?;
+        chart
+            .draw_series(dashed(&run.op_area, BLACK, 1))
+            .map_err(err)?;
+        // The estimated tracks up to the map's time (outside the window: clipped by plotters).
+        for rs in rows.values() {
+            let pts: Vec<(f64, f64)> = rs
+                .iter()
+                .filter(|q| q.t_s <= r.0)
+                .filter_map(|q| q.est_x_m.zip(q.est_y_m))
+                .filter(|p| x.contains(&p.0) && y.contains(&p.1))
+                .collect();
+            chart
+                .draw_series(std::iter::once(PathElement::new(
+                    thin(&pts, 2.0 * half_x / pw),
+                    RGBColor(70, 70, 70).mix(0.7).stroke_width(1),
+                )))
+                .map_err(err)?;
+        }
+        chart
+            .draw_series(std::iter::once(Cross::new(
+                (peak.x, peak.y),
+                6,
+                RGBColor(200, 0, 0).stroke_width(2),
+            )))
+            .map_err(err)?;
+        chart
+            .draw_series(
+                run.sources
+                    .iter()
+                    .map(|s| TriangleMarker::new((s.x, s.y), 7, SOURCE_MARK.filled())),
+            )
+            .map_err(err)?;
+        chart
+            .draw_series(
+                declared
+                    .iter()
+                    .map(|d| Circle::new((d.x, d.y), 5, BLACK.filled())),
+            )
+            .map_err(err)?;
+        let (px0, _) = chart.plotting_area().get_pixel_range();
+        let note = "+ most likely cell   \u{25b2} source   \u{25cf} declared";
+        panel
+            .draw(&Text::new(
+                note,
+                (px0.start + 4, h_px as i32 - 14),
+                ("sans-serif", 11).into_font().color(&BLACK),
+            ))
+            .map_err(err)?;
+    }
+    Ok(())
 }
 
 /// Text of `px` pixels at a point, anchored by `pos`.
@@ -2052,6 +2260,16 @@ where
         / 60.0)
         .max(1e-3);
     let strips_h = STRIP_PX * n as u32 + 56;
+    // The readings' unit: the sensors' when they share one.
+    let units: Vec<&str> = vehicles
+        .iter()
+        .filter_map(|&v| run.vehicles.get(v as usize))
+        .map(|v| v.reading_unit)
+        .collect();
+    let y_desc = match units.first() {
+        Some(u) if units.iter().all(|x| x == u) => format!("reading ({u})"),
+        _ => "reading".to_string(),
+    };
     let (_, h) = area.dim_in_pixel();
     let (upper, lower) = area.split_vertically(h.saturating_sub(strips_h));
     let y_max = vehicles
@@ -2082,7 +2300,7 @@ where
         .disable_mesh()
         .y_labels(5)
         .y_label_formatter(&|v| format!("{v:.digits$}"))
-        .y_desc("reading (V)")
+        .y_desc(y_desc)
         .label_style(("sans-serif", 13))
         .draw()
         .map_err(err)?;
@@ -2567,6 +2785,101 @@ mod tests {
             svg.contains("declared"),
             "the declaration's line in the reading panel"
         );
+    }
+
+    /// A 20 x 20 map of 5 m cells from (0, -50) peaked at cell `(i, j)`.
+    fn raster_event(t_s: f64, i: usize, j: usize) -> EventRecord {
+        let (nx, ny) = (20, 20);
+        let log10_p = (0..nx * ny)
+            .map(|k| {
+                let (di, dj) = ((k % nx) as f32 - i as f32, (k / nx) as f32 - j as f32);
+                -1.0 - 0.2 * (di * di + dj * dj)
+            })
+            .collect();
+        EventRecord {
+            t_s,
+            vehicle: 0,
+            event: EventKind::Telemetry(plumetrace_core::Telemetry::SourceMapRaster {
+                origin_m: Vec2::new(0.0, -50.0),
+                cell_m: 5.0,
+                nx,
+                ny,
+                log10_p,
+            }),
+        }
+    }
+
+    #[test]
+    fn the_source_map_is_shown_at_the_declaration_and_at_the_end() {
+        let mut run = demo(240.0);
+        // No map: no panels.
+        assert!(posterior_snapshots(&run).is_empty());
+        let without = mission_figure(&run, "maps").unwrap();
+        assert!(!without.contains("source map at"));
+        // Maps at 60 s and 150 s, a declaration at 100 s, a last map at 200 s: the panels show
+        // the 60 s map (the last before the declaration) and the 200 s one.
+        run.events.push(raster_event(60.0, 3, 4));
+        run.events.push(raster_event(150.0, 5, 5));
+        run.events.push(EventRecord {
+            t_s: 100.0,
+            vehicle: 0,
+            event: EventKind::Planner(PlannerEvent::Declared {
+                pos_m: Vec2::new(17.5, -27.5),
+                rule: DeclarationKind::SourceMap,
+            }),
+        });
+        run.events.push(raster_event(200.0, 10, 12));
+        let snaps = posterior_snapshots(&run);
+        let times: Vec<f64> = snaps.iter().map(|s| s.1.0).collect();
+        assert_eq!(times, [60.0, 200.0]);
+        assert_eq!(raster_peak(&snaps[0].1), Vec2::new(17.5, -27.5));
+        assert_eq!(raster_peak(&snaps[1].1), Vec2::new(52.5, 12.5));
+        let svg = mission_figure(&run, "maps").unwrap();
+        assert!(
+            svg.contains("source map at the declaration (60 s)"),
+            "title"
+        );
+        assert!(svg.contains("source map at the end (200 s)"), "title");
+        // Both panels carry their key; the figure without maps has none.
+        assert_eq!(svg.matches("most likely cell").count(), 2);
+        assert!(!without.contains("most likely cell"));
+        // One map reported at the declaration and none after: one panel says so.
+        run.events
+            .retain(|e| !matches!(&e.event, EventKind::Telemetry(_)) || e.t_s < 100.0);
+        let snaps = posterior_snapshots(&run);
+        assert_eq!(snaps.len(), 1);
+        assert!(
+            snaps[0].0.contains("at the declaration and end"),
+            "{}",
+            snaps[0].0
+        );
+        // The legend stays off the map's likely cells.
+        let lay = layout(&run);
+        if let Some(c) = lay.legend_corner {
+            let (lw, lh) = legend_px(&lay.legend);
+            let fx = lw / f64::from(lay.plot_px.0) * (lay.x.end - lay.x.start);
+            let fy = lh / f64::from(lay.plot_px.1) * (lay.y.end - lay.y.start);
+            let (bx, by) = c.box_in(&lay.x, &lay.y, fx, fy);
+            assert!(
+                !hot_points(&run)
+                    .iter()
+                    .any(|p| bx.contains(&p.0) && by.contains(&p.1)),
+                "the legend hides the map's peak"
+            );
+        }
+    }
+
+    #[test]
+    fn the_reading_panel_names_the_sensors_unit() {
+        let mut run = demo(60.0);
+        assert!(
+            mission_figure(&run, "volts")
+                .unwrap()
+                .contains("reading (V)")
+        );
+        run.vehicles[0].reading_unit = "ppt";
+        let svg = mission_figure(&run, "salinity").unwrap();
+        assert!(svg.contains("reading (ppt)") && !svg.contains("reading (V)"));
     }
 
     #[test]

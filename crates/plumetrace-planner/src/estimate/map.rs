@@ -26,6 +26,10 @@
 //! concentration at the bed. Near the source (small `T`) the chemical has not reached the
 //! vehicle's altitude, so a sample there says little about the cells just upflow of it; far
 //! downflow the factor approaches 1. `K_z = 0`, or an unknown altitude, turns the factor off.
+//! `K_z` is an effective value, not the plume's own vertical diffusivity: a filament's own size
+//! and a threshold detector bring chemical to the vehicle's altitude sooner than diffusion of
+//! the filaments' centres alone (on Duck-like sites whose plume diffuses vertically at
+//! 0.001 m^2/s, a map with `K_z` of 0.001-0.003 placed the source 10-100 m upflow of it).
 //!
 //! **Dilution.** The mean concentration of a plume from a point source falls as its cross-section
 //! grows, about as one over travel time once diffusion dominates: beyond `dilution_s` the chance

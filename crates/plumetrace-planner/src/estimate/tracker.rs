@@ -9,7 +9,12 @@
 //!
 //! The declaration rule: the most likely cell, once the posterior mass within `radius_m` of it
 //! reaches `mass` and the map has taken in at least `min_detections` detections (without them,
-//! non-detections alone pile the mass up where the vehicle has not looked).
+//! non-detections alone pile the mass up where the vehicle has not looked), and has kept doing so
+//! for `hold_s` with the most likely cell within `radius_m` of where it was when the rule first
+//! held. The hold is the map's version of the lost-point rule's agreement: a map read while the
+//! vehicle is still tracing the plume concentrates just upflow of the newest detections, and the
+//! next detections upflow move it on; at the plume's head further search (Track-Out, Reacquire)
+//! brings non-detections upflow and detections at the head, and the peak stays.
 
 use crate::estimate::{MapModel, SourceMap};
 use plumetrace_core::{SensorSnapshot, Telemetry, Vec2};
@@ -30,6 +35,9 @@ pub struct MapRule {
     /// Detections the map must have taken in before it may declare (non-detections alone
     /// concentrate the map where the vehicle has not looked, which is no evidence of a source).
     pub min_detections: u64,
+    /// How long the rule must hold, the most likely cell staying within `radius_m` of where it
+    /// was when the rule first held, before it declares (0: at once), s.
+    pub hold_s: f64,
 }
 
 /// A planner's map with its declaration rule.
@@ -41,6 +49,8 @@ pub struct MapTracker {
     last_read_s: Option<f64>,
     last_raster_s: Option<f64>,
     detections: u64,
+    /// Since when and where the rule has held, while it holds.
+    holding: Option<(f64, Vec2)>,
 }
 
 /// What one read of the map found.
@@ -74,6 +84,7 @@ impl MapTracker {
             last_read_s: None,
             last_raster_s: None,
             detections: 0,
+            holding: None,
         })
     }
 
@@ -97,6 +108,22 @@ impl MapTracker {
             self.detections += u64::from(detected);
             self.map.observe(at, c.time_s, s.nav.altitude_m, detected);
         }
+    }
+
+    /// Whether the rule declares on `r`, read at `t_s`: it holds and has held for `hold_s` with
+    /// the peak within `radius_m` of where it was when it first held (see the module docs).
+    /// Call it on every read (it keeps the hold's start).
+    pub fn declares(&mut self, t_s: f64, r: &MapRead) -> bool {
+        if !r.declares(&self.rule) {
+            self.holding = None;
+            return false;
+        }
+        match self.holding {
+            Some((_, at)) if (r.peak_m - at).norm() <= self.rule.radius_m => {}
+            _ => self.holding = Some((t_s, r.peak_m)),
+        }
+        self.holding
+            .is_some_and(|(since, _)| t_s - since >= self.rule.hold_s)
     }
 
     /// Reads the map now.
@@ -141,6 +168,66 @@ impl MapTracker {
     /// Starts again from the uniform prior (after a declaration in a multi-source mission).
     pub fn reset(&mut self) {
         self.detections = 0;
+        self.holding = None;
         self.map.reset();
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn tracker(hold_s: f64) -> MapTracker {
+        let area = OpArea::rectangle(0.0, 100.0, 0.0, 100.0).unwrap_or_else(|e| panic!("{e}"));
+        let rule = MapRule {
+            radius_m: 10.0,
+            mass: 0.5,
+            check_period_s: 5.0,
+            min_detections: 2,
+            hold_s,
+        };
+        MapTracker::new(&area, MapModel::default(), rule, 0.2).unwrap_or_else(|| panic!("no map"))
+    }
+
+    fn read(x: f64, mass: f64) -> MapRead {
+        MapRead {
+            entropy_bits: 1.0,
+            peak_m: Vec2::new(x, 50.0),
+            mass,
+            detections: 5,
+        }
+    }
+
+    #[test]
+    fn the_rule_declares_once_it_has_held_with_the_peak_in_place() {
+        let mut t = tracker(300.0);
+        assert!(!t.declares(0.0, &read(50.0, 0.6)));
+        assert!(!t.declares(200.0, &read(55.0, 0.6)));
+        assert!(t.declares(300.0, &read(58.0, 0.6)));
+        // Without the hold: at once; short of mass or detections: never.
+        let mut t = tracker(0.0);
+        assert!(t.declares(0.0, &read(50.0, 0.6)));
+        assert!(!t.declares(0.0, &read(50.0, 0.4)));
+        let few = MapRead {
+            detections: 1,
+            ..read(50.0, 0.9)
+        };
+        assert!(!t.declares(0.0, &few));
+    }
+
+    #[test]
+    fn the_hold_starts_again_when_the_peak_moves_or_the_mass_drops() {
+        let mut t = tracker(300.0);
+        assert!(!t.declares(0.0, &read(20.0, 0.6)));
+        // The peak moved more than the radius: the hold starts again at 250 s.
+        assert!(!t.declares(250.0, &read(40.0, 0.6)));
+        assert!(!t.declares(500.0, &read(40.0, 0.6)));
+        assert!(t.declares(550.0, &read(40.0, 0.6)));
+        // A read short of the mass breaks the hold.
+        let mut t = tracker(300.0);
+        assert!(!t.declares(0.0, &read(20.0, 0.6)));
+        assert!(!t.declares(100.0, &read(20.0, 0.3)));
+        assert!(!t.declares(300.0, &read(20.0, 0.6)));
+        assert!(t.declares(600.0, &read(20.0, 0.6)));
     }
 }

@@ -61,6 +61,8 @@ plumetrace_core::params! {
         map_mass: f64 = 0.5, "", Bounds::closed(0.01, 1.0);
         /// Map declaration: detections the map must have taken in first.
         map_min_detections: u32 = 50, "", Bounds::whole(0, 1_000_000);
+        /// Declaration: how long the rule must hold with the map's most likely cell staying within map_radius_m.
+        map_hold_s: f64 = 0.0, "s", Bounds::closed(0.0, 1e5);
         /// Time between reads of the map for the declaration.
         map_check_s: f64 = 5.0, "s", Bounds::closed(0.0, 3600.0);
         /// Source map: cell size.
@@ -136,6 +138,7 @@ impl InfotaxisParams {
             mass: self.map_mass,
             check_period_s: self.map_check_s,
             min_detections: u64::from(self.map_min_detections),
+            hold_s: self.map_hold_s,
         };
         build_tracker(area, model, rule, self.threshold_v)
     }
@@ -306,7 +309,7 @@ impl Planner for Infotaxis {
         }
         if !self.declared
             && let Some(r) = self.tracker.read_due(t, &mut telemetry)
-            && r.declares(self.tracker.rule())
+            && self.tracker.declares(t, &r)
         {
             self.declared = true;
             self.tracker.report(t, &r, &mut telemetry, true);

@@ -144,6 +144,8 @@ plumetrace_core::params! {
         map_mass: f64 = 0.5, "", Bounds::closed(0.01, 1.0);
         /// Map declaration: detections the map must have taken in first.
         map_min_detections: u32 = 50, "", Bounds::whole(0, 1_000_000);
+        /// Map declaration: how long the rule must hold with the map's most likely cell staying within map_radius_m (the plume traced to its head, not a map read mid-plume; 0 and 600 s did worse on Duck-like sites).
+        map_hold_s: f64 = 300.0, "s", Bounds::closed(0.0, 1e5);
         /// Time between reads of the map for the declaration.
         map_check_s: f64 = 5.0, "s", Bounds::closed(0.0, 3600.0);
         /// Source map: cell size.
@@ -235,6 +237,7 @@ impl AmpParams {
             mass: self.map_mass,
             check_period_s: self.map_check_s,
             min_detections: u64::from(self.map_min_detections),
+            hold_s: self.map_hold_s,
         };
         crate::planners::infotaxis::build_tracker(area, model, rule, self.threshold_v).map(Some)
     }
@@ -296,14 +299,14 @@ impl PlannerParams for AmpParams {
     }
 
     fn build(&self, ctx: &BuildContext) -> Result<Box<dyn Planner>, ParamError> {
-        let map = self.map_tracker(&ctx.geometry.op_area)?;
-        let mut amp = Amp::new(
+        // Refuse a map that does not fit (Amp::new would leave it out).
+        self.map_tracker(&ctx.geometry.op_area)?;
+        let amp = Amp::new(
             self.clone(),
             ctx.geometry.op_area.clone(),
             ctx.geometry.subregions.clone(),
             ctx.geometry.prior_flow_toward(),
         );
-        amp.m.map = map;
         Ok(Box::new(if ctx.geometry.prior_flow_given {
             amp.trusting_prior()
         } else {
@@ -783,8 +786,10 @@ impl Amp {
 
     /// A planner for `area`, searched whole (single-source mission) or, with several `regions`,
     /// one subregion after the other. `prior_flow` is the flow direction assumed until the first
-    /// flow measurement.
+    /// flow measurement. With `map_declaration` on, the source-likelihood map covers `area`
+    /// (when it does not fit, the planner has none: the registry's build refuses such keys).
     pub fn new(p: AmpParams, area: OpArea, regions: Vec<OpArea>, prior_flow: Heading) -> Self {
+        let map = p.map_tracker(&area).unwrap_or(None);
         let regions = if regions.is_empty() {
             vec![area.clone()]
         } else {
@@ -827,7 +832,7 @@ impl Amp {
                 declared: Vec::new(),
                 events: Vec::new(),
                 reacquire_since: None,
-                map: None,
+                map,
                 map_telemetry: Vec::new(),
             },
             switching: Switching {
@@ -843,6 +848,11 @@ impl Amp {
     /// The active behaviour.
     pub fn behaviour(&self) -> BehaviourKind {
         self.switching.active()
+    }
+
+    /// The source-likelihood map, when `map_declaration` is on.
+    pub fn source_map(&mut self) -> Option<&mut MapTracker> {
+        self.m.map.as_mut()
     }
 
     /// The saved lost points, oldest first.
@@ -907,7 +917,8 @@ impl Amp {
             return;
         };
         let by_map = matches!(mode, MapDeclaration::Instead | MapDeclaration::Also);
-        if !by_map || !searching || !read.declares(tracker.rule()) {
+        let holds = tracker.declares(t, &read);
+        if !by_map || !searching || !holds {
             return;
         }
         tracker.report(t, &read, telemetry, true);
