@@ -152,7 +152,10 @@ const SAMPLE_STEP_M: f64 = 0.5;
 /// minimum turning radius, followed by pursuit of a point a look-ahead distance along the path.
 /// The path is planned from the vehicle's pose on the first decision and planned again when a
 /// navigation fix puts the vehicle more than `replan_offtrack_m` from it or when the vehicle runs
-/// off its end without arriving.
+/// off its end without arriving. A path that has to be planned again more than `max_replans`
+/// times cannot be flown from where the vehicle keeps ending up (its turns lie beyond the cage,
+/// or the current carries the vehicle off them): the mode then ends with
+/// [`DoneReason::GaveUp`] rather than circle for good.
 #[derive(Debug, Clone)]
 pub struct GoToPointWithHeading {
     /// Destination pose.
@@ -169,6 +172,8 @@ pub struct GoToPointWithHeading {
     pub lookahead_m: f64,
     /// Distance from the path beyond which it is planned again, m.
     pub replan_offtrack_m: f64,
+    /// Re-plans (after the first path) before the mode gives up; `u32::MAX`: never.
+    pub max_replans: u32,
     plan: Option<CscPath>,
     /// Distance along the path of the point nearest the vehicle, m.
     progress_m: f64,
@@ -176,7 +181,8 @@ pub struct GoToPointWithHeading {
 }
 
 impl GoToPointWithHeading {
-    /// A mode with the look-ahead at half the turning radius and replanning beyond one radius.
+    /// A mode with the look-ahead at half the turning radius, replanning beyond one radius, and
+    /// giving up after [`GoToPointWithHeading::MAX_REPLANS`] re-plans.
     pub fn new(target: Pose, speed_mps: f64, radius_m: f64, min_turn_radius_m: f64) -> Self {
         GoToPointWithHeading {
             target,
@@ -186,11 +192,16 @@ impl GoToPointWithHeading {
             min_turn_radius_m,
             lookahead_m: 0.5 * min_turn_radius_m,
             replan_offtrack_m: min_turn_radius_m.max(radius_m),
+            max_replans: Self::MAX_REPLANS,
             plan: None,
             progress_m: 0.0,
             plans: 0,
         }
     }
+
+    /// Re-plans allowed by default. A path flown as planned needs none; a navigation fix that
+    /// moves the estimate off it, one or two.
+    pub const MAX_REPLANS: u32 = 4;
 
     /// The path being followed, if planned.
     pub fn path(&self) -> Option<&CscPath> {
@@ -233,6 +244,9 @@ impl GoToPointWithHeading {
             need_plan = best_d > self.replan_offtrack_m || best_s >= len - SAMPLE_STEP_M;
         }
         if need_plan {
+            if self.plans > self.max_replans {
+                return ModeStatus::Done(DoneReason::GaveUp);
+            }
             self.replan(pose);
         }
         let heading = match &self.plan {

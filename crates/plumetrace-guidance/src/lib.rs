@@ -68,4 +68,7 @@ pub enum DoneReason {
     PassedEnd,
     /// Within the arrival radius and heading tolerance of a posed destination.
     ArrivedWithHeading,
+    /// A posed approach that needed more re-plans than it is allowed: the path cannot be flown
+    /// (e.g. its turns lie where the cage or the current keeps the vehicle from going).
+    GaveUp,
 }

@@ -21,6 +21,10 @@ pub enum FollowLinePhase {
 /// cross-track distance (positive left of the line, so adding it turns clockwise, back towards
 /// the line). The mode ends within `radius_m` of the end (eq. 6) or once more than `pass_m` past
 /// it along the line (eq. 10), which catches navigation fixes that jump over the end.
+///
+/// An approach that gives up ([`DoneReason::GaveUp`]: the Dubins path to the start could not be
+/// flown, e.g. with its turns beyond the cage near an edge) hands over to the cross-track law
+/// from wherever the vehicle is: it joins the line at up to 45 deg and holds it to the end.
 #[derive(Debug, Clone)]
 pub struct FollowLine {
     /// Start of the line.
@@ -68,6 +72,14 @@ impl FollowLine {
             gain_deg_per_m,
             phase: FollowLinePhase::Approach(Box::new(approach)),
         }
+    }
+
+    /// The mode with its approach giving up after `n` re-plans (`u32::MAX`: never).
+    pub fn with_approach_replans(mut self, n: u32) -> Self {
+        if let FollowLinePhase::Approach(a) = &mut self.phase {
+            a.max_replans = n;
+        }
+        self
     }
 
     /// A mode that starts on the line, without the approach (e.g. the next leg of a pattern).
@@ -179,5 +191,92 @@ mod tests {
             matches!(f.update(at(30.0, 105.0)), ModeStatus::Running(_)),
             "5 m past is within R_L"
         );
+    }
+
+    /// Flies `line` through the autopilot with a point vehicle (2 m/s through the water, the
+    /// heading set to each rate-limited command, carried by `current`), navigation without fixes
+    /// (the cage's area shrunk by its full 20 m); the time it ended and the farthest it went
+    /// outside `area`, or `None` if still running after `seconds`.
+    fn fly_line(
+        mut line: FollowLine,
+        area: &crate::OpArea,
+        from: Pose,
+        current: Vec2,
+        seconds: f64,
+    ) -> (Option<f64>, f64) {
+        let mut autopilot = crate::Autopilot::new(crate::AutopilotParams {
+            op_area: area.clone(),
+            flow_compensation: true,
+            max_turn_rate_deg_s: 10.0,
+            vertical: plumetrace_core::VerticalCommand::Altitude(2.0),
+            nav_drift_mps: 0.02,
+            max_inset_m: 20.0,
+        });
+        let mut pose = from;
+        let mut outside = 0.0_f64;
+        let dt = 0.1;
+        for k in 0..(seconds / dt) as usize {
+            let t = 1000.0 + k as f64 * dt;
+            let steer = match line.update(pose) {
+                ModeStatus::Running(s) => s,
+                ModeStatus::Done(_) => return (Some(t - 1000.0), outside),
+            };
+            let nav = plumetrace_core::NavEstimate {
+                pos_m: Some(pose.pos_m),
+                heading: pose.heading,
+                speed_mps: 2.0,
+                altitude_m: None,
+                depth_m: None,
+                last_fix_s: None,
+            };
+            let Ok(c) = autopilot.command_nav(t, &nav, steer, current) else {
+                return (None, outside);
+            };
+            pose.heading = c.heading;
+            pose.pos_m += (c.heading.unit() * c.speed_mps + current) * dt;
+            let e = area.edge_info(pose.pos_m);
+            if !e.inside {
+                outside = outside.max(e.distance_m);
+            }
+        }
+        (None, outside)
+    }
+
+    #[test]
+    fn a_line_whose_start_the_cage_keeps_out_of_reach_is_still_flown() {
+        // A line 10 m inside the West edge, flown East, as the AMP's mapping lays one out near an
+        // edge; the vehicle comes from the North-East across a 0.15 m/s current to the North.
+        // Without fixes the cage acts 20 m inside the edge, so the Dubins turn onto the line's
+        // start lies where the cage does not let the vehicle go: re-planned for good, the
+        // approach circles along the cage. Given up after its re-plans, the line is joined from
+        // where the vehicle is and flown to its end.
+        let area = crate::OpArea::rectangle(0.0, 400.0, -200.0, 200.0).unwrap();
+        let current = Vec2::new(0.0, 0.15);
+        let make = || {
+            FollowLine::new(
+                Vec2::new(10.0, 0.0),
+                Vec2::new(70.0, 0.0),
+                2.0,
+                10.0,
+                5.0,
+                12.0,
+            )
+        };
+        let from = Pose {
+            pos_m: Vec2::new(60.0, 40.0),
+            heading: Heading::from_deg(200.0),
+        };
+        let (t, _) = fly_line(
+            make().with_approach_replans(u32::MAX),
+            &area,
+            from,
+            current,
+            3600.0,
+        );
+        assert_eq!(t, None, "the approach never gives up: it never arrives");
+        let (t, outside) = fly_line(make(), &area, from, current, 3600.0);
+        let t = t.expect("the line is flown");
+        assert!(t < 600.0, "flown in {t} s");
+        assert!(outside < 1e-9, "{outside} m outside");
     }
 }

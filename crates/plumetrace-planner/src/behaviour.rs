@@ -116,6 +116,9 @@ pub struct LineParams {
     pub gain_deg_per_m: f64,
     /// Turning radius of the approach to each line, m.
     pub min_turn_radius_m: f64,
+    /// Re-plans of the approach to a line's start before it gives up and the line is joined
+    /// from where the vehicle is (`u32::MAX`: never).
+    pub approach_replans: u32,
 }
 
 impl LineParams {
@@ -129,6 +132,7 @@ impl LineParams {
             self.gain_deg_per_m,
             self.min_turn_radius_m,
         )
+        .with_approach_replans(self.approach_replans)
     }
 }
 
@@ -143,7 +147,13 @@ pub struct Legs {
     /// Longest time the pattern is flown, s, and when it started.
     timeout_s: Option<f64>,
     started_s: Option<f64>,
+    /// Leg budgets on ([`Legs::with_leg_budgets`]), and the time and position the leg began at.
+    leg_budgets: bool,
+    leg_started: Option<(f64, Vec2)>,
 }
+
+/// Slack of a leg's time budget, s.
+const LEG_SLACK_S: f64 = 300.0;
 
 impl Legs {
     /// The pattern `legs` (start, end) flown with `params`, reported as `kind`.
@@ -157,7 +167,17 @@ impl Legs {
             kind,
             timeout_s: None,
             started_s: None,
+            leg_budgets: false,
+            leg_started: None,
         }
+    }
+
+    /// Each leg given up (the pattern goes on with the next) when not done in twice the time
+    /// to fly from where it began to its start and along it, plus five minutes: a leg the
+    /// vehicle cannot finish (the cage or the current in the way) never holds the pattern.
+    pub fn with_leg_budgets(mut self) -> Self {
+        self.leg_budgets = true;
+        self
     }
 
     /// The pattern, given up `timeout_s` after its first decision (done as if flown).
@@ -190,9 +210,20 @@ impl<M, D: From<Reached>> Behaviour<M, D> for Legs {
         }
         // Several legs may end at one decision (short legs, a fix that jumps past them).
         while let Some(line) = self.line.as_mut() {
-            match line.update(p.pose()) {
+            let (t0, from) = *self.leg_started.get_or_insert((p.t_s, p.pos_m));
+            let over_budget = self.leg_budgets && {
+                let length = (line.start_m - from).norm() + (line.end_m - line.start_m).norm();
+                p.t_s - t0 > 2.0 * length / self.params.speed_mps.max(0.1) + LEG_SLACK_S
+            };
+            let status = if over_budget {
+                ModeStatus::Done(plumetrace_guidance::DoneReason::GaveUp)
+            } else {
+                line.update(p.pose())
+            };
+            match status {
                 ModeStatus::Running(s) => return Proposal::Steer(s),
                 ModeStatus::Done(_) => {
+                    self.leg_started = None;
                     self.k += 1;
                     self.line = self
                         .legs
@@ -348,6 +379,7 @@ mod tests {
             radius_m: 5.0,
             gain_deg_per_m: 5.0,
             min_turn_radius_m: 5.0,
+            approach_replans: 4,
         };
         let go: Box<dyn Behaviour<Vec<PlannerEvent>, Reached>> = Box::new(GoTo {
             goal: GoToPoint {

@@ -58,6 +58,7 @@ fn paper() -> AmpParams {
         mapping_timeout_s: 0.0,
         flow_gate_deg: 180.0,
         nav_drift_mps: 0.0,
+        approach_replans: 0,
         ..AmpParams::default()
     }
 }
@@ -849,4 +850,39 @@ fn the_search_start_follows_the_flow_estimate() {
         "{}",
         a.last_course().deg()
     );
+}
+
+#[test]
+fn mapping_from_a_declaration_near_the_upflow_edge_is_flown_without_fixes() {
+    // A declaration 40 m inside the upflow (South) edge: the mapping lines start 10 m inside it,
+    // heading North. Without navigation fixes the cage acts 20 m inside the edge, so the turn
+    // onto each line's start lies where the cage does not let the vehicle go. The approach
+    // re-planned for good and the vehicle ran up and down along the cage until the mapping
+    // timed out; now each approach gives up after its re-plans and the line is joined from where
+    // the vehicle is.
+    let mut a = amp();
+    a.decide(&snap(0.0, (200.0, 500.0), 0.0, false));
+    lose_at(&mut a, &[(200.0, 42.0), (203.0, 41.0), (197.0, 40.0)]);
+    assert_eq!(a.behaviour(), BehaviourKind::Mapping);
+    // The mapping starts once the cage has shrunk its area by the full 20 m (t >= 1000 s).
+    let (t0, mut pos, mut h) = (1000.0, Vec2::new(197.0, 40.0), 180.0);
+    let (mut ended, mut lowest) = (None, f64::INFINITY);
+    for k in 0..30_000 {
+        let t = t0 + k as f64 * 0.1;
+        let d = a.decide(&snap(t, (pos.x, pos.y), h, false));
+        if a.behaviour() != BehaviourKind::Mapping {
+            ended = Some(t - t0);
+            break;
+        }
+        assert_eq!(d.status, PlanStatus::Running);
+        h = d.command.heading.deg();
+        pos += Heading::from_deg(h).unit() * (d.command.speed_mps * 0.1) + Vec2::new(0.0, 0.01);
+        lowest = lowest.min(pos.y);
+    }
+    let ended = ended.expect("the mapping ends");
+    assert!(
+        ended < 600.0,
+        "four 70 m lines flown in {ended} s (the mapping timeout is 1,800 s from the declaration)"
+    );
+    assert!(lowest > 0.0, "stays inside the op-area: y down to {lowest}");
 }

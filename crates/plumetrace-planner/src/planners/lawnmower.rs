@@ -235,6 +235,7 @@ impl Lawnmower {
             radius_m: self.p.r_m,
             gain_deg_per_m: self.p.k_deg_per_m,
             min_turn_radius_m: self.p.min_turn_radius_m,
+            approach_replans: plumetrace_guidance::GoToPointWithHeading::MAX_REPLANS,
         };
         let mut plan: Vec<Box<dyn Behaviour<Vec<PlannerEvent>, Reached>>> = Vec::new();
         if let Some((start, _)) = legs.first() {

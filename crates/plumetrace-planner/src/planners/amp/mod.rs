@@ -74,6 +74,8 @@ plumetrace_core::params! {
         r_m: f64 = 10.0, "m", Bounds::positive(1000.0);
         /// Turning radius of the Dubins approach to each line.
         min_turn_radius_m: f64 = 12.0, "m", Bounds::positive(1000.0);
+        /// Re-plans of the Dubins approach to a line's start before it gives up and the line is joined from where the vehicle is at up to 45 deg (0: never, as in the field: near an edge the cage or the current can keep the vehicle off the turn onto the line for good).
+        approach_replans: u32 = 4, "", Bounds::whole(0, 1000);
         /// Heading-rate limit of the commands.
         max_turn_rate_deg_s: f64 = 10.0, "deg/s", Bounds::positive(360.0);
         /// Most lost points kept (the field planner kept six).
@@ -126,7 +128,7 @@ plumetrace_core::params! {
         clip_patterns: bool = true, "", Bounds::Any;
         /// How far inside the op-area clipped pattern lines stay.
         pattern_margin_m: f64 = 10.0, "m", Bounds::non_negative(1000.0);
-        /// Longest post-declaration mapping (0: no bound).
+        /// Longest post-declaration mapping (0: no bound; above 0 each line is also given up when not done in twice its time plus five minutes).
         mapping_timeout_s: f64 = 1800.0, "s", Bounds::non_negative(1e6);
         /// A flow reading more than this from the recent mean (before the first reading: from the prior flow direction, when the scenario gives one) is held back until such readings persist for flow_gate_persist_s (180: every reading used; a wrong-layer current meter reads the current reversed).
         flow_gate_deg: f64 = 90.0, "deg", Bounds::closed(1.0, 180.0);
@@ -270,6 +272,10 @@ impl AmpParams {
             radius_m: self.r_m,
             gain_deg_per_m: self.k_deg_per_m,
             min_turn_radius_m: self.min_turn_radius_m,
+            approach_replans: match self.approach_replans {
+                0 => u32::MAX,
+                n => n,
+            },
         }
     }
 
@@ -621,7 +627,9 @@ impl Switching {
                 .collect();
             let mut pattern = Legs::new(legs, m.p.line_params(), BehaviourKind::Mapping);
             if m.p.mapping_timeout_s > 0.0 {
-                pattern = pattern.with_timeout(m.p.mapping_timeout_s);
+                pattern = pattern
+                    .with_timeout(m.p.mapping_timeout_s)
+                    .with_leg_budgets();
             }
             self.set(m, Box::new(pattern));
         } else {
