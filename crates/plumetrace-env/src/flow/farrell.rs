@@ -13,8 +13,8 @@
 //! reference uses a cubic spline; bilinear is cheaper and keeps the field within the range of its
 //! nodes). Positions outside the grid take the value at the nearest edge.
 //!
-//! The corner noise is integrated exactly ([`ColouredNoise`]), so its statistics do not depend
-//! on the step. The interior's explicit scheme is stable only for small enough steps;
+//! The corner noise can be integrated exactly (`noise_scheme = "exact"`, see [`ColouredNoise`]),
+//! so that its statistics do not depend on the step. The interior's explicit scheme is stable only for small enough steps;
 //! [`FarrellFlow::max_stable_dt_s`] gives the limit (the smaller of the diffusion limit
 //! `1 / (2 (Dx/dx^2 + Dy/dy^2))` with `D = k/2`, the centred-advection limit `2 min(D) / U^2`
 //! and the Courant limit `min(dx, dy) / U`, where `U` bounds the speed at the corners: mean speed
@@ -61,12 +61,12 @@ pub struct FarrellParams {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum NoiseScheme {
-    /// The oscillator's exact discretisation: the same statistics at every step (the default).
-    #[default]
+    /// The oscillator's exact discretisation: the same statistics at every step.
     Exact,
-    /// Explicit Euler-Maruyama (the scheme of earlier versions): its stationary variance grows
-    /// with the step, and it limits the step to the oscillator's Euler limit. Kept to compare
-    /// with results made before.
+    /// Explicit Euler-Maruyama (the default for now, so that results stay those the
+    /// documentation reports): its stationary variance grows with the step, and it limits the
+    /// step to the oscillator's Euler limit.
+    #[default]
     Euler,
 }
 
@@ -81,7 +81,7 @@ impl Default for FarrellParams {
             noise_damping: 0.1,
             noise_bandwidth_radps: 0.2,
             original_noise_updates: false,
-            noise_scheme: NoiseScheme::Exact,
+            noise_scheme: NoiseScheme::Euler,
         }
     }
 }
@@ -92,7 +92,7 @@ impl Default for FarrellParams {
 /// Its stationary variance is `G^2 w / (4 z)` (for `z > 0`), and its correlation time is about
 /// `1 / (z w)`.
 ///
-/// By default each step is the oscillator's **exact discretisation**: the state `s = (x0, x1)`
+/// With [`NoiseUpdates::Exact`] each step is the oscillator's **exact discretisation**: the state `s = (x0, x1)`
 /// moves to `Phi s + L n`, with `Phi = exp(A dt)` the oscillator's transition matrix and `L` the
 /// Cholesky factor of the covariance `Q = P - Phi P Phi^T` that the driving noise adds over the
 /// step (`P = diag(G^2 w / (4 z), G^2 w^3 / (4 z))`, the stationary covariance, which is diagonal
@@ -846,6 +846,7 @@ mod tests {
                 noise_gain: 0.1,
                 noise_damping: z,
                 noise_bandwidth_radps: w,
+                noise_scheme: NoiseScheme::Exact,
                 ..FarrellParams::default()
             };
             for dt in [2.0, 10.0] {
