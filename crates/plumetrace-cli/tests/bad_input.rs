@@ -357,7 +357,7 @@ fn errors_say_where() {
         "spinup.toml",
         &demo_with("spinup_dt_s = 2.0\n", "").replacen(
             "noise_bandwidth_radps = 0.05",
-            "noise_bandwidth_radps = 0.5",
+            "noise_bandwidth_radps = 0.5\nnoise_scheme = \"euler\"",
             1,
         ),
         "mission.spinup_dt_s (not given: 10 x mission.env_dt_s",

@@ -13,13 +13,16 @@
 //! reference uses a cubic spline; bilinear is cheaper and keeps the field within the range of its
 //! nodes). Positions outside the grid take the value at the nearest edge.
 //!
-//! The explicit scheme is stable only for small enough steps; [`FarrellFlow::max_stable_dt_s`]
-//! gives the limit (the smaller of the diffusion limit `1 / (2 (Dx/dx^2 + Dy/dy^2))` with
-//! `D = k/2`, the centred-advection limit `2 min(D) / U^2` and the Courant limit
-//! `min(dx, dy) / U`, where `U` bounds the speed at the corners: mean speed plus four standard
-//! deviations of the corner noise, and the corner oscillator's own limit `2 z / w`: explicit Euler
-//! on a lightly damped oscillator grows without bound beyond it, 1 s for pompy's parameters).
-//! Building the field with a larger step is an error.
+//! The corner noise can be integrated exactly (`noise_scheme = "exact"`, see [`ColouredNoise`]),
+//! so that its statistics do not depend on the step. The interior's explicit scheme is stable only for small enough steps;
+//! [`FarrellFlow::max_stable_dt_s`] gives the limit (the smaller of the diffusion limit
+//! `1 / (2 (Dx/dx^2 + Dy/dy^2))` with `D = k/2`, the centred-advection limit `2 min(D) / U^2`
+//! and the Courant limit `min(dx, dy) / U`, where `U` bounds the speed at the corners: mean speed
+//! plus four standard deviations of the corner noise; with the Euler schemes of the corner noise
+//! (`noise_scheme = "euler"`, or `original_noise_updates`) also the corner oscillator's
+//! explicit-Euler limit `2 z / w`, beyond which a lightly damped oscillator
+//! grows without bound, 1 s for pompy's parameters). Building the field with a step at or above
+//! the limit is an error: at the limit itself the scheme is only marginally stable.
 
 use super::{FlowField, MeanFlow, axis_weight};
 use crate::error::{EnvError, require_non_negative, require_positive};
@@ -48,8 +51,23 @@ pub struct FarrellParams {
     /// Noise bandwidth (undamped natural frequency) `w`, rad/s.
     pub noise_bandwidth_radps: f64,
     /// Use the original Farrell update, which scales the noise by `dt` instead of `sqrt(dt)` (its
-    /// amplitude then depends on the time step). Off by default.
+    /// amplitude then depends on the time step; always explicit Euler). Off by default.
     pub original_noise_updates: bool,
+    /// How the corner noise is integrated (ignored with `original_noise_updates`).
+    pub noise_scheme: NoiseScheme,
+}
+
+/// The integration of the corner noise.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum NoiseScheme {
+    /// The oscillator's exact discretisation: the same statistics at every step.
+    Exact,
+    /// Explicit Euler-Maruyama (the default for now, so that results stay those the
+    /// documentation reports): its stationary variance grows with the step, and it limits the
+    /// step to the oscillator's Euler limit.
+    #[default]
+    Euler,
 }
 
 impl Default for FarrellParams {
@@ -63,15 +81,29 @@ impl Default for FarrellParams {
             noise_damping: 0.1,
             noise_bandwidth_radps: 0.2,
             original_noise_updates: false,
+            noise_scheme: NoiseScheme::Euler,
         }
     }
 }
 
-/// Second-order coloured noise, integrated with Euler-Maruyama:
+/// Second-order coloured noise: per channel the damped, driven oscillator
 /// `dx0 = x1 dt; dx1 = -(w^2 x0 + 2 z w x1) dt + G w^2 dW`.
 ///
 /// Its stationary variance is `G^2 w / (4 z)` (for `z > 0`), and its correlation time is about
 /// `1 / (z w)`.
+///
+/// With [`NoiseUpdates::Exact`] each step is the oscillator's **exact discretisation**: the state `s = (x0, x1)`
+/// moves to `Phi s + L n`, with `Phi = exp(A dt)` the oscillator's transition matrix and `L` the
+/// Cholesky factor of the covariance `Q = P - Phi P Phi^T` that the driving noise adds over the
+/// step (`P = diag(G^2 w / (4 z), G^2 w^3 / (4 z))`, the stationary covariance, which is diagonal
+/// because `x1` is the derivative of `x0`), `n` two standard normal draws. The stationary variance
+/// is then the same at every step size and the scheme is stable at any step. `Phi` and `L` are
+/// computed once per step size.
+///
+/// The other [`NoiseUpdates`] are explicit Euler steps (one draw per channel and step): with
+/// the noise scaled by `sqrt(dt)` (Euler-Maruyama, whose stationary variance grows with the step)
+/// or by `dt` (the original Farrell update, whose amplitude depends on the step); both diverge
+/// beyond the oscillator's Euler limit (see `FarrellFlow`).
 #[derive(Debug, Clone)]
 pub struct ColouredNoise {
     x0: Vec<f64>,
@@ -79,7 +111,31 @@ pub struct ColouredNoise {
     gain: f64,
     damping: f64,
     bandwidth: f64,
-    original: bool,
+    updates: NoiseUpdates,
+    /// The exact step's matrices for the last step size: `(dt, Phi, L)`.
+    exact: Option<(f64, [[f64; 2]; 2], [[f64; 2]; 2])>,
+}
+
+/// How [`ColouredNoise`] steps its channels.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum NoiseUpdates {
+    /// The exact discretisation.
+    Exact,
+    /// Explicit Euler-Maruyama (noise scaled by `sqrt(dt)`).
+    EulerMaruyama,
+    /// The original Farrell update (explicit Euler, noise scaled by `dt`).
+    Original,
+}
+
+impl NoiseUpdates {
+    /// The updates a Farrell parameter set asks for.
+    pub fn of(params: &FarrellParams) -> Self {
+        match (params.original_noise_updates, params.noise_scheme) {
+            (true, _) => NoiseUpdates::Original,
+            (false, NoiseScheme::Exact) => NoiseUpdates::Exact,
+            (false, NoiseScheme::Euler) => NoiseUpdates::EulerMaruyama,
+        }
+    }
 }
 
 impl ColouredNoise {
@@ -89,7 +145,7 @@ impl ColouredNoise {
         gain: f64,
         damping: f64,
         bandwidth_radps: f64,
-        original_updates: bool,
+        updates: NoiseUpdates,
     ) -> Self {
         ColouredNoise {
             x0: vec![0.0; channels],
@@ -97,17 +153,41 @@ impl ColouredNoise {
             gain,
             damping,
             bandwidth: bandwidth_radps,
-            original: original_updates,
+            updates,
+            exact: None,
         }
     }
 
     /// Advances every channel by `dt_s`.
     pub fn update(&mut self, dt_s: f64, rng: &mut SimRng) {
+        match self.updates {
+            NoiseUpdates::Exact => {}
+            NoiseUpdates::EulerMaruyama => return self.update_euler(dt_s, dt_s.sqrt(), rng),
+            NoiseUpdates::Original => return self.update_euler(dt_s, dt_s, rng),
+        }
+        let (phi, l) = match self.exact {
+            Some((dt, phi, l)) if dt == dt_s => (phi, l),
+            _ => {
+                let (phi, l) = self.exact_step(dt_s);
+                self.exact = Some((dt_s, phi, l));
+                (phi, l)
+            }
+        };
+        for (x0, x1) in self.x0.iter_mut().zip(self.x1.iter_mut()) {
+            let n0: f64 = StandardNormal.sample(rng);
+            let n1: f64 = StandardNormal.sample(rng);
+            let (p, q) = (*x0, *x1);
+            *x0 = phi[0][0] * p + phi[0][1] * q + l[0][0] * n0;
+            *x1 = phi[1][0] * p + phi[1][1] * q + l[1][0] * n0 + l[1][1] * n1;
+        }
+    }
+
+    /// One explicit Euler step, the noise scaled by `noise_scale`.
+    fn update_euler(&mut self, dt_s: f64, noise_scale: f64, rng: &mut SimRng) {
         let w = self.bandwidth;
         let a = w * w;
         let b = 2.0 * self.damping * w;
         let c = self.gain * w * w;
-        let noise_scale = if self.original { dt_s } else { dt_s.sqrt() };
         for (x0, x1) in self.x0.iter_mut().zip(self.x1.iter_mut()) {
             let n: f64 = StandardNormal.sample(rng);
             let (p, q) = (*x0, *x1);
@@ -116,15 +196,69 @@ impl ColouredNoise {
         }
     }
 
+    /// The transition matrix `exp(A dt)` of the oscillator and the Cholesky factor (lower
+    /// triangular) of the covariance the noise adds over `dt`.
+    fn exact_step(&self, dt_s: f64) -> ([[f64; 2]; 2], [[f64; 2]; 2]) {
+        let phi = oscillator_transition(self.damping, self.bandwidth, dt_s);
+        let [p0, p1] = self.stationary_covariance();
+        // Q = P - Phi P Phi^T (P diagonal).
+        let q00 = p0 - (phi[0][0] * phi[0][0] * p0 + phi[0][1] * phi[0][1] * p1);
+        let q01 = -(phi[0][0] * phi[1][0] * p0 + phi[0][1] * phi[1][1] * p1);
+        let q11 = p1 - (phi[1][0] * phi[1][0] * p0 + phi[1][1] * phi[1][1] * p1);
+        // Rounding can leave a tiny negative where the added variance is ~0 (a zero gain).
+        let l00 = q00.max(0.0).sqrt();
+        let l10 = if l00 > 0.0 { q01 / l00 } else { 0.0 };
+        let l11 = (q11 - l10 * l10).max(0.0).sqrt();
+        (phi, [[l00, 0.0], [l10, l11]])
+    }
+
     /// Current outputs (the `x0` of each channel).
     pub fn output(&self) -> &[f64] {
         &self.x0
     }
 
-    /// The stationary variance `G^2 w / (4 z)` of the Euler-Maruyama form.
+    /// The stationary variance `G^2 w / (4 z)` of each channel's output.
     pub fn stationary_variance(&self) -> f64 {
         self.gain * self.gain * self.bandwidth / (4.0 * self.damping)
     }
+
+    /// The stationary variances of `x0` and `x1` (their covariance is zero).
+    fn stationary_covariance(&self) -> [f64; 2] {
+        let v0 = self.stationary_variance();
+        [v0, v0 * self.bandwidth * self.bandwidth]
+    }
+}
+
+/// `exp(A dt)` for the oscillator `A = [[0, 1], [-w^2, -2 z w]]`, through the closed form for a
+/// 2 x 2 matrix: with `m = tr(A) / 2 = -z w` and `s^2 = m^2 - det(A) = w^2 (z^2 - 1)`,
+/// `exp(A dt) = exp(m dt) (c I + g (A - m I))` where `c = cosh(s dt)` and `g = sinh(s dt) / s`
+/// (overdamped), `c = cos(|s| dt)` and `g = sin(|s| dt) / |s|` (underdamped), or their series
+/// near critical damping.
+fn oscillator_transition(z: f64, w: f64, dt: f64) -> [[f64; 2]; 2] {
+    let m = -z * w;
+    let s2 = w * w * (z * z - 1.0);
+    let x = s2 * dt * dt;
+    // `c` and `g` already multiplied by exp(m dt).
+    let (c, g) = if x.abs() < 1e-8 {
+        // cosh(s dt) = 1 + x/2 + x^2/24, sinh(s dt)/s = dt (1 + x/6 + x^2/120).
+        let e = (m * dt).exp();
+        (
+            e * (1.0 + x / 2.0 + x * x / 24.0),
+            e * dt * (1.0 + x / 6.0 + x * x / 120.0),
+        )
+    } else if s2 > 0.0 {
+        // Overdamped: the two modes' exponentials, each at most 1 (m + s <= 0), so nothing
+        // overflows however strong the damping.
+        let s = s2.sqrt();
+        let (slow, fast) = (((m + s) * dt).exp(), ((m - s) * dt).exp());
+        (0.5 * (slow + fast), 0.5 * (slow - fast) / s)
+    } else {
+        let s = (-s2).sqrt();
+        let e = (m * dt).exp();
+        (e * (s * dt).cos(), e * (s * dt).sin() / s)
+    };
+    // A - m I = [[z w, 1], [-w^2, -z w]].
+    [[c + g * z * w, g], [-g * w * w, c - g * z * w]]
 }
 
 /// The Farrell et al. (2002) meandering flow field (see the module docs).
@@ -193,7 +327,7 @@ impl FarrellFlow {
             params.noise_gain,
             params.noise_damping,
             params.noise_bandwidth_radps,
-            params.original_noise_updates,
+            NoiseUpdates::of(&params),
         );
         let v0 = mean.velocity_at(0.0);
         let n_all = (params.nx + 2) * (params.ny + 2);
@@ -215,7 +349,7 @@ impl FarrellFlow {
             max_speed_mps: v0.norm(),
         };
         flow.max_stable_dt_s = flow.stable_dt_limit(dt_s);
-        if dt_s > flow.max_stable_dt_s {
+        if dt_s >= flow.max_stable_dt_s {
             return Err(EnvError::invalid(
                 "sim.dt_s",
                 format!(
@@ -250,12 +384,16 @@ impl FarrellFlow {
             .min(self.noise_limit())
     }
 
-    /// Explicit Euler on the corner oscillator is stable only while `|1 + lambda dt| < 1` for both
+    /// With the original updates (explicit Euler), the corner oscillator is stable only while `|1 + lambda dt| < 1` for both
     /// eigenvalues: underdamped (`z < 1`, `lambda = w (-z +- i sqrt(1 - z^2))`) that is
     /// `dt < 2 z / w`; overdamped (`z >= 1`, real `lambda = w (-z +- sqrt(z^2 - 1))`) it is
     /// `dt < 2 / (w (z + sqrt(z^2 - 1)))`, set by the faster mode (a damping of 21 with the
     /// default bandwidth once passed the first bound and diverged).
     fn noise_limit(&self) -> f64 {
+        if NoiseUpdates::of(&self.params) == NoiseUpdates::Exact {
+            // The exact discretisation is stable at any step.
+            return f64::INFINITY;
+        }
         let (z, w) = (self.params.noise_damping, self.params.noise_bandwidth_radps);
         if z < 1.0 {
             2.0 * z / w
@@ -451,21 +589,20 @@ mod tests {
         }
     }
 
-    #[test]
-    fn coloured_noise_variance_matches_theory() {
-        // G = 2, w = 0.2, z = 0.1: variance G^2 w / (4 z) = 2.0, correlation time ~50 s.
-        let mut noise = ColouredNoise::new(64, 2.0, 0.1, 0.2, false);
-        let mut rng = stream_rng(3, StreamId::Flow);
-        // dt = 0.01 s as in pompy's scenario: the Euler-Maruyama bias is then ~1 % (at 0.1 s it
-        // is ~12 %, because explicit Euler weakens the oscillator's damping).
-        let dt = 0.01;
-        for _ in 0..50_000 {
-            noise.update(dt, &mut rng); // 500 s burn-in, ten correlation times
-        }
-        let (mut sum, mut sum_sq, mut n) = (0.0, 0.0, 0.0);
-        for step in 0..600_000 {
+    /// Sample variance of the channels' output after `steps` steps of `dt` (after ten
+    /// correlation times of burn-in), sampled about once per correlation time.
+    fn sample_variance(noise: &mut ColouredNoise, dt: f64, steps: usize, seed: u64) -> f64 {
+        let mut rng = stream_rng(seed, StreamId::Flow);
+        let corr = 1.0 / (noise.damping * noise.bandwidth);
+        let burn = (10.0 * corr / dt).ceil() as usize;
+        for _ in 0..burn {
             noise.update(dt, &mut rng);
-            if step % 100 == 0 {
+        }
+        let every = ((0.5 * corr / dt).round() as usize).max(1);
+        let (mut sum, mut sum_sq, mut n) = (0.0, 0.0, 0.0);
+        for step in 0..steps {
+            noise.update(dt, &mut rng);
+            if step % every == 0 {
                 for &x in noise.output() {
                     sum += x;
                     sum_sq += x * x;
@@ -474,14 +611,105 @@ mod tests {
             }
         }
         let mean = sum / n;
-        let var = sum_sq / n - mean * mean;
+        sum_sq / n - mean * mean
+    }
+
+    #[test]
+    fn coloured_noise_variance_is_the_same_at_every_step() {
+        // pompy's G = 2, w = 0.2, z = 0.1 (variance 2.0, correlation time 50 s) at steps from
+        // 0.1 s to 10 s (explicit Euler was 12 % off at 0.1 s and diverged beyond 1 s), and the
+        // Duck presets' slow meander z = 0.2, w = 0.02 (correlation time 250 s).
+        let cases: [(f64, f64, f64, &[f64]); 2] = [
+            (2.0, 0.1, 0.2, &[0.1, 1.0, 5.0, 10.0]),
+            // The Duck presets' environment step, spin-up step, and beyond.
+            (0.5, 0.2, 0.02, &[0.5, 5.0, 10.0]),
+        ];
+        for (gain, z, w, steps_s) in cases {
+            let corr = 1.0 / (z * w);
+            for &dt in steps_s {
+                // About 400,000 samples half a correlation time apart: standard error of the
+                // variance about 0.3 % (sampled twice per correlation time they are only weakly
+                // correlated).
+                let mut noise = ColouredNoise::new(1000, gain, z, w, NoiseUpdates::Exact);
+                let steps = (200.0 * corr / dt).round() as usize;
+                let var = sample_variance(&mut noise, dt, steps, 3);
+                let want = noise.stationary_variance();
+                eprintln!("z {z} w {w} dt {dt}: variance {var:.5}, theory {want:.5}");
+                assert!(
+                    (var - want).abs() / want < 0.02,
+                    "z {z}, w {w}, dt {dt}: variance {var}, theory {want}"
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn euler_maruyama_variance_depends_on_the_step() {
+        // The same measurement as above finds the Euler scheme's bias (about 12 % at 0.1 s for
+        // pompy's parameters), so a 2 % tolerance there is a real test.
+        let mut noise = ColouredNoise::new(1000, 2.0, 0.1, 0.2, NoiseUpdates::EulerMaruyama);
+        let var = sample_variance(&mut noise, 0.1, (200.0 * 50.0 / 0.1) as usize, 3);
         let want = noise.stationary_variance();
-        assert!((want - 2.0).abs() < 1e-12);
-        eprintln!("coloured noise variance {var:.4}, theory {want}");
-        assert!(
-            (var - want).abs() / want < 0.06,
-            "variance {var}, theory {want}"
-        );
+        eprintln!("Euler-Maruyama at 0.1 s: variance {var:.5}, theory {want:.5}");
+        assert!((var - want) / want > 0.06, "variance {var}, theory {want}");
+    }
+
+    #[test]
+    fn exact_step_keeps_the_stationary_covariance() {
+        // Algebra of the exact step: P = Phi P Phi^T + L L^T for under-, critically and
+        // overdamped channels, at small and large steps (a wrong Phi or L breaks it).
+        for (z, w) in [
+            (0.1, 0.2),
+            (0.2, 0.02),
+            (1.0, 0.3),
+            (1.0 + 1e-9, 0.3),
+            (21.0, 0.2),
+        ] {
+            for dt in [1e-3, 0.1, 1.0, 5.0, 10.0, 100.0] {
+                let noise = ColouredNoise::new(1, 2.0, z, w, NoiseUpdates::Exact);
+                let (phi, l) = noise.exact_step(dt);
+                let [p0, p1] = noise.stationary_covariance();
+                let p = [[p0, 0.0], [0.0, p1]];
+                let q = [
+                    [l[0][0] * l[0][0], l[0][0] * l[1][0]],
+                    [l[0][0] * l[1][0], l[1][0] * l[1][0] + l[1][1] * l[1][1]],
+                ];
+                for i in 0..2 {
+                    for j in 0..2 {
+                        let mut v = q[i][j];
+                        for k in 0..2 {
+                            v += phi[i][k] * p[k][k] * phi[j][k];
+                        }
+                        let scale = (p[i][i] * p[j][j]).sqrt();
+                        assert!(
+                            (v - p[i][j]).abs() <= 1e-9 * scale,
+                            "z {z} w {w} dt {dt} ({i},{j}): {v} vs {}",
+                            p[i][j]
+                        );
+                    }
+                }
+                // Phi is the flow of the noiseless oscillator: d Phi/dt = A Phi at small steps.
+                let small = oscillator_transition(z, w, 1e-6);
+                assert!(
+                    (small[0][1] - 1e-6).abs() < 1e-9 && (small[1][0] + w * w * 1e-6).abs() < 1e-9
+                );
+                assert!(phi.iter().flatten().all(|x| x.is_finite()));
+            }
+        }
+        // Composition: two half steps equal one full step.
+        let (z, w) = (0.1, 0.2);
+        let half = oscillator_transition(z, w, 2.5);
+        let full = oscillator_transition(z, w, 5.0);
+        for i in 0..2 {
+            for j in 0..2 {
+                let v = half[i][0] * half[0][j] + half[i][1] * half[1][j];
+                assert!(
+                    (v - full[i][j]).abs() < 1e-12,
+                    "({i},{j}) {v} vs {}",
+                    full[i][j]
+                );
+            }
+        }
     }
 
     #[test]
@@ -524,9 +752,10 @@ mod tests {
     }
 
     #[test]
-    fn the_corner_oscillator_limits_the_step() {
-        // Damping 0.1, bandwidth 0.2 rad/s: dt < 2 z / w = 1 s. A small gain keeps the other
-        // limits (advection, diffusion, Courant) far above it.
+    fn the_corner_oscillator_limits_the_step_of_the_original_updates() {
+        // Damping 0.1, bandwidth 0.2 rad/s: with the original (explicit Euler) updates
+        // dt < 2 z / w = 1 s. A small gain keeps the other limits (advection, diffusion, Courant)
+        // far above it.
         let region = Rect {
             x_min_m: 0.0,
             x_max_m: 1000.0,
@@ -535,6 +764,7 @@ mod tests {
         };
         let params = FarrellParams {
             noise_gain: 0.1,
+            original_noise_updates: true,
             ..FarrellParams::default()
         };
         let err = FarrellFlow::new(region, steady(0.1, 90.0), params, 2.0)
@@ -542,6 +772,9 @@ mod tests {
             .map(|e| e.to_string())
             .unwrap_or_default();
         assert!(err.contains("sim.dt_s") && err.contains("1.0000"), "{err}");
+        // The check is strict: at the limit itself Euler is only marginally stable.
+        assert!(FarrellFlow::new(region, steady(0.1, 90.0), params, 1.0).is_err());
+        assert!(FarrellFlow::new(region, steady(0.1, 90.0), params, 0.999).is_ok());
         let f = FarrellFlow::new(region, steady(0.1, 90.0), params, 0.5).unwrap();
         assert!((f.max_stable_dt_s().unwrap() - 1.0).abs() < 1e-12);
         // A run at 2 s (what the check forbids) does blow up.
@@ -558,9 +791,10 @@ mod tests {
     }
 
     #[test]
-    fn an_overdamped_oscillator_is_limited_by_its_fast_mode() {
-        // Damping 21, bandwidth 0.05 rad/s: 2 z / w = 840 s would allow any step, but the fast
-        // real eigenvalue w (z + sqrt(z^2 - 1)) = 2.0988 rad/s limits dt to about 0.953 s.
+    fn an_overdamped_oscillator_is_limited_by_its_fast_mode_in_the_original_updates() {
+        // Damping 21, bandwidth 0.05 rad/s, original (explicit Euler) updates: 2 z / w = 840 s
+        // would allow any step, but the fast real eigenvalue w (z + sqrt(z^2 - 1)) = 2.0988 rad/s
+        // limits dt to about 0.953 s.
         let region = Rect {
             x_min_m: 0.0,
             x_max_m: 1000.0,
@@ -571,6 +805,7 @@ mod tests {
             noise_gain: 0.1,
             noise_damping: 21.0,
             noise_bandwidth_radps: 0.05,
+            original_noise_updates: true,
             ..FarrellParams::default()
         };
         let want = 2.0 / (0.05 * (21.0 + (21.0_f64 * 21.0 - 1.0).sqrt()));
@@ -593,6 +828,39 @@ mod tests {
             "explicit Euler beyond the fast mode's limit should diverge"
         );
         assert!(run(0.5));
+    }
+
+    #[test]
+    fn the_exact_corner_noise_allows_any_step() {
+        // The two set-ups above, with the default (exact) corner noise: the oscillator no longer
+        // limits the step, and stepping at 2 s and 10 s stays bounded with the same corner
+        // statistics (the interior's own limits are far above these steps).
+        let region = Rect {
+            x_min_m: 0.0,
+            x_max_m: 1000.0,
+            y_min_m: 0.0,
+            y_max_m: 1000.0,
+        };
+        for (z, w) in [(0.1, 0.2), (21.0, 0.05)] {
+            let params = FarrellParams {
+                noise_gain: 0.1,
+                noise_damping: z,
+                noise_bandwidth_radps: w,
+                noise_scheme: NoiseScheme::Exact,
+                ..FarrellParams::default()
+            };
+            for dt in [2.0, 10.0] {
+                let mut g = FarrellFlow::new(region, steady(0.1, 90.0), params, dt)
+                    .unwrap_or_else(|e| panic!("z {z} dt {dt}: {e}"));
+                assert!(g.max_stable_dt_s().is_some_and(|l| l > dt));
+                let mut rng = stream_rng(1, StreamId::Flow);
+                for k in 1..=2_000u32 {
+                    g.advance(f64::from(k) * dt, dt, &mut rng)
+                        .unwrap_or_else(|e| panic!("z {z} dt {dt}: {e}"));
+                }
+                assert!(g.max_speed_mps() < 0.1 + 6.0 * g.noise.stationary_variance().sqrt());
+            }
+        }
     }
 
     #[test]

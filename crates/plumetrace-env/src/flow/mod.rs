@@ -16,7 +16,7 @@ mod gridded;
 mod mean;
 mod uniform;
 
-pub use farrell::{ColouredNoise, FarrellFlow, FarrellParams};
+pub use farrell::{ColouredNoise, FarrellFlow, FarrellParams, NoiseScheme, NoiseUpdates};
 pub use gridded::GriddedFlow;
 pub use mean::MeanFlow;
 pub use uniform::UniformFlow;
