@@ -35,7 +35,7 @@ pub mod spec;
 pub mod stats;
 
 pub use error::CampaignError;
-pub use execute::{CampaignReport, RunOptions, run_campaign};
+pub use execute::{CampaignReport, RunOptions, Share, run_campaign};
 pub use merge::{MergeReport, merge};
 pub use runs::{RUNS_FILE, RunRow};
 pub use spec::{Campaign, RunKey, Shard};

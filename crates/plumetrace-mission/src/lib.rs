@@ -27,6 +27,7 @@ pub mod plot;
 pub mod record;
 pub mod replay_page;
 pub mod setup;
+pub mod shared;
 pub mod snapshot_log;
 pub mod summary;
 pub mod team;
@@ -41,5 +42,6 @@ pub use record::{
     EventKind, EventRecord, Observer, PlumeFrame, PlumeFrames, StepView, TrajectoryRow,
 };
 pub use setup::{MissionError, MissionSetup, PlannedVehicle};
+pub use shared::fly_shared;
 pub use summary::{DeclarationRecord, LOCATED_RADIUS_M, SourceRecord, Summary, VehicleSummary};
 pub use team::{TeamStats, TeamSummary};

@@ -32,4 +32,6 @@ pub use sensors::{
     RangeSensorParams,
 };
 pub use vehicle::{Vehicle, VehicleParams, VehicleState};
-pub use world::{Incident, SimVehicle, StageTimes, StepReport, World, WorldEvent};
+pub use world::{
+    Fleet, Incident, SimVehicle, StageTimes, StepReport, World, WorldEvent, WorldView,
+};
