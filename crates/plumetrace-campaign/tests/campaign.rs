@@ -312,7 +312,15 @@ fn runs_sharing_a_spin_up_give_the_bits_of_separate_spin_ups() {
         }
     }
     let (shared, separate) = (tmp.path().join("shared"), tmp.path().join("separate"));
-    run(&file, &shared, RunOptions::default(), None);
+    run(
+        &file,
+        &shared,
+        RunOptions {
+            share: Share::SpinUp,
+            ..RunOptions::default()
+        },
+        None,
+    );
     run(
         &file,
         &separate,

@@ -9,6 +9,8 @@
 //!
 //! - [`setup`]: scenario to mission, planners checked;
 //! - [`mission`]: the stepper ([`Mission::new`], [`Mission::step`], [`Mission::finish`]);
+//! - [`shared`]: several missions of one scenario and seed in one environment
+//!   ([`fly_shared`]), each with the result it has alone;
 //! - [`outcome`]: how a mission ends and what it comes to;
 //! - [`record`]: the observer trait and the mission's own recorders;
 //! - [`summary`]: the key numbers written as `summary.json`; [`team`]: what a team of vehicles

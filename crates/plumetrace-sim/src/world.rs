@@ -1,8 +1,13 @@
-//! The world: an environment and several vehicles stepped together in named stages.
+//! The world: an environment and a fleet of vehicles stepped together in named stages.
+//!
+//! A [`World`] owns its environment; a [`Fleet`] (the vehicles with their streams, channels,
+//! clock and stage times) only reads one, so several fleets can fly against one environment that
+//! their caller steps once for all of them, each giving the bits of a world of its own.
 //!
 //! One step of `dt` runs, in order:
 //! 1. **advance environment**: the flow and plume advance every `env_every` steps (the plume's
-//!    step is a multiple of the vehicles'; its physics does not depend on the step);
+//!    step is a multiple of the vehicles'; its physics does not depend on the step); the world
+//!    does this, or the caller of [`Fleet::step`] when [`Fleet::env_due`];
 //! 2. **sense**: each vehicle's due chemical, flow and range samples, taken at its true position;
 //! 3. **communicate**: messages that have arrived by now are delivered to their recipients'
 //!    inboxes;
