@@ -87,6 +87,10 @@ pub const CAMPAIGNS: &[(&str, &str)] = &[
         "probabilistic",
         include_str!("../../../examples/campaigns/probabilistic.toml"),
     ),
+    (
+        "ten-planners-one-plume",
+        include_str!("../../../examples/campaigns/ten-planners-one-plume.toml"),
+    ),
 ];
 
 /// The example families (`examples/families/*.family.toml`; a test checks the list is complete).

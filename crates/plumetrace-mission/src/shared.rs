@@ -24,8 +24,9 @@ use std::time::Instant;
 
 /// Flies `missions` (each a setup and what to record), sharing one environment among those
 /// that can share it, and calls `done(k, result)` for mission `k` (its index in `missions`) as
-/// soon as it ends: in the order they end, missions ending in the same step in index order;
-/// missions that could not be set up first, in index order. Each result is the one
+/// soon as it ends. Missions of another seed or vehicle step than the first's (flown alone) and
+/// missions whose planners could not be built come first, in index order; the others come in
+/// the order they end, those ending in the same step in index order. Each result is the one
 /// [`Mission::new`], [`Mission::run`] and [`Mission::finish`] give for that mission alone,
 /// except for the wall times: the shared environment's time (spin-up and steps) is split
 /// evenly among the missions flying in it.
