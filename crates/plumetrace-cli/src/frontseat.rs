@@ -18,6 +18,7 @@ use plumetrace_mission::{Mission, MissionOptions, MissionSetup};
 use plumetrace_onboard::bluefin::{self, AckStatus, HorizontalMode, SpeedMode, VerticalMode};
 use plumetrace_onboard::chem::ChemFormat;
 use plumetrace_onboard::command::VehicleLimits;
+use plumetrace_onboard::current::Cur;
 use plumetrace_onboard::geo::{LocalFrame, Origin};
 use plumetrace_onboard::iver::{self, M_PER_FT, MPS_PER_KN, Units};
 use plumetrace_onboard::sentence::UtcTime;
@@ -92,7 +93,9 @@ pub struct FrontseatArgs {
     /// ... for this long, s.
     #[arg(long, default_value_t = 30.0)]
     pub silent_for: f64,
-    /// Fault (Bluefin): close the connection and stop listening at this mission time, s ...
+    /// Fault: restart the front seat at this mission time, s (Bluefin: the connection and the
+    /// listening socket closed; Iver: the serial line silent, what arrives lost, then a line of
+    /// boot text) ...
     #[arg(long)]
     pub restart_at: Option<f64>,
     /// ... for this long (wall time), s.
@@ -104,6 +107,10 @@ pub struct FrontseatArgs {
     /// Seed of the fault draws.
     #[arg(long, default_value_t = 1)]
     pub fault_seed: u64,
+    /// Do not send the vehicle's current readings (`$VDCUR`); the onboard file then has no
+    /// `[flow]` table and the planner keeps the prior flow.
+    #[arg(long)]
+    pub no_flow: bool,
 }
 
 /// What the front seat saw, for `frontseat.json` and the tests.
@@ -121,6 +128,8 @@ pub struct FrontSeatStats {
     pub bad_lines: u64,
     /// Connections accepted.
     pub connections: u64,
+    /// Restarts injected (`--restart-at`).
+    pub restarts: u64,
     /// Navigation records that got no answer in time (lock-step).
     pub unanswered: u64,
     /// Whether the back seat said it finished.
@@ -163,6 +172,8 @@ pub struct FrontSeat {
     lock_step: bool,
     wait: Duration,
     chem: ChemFormat,
+    flow: bool,
+    last_flow_s: Option<f64>,
     units: Units,
     limits: VehicleLimits,
     command: Option<Command>,
@@ -460,17 +471,33 @@ impl FrontSeat {
             return;
         }
         self.restart = None;
-        if let Wire::Tcp {
-            addr,
-            listener,
-            conn,
-        } = &mut self.wire
-        {
-            *conn = None;
-            *listener = None;
-            std::thread::sleep(pause);
-            *listener = TcpListener::bind(*addr).ok();
+        match &mut self.wire {
+            Wire::Tcp {
+                addr,
+                listener,
+                conn,
+            } => {
+                *conn = None;
+                *listener = None;
+                std::thread::sleep(pause);
+                *listener = TcpListener::bind(*addr).ok();
+            }
+            Wire::Pty(p) => {
+                // An Iver's computer restarting: the serial line stays, but nothing answers
+                // and what the back seat sends meanwhile is lost; it comes back with a line of
+                // boot text (not a sentence) and answers polls again.
+                let deadline = Instant::now() + pause;
+                let mut chunk = [0u8; 4096];
+                while Instant::now() < deadline {
+                    if !matches!(p.controller.read(&mut chunk), Ok(n) if n > 0) {
+                        std::thread::sleep(Duration::from_millis(10));
+                    }
+                }
+                let _ = p.controller.write_all(b"remote helm restarted\r\n");
+                self.polled = false;
+            }
         }
+        self.stat(|s| s.restarts += 1);
         self.buf.clear();
     }
 }
@@ -514,6 +541,15 @@ impl Planner for FrontSeat {
         for c in &s.chem {
             let line = self.chem.encode(time, c.reading);
             self.send(&line);
+        }
+        // A new reading of the vehicle's flow sensor goes out as the current meter's sentence.
+        if let Some(f) = s
+            .flow
+            .filter(|f| self.flow && self.last_flow_s != Some(f.time_s))
+        {
+            self.last_flow_s = Some(f.time_s);
+            let cur = Cur::of_velocity(f.velocity_mps, s.nav.depth_m, 1);
+            self.send(&cur.encode());
         }
         if self.garbage > 0.0 && self.rng.unit() < self.garbage {
             let n = (self.rng.unit() * 60.0) as usize;
@@ -608,6 +644,7 @@ fn onboard_file(
     link: &toml::Table,
     lock_step: bool,
     nav_period_s: f64,
+    flow: bool,
 ) -> Result<String> {
     let k = setup
         .planners
@@ -658,6 +695,10 @@ fn onboard_file(
         p.config.to_table().map_err(anyhow::Error::msg)?.into(),
     );
     file.insert("link".into(), link.clone().into());
+    if flow {
+        // The current meter's sentences travel on the vehicle link.
+        file.insert("flow".into(), toml::Table::new().into());
+    }
     file.insert("run".into(), run.into());
     Ok(format!(
         "# Written by `plumetrace frontseat` for scenario '{}': the planner table, mission geometry\n# and link of its first planned vehicle.\n{}",
@@ -685,6 +726,11 @@ pub fn run(args: &FrontseatArgs) -> Result<()> {
         if !(v.is_finite() && (0.0..=3600.0).contains(&v)) {
             bail!("{name}: {v} is outside [0, 3600]");
         }
+    }
+    if args.protocol == Protocol::Iver && args.lock_step && args.silent_at.is_some() {
+        bail!(
+            "--silent-at: Iver sentences carry no time, so in lock-step a back seat cannot see navigation missing for a span of mission time; use --restart-at (the serial line silent for a span of wall time)"
+        );
     }
     let origin = parse_origin(&args.origin)?;
     let frame = LocalFrame::new(origin).map_err(anyhow::Error::msg)?;
@@ -742,7 +788,13 @@ pub fn run(args: &FrontseatArgs) -> Result<()> {
     };
     link.insert("give_up_s".into(), give_up.into());
     if let Some(path) = &args.write_onboard {
-        let text = onboard_file(&setup, &link, args.lock_step, args.nav_period_s)?;
+        let text = onboard_file(
+            &setup,
+            &link,
+            args.lock_step,
+            args.nav_period_s,
+            !args.no_flow,
+        )?;
         crate::output::write_atomic(path, text.as_bytes())?;
     }
     let k = setup
@@ -760,6 +812,8 @@ pub fn run(args: &FrontseatArgs) -> Result<()> {
         lock_step: args.lock_step,
         wait: Duration::from_secs_f64(args.wait_s),
         chem: ChemFormat::default(),
+        flow: !args.no_flow,
+        last_flow_s: None,
         units: Units {
             remote_helm_major: args.remote_helm_major,
         },

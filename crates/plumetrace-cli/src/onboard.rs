@@ -89,7 +89,9 @@ pub fn run(args: &OnboardArgs) -> Result<()> {
     let traffic_path = args.out.join("link.log");
     let traffic = std::fs::File::create(&traffic_path)
         .with_context(|| format!("creating {}", traffic_path.display()))?;
-    let mut link = runner::link_for(&onboard, Some(Box::new(std::io::BufWriter::new(traffic))));
+    let mut link = runner::link_for(&onboard, Some(Box::new(std::io::BufWriter::new(traffic))))
+        .map_err(anyhow::Error::msg)
+        .with_context(|| format!("{}", args.file.display()))?;
     let chem_traffic = match &onboard.file.chemical {
         c if c.address.is_some() || c.device.is_some() => {
             let p = args.out.join("chem.log");
@@ -100,6 +102,16 @@ pub fn run(args: &OnboardArgs) -> Result<()> {
         _ => None,
     };
     let mut chem = runner::chem_link_for(&onboard, chem_traffic);
+    let flow_traffic = match &onboard.file.flow {
+        Some(f) if f.address.is_some() || f.device.is_some() => {
+            let p = args.out.join("flow.log");
+            let f =
+                std::fs::File::create(&p).with_context(|| format!("creating {}", p.display()))?;
+            Some(Box::new(std::io::BufWriter::new(f)) as Box<dyn std::io::Write + Send>)
+        }
+        _ => None,
+    };
+    let mut flow = runner::flow_link_for(&onboard, flow_traffic);
     let alog_path = args.out.join("run.alog");
     let alog_file = std::fs::File::create(&alog_path)
         .with_context(|| format!("creating {}", alog_path.display()))?;
@@ -113,8 +125,10 @@ pub fn run(args: &OnboardArgs) -> Result<()> {
         "pPlumetrace",
     )?;
     let mut log_error = None;
-    let chem_dyn: Option<&mut dyn plumetrace_onboard::link::Link> = chem.as_mut().map(|c| c as _);
-    let report = runner::run(&onboard, &mut link, chem_dyn, &mut |s, d| {
+    let mut inputs: Vec<&mut dyn plumetrace_onboard::link::Link> = Vec::new();
+    inputs.extend(chem.as_mut().map(|c| c as _));
+    inputs.extend(flow.as_mut().map(|c| c as _));
+    let report = runner::run_with_inputs(&onboard, &mut *link, &mut inputs, &mut |s, d| {
         if log_error.is_none() {
             let written = log
                 .write(0, s, d)

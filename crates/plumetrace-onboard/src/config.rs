@@ -11,8 +11,8 @@
 //! [planner]
 //! kind = "amp"
 //! [link]
-//! protocol = "bluefin"          # or "iver"
-//! address = "127.0.0.1:29500"   # bluefin; iver: device = "/dev/ttyUSB0"
+//! protocol = "bluefin"          # or "iver", or "moos" (the `moos` feature)
+//! address = "127.0.0.1:29500"   # bluefin; iver: device = "/dev/ttyUSB0"; moos: [link.moos]
 //! origin = { lat_deg = 36.18, lon_deg = -75.75 }
 //! [chemical]
 //! format = "sentence"           # or "plain"
@@ -48,6 +48,9 @@ pub struct OnboardFile {
     /// The chemical sensor.
     #[serde(default)]
     pub chemical: ChemicalFile,
+    /// The current meter (`None`: no measured current; the planner keeps the prior flow).
+    #[serde(default)]
+    pub flow: Option<FlowFile>,
     /// How time runs.
     #[serde(default)]
     pub run: RunFile,
@@ -86,6 +89,57 @@ pub enum ProtocolKind {
     Bluefin,
     /// Iver remote helm over a serial line.
     Iver,
+    /// A MOOS community client (a MOOSDB over TCP); needs the `moos` cargo feature.
+    Moos,
+}
+
+/// What a build without the `moos` feature says of `protocol = "moos"`.
+pub const MOOS_MISSING: &str = "this build has no MOOS link: build plumetrace with the `moos` feature (`cargo build --release -p plumetrace-cli --features moos`)";
+
+/// `[link.moos]`: the MOOS community client's settings.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MoosFile {
+    /// The MOOSDB's host (`localhost`).
+    #[serde(default = "default_moos_host")]
+    pub host: String,
+    /// The MOOSDB's port (1 to 65535; 9000).
+    #[serde(default = "default_moos_port")]
+    pub port: u16,
+    /// The name the client connects as (a MOOS variable-like name, 1 to 64 characters;
+    /// `pPlumetrace`).
+    #[serde(default = "default_moos_app")]
+    pub app_name: String,
+    /// The variable carrying the chemical reading (a double, or a string holding a number);
+    /// required unless `chemical.address` or `chemical.device` names a separate input.
+    pub chem_variable: Option<String>,
+}
+
+fn default_moos_host() -> String {
+    "localhost".into()
+}
+fn default_moos_port() -> u16 {
+    9000
+}
+fn default_moos_app() -> String {
+    "pPlumetrace".into()
+}
+
+impl Default for MoosFile {
+    fn default() -> Self {
+        MoosFile {
+            host: default_moos_host(),
+            port: default_moos_port(),
+            app_name: default_moos_app(),
+            chem_variable: None,
+        }
+    }
+}
+
+/// Whether `name` can be a MOOS variable or application name here: 1 to 64 printable ASCII
+/// characters without spaces.
+pub fn moos_name_ok(name: &str) -> bool {
+    !name.is_empty() && name.len() <= 64 && name.bytes().all(|b| b.is_ascii_graphic())
 }
 
 /// What the link sends when the planner pauses (stale navigation, lost link).
@@ -102,7 +156,7 @@ pub enum SafeAction {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct LinkFile {
-    /// `bluefin` or `iver`.
+    /// `bluefin`, `iver` or `moos`.
     pub protocol: ProtocolKind,
     /// Bluefin: the front seat's `host:port`.
     pub address: Option<String>,
@@ -151,6 +205,9 @@ pub struct LinkFile {
     /// The vehicle's limits, checked at the chokepoint.
     #[serde(default)]
     pub limits: VehicleLimits,
+    /// MOOS: the community client's settings (defaults when left out).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub moos: Option<MoosFile>,
 }
 
 fn default_baud() -> u32 {
@@ -244,6 +301,27 @@ impl ChemicalFile {
                 field: self.field,
             },
         }
+    }
+}
+
+/// `[flow]`: a current meter (ADCP or DVL) writing NMEA 0183 `$--CUR` sentences (see
+/// [`crate::current`]), and where its lines come from.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct FlowFile {
+    /// Only this layer's readings (0 to 99; left out: every reading).
+    pub layer: Option<u32>,
+    /// A separate TCP source (`host:port`); neither this nor `device`: the lines travel on the
+    /// vehicle link.
+    pub address: Option<String>,
+    /// A separate serial device.
+    pub device: Option<PathBuf>,
+}
+
+impl FlowFile {
+    /// The line format.
+    pub fn line_format(&self) -> crate::current::FlowFormat {
+        crate::current::FlowFormat { layer: self.layer }
     }
 }
 
@@ -370,7 +448,11 @@ impl Onboard {
                     "missing: the vehicle's remote-helm major version (it sets the depth unit: feet below 5, metres from 5)",
                 ));
             }
+            ProtocolKind::Moos => check_moos(&file)?,
             _ => {}
+        }
+        if l.protocol != ProtocolKind::Moos && l.moos.is_some() {
+            return Err(err("link.moos", "only for protocol = \"moos\""));
         }
         if let Some(v) = l.remote_helm_major {
             in_range("link.remote_helm_major", f64::from(v), 1.0, 99.0, false)?;
@@ -421,6 +503,14 @@ impl Onboard {
             }
             in_range("chemical.field", *field as f64, 1.0, 40.0, false)?;
         }
+        if let Some(fl) = &file.flow {
+            if fl.address.is_some() && fl.device.is_some() {
+                return Err(err("flow", "give address or device, not both"));
+            }
+            if let Some(layer) = fl.layer {
+                in_range("flow.layer", f64::from(layer), 0.0, 99.0, false)?;
+            }
+        }
         let context = BuildContext {
             geometry,
             vehicle: plumetrace_core::VehicleId(0),
@@ -431,6 +521,58 @@ impl Onboard {
             planner,
             context,
         })
+    }
+}
+
+/// The MOOS link's keys.
+fn check_moos(file: &OnboardFile) -> Result<(), ParamError> {
+    let l = &file.link;
+    if !cfg!(feature = "moos") {
+        return Err(err("link.protocol", MOOS_MISSING));
+    }
+    if l.address.is_some() {
+        return Err(err(
+            "link.address",
+            "not used by the moos link: give link.moos.host and link.moos.port",
+        ));
+    }
+    if l.device.is_some() {
+        return Err(err("link.device", "not used by the moos link"));
+    }
+    let m = l.moos.clone().unwrap_or_default();
+    let h = &m.host;
+    if h.is_empty() || h.len() > 253 || !h.bytes().all(|b| b.is_ascii_graphic()) {
+        return Err(err(
+            "link.moos.host",
+            format!("'{h}' is not a host name or address"),
+        ));
+    }
+    in_range("link.moos.port", f64::from(m.port), 1.0, 65_535.0, false)?;
+    if !moos_name_ok(&m.app_name) {
+        return Err(err(
+            "link.moos.app_name",
+            format!(
+                "'{}' is not 1 to 64 printable characters without spaces",
+                m.app_name
+            ),
+        ));
+    }
+    let c = &file.chemical;
+    let separate = c.address.is_some() || c.device.is_some();
+    match &m.chem_variable {
+        Some(v) if !moos_name_ok(v) => Err(err(
+            "link.moos.chem_variable",
+            format!("'{v}' is not 1 to 64 printable characters without spaces"),
+        )),
+        Some(_) if separate => Err(err(
+            "link.moos.chem_variable",
+            "give the MOOS chemical variable or a separate chemical input (chemical.address, chemical.device), not both",
+        )),
+        None if !separate => Err(err(
+            "link.moos.chem_variable",
+            "missing: the MOOS variable carrying the chemical reading (or give chemical.address or chemical.device)",
+        )),
+        _ => Ok(()),
     }
 }
 
@@ -499,6 +641,117 @@ origin = { lat_deg = 36.18, lon_deg = -75.75 }
             Onboard::from_toml(&unknown).is_err(),
             "unknown keys are refused"
         );
+    }
+
+    fn moos_file(link_moos: &str, chemical: &str) -> String {
+        let link = "protocol = \"bluefin\"\naddress = \"127.0.0.1:29500\"";
+        let text = GOOD.replacen(link, "protocol = \"moos\"", 1);
+        format!("{text}{link_moos}{chemical}")
+    }
+
+    #[cfg(not(feature = "moos"))]
+    #[test]
+    fn without_the_feature_the_moos_link_says_how_to_build_it() {
+        let text = moos_file("[link.moos]\nchem_variable = \"CHEM\"\n", "");
+        let e = Onboard::from_toml(&text).err();
+        assert_eq!(e.as_ref().map(|e| e.key.as_str()), Some("link.protocol"));
+        assert!(
+            e.is_some_and(|e| e.message.contains("--features moos")),
+            "the error says how to build with it"
+        );
+    }
+
+    #[cfg(feature = "moos")]
+    #[test]
+    fn the_moos_keys_have_defaults_and_bounds() {
+        let text = moos_file("[link.moos]\nchem_variable = \"CHEM\"\n", "");
+        let o = Onboard::from_toml(&text).unwrap_or_else(|e| panic!("{e}"));
+        let m = o.file.link.moos.unwrap_or_default();
+        assert_eq!((m.host.as_str(), m.port), ("localhost", 9000));
+        assert_eq!(m.app_name, "pPlumetrace");
+        let separate = moos_file("", "[chemical]\naddress = \"127.0.0.1:4000\"\n");
+        assert!(Onboard::from_toml(&separate).is_ok());
+        let cases = [
+            (moos_file("", ""), "link.moos.chem_variable"),
+            (
+                moos_file(
+                    "[link.moos]\nchem_variable = \"C\"\n",
+                    "[chemical]\naddress = \"127.0.0.1:4000\"\n",
+                ),
+                "link.moos.chem_variable",
+            ),
+            (
+                moos_file("[link.moos]\nchem_variable = \"A B\"\n", ""),
+                "link.moos.chem_variable",
+            ),
+            (
+                moos_file("[link.moos]\nchem_variable = \"C\"\nport = 0\n", ""),
+                "link.moos.port",
+            ),
+            (
+                moos_file("[link.moos]\nchem_variable = \"C\"\nport = 70000\n", ""),
+                "link.moos.port",
+            ),
+            (
+                moos_file("[link.moos]\nchem_variable = \"C\"\napp_name = \"\"\n", ""),
+                "link.moos.app_name",
+            ),
+            (
+                moos_file("[link.moos]\nchem_variable = \"C\"\nhost = \"a b\"\n", ""),
+                "link.moos.host",
+            ),
+            (
+                moos_file("[link.moos]\nchem_variable = \"C\"\nrate = 1\n", ""),
+                "link.moos",
+            ),
+            (
+                moos_file("[link.moos]\nchem_variable = \"C\"\n", "").replacen(
+                    "protocol = \"moos\"",
+                    "protocol = \"moos\"\naddress = \"h:1\"",
+                    1,
+                ),
+                "link.address",
+            ),
+            (
+                format!("{GOOD}[link.moos]\nchem_variable = \"C\"\n"),
+                "link.moos",
+            ),
+        ];
+        for (text, key) in cases {
+            let e = Onboard::from_toml(&text).err();
+            let got = e.as_ref().map(|e| e.key.clone());
+            assert!(
+                got.as_deref().is_some_and(|g| g.starts_with(key)),
+                "{text}: {e:?}"
+            );
+        }
+    }
+
+    #[test]
+    fn the_flow_table_is_optional_and_checked() {
+        let o = Onboard::from_toml(GOOD).unwrap_or_else(|e| panic!("{e}"));
+        assert_eq!(
+            o.file.flow, None,
+            "no current meter unless a [flow] table is given"
+        );
+        let on_link = format!("{GOOD}\n[flow]\n");
+        let o = Onboard::from_toml(&on_link).unwrap_or_else(|e| panic!("{e}"));
+        assert_eq!(o.file.flow, Some(FlowFile::default()));
+        let own = format!("{GOOD}\n[flow]\nlayer = 3\naddress = \"127.0.0.1:4001\"\n");
+        let o = Onboard::from_toml(&own).unwrap_or_else(|e| panic!("{e}"));
+        assert_eq!(o.file.flow.as_ref().and_then(|f| f.layer), Some(3));
+        for (bad, key) in [
+            ("layer = 100", "flow.layer"),
+            ("address = \"a:1\"\ndevice = \"/dev/ttyS1\"", "flow"),
+            ("rate = 1", "flow"),
+        ] {
+            let text = format!("{GOOD}\n[flow]\n{bad}\n");
+            let e = Onboard::from_toml(&text).err();
+            assert!(
+                e.as_ref().is_some_and(|e| e.key.starts_with(key)),
+                "{bad}: {e:?}"
+            );
+        }
     }
 
     #[test]

@@ -12,10 +12,12 @@
 //! - [`bluefin`]: the Bluefin standard payload interface sentences;
 //! - [`iver`]: the Iver remote-helm sentences and their unit setting;
 //! - [`chem`]: the chemical sensor's line input;
+//! - [`current`]: the current meter's `$--CUR` sentences (measured flow);
 //! - [`config`]: the onboard file (planner, mission geometry, chemical input, link, time);
 //! - [`command`]: the chokepoint every command passes (finite, within the vehicle's limits);
 //! - [`link`]: the link trait, the Bluefin and Iver protocols on TCP or a serial line,
 //!   reconnection, keep-alives, acknowledgements and the raw traffic log;
+//! - `moos` (the `moos` feature): a MOOS community client, its wire format and the MOOS link;
 //! - [`runner`]: the onboard runner (snapshots in, checked commands out, pauses for safety);
 //! - [`serial`]: raw serial lines and pseudo-terminals (no system library);
 //! - [`geo`]: latitude and longitude to the local frame and back (GeographicLib geodesics);
@@ -26,9 +28,12 @@ pub mod bluefin;
 pub mod chem;
 pub mod command;
 pub mod config;
+pub mod current;
 pub mod geo;
 pub mod iver;
 pub mod link;
+#[cfg(feature = "moos")]
+pub mod moos;
 pub mod runner;
 pub mod sentence;
 pub mod serial;

@@ -9,6 +9,7 @@
 use crate::bluefin::{self, AckStatus, HorizontalMode, Rmb, SpeedMode, VerticalMode};
 use crate::chem::ChemFormat;
 use crate::command::{CheckedCommand, Vertical};
+use crate::current::FlowFormat;
 use crate::iver::{self, M_PER_FT, MPS_PER_KN, Oms, Units};
 use crate::sentence::{LineCounts, MAX_LINE, SentenceError, UtcTime};
 use std::io::{Read, Write};
@@ -44,10 +45,16 @@ pub enum LinkEvent {
     Connected,
     /// The link went down (why).
     Lost(String),
+    /// A serial line stays open but nothing has come for the silence timeout (a vehicle
+    /// computer restarting, a cut cable): the planner pauses; the device is kept open and
+    /// polled, and the next navigation record resumes it.
+    Quiet(String),
     /// A complete navigation record.
     Nav(NavFix),
     /// A chemical reading.
     Chem(f64),
+    /// A current reading (a `$--CUR` sentence): the water's velocity `(east, north)`, m/s.
+    Flow(plumetrace_core::Vec2),
     /// The front seat's time, from any sentence that carries one.
     Clock(UtcTime),
     /// Whether the front seat accepts payload commands.
@@ -80,6 +87,17 @@ pub trait Link {
     fn counts(&self) -> &LineCounts;
     /// Whether the link is connected.
     fn connected(&self) -> bool;
+    /// Ends the link after the last send, so that what was sent reaches the other side.
+    fn close(&mut self) {}
+    /// What the planner decided from a snapshot (before its command is sent). A link that
+    /// publishes more than set-points (MOOS: behaviour, detections, declarations) uses it;
+    /// the others ignore it.
+    fn decided(
+        &mut self,
+        _snapshot: &plumetrace_core::SensorSnapshot,
+        _decision: &plumetrace_core::Decision,
+    ) {
+    }
 }
 
 /// One protocol's side of a link: what to say on connecting, how to read a line, how to write a
@@ -540,6 +558,7 @@ pub struct LineLink {
     endpoint: Endpoint,
     protocol: Box<dyn Protocol>,
     chem: Option<ChemFormat>,
+    flow: Option<FlowFormat>,
     timing: LinkTiming,
     conn: Option<Conn>,
     buf: Vec<u8>,
@@ -550,6 +569,8 @@ pub struct LineLink {
     clock: UtcTime,
     traffic: Option<Box<dyn Write + Send>>,
     started: Instant,
+    // A serial line silent for the silence timeout (reported once until bytes come again).
+    quiet: bool,
     // Events from sending (a write that failed), reported by the next poll.
     deferred: Vec<LinkEvent>,
 }
@@ -570,6 +591,7 @@ impl LineLink {
             endpoint,
             protocol,
             chem,
+            flow: None,
             backoff: timing.reconnect_min,
             timing,
             conn: None,
@@ -580,8 +602,15 @@ impl LineLink {
             clock: UtcTime::default(),
             traffic,
             started: now,
+            quiet: false,
             deferred: Vec::new(),
         }
+    }
+
+    /// The same link with current readings in `flow` travelling on it too.
+    pub fn with_flow(mut self, flow: FlowFormat) -> Self {
+        self.flow = Some(flow);
+        self
     }
 
     /// Sets lock-step behaviour of the protocol (Iver polls after each command).
@@ -597,6 +626,7 @@ impl LineLink {
     }
 
     fn drop_conn(&mut self, why: String, events: &mut Vec<LinkEvent>) {
+        self.quiet = false;
         if self.conn.take().is_some() {
             self.log('#', &format!("lost: {why}"));
             events.push(LinkEvent::Lost(why));
@@ -658,6 +688,16 @@ impl LineLink {
             }
             return;
         }
+        if let Some(flow) = self.flow.as_ref().filter(|f| f.claims(line)) {
+            let r = flow.parse(line);
+            self.counts.count(&r);
+            match r {
+                Ok(Some(v)) => events.push(LinkEvent::Flow(v)),
+                Ok(None) => {}
+                Err(e) => self.log('!', &e.to_string()),
+            }
+            return;
+        }
         let before = events.len();
         let r = self.protocol.read(line, events);
         self.counts.count(&r);
@@ -695,6 +735,10 @@ impl Link for LineLink {
                 Ok(0) => {}
                 Ok(n) => {
                     self.last_byte = Instant::now();
+                    if self.quiet {
+                        self.quiet = false;
+                        self.log('#', "the line speaks again");
+                    }
                     self.buf.extend_from_slice(&chunk[..n]);
                     while let Some(k) = self.buf.iter().position(|b| *b == b'\n') {
                         let raw: Vec<u8> = self.buf.drain(..=k).collect();
@@ -717,8 +761,18 @@ impl Link for LineLink {
             }
             if self.conn.is_some() && self.last_byte.elapsed() >= self.timing.silence_timeout {
                 let s = self.timing.silence_timeout.as_secs_f64();
-                self.drop_conn(format!("nothing received for {s:.1} s"), &mut events);
-                break;
+                let why = format!("nothing received for {s:.1} s");
+                if matches!(self.conn, Some(Conn::Serial(_))) {
+                    // A serial device stays: reopening it would not bring the vehicle back.
+                    if !self.quiet {
+                        self.quiet = true;
+                        self.log('#', &format!("silent: {why}"));
+                        events.push(LinkEvent::Quiet(why));
+                    }
+                } else {
+                    self.drop_conn(why, &mut events);
+                    break;
+                }
             }
             if !events.is_empty() || Instant::now() >= deadline {
                 break;
@@ -748,5 +802,28 @@ impl Link for LineLink {
 
     fn connected(&self) -> bool {
         self.conn.is_some()
+    }
+
+    fn close(&mut self) {
+        if let Some(t) = self.traffic.as_mut() {
+            let _ = t.flush();
+        }
+        // Closing a TCP socket with unread data resets the connection, and the other side may
+        // then drop what it had not read yet (the final stop): end the sending side, then read
+        // what is left until the other side closes or half a second has passed.
+        if let Some(Conn::Tcp(s)) = self.conn.as_mut() {
+            let _ = s.flush();
+            let _ = s.shutdown(std::net::Shutdown::Write);
+            let deadline = Instant::now() + Duration::from_millis(500);
+            let mut chunk = [0u8; 4096];
+            while Instant::now() < deadline {
+                let left = deadline.saturating_duration_since(Instant::now());
+                match read_tcp(s, &mut chunk, left.min(Duration::from_millis(50))) {
+                    Ok(_) => {}
+                    Err(_) => break,
+                }
+            }
+        }
+        self.conn = None;
     }
 }

@@ -3,8 +3,13 @@
 //!
 //! Safety comes first. The planner is paused, and the link sends the protocol's safe command
 //! (or nothing, as configured), when navigation is older than `link.stale_nav_s`, when the link
-//! is lost (it reconnects with back-off meanwhile) or when the front seat says it does not
-//! accept commands; it resumes with the next fresh navigation record. A command that fails the
+//! is lost (it reconnects with back-off meanwhile), when a serial line has been silent for
+//! `link.silence_timeout_s` (the device stays open) or when the front seat says it does not
+//! accept commands; it resumes with the next fresh navigation record.
+//!
+//! Current readings (the `[flow]` table: `$--CUR` sentences on the vehicle link or an input of
+//! their own) go into every snapshot as the latest [`FlowSample`], stamped on arrival, as a
+//! simulated flow sensor's do; without them the planner keeps the prior flow direction. A command that fails the
 //! chokepoint is not sent (the previous one stands) and is counted.
 //!
 //! Time is either the wall clock (`real_time`) or the front seat's (`lock_step`): mission time
@@ -23,8 +28,8 @@ use crate::link::{
 };
 use crate::sentence::{LineCounts, UtcTime};
 use plumetrace_core::{
-    ChemSample, Decision, Heading, NavEstimate, PlanStatus, PlannerEvent, SensorSnapshot, Vec2,
-    VehicleId,
+    ChemSample, Decision, FlowSample, Heading, NavEstimate, PlanStatus, PlannerEvent,
+    SensorSnapshot, Vec2, VehicleId,
 };
 use std::io::Write;
 use std::time::{Duration, Instant, SystemTime};
@@ -92,8 +97,12 @@ fn timing(l: &crate::config::LinkFile) -> LinkTiming {
     }
 }
 
-/// Makes the link an onboard file describes; raw traffic goes to `traffic`.
-pub fn link_for(onboard: &Onboard, traffic: Option<Box<dyn Write + Send>>) -> LineLink {
+/// Makes the link an onboard file describes; raw traffic goes to `traffic`. An error when the
+/// file asks for a link this build does not have (MOOS without the `moos` feature).
+pub fn link_for(
+    onboard: &Onboard,
+    traffic: Option<Box<dyn Write + Send>>,
+) -> Result<Box<dyn Link>, String> {
     let l = &onboard.file.link;
     let secs = Duration::from_secs_f64;
     let safe_stop = l.safe_command == SafeAction::Stop;
@@ -122,6 +131,13 @@ pub fn link_for(onboard: &Onboard, traffic: Option<Box<dyn Write + Send>>) -> Li
                 safe_stop,
             })),
         ),
+        #[cfg(feature = "moos")]
+        ProtocolKind::Moos => {
+            return crate::moos::MoosLink::for_onboard(onboard, timing(l), traffic)
+                .map(|m| Box::new(m) as Box<dyn Link>);
+        }
+        #[cfg(not(feature = "moos"))]
+        ProtocolKind::Moos => return Err(crate::config::MOOS_MISSING.into()),
     };
     let c = &onboard.file.chemical;
     let on_link = c.address.is_none() && c.device.is_none();
@@ -132,8 +148,65 @@ pub fn link_for(onboard: &Onboard, traffic: Option<Box<dyn Write + Send>>) -> Li
         timing(l),
         traffic,
     );
+    if let Some(f) = onboard
+        .file
+        .flow
+        .as_ref()
+        .filter(|f| f.address.is_none() && f.device.is_none())
+    {
+        link = link.with_flow(f.line_format());
+    }
     link.set_lock_step(onboard.file.run.mode == RunMode::LockStep);
-    link
+    Ok(Box::new(link))
+}
+
+/// Where the current meter's lines come from when not on the vehicle link.
+fn flow_endpoint(onboard: &Onboard) -> Option<Endpoint> {
+    let f = onboard.file.flow.as_ref()?;
+    match (&f.address, &f.device) {
+        (Some(a), _) => Some(Endpoint::Tcp(a.clone())),
+        (None, Some(d)) => Some(Endpoint::Serial {
+            path: d.clone(),
+            baud: onboard.file.link.baud,
+        }),
+        (None, None) => None,
+    }
+}
+
+/// The separate current-meter input an onboard file names (`flow.address` or `flow.device`),
+/// unless it is the chemical input's too (then that input carries both); its raw lines go to
+/// `traffic`.
+pub fn flow_link_for(
+    onboard: &Onboard,
+    traffic: Option<Box<dyn Write + Send>>,
+) -> Option<LineLink> {
+    let endpoint = flow_endpoint(onboard)?;
+    if chem_endpoint(onboard).as_ref() == Some(&endpoint) {
+        return None;
+    }
+    let f = onboard.file.flow.as_ref()?;
+    Some(
+        LineLink::new(
+            endpoint,
+            Box::new(crate::link::ChemOnly),
+            None,
+            timing(&onboard.file.link),
+            traffic,
+        )
+        .with_flow(f.line_format()),
+    )
+}
+
+fn chem_endpoint(onboard: &Onboard) -> Option<Endpoint> {
+    let c = &onboard.file.chemical;
+    match (&c.address, &c.device) {
+        (Some(a), _) => Some(Endpoint::Tcp(a.clone())),
+        (None, Some(d)) => Some(Endpoint::Serial {
+            path: d.clone(),
+            baud: onboard.file.link.baud,
+        }),
+        (None, None) => None,
+    }
 }
 
 /// The separate chemical input an onboard file names (`chemical.address` or
@@ -143,22 +216,19 @@ pub fn chem_link_for(
     traffic: Option<Box<dyn Write + Send>>,
 ) -> Option<LineLink> {
     let c = &onboard.file.chemical;
-    let l = &onboard.file.link;
-    let endpoint = match (&c.address, &c.device) {
-        (Some(a), _) => Endpoint::Tcp(a.clone()),
-        (None, Some(d)) => Endpoint::Serial {
-            path: d.clone(),
-            baud: l.baud,
-        },
-        (None, None) => return None,
-    };
-    Some(LineLink::new(
+    let endpoint = chem_endpoint(onboard)?;
+    let shared = flow_endpoint(onboard).as_ref() == Some(&endpoint);
+    let mut link = LineLink::new(
         endpoint,
         Box::new(crate::link::ChemOnly),
         Some(c.line_format()),
-        timing(l),
+        timing(&onboard.file.link),
         traffic,
-    ))
+    );
+    if let Some(f) = onboard.file.flow.as_ref().filter(|_| shared) {
+        link = link.with_flow(f.line_format());
+    }
+    Some(link)
 }
 
 /// The UTC time of day now.
@@ -232,7 +302,20 @@ impl State {
 pub fn run(
     onboard: &Onboard,
     link: &mut dyn Link,
-    mut chem_link: Option<&mut dyn Link>,
+    chem_link: Option<&mut dyn Link>,
+    observe: &mut dyn FnMut(&SensorSnapshot, &Decision),
+) -> Result<RunReport, String> {
+    let mut inputs: Vec<&mut dyn Link> = chem_link.into_iter().collect();
+    run_with_inputs(onboard, link, &mut inputs, observe)
+}
+
+/// [`run`] with any number of separate sensor inputs (the chemical sensor, the current meter):
+/// only their chemical and current readings count, their connection state is not the
+/// vehicle's.
+pub fn run_with_inputs(
+    onboard: &Onboard,
+    link: &mut dyn Link,
+    inputs: &mut [&mut dyn Link],
     observe: &mut dyn FnMut(&SensorSnapshot, &Decision),
 ) -> Result<RunReport, String> {
     let mut planner = onboard
@@ -268,21 +351,23 @@ pub fn run(
         },
     };
     let mut chem: Vec<ChemSample> = Vec::new();
+    let mut flow: Option<FlowSample> = None;
     let mut last_fix_s: Option<f64> = None;
     let mut next_decision_s = f64::NEG_INFINITY;
     let mut current: Option<CheckedCommand> = None;
     let mut down_since: Option<Instant> = Some(Instant::now());
     let period = planner.decision_period_s();
     let end = loop {
-        let mut events = match chem_link.as_mut() {
-            // Only its readings count: its connection state is not the vehicle's.
-            Some(c) => c
-                .poll(Duration::ZERO)
-                .into_iter()
-                .filter(|e| matches!(e, LinkEvent::Chem(_)))
-                .collect(),
-            None => Vec::new(),
-        };
+        let mut events: Vec<LinkEvent> = Vec::new();
+        for input in inputs.iter_mut() {
+            // Only their readings count: their connection state is not the vehicle's.
+            events.extend(
+                input
+                    .poll(Duration::ZERO)
+                    .into_iter()
+                    .filter(|e| matches!(e, LinkEvent::Chem(_) | LinkEvent::Flow(_))),
+            );
+        }
         events.extend(link.poll(Duration::from_millis(100)));
         let mut fixes: Vec<NavFix> = Vec::new();
         for e in events {
@@ -295,6 +380,7 @@ pub fn run(
                     down_since.get_or_insert_with(Instant::now);
                     s.pause(link, format!("link lost: {why}"));
                 }
+                LinkEvent::Quiet(why) => s.pause(link, format!("line silent: {why}")),
                 LinkEvent::Clock(t) => {
                     s.front_time = t;
                     if s.lock_step {
@@ -311,6 +397,14 @@ pub fn run(
                     time_s: s.now_s(),
                     reading,
                 }),
+                // Like a simulated flow sensor's: the latest reading, stamped on arrival, in
+                // every snapshot until the next.
+                LinkEvent::Flow(velocity_mps) => {
+                    flow = Some(FlowSample {
+                        time_s: s.now_s(),
+                        velocity_mps,
+                    });
+                }
                 LinkEvent::Accepting(a) => {
                     s.accepting = a;
                     if !a {
@@ -354,7 +448,7 @@ pub fn run(
                         last_fix_s,
                     },
                     chem: std::mem::take(&mut chem),
-                    flow: None,
+                    flow,
                     ranges: None,
                     inbox: Vec::new(),
                 };
@@ -362,6 +456,7 @@ pub fn run(
                 s.report.decisions += 1;
                 next_decision_s = if period > 0.0 { t + period } else { t };
                 observe(&snapshot, &decision);
+                link.decided(&snapshot, &decision);
                 for e in &decision.events {
                     if let PlannerEvent::Declared { pos_m, .. } = e {
                         s.report.declarations.push(*pos_m);
@@ -371,13 +466,14 @@ pub fn run(
                     PlanStatus::Running => {}
                     PlanStatus::Finished | PlanStatus::Abort => {
                         link.send(Outgoing::Finished, s.stamp());
+                        s.report.lines = link.counts().clone();
+                        link.close();
                         s.report.time_s = t;
                         s.report.end = if decision.status == PlanStatus::Finished {
                             RunEnd::Finished
                         } else {
                             RunEnd::Aborted
                         };
-                        s.report.lines = link.counts().clone();
                         return Ok(s.report);
                     }
                 }
@@ -421,6 +517,7 @@ pub fn run(
     s.report.end = end;
     s.report.time_s = s.now_s();
     s.report.lines = link.counts().clone();
+    link.close();
     Ok(s.report)
 }
 

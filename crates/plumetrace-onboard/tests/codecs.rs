@@ -7,6 +7,7 @@ use plumetrace_onboard::bluefin::{
     self, Ack, AckStatus, HorizontalMode, Nvg, Nvr, Rmb, SpeedMode, VerticalMode,
 };
 use plumetrace_onboard::chem::ChemFormat;
+use plumetrace_onboard::current::{Cur, DirectionRef, FlowFormat};
 use plumetrace_onboard::iver::{self, Mode, Oms, Osi, Units};
 use plumetrace_onboard::sentence::{LineCounts, SentenceError, UtcTime, checksum};
 
@@ -215,6 +216,113 @@ fn the_chemical_input_reads_its_sentence_and_plain_readings() {
     ));
 }
 
+fn cur_golden() -> Vec<(&'static str, Cur)> {
+    vec![
+        (
+            "$VDCUR,A,0,1,6.0,78.1,T,0.300,,,,B*39\r\n",
+            Cur {
+                data_set: 0,
+                layer: 1,
+                depth_m: Some(6.0),
+                direction_deg: 78.1,
+                reference: DirectionRef::True,
+                speed_kn: 0.3,
+                ref_layer_depth_m: None,
+                heading_deg: None,
+                bottom_track: true,
+            },
+        ),
+        (
+            "$VDCUR,A,0,3,12.5,45.0,R,1.000,,90.0,T,P*51\r\n",
+            Cur {
+                data_set: 0,
+                layer: 3,
+                depth_m: Some(12.5),
+                direction_deg: 45.0,
+                reference: DirectionRef::Relative,
+                speed_kn: 1.0,
+                ref_layer_depth_m: None,
+                heading_deg: Some(90.0),
+                bottom_track: false,
+            },
+        ),
+    ]
+}
+
+#[test]
+fn the_current_meter_sentence_reads_and_writes_its_golden_lines() {
+    for (line, c) in cur_golden() {
+        assert_eq!(Cur::parse(line).as_ref(), Ok(&c), "{line}");
+        assert_eq!(c.encode(), line);
+        assert!(Cur::claims(line));
+    }
+    // Any talker; the velocity is (east, north) in m/s.
+    let other = "$IICUR,A,0,2,,180.0,T,0.500,,,,B*31";
+    assert!(Cur::claims(other));
+    let v = Cur::parse(other).unwrap().velocity_mps();
+    assert!(
+        v.x.abs() < 1e-12 && (v.y + 0.5 * 1852.0 / 3600.0).abs() < 1e-12,
+        "{v:?}"
+    );
+    // Relative to the heading of field 9: 45 deg right of a vehicle heading east is south-east.
+    let v = cur_golden()[1].1.velocity_mps();
+    let s = 1852.0 / 3600.0 / 2f64.sqrt();
+    assert!((v.x - s).abs() < 1e-12 && (v.y + s).abs() < 1e-12, "{v:?}");
+    // A simulated front seat's reading comes back as the velocity it was made from.
+    let v0 = plumetrace_core::Vec2::new(0.151, 0.032);
+    let back = Cur::parse(&Cur::of_velocity(v0, Some(6.0), 1).encode())
+        .unwrap()
+        .velocity_mps();
+    assert!((back - v0).norm() < 0.002, "{back:?}");
+    let north = Cur::of_velocity(plumetrace_core::Vec2::new(-1e-4, 0.3), None, 1);
+    assert_eq!(Cur::parse(&north.encode()).unwrap().direction_deg, 0.0);
+    assert!(!Cur::claims("$PTCHM,120000.000,0.125000*47"));
+    assert!(!Cur::claims("$CURX,1*00"));
+    // One layer only, when configured: other layers' good readings are skipped, not errors.
+    let layer2 = FlowFormat { layer: Some(2) };
+    assert!(layer2.parse(other).unwrap().is_some());
+    assert_eq!(layer2.parse(cur_golden()[0].0), Ok(None));
+    assert!(
+        FlowFormat::default()
+            .parse(cur_golden()[0].0)
+            .unwrap()
+            .is_some()
+    );
+}
+
+#[test]
+fn current_readings_out_of_range_or_not_over_the_ground_are_refused() {
+    use plumetrace_onboard::sentence::frame;
+    let cases: &[(&str, &str)] = &[
+        ("VDCUR,V,0,1,6.0,78.1,T,0.300,,,,B", "bad_field"),
+        ("VDCUR,A,0,1,6.0,78.1,T,0.300,,,,W", "bad_field"),
+        ("VDCUR,A,0,1,6.0,78.1,T,25.000,,,,B", "out_of_range"),
+        ("VDCUR,A,0,1,6.0,-5.0,T,0.300,,,,B", "out_of_range"),
+        ("VDCUR,A,0,1,6.0,400.0,T,0.300,,,,B", "out_of_range"),
+        ("VDCUR,A,0,1,-3.0,78.1,T,0.300,,,,B", "out_of_range"),
+        ("VDCUR,A,0,1,6.0,78.1,T,nan,,,,B", "bad_field"),
+        ("VDCUR,A,0,1,6.0,78.1,R,0.300,,,,B", "bad_field"),
+        ("VDCUR,A,0,1,6.0,78.1,R,0.300,,90.0,M,B", "bad_field"),
+        ("VDCUR,A,0,1,6.0,78.1,X,0.300,,,,B", "bad_field"),
+        ("VDCUR,A,10,1,6.0,78.1,T,0.300,,,,B", "out_of_range"),
+        ("VDCUR,A,0,100,6.0,78.1,T,0.300,,,,B", "out_of_range"),
+        ("VDCUR,A,0,1,6.0,78.1,T,0.300,,,B", "field_count"),
+        ("VDCURX,A,0,1,6.0,78.1,T,0.300,,,,B", "unknown"),
+    ];
+    for (body, kind) in cases {
+        let r = Cur::parse(&frame(body));
+        assert_eq!(
+            r.as_ref().err().map(SentenceError::kind),
+            Some(*kind),
+            "{body}: {r:?}"
+        );
+    }
+    assert!(matches!(
+        Cur::parse("$VDCUR,A,0,1,6.0,78.1,T,0.300,,,,B*38"),
+        Err(SentenceError::BadChecksum { .. })
+    ));
+}
+
 #[test]
 fn iver_depth_units_follow_the_remote_helm_version() {
     let old = Units {
@@ -404,8 +512,10 @@ fn a_million_random_and_mutated_lines_are_each_accepted_or_counted_as_bad() {
     let mut seeds: Vec<String> = bluefin_golden().iter().map(|g| g.0.to_string()).collect();
     seeds.extend(iver_golden().iter().map(|g| g.0.to_string()));
     seeds.push("$PTCHM,120000.000,0.125000*47\r\n".into());
+    seeds.extend(cur_golden().iter().map(|g| g.0.to_string()));
     let chem = ChemFormat::default();
-    let (mut b, mut i, mut c) = (
+    let (mut b, mut i, mut c, mut f) = (
+        LineCounts::default(),
         LineCounts::default(),
         LineCounts::default(),
         LineCounts::default(),
@@ -429,8 +539,20 @@ fn a_million_random_and_mutated_lines_are_each_accepted_or_counted_as_bad() {
         }
         i.count(&ri);
         c.count(&chem.parse(&line));
+        let rf = Cur::parse(&line);
+        if let Ok(s) = &rf {
+            assert!(s.velocity_mps().norm().is_finite(), "{line:?}");
+            let again = Cur::parse(&s.encode()).unwrap();
+            assert_eq!(again.encode(), s.encode(), "{line:?}");
+        }
+        f.count(&rf);
     }
-    for (name, counts) in [("bluefin", &b), ("iver", &i), ("chemical", &c)] {
+    for (name, counts) in [
+        ("bluefin", &b),
+        ("iver", &i),
+        ("chemical", &c),
+        ("current", &f),
+    ] {
         println!(
             "{name}: {N} lines, {} accepted, {} rejected {:?}",
             counts.accepted,
