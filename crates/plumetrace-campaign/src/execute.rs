@@ -6,7 +6,7 @@ use crate::example::{EXAMPLES_DIR, ExampleRun};
 use crate::runs::{Appender, RUNS_FILE, RunRow, row_key};
 use crate::spec::{Campaign, RunKey, Shard};
 use plumetrace_env::Environment;
-use plumetrace_mission::{Mission, MissionOptions, MissionSetup};
+use plumetrace_mission::{Mission, MissionOptions, MissionRun, MissionSetup, fly_shared};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 use std::collections::{BTreeMap, BTreeSet};
@@ -30,6 +30,21 @@ pub struct Meta {
     pub seeds: u64,
 }
 
+/// What runs of one seed share where their environments are built from the same settings
+/// ([`share_groups`]). The results are the same bits whatever is shared; sharing saves CPU.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub enum Share {
+    /// One world: the plume is spun up once and stepped once per step for all the runs of a
+    /// group, each run's vehicles flying against it with their own random streams.
+    #[default]
+    Plume,
+    /// The spin-up only: the first run of a group develops the plume, the others start from a
+    /// copy and step their own.
+    SpinUp,
+    /// Nothing: every run spins up and steps its own plume.
+    Nothing,
+}
+
 /// How to run.
 #[derive(Debug, Clone, Copy, Default)]
 pub struct RunOptions {
@@ -37,9 +52,8 @@ pub struct RunOptions {
     pub jobs: Option<usize>,
     /// Only this shard's runs.
     pub shard: Option<Shard>,
-    /// Spin every run's plume up on its own, even where runs of the same seed could share one
-    /// (the results are the same bits either way; this is for checking that).
-    pub separate_spinups: bool,
+    /// What runs of the same seed share (the results are the same bits either way).
+    pub share: Share,
 }
 
 /// What a campaign call did.
@@ -165,20 +179,18 @@ pub fn run_campaign(
     let finished = AtomicU64::new(0);
     let failed = AtomicU64::new(0);
     let total = todo.len() as u64;
-    let groups = if opts.separate_spinups {
-        todo.iter().map(|k| vec![*k]).collect()
-    } else {
-        spinup_groups(c, &todo)
+    let groups = match opts.share {
+        Share::Nothing => todo.iter().map(|k| vec![*k]).collect(),
+        Share::Plume | Share::SpinUp => share_groups(c, &todo),
     };
     let work = || {
         groups.par_iter().for_each(|group| {
-            let mut shared: Option<Environment> = None;
-            for (i, key) in group.iter().enumerate() {
+            // Each row is appended the moment its run ends, so an interrupted group keeps the
+            // rows of the runs that ended before it.
+            let mut emit = |row: RunRow| {
                 if stop.load(Ordering::Relaxed) {
                     return;
                 }
-                let more = i + 1 < group.len();
-                let row = run_one(c, key, out, &mut shared, more);
                 if row.outcome == crate::runs::RunOutcome::ERROR {
                     failed.fetch_add(1, Ordering::Relaxed);
                 }
@@ -194,6 +206,22 @@ pub fn run_campaign(
                     return;
                 }
                 progress(finished.fetch_add(1, Ordering::Relaxed) + 1, total);
+            };
+            if stop.load(Ordering::Relaxed) {
+                return;
+            }
+            match opts.share {
+                Share::Plume if group.len() > 1 => run_shared(c, group, out, &mut emit),
+                _ => {
+                    let mut shared: Option<Environment> = None;
+                    for (i, key) in group.iter().enumerate() {
+                        if stop.load(Ordering::Relaxed) {
+                            return;
+                        }
+                        let more = i + 1 < group.len();
+                        emit(run_one(c, key, out, &mut shared, more));
+                    }
+                }
             }
         });
     };
@@ -215,13 +243,15 @@ pub fn run_campaign(
     Ok(report)
 }
 
-/// The runs that can share one spin-up: runs of the same scenario and seed whose scenario
-/// tables differ only in what the environment is not built from (planner tables, outputs, the
-/// mission's geometry and time limit). Everything else (domain, flow, plume, sources, obstacles,
-/// kelp, vehicles, whose start positions keep kelp clear, the simulation and spin-up steps)
-/// must be equal, so a shared spin-up gives the same bits as separate ones. Groups come in run
-/// order.
-pub fn spinup_groups(c: &Campaign, todo: &[RunKey]) -> Vec<Vec<RunKey>> {
+/// The runs that can share one environment (its spin-up, or the whole world): runs of the same
+/// scenario and seed whose scenario tables differ only in what the environment is not built
+/// from (planner tables, outputs, message channels, the mission's geometry and time limit).
+/// Everything else (domain, flow, plume, sources, obstacles, kelp, vehicles, whose start
+/// positions keep kelp clear, the simulation, environment and spin-up steps) must be equal, so
+/// the environment each run sees is, step for step, the one it would build alone. A time limit
+/// may differ: a run that ends stops looking, and the environment steps on for the others. Groups
+/// come in run order.
+pub fn share_groups(c: &Campaign, todo: &[RunKey]) -> Vec<Vec<RunKey>> {
     let mut groups: BTreeMap<(usize, u64, String), Vec<RunKey>> = BTreeMap::new();
     let mut alone = Vec::new();
     for k in todo {
@@ -268,14 +298,7 @@ fn run_one(
     more: bool,
 ) -> RunRow {
     let attempt = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-        let sc = c.build(key).map_err(|e| e.to_string())?;
-        let example = key.seed_index == 0;
-        let options = MissionOptions {
-            mean_plume: false,
-            trajectory: example,
-            plume_frames_every_s: example.then_some(plumetrace_mission::PLUME_FRAME_EVERY_S),
-        };
-        let mut setup = MissionSetup::new(sc).map_err(|e| e.to_string())?;
+        let (mut setup, options) = prepare(c, key)?;
         match shared.as_ref().and_then(Environment::try_clone) {
             Some(env) => setup.use_spun_up(env),
             None => {
@@ -288,18 +311,82 @@ fn run_one(
         let mut mission = Mission::new(setup, options).map_err(|e| e.to_string())?;
         mission.run(&mut |_, _| {}).map_err(|e| e.to_string())?;
         let run = mission.finish().map_err(|e| e.to_string())?;
-        if let Some(at) = plumetrace_mission::output::first_non_finite(&run.summary) {
-            return Err(format!(
-                "the summary has a number that is not finite ({at})"
-            ));
-        }
-        if example {
-            let ex = ExampleRun::from_run(c, key, &run);
-            ex.write(out).map_err(|e| e.to_string())?;
-            crate::example::write_page(c, key, &run, out)?;
-        }
-        Ok::<RunRow, String>(RunRow::from_summary(c, key, &run.summary))
+        row_of(c, key, out, run)
     }));
+    row_or_failure(c, key, attempt)
+}
+
+/// A run's setup and what it records (everything for the example run at seed index 0).
+fn prepare(c: &Campaign, key: &RunKey) -> Result<(MissionSetup, MissionOptions), String> {
+    let sc = c.build(key).map_err(|e| e.to_string())?;
+    let example = key.seed_index == 0;
+    let options = MissionOptions {
+        mean_plume: false,
+        trajectory: example,
+        plume_frames_every_s: example.then_some(plumetrace_mission::PLUME_FRAME_EVERY_S),
+    };
+    let setup = MissionSetup::new(sc).map_err(|e| e.to_string())?;
+    Ok((setup, options))
+}
+
+/// A finished run's row; the example run's files are written on the way.
+fn row_of(c: &Campaign, key: &RunKey, out: &Path, run: MissionRun) -> Result<RunRow, String> {
+    if let Some(at) = plumetrace_mission::output::first_non_finite(&run.summary) {
+        return Err(format!(
+            "the summary has a number that is not finite ({at})"
+        ));
+    }
+    if key.seed_index == 0 {
+        let ex = ExampleRun::from_run(c, key, &run);
+        ex.write(out).map_err(|e| e.to_string())?;
+        crate::example::write_page(c, key, &run, out)?;
+    }
+    Ok(RunRow::from_summary(c, key, &run.summary))
+}
+
+/// Flies a group's runs in one world ([`fly_shared`]) and emits each run's row as it ends. If
+/// anything panics, the runs without a row yet are flown again one by one (each then fails or
+/// not on its own, as it would in a campaign that shares nothing).
+fn run_shared(c: &Campaign, group: &[RunKey], out: &Path, emit: &mut dyn FnMut(RunRow)) {
+    let mut written = vec![false; group.len()];
+    let attempt = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+        let mut missions = Vec::with_capacity(group.len());
+        let mut keys = Vec::with_capacity(group.len());
+        for (i, key) in group.iter().enumerate() {
+            match prepare(c, key) {
+                Ok(m) => {
+                    missions.push(m);
+                    keys.push(i);
+                }
+                Err(message) => {
+                    written[i] = true;
+                    emit(RunRow::failed(c, key, message));
+                }
+            }
+        }
+        fly_shared(missions, &mut |k, result| {
+            let Some(&i) = keys.get(k) else { return };
+            let key = &group[i];
+            let row = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+                row_of(c, key, out, result.map_err(|e| e.to_string())?)
+            }));
+            written[i] = true;
+            emit(row_or_failure(c, key, row));
+        });
+    }));
+    if attempt.is_err() {
+        for (key, _) in group.iter().zip(&written).filter(|(_, w)| !**w) {
+            emit(run_one(c, key, out, &mut None, false));
+        }
+    }
+}
+
+/// The row of an attempt: its own, or a failed row naming the error or the panic.
+fn row_or_failure(
+    c: &Campaign,
+    key: &RunKey,
+    attempt: std::thread::Result<Result<RunRow, String>>,
+) -> RunRow {
     match attempt {
         Ok(Ok(row)) => row,
         Ok(Err(message)) => RunRow::failed(c, key, message),

@@ -6,8 +6,10 @@
 //! realisations (common random numbers). [`run_campaign`] flies the runs in parallel, appends
 //! each row to `runs.csv` the moment it finishes (a killed campaign loses only the runs in
 //! flight; the next call skips what is recorded), and at the end sorts `runs.csv` into the
-//! canonical order and writes `summary.csv`, `summary.md` and the charts. Results do not depend
-//! on the thread count or on sharding: [`merge::merge`] of the shards of a campaign gives the
+//! canonical order and writes `summary.csv`, `summary.md` and the charts. Runs of one seed whose
+//! environments are built from the same settings fly in one world by default
+//! ([`execute::share_groups`], [`Share`]): one plume for all of them, the same rows as alone.
+//! Results do not depend on the thread count or on sharding: [`merge::merge`] of the shards of a campaign gives the
 //! same `runs.csv` as one unsharded call.
 //!
 //! Files of a campaign directory:
@@ -35,7 +37,7 @@ pub mod spec;
 pub mod stats;
 
 pub use error::CampaignError;
-pub use execute::{CampaignReport, RunOptions, run_campaign};
+pub use execute::{CampaignReport, RunOptions, Share, run_campaign};
 pub use merge::{MergeReport, merge};
 pub use runs::{RUNS_FILE, RunRow};
 pub use spec::{Campaign, RunKey, Shard};

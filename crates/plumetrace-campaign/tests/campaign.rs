@@ -3,7 +3,7 @@
 
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
-use plumetrace_campaign::{Campaign, CampaignError, RunOptions, Shard, merge, run_campaign};
+use plumetrace_campaign::{Campaign, CampaignError, RunOptions, Shard, Share, merge, run_campaign};
 use std::path::{Path, PathBuf};
 
 /// Two configurations x two sweep values x 2 seeds of a 1,500 s demo mission.
@@ -301,7 +301,7 @@ fn runs_sharing_a_spin_up_give_the_bits_of_separate_spin_ups() {
     let tmp = tempfile::tempdir().unwrap();
     let file = campaign_file(tmp.path(), &text);
     let c = Campaign::load(&file, None).unwrap();
-    let groups = plumetrace_campaign::execute::spinup_groups(&c, &c.runs());
+    let groups = plumetrace_campaign::execute::share_groups(&c, &c.runs());
     // Per seed: {paper, cross} together, {stronger} alone.
     assert_eq!(groups.len(), 2 * 2, "{groups:?}");
     assert_eq!(groups.iter().filter(|g| g.len() == 2).count(), 2);
@@ -312,12 +312,20 @@ fn runs_sharing_a_spin_up_give_the_bits_of_separate_spin_ups() {
         }
     }
     let (shared, separate) = (tmp.path().join("shared"), tmp.path().join("separate"));
-    run(&file, &shared, RunOptions::default(), None);
+    run(
+        &file,
+        &shared,
+        RunOptions {
+            share: Share::SpinUp,
+            ..RunOptions::default()
+        },
+        None,
+    );
     run(
         &file,
         &separate,
         RunOptions {
-            separate_spinups: true,
+            share: Share::Nothing,
             ..RunOptions::default()
         },
         None,
@@ -326,4 +334,120 @@ fn runs_sharing_a_spin_up_give_the_bits_of_separate_spin_ups() {
     assert_eq!(runs.lines().count(), 1 + 3 * 2, "{runs}");
     assert_eq!(runs, read(&separate.join("runs.csv")));
     assert!(runs.contains("declared"), "{runs}");
+}
+
+/// Every file of a campaign directory but `campaign.json` and `campaign.toml`, by name.
+fn results(dir: &Path) -> Vec<(String, Vec<u8>)> {
+    let mut out = Vec::new();
+    for sub in ["", "examples"] {
+        for entry in std::fs::read_dir(dir.join(sub)).unwrap() {
+            let path = entry.unwrap().path();
+            if path.is_file() {
+                out.push((
+                    format!("{sub}/{}", path.file_name().unwrap().to_string_lossy()),
+                    std::fs::read(&path).unwrap(),
+                ));
+            }
+        }
+    }
+    out.sort();
+    out
+}
+
+#[test]
+fn runs_in_one_world_give_the_bits_of_separate_runs_on_any_thread_count() {
+    // Four configurations at each seed: three planners (two AMP rules with different time
+    // limits, a lawnmower) fly in one world; the fourth changes the source and flies alone.
+    let text = CAMPAIGN
+        .replace("\n[sweep]\nbeta_deg = [20.0, 30.0]\n", "\n")
+        .replace(
+            "name = \"cross\"\n[configs.set]\ndeclaration = \"along_and_cross_flow\"\nmapping = false\n\
+             \"mission.time_limit_s\" = 1500.0",
+            "name = \"cross\"\n[configs.set]\ndeclaration = \"along_and_cross_flow\"\nmapping = false\n\
+             \"mission.time_limit_s\" = 900.0",
+        )
+        + "\n[[configs]]\nname = \"lawnmower\"\n[configs.planner]\nkind = \"lawnmower\"\n\
+           lane_spacing_m = 40.0\n[configs.set]\n\"mission.time_limit_s\" = 1200.0\n\
+           \"mission.spinup_s\" = 1500.0\n\
+           \n[[configs]]\nname = \"stronger\"\n[configs.set]\nmapping = false\n\
+           \"mission.time_limit_s\" = 1200.0\n\"mission.spinup_s\" = 1500.0\n\
+           \"sources.0.mass_rate_per_s\" = 30.0\n";
+    let tmp = tempfile::tempdir().unwrap();
+    let file = campaign_file(tmp.path(), &text);
+    let c = Campaign::load(&file, None).unwrap();
+    assert_eq!(c.configs.len(), 4, "{text}");
+    let groups = plumetrace_campaign::execute::share_groups(&c, &c.runs());
+    // Per seed: {paper, cross, lawnmower} in one world, {stronger} alone.
+    assert_eq!(groups.len(), 2 * 2, "{groups:?}");
+    for g in &groups {
+        assert!(g.iter().all(|k| k.seed_index == g[0].seed_index));
+        match g.len() {
+            3 => assert!(g.iter().all(|k| k.config < 3), "{g:?}"),
+            1 => assert_eq!(g[0].config, 3, "{g:?}"),
+            _ => panic!("{g:?}"),
+        }
+    }
+    let separate = tmp.path().join("separate");
+    run(
+        &file,
+        &separate,
+        RunOptions {
+            jobs: Some(1),
+            share: Share::Nothing,
+            ..RunOptions::default()
+        },
+        None,
+    );
+    let expected = results(&separate);
+    let runs = read(&separate.join("runs.csv"));
+    assert_eq!(runs.lines().count(), 1 + 4 * 2, "{runs}");
+    assert!(
+        runs.contains("lawnmower") && runs.contains("declared"),
+        "{runs}"
+    );
+    // The examples' replay pages and tracks are compared too.
+    assert!(
+        expected
+            .iter()
+            .filter(|(n, _)| n.starts_with("examples/"))
+            .count()
+            >= 8
+    );
+    for jobs in [1, 2] {
+        let shared = tmp.path().join(format!("shared-{jobs}"));
+        run(
+            &file,
+            &shared,
+            RunOptions {
+                jobs: Some(jobs),
+                ..RunOptions::default()
+            },
+            None,
+        );
+        let got = results(&shared);
+        assert_eq!(
+            got.iter().map(|(n, _)| n).collect::<Vec<_>>(),
+            expected.iter().map(|(n, _)| n).collect::<Vec<_>>()
+        );
+        for ((name, a), (_, b)) in got.iter().zip(&expected) {
+            assert!(a == b, "{jobs} threads: {name} differs");
+        }
+    }
+    // A group interrupted after some of its runs: the rest fly in a fresh shared world and
+    // the results are the same.
+    let resumed = tmp.path().join("resumed");
+    std::fs::create_dir_all(&resumed).unwrap();
+    run(
+        &file,
+        &resumed,
+        RunOptions {
+            shard: Some("1/3".parse().unwrap()),
+            ..RunOptions::default()
+        },
+        None,
+    );
+    let partial = read(&resumed.join("runs.csv"));
+    assert_eq!(partial.lines().count(), 1 + 3, "{partial}");
+    run(&file, &resumed, RunOptions::default(), None);
+    assert_eq!(read(&resumed.join("runs.csv")), runs);
 }

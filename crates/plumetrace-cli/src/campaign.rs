@@ -1,7 +1,7 @@
 //! `plumetrace campaign` and `plumetrace merge`.
 
 use anyhow::{Context, Result};
-use plumetrace_campaign::{Campaign, RunOptions, Shard, merge, run_campaign};
+use plumetrace_campaign::{Campaign, RunOptions, Shard, Share, merge, run_campaign};
 use std::path::PathBuf;
 use std::time::Instant;
 
@@ -22,11 +22,26 @@ pub struct CampaignArgs {
     /// Seeds per group, 1 to 1,000,000 (overrides the file's `seeds`).
     #[arg(long, allow_hyphen_values = true, value_parser = crate::args::seeds)]
     pub seeds: Option<u64>,
-    /// Spin every run's plume up on its own. By default runs of the same seed whose scenarios
-    /// differ only in planner keys, outputs or mission geometry share one spin-up (the same
-    /// bits as separate ones, less CPU).
-    #[arg(long)]
+    /// What runs of the same seed share where their scenarios differ only in planner keys,
+    /// outputs, message channels or mission geometry and time limit: `plume` (default: one
+    /// world, the plume spun up and stepped once for all of them), `spin-up` (one spin-up, then
+    /// a plume each) or `none`. The results are the same bits whatever is shared.
+    #[arg(long, value_enum, default_value = "plume")]
+    pub share: ShareArg,
+    /// The same as `--share none`.
+    #[arg(long, conflicts_with = "share")]
     pub separate_spinups: bool,
+}
+
+/// What runs of the same seed share (`--share`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum ShareArg {
+    /// One world: one spin-up and one plume stepped for all the runs of a group.
+    Plume,
+    /// One spin-up, then each run steps its own copy of the plume.
+    SpinUp,
+    /// Every run spins up and steps its own plume.
+    None,
 }
 
 /// Runs (or resumes) a campaign and prints where the results are.
@@ -41,7 +56,11 @@ pub fn run(args: &CampaignArgs) -> Result<()> {
         RunOptions {
             jobs: args.jobs,
             shard: args.shard,
-            separate_spinups: args.separate_spinups,
+            share: match (args.separate_spinups, args.share) {
+                (true, _) | (_, ShareArg::None) => Share::Nothing,
+                (_, ShareArg::SpinUp) => Share::SpinUp,
+                (_, ShareArg::Plume) => Share::Plume,
+            },
         },
         &|done, _| progress.tick(done),
     )

@@ -91,6 +91,18 @@ pub const CAMPAIGNS: &[(&str, &str)] = &[
         "map-tuning",
         include_str!("../../../examples/campaigns/map-tuning.toml"),
     ),
+    (
+        "ten-planners-one-plume",
+        include_str!("../../../examples/campaigns/ten-planners-one-plume.toml"),
+    ),
+    (
+        "amp-mapping",
+        include_str!("../../../examples/campaigns/amp-mapping.toml"),
+    ),
+    (
+        "meander-noise",
+        include_str!("../../../examples/campaigns/meander-noise.toml"),
+    ),
 ];
 
 /// The example families (`examples/families/*.family.toml`; a test checks the list is complete).

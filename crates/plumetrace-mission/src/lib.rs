@@ -9,6 +9,8 @@
 //!
 //! - [`setup`]: scenario to mission, planners checked;
 //! - [`mission`]: the stepper ([`Mission::new`], [`Mission::step`], [`Mission::finish`]);
+//! - [`shared`]: several missions of one scenario and seed in one environment
+//!   ([`fly_shared`]), each with the result it has alone;
 //! - [`outcome`]: how a mission ends and what it comes to;
 //! - [`record`]: the observer trait and the mission's own recorders;
 //! - [`summary`]: the key numbers written as `summary.json`; [`team`]: what a team of vehicles
@@ -27,6 +29,7 @@ pub mod plot;
 pub mod record;
 pub mod replay_page;
 pub mod setup;
+pub mod shared;
 pub mod snapshot_log;
 pub mod summary;
 pub mod team;
@@ -41,5 +44,6 @@ pub use record::{
     EventKind, EventRecord, Observer, PlumeFrame, PlumeFrames, StepView, TrajectoryRow,
 };
 pub use setup::{MissionError, MissionSetup, PlannedVehicle};
+pub use shared::fly_shared;
 pub use summary::{DeclarationRecord, LOCATED_RADIUS_M, SourceRecord, Summary, VehicleSummary};
 pub use team::{TeamStats, TeamSummary};

@@ -14,9 +14,10 @@ use crate::record::{
 use crate::setup::{MissionError, MissionSetup, PlannedVehicle};
 use crate::summary::{Summary, SummaryInput};
 use plumetrace_core::{PlanStatus, Planner, Vec2, Vec3, VehicleId, VehicleKind};
+use plumetrace_env::Environment;
 use plumetrace_env::MeanConcentrationGrid;
 use plumetrace_planner::{MissionGeometry, PlannerKind};
-use plumetrace_sim::{SimVehicle, StageTimes, World, WorldEvent};
+use plumetrace_sim::{Fleet, SimVehicle, StageTimes, WorldEvent, WorldView};
 use std::time::Instant;
 
 /// What a mission records besides its summary and events.
@@ -107,9 +108,17 @@ pub struct MissionRun {
 
 /// A mission being flown.
 pub struct Mission {
+    env: Environment,
+    flight: Flight,
+}
+
+/// A mission without its environment: the fleet, its planners, observers and end conditions.
+/// It flies in an environment it is given at every step, its own ([`Mission`]) or one shared
+/// with other missions ([`crate::shared::SharedMissions`]), and only reads it.
+pub(crate) struct Flight {
     name: String,
     seed: u64,
-    world: World,
+    fleet: Fleet,
     planners: Vec<Option<Box<dyn Planner>>>,
     planned: Vec<Option<PlannedVehicle>>,
     statuses: Vec<VehicleStatus>,
@@ -133,7 +142,28 @@ pub struct Mission {
 
 impl Mission {
     /// Develops the plume (spin-up), then builds the world and every vehicle's planner.
-    pub fn new(setup: MissionSetup, options: MissionOptions) -> Result<Self, MissionError> {
+    pub fn new(mut setup: MissionSetup, options: MissionOptions) -> Result<Self, MissionError> {
+        let started = Instant::now();
+        setup.spin_up()?;
+        let spinup_wall_s = started.elapsed().as_secs_f64();
+        let (env, flight) = Flight::new(setup, options, None, spinup_wall_s);
+        Ok(Mission {
+            env,
+            flight: flight?,
+        })
+    }
+}
+
+impl Flight {
+    /// Builds the fleet and every vehicle's planner from a spun-up setup, to fly in `shared`
+    /// if given, else in the setup's own environment; the setup's own environment is returned
+    /// either way (unused and unchanged when `shared` is given or building fails).
+    pub(crate) fn new(
+        setup: MissionSetup,
+        options: MissionOptions,
+        shared: Option<&Environment>,
+        spinup_wall_s: f64,
+    ) -> (Environment, Result<Self, MissionError>) {
         let origin = setup.origin.to_string();
         let env_error = |error| MissionError::Env {
             origin: origin.clone(),
@@ -142,7 +172,7 @@ impl Mission {
         let MissionSetup {
             name,
             seed,
-            mut env,
+            env: own_env,
             vehicles: setups,
             planners: planned,
             geometry,
@@ -150,166 +180,168 @@ impl Mission {
             dt_s,
             depth_m,
             comms,
-            spun_up,
             ..
         } = setup;
-        let started = Instant::now();
-        if !spun_up {
-            env.spin_up(spec.spinup_s, spec.spinup_dt_s)
-                .map_err(env_error)?;
-        }
-        let spinup_wall_s = started.elapsed().as_secs_f64();
-        let mut vehicles = Vec::with_capacity(setups.len());
-        let mut planners: Vec<Option<Box<dyn Planner>>> = Vec::with_capacity(setups.len());
-        for (v, p) in setups.iter().zip(&planned) {
-            let mut sim = SimVehicle::new(
-                v.name.clone(),
-                v.vehicle.clone(),
-                v.nav,
-                v.chem_sensor,
-                v.flow_sensor,
-                v.range_sensor,
-                seed,
-            );
-            sim.deaf_window_s = v.deaf_window_s;
-            vehicles.push(sim);
-            planners.push(match p {
-                Some(p) => Some(p.config.build(&p.context, &p.key).map_err(|error| {
-                    MissionError::Invalid {
-                        origin: origin.clone(),
-                        error,
+        let env = shared.unwrap_or(&own_env);
+        let built = (|| {
+            let mut vehicles = Vec::with_capacity(setups.len());
+            let mut planners: Vec<Option<Box<dyn Planner>>> = Vec::with_capacity(setups.len());
+            for (v, p) in setups.iter().zip(&planned) {
+                let mut sim = SimVehicle::new(
+                    v.name.clone(),
+                    v.vehicle.clone(),
+                    v.nav,
+                    v.chem_sensor,
+                    v.flow_sensor,
+                    v.range_sensor,
+                    seed,
+                );
+                sim.deaf_window_s = v.deaf_window_s;
+                vehicles.push(sim);
+                planners.push(match p {
+                    Some(p) => Some(p.config.build(&p.context, &p.key).map_err(|error| {
+                        MissionError::Invalid {
+                            origin: origin.clone(),
+                            error,
+                        }
+                    })?),
+                    None => None,
+                });
+            }
+            let fleet = Fleet::new(env, vehicles, dt_s, depth_m, comms, seed).map_err(env_error)?;
+            let sources = true_sources(WorldView::new(env, &fleet));
+            let statuses: Vec<VehicleStatus> = planned
+                .iter()
+                .map(|p| {
+                    if p.is_some() {
+                        VehicleStatus::Active
+                    } else {
+                        VehicleStatus::NoPlanner
                     }
-                })?),
-                None => None,
-            });
-        }
-        let world =
-            World::with_comms(env, vehicles, dt_s, depth_m, comms, seed).map_err(env_error)?;
-        let sources = true_sources(&world);
-        let statuses: Vec<VehicleStatus> = planned
-            .iter()
-            .map(|p| {
-                if p.is_some() {
-                    VehicleStatus::Active
-                } else {
-                    VehicleStatus::NoPlanner
-                }
-            })
-            .collect();
-        let sample_every = (20.0 / dt_s).round().max(1.0) as u64;
-        let thresholds: Vec<Option<f64>> = planned
-            .iter()
-            .map(|p| p.as_ref().and_then(|p| p.config.detection_threshold_v()))
-            .collect();
-        let positions: Vec<bool> = setups.iter().map(|v| v.nav.position_estimate).collect();
-        // The figure's plume at the height of the first vehicle with a planner.
-        let z = planned
-            .iter()
-            .position(Option::is_some)
-            .and_then(|k| setups.get(k))
-            .map_or(0.0, |v| v.vehicle.state.z_m);
-        let mean_plume = options.mean_plume.then(|| {
-            MeanPlumeRecorder::new(
-                MeanPlumeRecorder::grid_over(&spec.op_area, world.env().domain(), z),
-                sample_every,
-            )
-        });
-        let plume_frames = options
-            .plume_frames_every_s
-            .filter(|s| s.is_finite() && *s > 0.0)
-            .map(|every| {
-                let (x0, x1, y0, y1) = crate::record::bounds_of(&spec.op_area);
-                let pad = 0.15 * (x1 - x0).max(y1 - y0);
-                PlumeFrames::new(
-                    (x0 - pad, x1 + pad, y0 - pad, y1 + pad),
-                    world.env().domain(),
-                    z,
-                    (every / dt_s).round().max(1.0) as u64,
+                })
+                .collect();
+            let sample_every = (20.0 / dt_s).round().max(1.0) as u64;
+            let thresholds: Vec<Option<f64>> = planned
+                .iter()
+                .map(|p| p.as_ref().and_then(|p| p.config.detection_threshold_v()))
+                .collect();
+            let positions: Vec<bool> = setups.iter().map(|v| v.nav.position_estimate).collect();
+            // The figure's plume at the height of the first vehicle with a planner.
+            let z = planned
+                .iter()
+                .position(Option::is_some)
+                .and_then(|k| setups.get(k))
+                .map_or(0.0, |v| v.vehicle.state.z_m);
+            let mean_plume = options.mean_plume.then(|| {
+                MeanPlumeRecorder::new(
+                    MeanPlumeRecorder::grid_over(&spec.op_area, env.domain(), z),
+                    sample_every,
                 )
             });
-        let faults = setups
-            .iter()
-            .map(|v| {
-                v.flow_sensor
-                    .fault
-                    .map(|f| FaultWindow {
-                        start_s: f.start_s,
-                        end_s: f.end_s,
-                        what: "flow sensor reads the wrong layer",
-                    })
-                    .into_iter()
-                    .collect()
-            })
-            .collect();
-        Ok(Mission {
-            name,
-            plume_frames,
-            faults,
-            seed,
-            step_limit: (spec.time_limit_s / dt_s).round() as u64,
-            stats: TrackStats::new(
-                thresholds.clone(),
-                &spec.op_area,
-                sources.first().map(|s| s.xy()),
-                sample_every,
-            ),
-            team: crate::team::TeamStats::new(
-                planned.iter().map(Option::is_some).collect(),
-                sources.first().copied(),
-            ),
-            trajectory: options
-                .trajectory
-                .then(|| TrajectoryRecorder::new(thresholds, positions)),
-            world,
-            planners,
-            planned,
-            statuses,
-            first_failure: None,
-            end: None,
-            events: EventRecorder::default(),
-            mean_plume,
-            observers: Vec::new(),
-            sources,
-            geometry,
-            op_area: spec.op_area,
-            subregions: spec.subregions,
-            spinup_wall_s,
-        })
+            let plume_frames = options
+                .plume_frames_every_s
+                .filter(|s| s.is_finite() && *s > 0.0)
+                .map(|every| {
+                    let (x0, x1, y0, y1) = crate::record::bounds_of(&spec.op_area);
+                    let pad = 0.15 * (x1 - x0).max(y1 - y0);
+                    PlumeFrames::new(
+                        (x0 - pad, x1 + pad, y0 - pad, y1 + pad),
+                        env.domain(),
+                        z,
+                        (every / dt_s).round().max(1.0) as u64,
+                    )
+                });
+            let faults = setups
+                .iter()
+                .map(|v| {
+                    v.flow_sensor
+                        .fault
+                        .map(|f| FaultWindow {
+                            start_s: f.start_s,
+                            end_s: f.end_s,
+                            what: "flow sensor reads the wrong layer",
+                        })
+                        .into_iter()
+                        .collect()
+                })
+                .collect();
+            let flight = Flight {
+                name,
+                plume_frames,
+                faults,
+                seed,
+                step_limit: (spec.time_limit_s / dt_s).round() as u64,
+                stats: TrackStats::new(
+                    thresholds.clone(),
+                    &spec.op_area,
+                    sources.first().map(|s| s.xy()),
+                    sample_every,
+                ),
+                team: crate::team::TeamStats::new(
+                    planned.iter().map(Option::is_some).collect(),
+                    sources.first().copied(),
+                ),
+                trajectory: options
+                    .trajectory
+                    .then(|| TrajectoryRecorder::new(thresholds, positions)),
+                fleet,
+                planners,
+                planned,
+                statuses,
+                first_failure: None,
+                end: None,
+                events: EventRecorder::default(),
+                mean_plume,
+                observers: Vec::new(),
+                sources,
+                geometry,
+                op_area: spec.op_area,
+                subregions: spec.subregions,
+                spinup_wall_s,
+            };
+            Ok(flight)
+        })();
+        (own_env, built)
+    }
+
+    /// The fleet.
+    pub(crate) fn fleet(&self) -> &Fleet {
+        &self.fleet
+    }
+
+    /// Adds time spent advancing the environment for this mission.
+    pub(crate) fn add_environment_time(&mut self, s: f64) {
+        self.fleet.add_environment_time(s);
     }
 
     /// Adds an observer (e.g. a snapshot log); the world keeps snapshots if it wants them. An
     /// observer that wants snapshots must come before the first step (a log that misses the first
     /// decisions could not be replayed).
-    pub fn observe(&mut self, o: Box<dyn Observer>) -> Result<(), MissionError> {
+    pub(crate) fn observe(&mut self, o: Box<dyn Observer>) -> Result<(), MissionError> {
         if o.wants_snapshots() {
-            if self.world.steps() > 0 {
+            if self.fleet.steps() > 0 {
                 return Err(MissionError::Output {
                     what: "a snapshot log".into(),
                     message: format!(
                         "it must observe the mission from its start, not from step {}",
-                        self.world.steps()
+                        self.fleet.steps()
                     ),
                 });
             }
-            self.world.record_snapshots(true);
+            self.fleet.record_snapshots(true);
         }
         self.observers.push(o);
         Ok(())
     }
 
     /// Scenario name.
-    pub fn name(&self) -> &str {
+    pub(crate) fn name(&self) -> &str {
         &self.name
     }
 
     /// Run seed.
-    pub fn seed(&self) -> u64 {
+    pub(crate) fn seed(&self) -> u64 {
         self.seed
-    }
-
-    /// The world.
-    pub fn world(&self) -> &World {
-        &self.world
     }
 
     /// Flies `planner` for vehicle `vehicle` instead of the one its planner table builds: a
@@ -317,7 +349,7 @@ impl Mission {
     /// same [`Planner`] seam. Only before the first step, and only for a vehicle with a planner
     /// table: the table still gives the detection threshold the trajectory and statistics mark
     /// detections with, and the snapshot log's header still names it.
-    pub fn replace_planner(
+    pub(crate) fn replace_planner(
         &mut self,
         vehicle: usize,
         planner: Box<dyn Planner>,
@@ -326,10 +358,10 @@ impl Mission {
             what: "a replacement planner".into(),
             message,
         };
-        if self.world.steps() > 0 {
+        if self.fleet.steps() > 0 {
             return Err(invalid(format!(
                 "planners can only be replaced before the first step, not at step {}",
-                self.world.steps()
+                self.fleet.steps()
             )));
         }
         match self.planners.get_mut(vehicle) {
@@ -339,7 +371,7 @@ impl Mission {
             }
             Some(None) => Err(invalid(format!(
                 "vehicle {vehicle} ({}) has no planner table to replace",
-                self.world.vehicles()[vehicle].name
+                self.fleet.vehicles()[vehicle].name
             ))),
             None => Err(invalid(format!(
                 "there is no vehicle {vehicle} (the mission has {})",
@@ -349,23 +381,23 @@ impl Mission {
     }
 
     /// Each vehicle's planner as configured.
-    pub fn planned(&self) -> &[Option<PlannedVehicle>] {
+    pub(crate) fn planned(&self) -> &[Option<PlannedVehicle>] {
         &self.planned
     }
 
     /// The mission geometry the planners fly.
-    pub fn geometry(&self) -> &MissionGeometry {
+    pub(crate) fn geometry(&self) -> &MissionGeometry {
         &self.geometry
     }
 
     /// Each vehicle's status.
-    pub fn statuses(&self) -> &[VehicleStatus] {
+    pub(crate) fn statuses(&self) -> &[VehicleStatus] {
         &self.statuses
     }
 
     /// The vehicles' names, by index.
-    pub fn vehicle_names(&self) -> Vec<String> {
-        self.world
+    pub(crate) fn vehicle_names(&self) -> Vec<String> {
+        self.fleet
             .vehicles()
             .iter()
             .map(|v| v.name.clone())
@@ -373,32 +405,37 @@ impl Mission {
     }
 
     /// Mission time, s.
-    pub fn time_s(&self) -> f64 {
-        self.world.time_s()
+    pub(crate) fn time_s(&self) -> f64 {
+        self.fleet.time_s()
     }
 
     /// The mission's time limit, s.
-    pub fn time_limit_s(&self) -> f64 {
-        self.step_limit as f64 * self.world.dt_s()
+    pub(crate) fn time_limit_s(&self) -> f64 {
+        self.step_limit as f64 * self.fleet.dt_s()
     }
 
     /// The end, once reached.
-    pub fn end(&self) -> Option<MissionEnd> {
+    pub(crate) fn end(&self) -> Option<MissionEnd> {
         self.end
     }
 
     /// One step; returns the end when this step (or an earlier one) ended the mission.
-    pub fn step(&mut self) -> Result<Option<MissionEnd>, MissionError> {
+    /// An environment error of this mission, named by its scenario.
+    pub(crate) fn env_error(&self, error: plumetrace_env::EnvError) -> MissionError {
+        MissionError::Env {
+            origin: format!("scenario '{}'", self.name),
+            error,
+        }
+    }
+
+    pub(crate) fn step(&mut self, env: &Environment) -> Result<Option<MissionEnd>, MissionError> {
         if self.end.is_some() {
             return Ok(self.end);
         }
         let report = self
-            .world
-            .step(&mut self.planners)
-            .map_err(|error| MissionError::Env {
-                origin: format!("scenario '{}'", self.name),
-                error,
-            })?;
+            .fleet
+            .step(env, &mut self.planners)
+            .map_err(|error| self.env_error(error))?;
         let mut mission_events = Vec::new();
         for (i, d) in report.decisions.iter().enumerate() {
             let Some(d) = d else { continue };
@@ -408,7 +445,7 @@ impl Mission {
                 PlanStatus::Finished => {
                     if self.statuses[i] == VehicleStatus::Active {
                         self.statuses[i] = VehicleStatus::Finished;
-                        self.world.stop(id);
+                        self.fleet.stop(id);
                         mission_events.push((id, MissionEvent::PlannerFinished));
                     }
                 }
@@ -416,7 +453,7 @@ impl Mission {
                     self.statuses[i] = VehicleStatus::Aborted;
                     self.first_failure
                         .get_or_insert(Outcome::of_abort(&d.events));
-                    self.world.stop(id);
+                    self.fleet.stop(id);
                     mission_events.push((id, MissionEvent::PlannerAborted));
                 }
             }
@@ -435,7 +472,7 @@ impl Mission {
         let t0 = Instant::now();
         {
             let view = StepView {
-                world: &self.world,
+                world: WorldView::new(env, &self.fleet),
                 report: &report,
                 mission_events: &mission_events,
                 statuses: &self.statuses,
@@ -456,14 +493,14 @@ impl Mission {
                 o.observe(&view);
             }
         }
-        self.world.add_record_time(t0.elapsed().as_secs_f64());
-        let t = self.world.time_s();
+        self.fleet.add_record_time(t0.elapsed().as_secs_f64());
+        let t = self.fleet.time_s();
         if !self.statuses.contains(&VehicleStatus::Active) {
             self.end = Some(MissionEnd {
                 reason: EndReason::PlannersDone,
                 t_s: t,
             });
-        } else if self.world.steps() >= self.step_limit {
+        } else if self.fleet.steps() >= self.step_limit {
             self.end = Some(MissionEnd {
                 reason: EndReason::TimeLimit,
                 t_s: t,
@@ -472,21 +509,8 @@ impl Mission {
         Ok(self.end)
     }
 
-    /// Steps to the end; `progress(t, limit)` is called every 600 steps.
-    pub fn run(&mut self, progress: &mut dyn FnMut(f64, f64)) -> Result<MissionEnd, MissionError> {
-        let limit = self.time_limit_s();
-        loop {
-            if let Some(end) = self.step()? {
-                return Ok(end);
-            }
-            if self.world.steps().is_multiple_of(600) {
-                progress(self.world.time_s(), limit);
-            }
-        }
-    }
-
     /// What was recorded; the observers are finished (their buffered output flushed).
-    pub fn finish(mut self) -> Result<MissionRun, MissionError> {
+    pub(crate) fn finish(mut self, env: &Environment) -> Result<MissionRun, MissionError> {
         for o in &mut self.observers {
             o.finish().map_err(|message| MissionError::Output {
                 what: "an observer's output".into(),
@@ -495,10 +519,10 @@ impl Mission {
         }
         let end = self.end.unwrap_or(MissionEnd {
             reason: EndReason::TimeLimit,
-            t_s: self.world.time_s(),
+            t_s: self.fleet.time_s(),
         });
         let vehicles: Vec<VehicleInfo> = self
-            .world
+            .fleet
             .vehicles()
             .iter()
             .zip(&self.planned)
@@ -536,16 +560,14 @@ impl Mission {
             summary,
             trajectory: self.trajectory.map(|t| t.rows).unwrap_or_default(),
             events: self.events.events,
-            stage_times: self.world.stage_times(),
+            stage_times: self.fleet.stage_times(),
             spinup_wall_s: self.spinup_wall_s,
             mean_plume: self.mean_plume.map(|m| m.grid),
             plume_frames: self.plume_frames,
             sources: self.sources,
             op_area: self.op_area,
             subregions: self.subregions,
-            obstacles: self
-                .world
-                .env()
+            obstacles: env
                 .obstacles()
                 .iter()
                 .map(|o| {
@@ -559,6 +581,114 @@ impl Mission {
             mean_flow_mps: mean_flow,
             vehicles,
         })
+    }
+}
+
+impl Mission {
+    /// Adds an observer (e.g. a snapshot log); the world keeps snapshots if it wants them. An
+    /// observer that wants snapshots must come before the first step (a log that misses the first
+    /// decisions could not be replayed).
+    pub fn observe(&mut self, o: Box<dyn Observer>) -> Result<(), MissionError> {
+        self.flight.observe(o)
+    }
+
+    /// Scenario name.
+    pub fn name(&self) -> &str {
+        self.flight.name()
+    }
+
+    /// Run seed.
+    pub fn seed(&self) -> u64 {
+        self.flight.seed()
+    }
+
+    /// The world: the mission's environment and its fleet.
+    pub fn world(&self) -> WorldView<'_> {
+        WorldView::new(&self.env, &self.flight.fleet)
+    }
+
+    /// Flies `planner` for vehicle `vehicle` instead of the one its planner table builds: a
+    /// planner outside the registry (written in Python, or an agent being trained) behind the
+    /// same [`Planner`] seam. Only before the first step, and only for a vehicle with a planner
+    /// table: the table still gives the detection threshold the trajectory and statistics mark
+    /// detections with, and the snapshot log's header still names it.
+    pub fn replace_planner(
+        &mut self,
+        vehicle: usize,
+        planner: Box<dyn Planner>,
+    ) -> Result<(), MissionError> {
+        self.flight.replace_planner(vehicle, planner)
+    }
+
+    /// Each vehicle's planner as configured.
+    pub fn planned(&self) -> &[Option<PlannedVehicle>] {
+        self.flight.planned()
+    }
+
+    /// The mission geometry the planners fly.
+    pub fn geometry(&self) -> &MissionGeometry {
+        self.flight.geometry()
+    }
+
+    /// Each vehicle's status.
+    pub fn statuses(&self) -> &[VehicleStatus] {
+        self.flight.statuses()
+    }
+
+    /// The vehicles' names, by index.
+    pub fn vehicle_names(&self) -> Vec<String> {
+        self.flight.vehicle_names()
+    }
+
+    /// Mission time, s.
+    pub fn time_s(&self) -> f64 {
+        self.flight.time_s()
+    }
+
+    /// The mission's time limit, s.
+    pub fn time_limit_s(&self) -> f64 {
+        self.flight.time_limit_s()
+    }
+
+    /// The end, once reached.
+    pub fn end(&self) -> Option<MissionEnd> {
+        self.flight.end()
+    }
+
+    /// One step (the environment first when it is due, then the fleet); returns the end when
+    /// this step (or an earlier one) ended the mission.
+    pub fn step(&mut self) -> Result<Option<MissionEnd>, MissionError> {
+        if self.flight.end.is_some() {
+            return Ok(self.flight.end);
+        }
+        if self.flight.fleet.env_due() {
+            let t0 = Instant::now();
+            self.env
+                .step()
+                .map_err(|error| self.flight.env_error(error))?;
+            self.flight
+                .fleet
+                .add_environment_time(t0.elapsed().as_secs_f64());
+        }
+        self.flight.step(&self.env)
+    }
+
+    /// Steps to the end; `progress(t, limit)` is called every 600 steps.
+    pub fn run(&mut self, progress: &mut dyn FnMut(f64, f64)) -> Result<MissionEnd, MissionError> {
+        let limit = self.time_limit_s();
+        loop {
+            if let Some(end) = self.step()? {
+                return Ok(end);
+            }
+            if self.flight.fleet.steps().is_multiple_of(600) {
+                progress(self.flight.fleet.time_s(), limit);
+            }
+        }
+    }
+
+    /// What was recorded; the observers are finished (their buffered output flushed).
+    pub fn finish(self) -> Result<MissionRun, MissionError> {
+        self.flight.finish(&self.env)
     }
 }
 

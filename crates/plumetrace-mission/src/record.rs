@@ -10,13 +10,13 @@
 use crate::outcome::{MissionEvent, VehicleStatus};
 use plumetrace_core::{BehaviourKind, PlannerEvent, Telemetry, Vec2, Vec3, VehicleId};
 use plumetrace_env::{ConcentrationField, FlowField, GridSpec, MeanConcentrationGrid};
-use plumetrace_sim::{StepReport, World, WorldEvent};
+use plumetrace_sim::{StepReport, WorldEvent, WorldView};
 use serde::Serialize;
 
 /// What observers see after a step.
 pub struct StepView<'a> {
     /// The world after the step.
-    pub world: &'a World,
+    pub world: WorldView<'a>,
     /// The step's decisions, snapshots (when recorded) and world events; `report.t_s` is the
     /// time the snapshots were taken.
     pub report: &'a StepReport,
@@ -497,7 +497,7 @@ impl PlumeFrames {
         }
     }
 
-    fn sample(&mut self, world: &World) {
+    fn sample(&mut self, world: WorldView<'_>) {
         let mut c = vec![0.0; self.points.len()];
         world.env().plume().concentrations(&self.points, &mut c);
         let flow = world.env().flow();
@@ -528,7 +528,7 @@ impl Observer for PlumeFrames {
 }
 
 /// The true sources of the mission's plume.
-pub fn true_sources(world: &World) -> Vec<Vec3> {
+pub fn true_sources(world: WorldView<'_>) -> Vec<Vec3> {
     world
         .env()
         .plume()

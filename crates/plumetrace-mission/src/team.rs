@@ -136,7 +136,7 @@ impl TeamStats {
 }
 
 /// True slant distance between two vehicles, m.
-fn slant(world: &plumetrace_sim::World, a: VehicleId, b: VehicleId) -> Option<f64> {
+fn slant(world: plumetrace_sim::WorldView<'_>, a: VehicleId, b: VehicleId) -> Option<f64> {
     let v = world.vehicles();
     let (p, q) = (
         &v.get(a.0 as usize)?.vehicle.state,

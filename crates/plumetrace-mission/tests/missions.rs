@@ -677,3 +677,48 @@ fn a_replaced_planner_flies_the_vehicle_and_only_before_the_first_step() {
         "the replacement reported nothing, so no planner events"
     );
 }
+
+#[test]
+fn missions_flown_in_one_environment_give_what_they_give_alone() {
+    // Two missions of seed 7 with different time limits share one environment; one of seed 8
+    // cannot (another plume) and flies alone. Everything is recorded: trajectories, events, the
+    // mean plume and the replay page's frames, which read the shared environment.
+    let cases = [(7, 300.0), (7, 200.0), (8, 300.0)];
+    let digest = |r: &plumetrace_mission::MissionRun| {
+        (
+            serde_json::to_string(&r.summary).unwrap(),
+            serde_json::to_string(&r.trajectory).unwrap(),
+            serde_json::to_string(&r.events).unwrap(),
+            format!("{:?}", r.mean_plume),
+            format!("{:?}", r.plume_frames.as_ref().map(|f| &f.frames)),
+        )
+    };
+    let alone: Vec<_> = cases
+        .iter()
+        .map(|&(seed, limit)| {
+            let r = run_mission(shortened("demo", 600.0, limit, seed), &mut |_, _| {}).unwrap();
+            digest(&r)
+        })
+        .collect();
+    let missions = cases
+        .iter()
+        .map(|&(seed, limit)| {
+            (
+                MissionSetup::new(shortened("demo", 600.0, limit, seed)).unwrap(),
+                MissionOptions::default(),
+            )
+        })
+        .collect();
+    let mut order = Vec::new();
+    let mut shared = vec![None; cases.len()];
+    plumetrace_mission::fly_shared(missions, &mut |k, r| {
+        order.push(k);
+        shared[k] = Some(digest(&r.unwrap()));
+    });
+    // The other seed first (it cannot join), then the shorter mission, then the longer.
+    assert_eq!(order, [2, 1, 0]);
+    for (k, (a, b)) in alone.iter().zip(&shared).enumerate() {
+        assert!(Some(a) == b.as_ref(), "mission {k} differs");
+    }
+    assert_ne!(alone[0].1, alone[1].1);
+}

@@ -11,7 +11,8 @@
 //! - [`nav`]: dead reckoning from measured heading, speed and flow with a slowly drifting error,
 //!   corrected by position fixes (long-baseline for an AUV, GPS for a surface craft);
 //! - [`world`]: an environment and several vehicles stepped together in named, timed stages,
-//!   with planners plugged in through `plumetrace_core::Planner`;
+//!   with planners plugged in through `plumetrace_core::Planner`; the vehicles' side is a
+//!   [`Fleet`], which only reads the environment, so several fleets can share one;
 //! - [`sensors`]: the 10 Hz chemical sensor (readings; planners threshold them), an ADCP-like flow sensor
 //!   with bias and a wrong-layer fault, and three-group obstacle range sensors.
 //!
@@ -32,4 +33,6 @@ pub use sensors::{
     RangeSensorParams,
 };
 pub use vehicle::{Vehicle, VehicleParams, VehicleState};
-pub use world::{Incident, SimVehicle, StageTimes, StepReport, World, WorldEvent};
+pub use world::{
+    Fleet, Incident, SimVehicle, StageTimes, StepReport, World, WorldEvent, WorldView,
+};

@@ -1,8 +1,13 @@
-//! The world: an environment and several vehicles stepped together in named stages.
+//! The world: an environment and a fleet of vehicles stepped together in named stages.
+//!
+//! A [`World`] owns its environment; a [`Fleet`] (the vehicles with their streams, channels,
+//! clock and stage times) only reads one, so several fleets can fly against one environment that
+//! their caller steps once for all of them, each giving the bits of a world of its own.
 //!
 //! One step of `dt` runs, in order:
 //! 1. **advance environment**: the flow and plume advance every `env_every` steps (the plume's
-//!    step is a multiple of the vehicles'; its physics does not depend on the step);
+//!    step is a multiple of the vehicles'; its physics does not depend on the step); the world
+//!    does this, or the caller of [`Fleet::step`] when [`Fleet::env_due`];
 //! 2. **sense**: each vehicle's due chemical, flow and range samples, taken at its true position;
 //! 3. **communicate**: messages that have arrived by now are delivered to their recipients'
 //!    inboxes;
@@ -202,18 +207,85 @@ pub struct StepReport {
     pub events: Vec<(VehicleId, WorldEvent)>,
 }
 
-/// The simulated world.
+/// The vehicles of one world with everything that is theirs: navigation, sensors, random
+/// streams, message channels, clock and stage times. A fleet only reads the environment
+/// (`&Environment` in every stage), so several fleets can fly against one environment that is
+/// stepped once for all of them ([`Fleet::step`]); each then gives the bits it would give in a
+/// world of its own, since nothing a fleet does reaches the environment or another fleet.
 #[derive(Debug)]
-pub struct World {
-    env: Environment,
+pub struct Fleet {
     vehicles: Vec<SimVehicle>,
     dt_s: f64,
+    env_dt_s: f64,
     env_every: u64,
+    env_start: u64,
     step: u64,
     water_depth_m: Option<f64>,
     comms: Comms,
     record_snapshots: bool,
     times: StageTimes,
+}
+
+/// The simulated world: an environment and the fleet flying in it.
+#[derive(Debug)]
+pub struct World {
+    env: Environment,
+    fleet: Fleet,
+}
+
+/// A look at a world after a step: the environment and one fleet. The environment may be a
+/// world's own or one shared by several fleets.
+#[derive(Debug, Clone, Copy)]
+pub struct WorldView<'a> {
+    env: &'a Environment,
+    fleet: &'a Fleet,
+}
+
+impl<'a> WorldView<'a> {
+    /// A view of `fleet` flying in `env`.
+    pub fn new(env: &'a Environment, fleet: &'a Fleet) -> Self {
+        WorldView { env, fleet }
+    }
+
+    /// The environment.
+    pub fn env(&self) -> &'a Environment {
+        self.env
+    }
+
+    /// The fleet.
+    pub fn fleet(&self) -> &'a Fleet {
+        self.fleet
+    }
+
+    /// The vehicles.
+    pub fn vehicles(&self) -> &'a [SimVehicle] {
+        &self.fleet.vehicles
+    }
+
+    /// Mission time, s.
+    pub fn time_s(&self) -> f64 {
+        self.fleet.time_s()
+    }
+
+    /// Steps taken by the fleet.
+    pub fn steps(&self) -> u64 {
+        self.fleet.step
+    }
+
+    /// The vehicles' step, s.
+    pub fn dt_s(&self) -> f64 {
+        self.fleet.dt_s
+    }
+
+    /// Water depth, m, if the scenario gives one.
+    pub fn water_depth_m(&self) -> Option<f64> {
+        self.fleet.water_depth_m
+    }
+
+    /// Messages on their way.
+    pub fn messages_in_flight(&self) -> usize {
+        self.fleet.comms.in_flight()
+    }
 }
 
 fn timed<T>(acc: &mut f64, f: impl FnOnce() -> T) -> T {
@@ -251,6 +323,112 @@ impl World {
         comms: CommsParams,
         seed: u64,
     ) -> Result<Self, EnvError> {
+        let fleet = Fleet::new(&env, vehicles, dt_s, water_depth_m, comms, seed)?;
+        Ok(World { env, fleet })
+    }
+
+    /// The environment and the fleet.
+    pub fn view(&self) -> WorldView<'_> {
+        WorldView::new(&self.env, &self.fleet)
+    }
+
+    /// The fleet.
+    pub fn fleet(&self) -> &Fleet {
+        &self.fleet
+    }
+
+    /// Keep every snapshot given to a planner in the step reports (for snapshot logs).
+    pub fn record_snapshots(&mut self, on: bool) {
+        self.fleet.record_snapshots(on);
+    }
+
+    /// Mission time, s (0 at the start, after any spin-up).
+    pub fn time_s(&self) -> f64 {
+        self.fleet.time_s()
+    }
+
+    /// Steps taken.
+    pub fn steps(&self) -> u64 {
+        self.fleet.steps()
+    }
+
+    /// The vehicles' step, s.
+    pub fn dt_s(&self) -> f64 {
+        self.fleet.dt_s()
+    }
+
+    /// Water depth, m, if the scenario gives one.
+    pub fn water_depth_m(&self) -> Option<f64> {
+        self.fleet.water_depth_m()
+    }
+
+    /// The environment.
+    pub fn env(&self) -> &Environment {
+        &self.env
+    }
+
+    /// The vehicles.
+    pub fn vehicles(&self) -> &[SimVehicle] {
+        self.fleet.vehicles()
+    }
+
+    /// The vehicles, mutably (tests and scripted scenarios: a forced fix, a moved vehicle).
+    pub fn vehicles_mut(&mut self) -> &mut [SimVehicle] {
+        self.fleet.vehicles_mut()
+    }
+
+    /// Messages on their way.
+    pub fn messages_in_flight(&self) -> usize {
+        self.fleet.messages_in_flight()
+    }
+
+    /// Stops a vehicle (it keeps its position and takes no more decisions).
+    pub fn stop(&mut self, id: VehicleId) {
+        self.fleet.stop(id);
+    }
+
+    /// Sends a message now from its sender's true position (scripted scenarios, tests); what
+    /// became of it for each recipient that lost it is returned as events.
+    pub fn send(&mut self, message: Message) -> Vec<(VehicleId, WorldEvent)> {
+        self.fleet.send(message)
+    }
+
+    /// Time spent per stage so far.
+    pub fn stage_times(&self) -> StageTimes {
+        self.fleet.stage_times()
+    }
+
+    /// Adds the observers' time of a step to the record stage.
+    pub fn add_record_time(&mut self, s: f64) {
+        self.fleet.add_record_time(s);
+    }
+
+    /// One step with one planner slot per vehicle (`None`: no planner, the vehicle keeps its
+    /// command), stages 1 to 7.
+    pub fn step(
+        &mut self,
+        planners: &mut [Option<Box<dyn Planner>>],
+    ) -> Result<StepReport, EnvError> {
+        if self.fleet.env_due() {
+            let t0 = Instant::now();
+            self.env.step()?;
+            self.fleet.add_environment_time(t0.elapsed().as_secs_f64());
+        }
+        self.fleet.step(&self.env, planners)
+    }
+}
+
+impl Fleet {
+    /// A fleet stepping `vehicles` at `dt_s` in `env` (whose step must be a whole number of
+    /// vehicle steps), with the given channel models, their losses drawn from the run `seed`.
+    pub fn new(
+        env: &Environment,
+        vehicles: Vec<SimVehicle>,
+        dt_s: f64,
+        water_depth_m: Option<f64>,
+        comms: CommsParams,
+        seed: u64,
+    ) -> Result<Self, EnvError> {
         plumetrace_env::error::require_positive("sim.dt_s", dt_s)?;
         let ratio = env.dt_s() / dt_s;
         if (ratio - ratio.round()).abs() > 1e-9 || ratio < 0.5 {
@@ -275,17 +453,36 @@ impl World {
         comms.acoustic.validate("comms.acoustic")?;
         comms.radio.validate("comms.radio")?;
         comms.ranging.validate("comms.ranging")?;
-        Ok(World {
-            env,
+        Ok(Fleet {
             vehicles,
             dt_s,
+            env_dt_s: env.dt_s(),
             env_every: ratio.round() as u64,
+            env_start: env.steps(),
             step: 0,
             water_depth_m,
             comms: Comms::new(comms, seed),
             record_snapshots: false,
             times: StageTimes::default(),
         })
+    }
+
+    /// Whether the environment advances before this fleet's next step (stage 1: every
+    /// `env_every` vehicle steps, starting with the first).
+    pub fn env_due(&self) -> bool {
+        self.step.is_multiple_of(self.env_every)
+    }
+
+    /// The environment's step count that the fleet's next step must see: its count when the
+    /// fleet was made, plus one for each stage 1 so far and the one before this step.
+    pub fn env_steps_expected(&self) -> u64 {
+        self.env_start + self.step / self.env_every + 1
+    }
+
+    /// Adds time spent advancing the environment for this fleet (its own, or its share of a
+    /// shared environment's) to stage 1.
+    pub fn add_environment_time(&mut self, s: f64) {
+        self.times.advance_environment_s += s;
     }
 
     /// Keep every snapshot given to a planner in the step reports (for snapshot logs).
@@ -311,11 +508,6 @@ impl World {
     /// Water depth, m, if the scenario gives one.
     pub fn water_depth_m(&self) -> Option<f64> {
         self.water_depth_m
-    }
-
-    /// The environment.
-    pub fn env(&self) -> &Environment {
-        &self.env
     }
 
     /// The vehicles.
@@ -463,22 +655,36 @@ impl World {
         self.times.record_s += s;
     }
 
-    /// One step with one planner slot per vehicle (`None`: no planner, the vehicle keeps its
-    /// command), stages 1 to 7.
+    /// One step of the fleet in `env`, which the caller has advanced for it (stage 1, when
+    /// [`Fleet::env_due`]): stages 2 to 7 with one planner slot per vehicle (`None`: no
+    /// planner, the vehicle keeps its command). An environment at another step than the fleet's
+    /// clock expects, or with another step length, is refused.
     pub fn step(
         &mut self,
+        env: &Environment,
         planners: &mut [Option<Box<dyn Planner>>],
     ) -> Result<StepReport, EnvError> {
+        if env.steps() != self.env_steps_expected() || env.dt_s() != self.env_dt_s {
+            return Err(EnvError::invalid(
+                "world.env",
+                format!(
+                    "the environment is at step {} of {} s; the fleet's step {} needs step {} of \
+                     {} s",
+                    env.steps(),
+                    env.dt_s(),
+                    self.step,
+                    self.env_steps_expected(),
+                    self.env_dt_s
+                ),
+            ));
+        }
         let mut times = self.times;
         let t = self.time_s();
         let mut report = StepReport {
             t_s: t,
             ..StepReport::default()
         };
-        timed(&mut times.advance_environment_s, || {
-            self.advance_environment()
-        })?;
-        timed(&mut times.sense_s, || self.sense(t));
+        timed(&mut times.sense_s, || self.sense(env, t));
         timed(&mut times.communicate_s, || {
             self.communicate(t, &mut report.events)
         });
@@ -489,23 +695,15 @@ impl World {
             self.control(&report.decisions, &mut report.events)
         });
         timed(&mut times.integrate_s, || {
-            self.integrate(t, &mut report.events)
+            self.integrate(env, t, &mut report.events)
         });
-        timed(&mut times.check_s, || self.check(&mut report.events));
+        timed(&mut times.check_s, || self.check(env, &mut report.events));
         self.step += 1;
         self.times = times;
         Ok(report)
     }
 
-    fn advance_environment(&mut self) -> Result<(), EnvError> {
-        if self.step.is_multiple_of(self.env_every) {
-            self.env.step()?;
-        }
-        Ok(())
-    }
-
-    fn sense(&mut self, t: f64) {
-        let env = &self.env;
+    fn sense(&mut self, env: &Environment, t: f64) {
         for v in self.vehicles.iter_mut().filter(|v| v.active) {
             let s = v.vehicle.state;
             if v.chem.due(t) {
@@ -646,10 +844,10 @@ impl World {
         }
     }
 
-    fn integrate(&mut self, t: f64, events: &mut Vec<(VehicleId, WorldEvent)>) {
+    fn integrate(&mut self, env: &Environment, t: f64, events: &mut Vec<(VehicleId, WorldEvent)>) {
         let dt = self.dt_s;
         for v in self.vehicles.iter_mut().filter(|v| v.active) {
-            let flow = self.env.flow().velocity(v.vehicle.state.pos_m);
+            let flow = env.flow().velocity(v.vehicle.state.pos_m);
             v.vehicle
                 .step(&v.command, flow, self.water_depth_m, dt, &mut v.rng_motion);
             let measured = v.last_flow.map(|f| f.velocity_mps);
@@ -668,13 +866,13 @@ impl World {
         }
     }
 
-    fn check(&mut self, events: &mut Vec<(VehicleId, WorldEvent)>) {
-        let domain = self.env.domain();
+    fn check(&mut self, env: &Environment, events: &mut Vec<(VehicleId, WorldEvent)>) {
+        let domain = env.domain();
         for v in self.vehicles.iter_mut().filter(|v| v.active) {
             let p = v.vehicle.state.pos_m;
             let incident = if !(domain.contains(p) && p.x.is_finite() && p.y.is_finite()) {
                 Some(Incident::LeftDomain)
-            } else if self.env.obstacles().contains(p) {
+            } else if env.obstacles().contains(p) {
                 Some(Incident::Collided)
             } else {
                 None

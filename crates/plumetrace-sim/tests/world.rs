@@ -723,3 +723,59 @@ fn an_unsolicited_echo_is_lost_and_a_deaf_modem_hears_nothing() {
         r.events
     );
 }
+
+#[test]
+fn fleets_sharing_an_environment_step_as_in_worlds_of_their_own() {
+    let moving = |k: u32, y: f64| {
+        let mut v = auv(k, (50.0 + 5.0 * f64::from(k), y), 90.0);
+        v.command.speed_mps = 1.0;
+        v
+    };
+    let fleet_vehicles = |y: f64| vec![moving(0, y), moving(1, y)];
+    let params = CommsParams::default();
+    let mut shared = env(vec![]);
+    let mut fleets: Vec<plumetrace_sim::Fleet> = [40.0, 120.0]
+        .iter()
+        .map(|&y| {
+            plumetrace_sim::Fleet::new(&shared, fleet_vehicles(y), DT, Some(10.0), params, 3)
+                .unwrap()
+        })
+        .collect();
+    let mut alone: Vec<World> = [40.0, 120.0]
+        .iter()
+        .map(|&y| World::with_comms(env(vec![]), fleet_vehicles(y), DT, Some(10.0), params, 3))
+        .collect::<Result<_, _>>()
+        .unwrap();
+    let mut none: Vec<Option<Box<dyn Planner>>> = vec![None, None];
+    for _ in 0..50 {
+        if fleets[0].env_due() {
+            shared.step().unwrap();
+        }
+        for (f, w) in fleets.iter_mut().zip(&mut alone) {
+            f.step(&shared, &mut none).unwrap();
+            w.step(&mut none).unwrap();
+        }
+    }
+    for (f, w) in fleets.iter().zip(&alone) {
+        let states = |v: &[SimVehicle]| {
+            v.iter()
+                .map(|v| format!("{:?} {:?}", v.vehicle.state, v.last_chem))
+                .collect::<Vec<_>>()
+        };
+        assert_eq!(states(f.vehicles()), states(w.vehicles()));
+        assert!(
+            (f.vehicles()[0].vehicle.state.pos_m - Vec2::new(50.0, 40.0)).norm() > 1.0
+                || f.vehicles()[0].vehicle.state.pos_m.y > 100.0
+        );
+    }
+    // An environment that was not advanced for the fleet's step (or advanced twice) is refused.
+    let mut late =
+        plumetrace_sim::Fleet::new(&shared, fleet_vehicles(40.0), DT, None, params, 3).unwrap();
+    let e = late.step(&shared, &mut none).unwrap_err().to_string();
+    assert!(e.contains("world.env") && e.contains("needs step"), "{e}");
+    shared.step().unwrap();
+    late.step(&shared, &mut none).unwrap();
+    shared.step().unwrap();
+    shared.step().unwrap();
+    assert!(late.step(&shared, &mut none).is_err());
+}
