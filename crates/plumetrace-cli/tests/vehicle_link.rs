@@ -134,7 +134,7 @@ fn no_unsafe_commands(fs: &Value) {
 #[test]
 fn bluefin_over_tcp_in_lock_step_declares_and_replays_exactly_and_again_the_same() {
     let dir = tempfile::tempdir().unwrap();
-    let (ob, fs) = fly(dir.path(), &["--listen", "127.0.0.1:0"]);
+    let (ob, fs) = fly(dir.path(), &["--listen", "127.0.0.1:0", "--no-flow"]);
     assert_eq!(ob["end"], "finished", "{ob}");
     let error = declared_near_the_source(&ob);
     println!("Bluefin: declared {error:.1} m from the source: {ob}");
@@ -179,7 +179,7 @@ fn bluefin_over_tcp_in_lock_step_declares_and_replays_exactly_and_again_the_same
     );
     // Lock-step is deterministic: a second flight logs the same decisions.
     let again = tempfile::tempdir().unwrap();
-    let (ob2, _) = fly(again.path(), &["--listen", "127.0.0.1:0"]);
+    let (ob2, _) = fly(again.path(), &["--listen", "127.0.0.1:0", "--no-flow"]);
     assert_eq!(ob2["declarations"], ob["declarations"]);
     let lines = |p: &Path| -> Vec<String> {
         let r = plumetrace_onboard_log(p);
