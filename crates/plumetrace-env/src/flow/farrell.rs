@@ -113,8 +113,11 @@ pub struct ColouredNoise {
     bandwidth: f64,
     updates: NoiseUpdates,
     /// The exact step's matrices for the last step size: `(dt, Phi, L)`.
-    exact: Option<(f64, [[f64; 2]; 2], [[f64; 2]; 2])>,
+    exact: Option<(f64, Mat2, Mat2)>,
 }
+
+/// A 2 x 2 matrix, row-major.
+type Mat2 = [[f64; 2]; 2];
 
 /// How [`ColouredNoise`] steps its channels.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -198,7 +201,7 @@ impl ColouredNoise {
 
     /// The transition matrix `exp(A dt)` of the oscillator and the Cholesky factor (lower
     /// triangular) of the covariance the noise adds over `dt`.
-    fn exact_step(&self, dt_s: f64) -> ([[f64; 2]; 2], [[f64; 2]; 2]) {
+    fn exact_step(&self, dt_s: f64) -> (Mat2, Mat2) {
         let phi = oscillator_transition(self.damping, self.bandwidth, dt_s);
         let [p0, p1] = self.stationary_covariance();
         // Q = P - Phi P Phi^T (P diagonal).
@@ -234,7 +237,7 @@ impl ColouredNoise {
 /// `exp(A dt) = exp(m dt) (c I + g (A - m I))` where `c = cosh(s dt)` and `g = sinh(s dt) / s`
 /// (overdamped), `c = cos(|s| dt)` and `g = sin(|s| dt) / |s|` (underdamped), or their series
 /// near critical damping.
-fn oscillator_transition(z: f64, w: f64, dt: f64) -> [[f64; 2]; 2] {
+fn oscillator_transition(z: f64, w: f64, dt: f64) -> Mat2 {
     let m = -z * w;
     let s2 = w * w * (z * z - 1.0);
     let x = s2 * dt * dt;
