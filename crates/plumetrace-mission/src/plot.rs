@@ -915,11 +915,7 @@ fn plume_cells(
         return Vec::new();
     }
     let mean = mp.mean();
-    let max = mean
-        .iter()
-        .copied()
-        .filter(|c| c.is_finite())
-        .fold(0.0, f64::max);
+    let max = finite_peak(&mean);
     if max <= 0.0 {
         return Vec::new();
     }
@@ -1022,6 +1018,15 @@ fn raster_peak(r: &Raster<'_>) -> Vec2 {
     )
 }
 
+/// The largest finite value of a mean-plume raster (0 when there is none).
+fn finite_peak(values: &[f64]) -> f64 {
+    values
+        .iter()
+        .copied()
+        .filter(|c| c.is_finite())
+        .fold(0.0, f64::max)
+}
+
 /// Centres of the cells the legend must not hide: the mean plume above a tenth of its peak and
 /// the last source map within 3 decades of its peak.
 fn hot_points(run: &MissionRun) -> Vec<(f64, f64)> {
@@ -1029,11 +1034,7 @@ fn hot_points(run: &MissionRun) -> Vec<(f64, f64)> {
     if let Some(mp) = &run.mean_plume {
         let g = *mp.spec();
         let mean = mp.mean();
-        let max = mean
-            .iter()
-            .copied()
-            .filter(|c| c.is_finite())
-            .fold(0.0, f64::max);
+        let max = finite_peak(&mean);
         if g.nx >= 2 && g.ny >= 2 && max > 0.0 {
             let dx = (g.x_max_m - g.x_min_m) / (g.nx - 1) as f64;
             let dy = (g.y_max_m - g.y_min_m) / (g.ny - 1) as f64;
