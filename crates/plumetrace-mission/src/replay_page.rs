@@ -660,8 +660,8 @@ mod tests {
         let html = page.html().unwrap_or_default();
         assert_eq!(
             html.matches("</script>").count(),
-            2,
-            "only the page's own two"
+            3,
+            "only the page's own three (the head's counter, the data, the script)"
         );
         assert!(!html.contains("<script>alert"));
     }
