@@ -245,9 +245,10 @@ pub fn run_campaign(
 
 /// The runs that can share one environment (its spin-up, or the whole world): runs of the same
 /// scenario and seed whose scenario tables differ only in what the environment is not built
-/// from (planner tables, outputs, message channels, the mission's geometry and time limit).
+/// from (planner tables, outputs, message channels, the mission's time limit and prior flow).
 /// Everything else (domain, flow, plume, sources, obstacles, kelp, vehicles, whose start
-/// positions keep kelp clear, the simulation, environment and spin-up steps) must be equal, so
+/// positions keep kelp clear, the op-area and subregions, which place the plume's downflow
+/// sink, the simulation, environment and spin-up steps) must be equal, so
 /// the environment each run sees is, step for step, the one it would build alone. A time limit
 /// may differ: a run that ends stops looking, and the environment steps on for the others. Groups
 /// come in run order.
@@ -282,7 +283,19 @@ fn env_fingerprint(mut t: toml::Table) -> String {
         t.remove(k);
     }
     if let Some(toml::Value::Table(m)) = t.get_mut("mission") {
-        m.retain(|k, _| ["spinup_s", "spinup_dt_s", "env_dt_s"].contains(&k));
+        // The op-area and subregions place the plume's downflow sink (see the scenario's
+        // `mission.drop_margin_m`), so they are part of the environment too.
+        m.retain(|k, _| {
+            [
+                "spinup_s",
+                "spinup_dt_s",
+                "env_dt_s",
+                "op_area",
+                "subregions",
+                "drop_margin_m",
+            ]
+            .contains(&k)
+        });
     }
     toml::to_string(&t).unwrap_or_default()
 }

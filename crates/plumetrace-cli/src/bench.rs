@@ -161,24 +161,104 @@ pub struct MissionBenchArgs {
     /// Base seed.
     #[arg(long, default_value_t = 1, allow_hyphen_values = true, value_parser = crate::args::seed)]
     seed: u64,
+    /// Override a scenario key, as a campaign's `set` does: `KEY=VALUE` with VALUE in TOML
+    /// (`mission.env_dt_s=0.5`, `flow.farrell.noise_scheme="euler"`); repeatable.
+    #[arg(long = "set", value_name = "KEY=VALUE")]
+    set: Vec<String>,
 }
 
 #[derive(Debug, Serialize)]
 struct MissionBench {
     preset: String,
+    /// The `--set` overrides.
+    set: Vec<String>,
     runs: u64,
     mean_mission_s: f64,
     results: Vec<MissionBenchRow>,
     /// missions/s on the largest thread count over missions/s on the smallest.
     scaling: f64,
+    /// The split by stage on the first thread count, seconds per mission (wall time measured
+    /// inside each mission: on one thread, about its CPU time), spin-up included.
+    stages_s_per_mission: StageSplit,
+    /// The machine's load average (1 minute) when the benchmark ended, if known.
+    load_average: Option<f64>,
 }
 
 #[derive(Debug, Serialize)]
 struct MissionBenchRow {
     threads: usize,
     wall_s: f64,
+    /// CPU time of the process (all threads) over the row, s.
+    cpu_s: f64,
+    cpu_per_mission_s: f64,
+    /// CPU per second of mission flown, ms.
+    cpu_per_mission_second_ms: f64,
     missions_per_s: f64,
     real_time_factor: f64,
+}
+
+#[derive(Debug, Default, Serialize)]
+struct StageSplit {
+    spin_up: f64,
+    advance_environment: f64,
+    sense: f64,
+    communicate: f64,
+    decide: f64,
+    control: f64,
+    integrate: f64,
+    check: f64,
+    record: f64,
+}
+
+impl StageSplit {
+    fn add(&mut self, run: &plumetrace_mission::MissionRun, weight: f64) {
+        let t = &run.stage_times;
+        self.spin_up += run.spinup_wall_s * weight;
+        self.advance_environment += t.advance_environment_s * weight;
+        self.sense += t.sense_s * weight;
+        self.communicate += t.communicate_s * weight;
+        self.decide += t.decide_s * weight;
+        self.control += t.control_s * weight;
+        self.integrate += t.integrate_s * weight;
+        self.check += t.check_s * weight;
+        self.record += t.record_s * weight;
+    }
+}
+
+/// The 1-minute load average from `/proc/loadavg`, where there is one.
+fn load_average() -> Option<f64> {
+    std::fs::read_to_string("/proc/loadavg")
+        .ok()?
+        .split_whitespace()
+        .next()?
+        .parse()
+        .ok()
+}
+
+/// The preset's scenario with `KEY=VALUE` overrides applied.
+fn preset_with_sets(
+    preset: &str,
+    sets: &[String],
+) -> Result<plumetrace_scenario::config::ScenarioConfig> {
+    let text = plumetrace_scenario::find_preset(preset)
+        .ok_or_else(|| anyhow::anyhow!("unknown preset '{preset}' (see `plumetrace presets`)"))?
+        .toml;
+    let mut table: toml::Table = toml::from_str(text)?;
+    for s in sets {
+        let (key, value) = s
+            .split_once('=')
+            .ok_or_else(|| anyhow::anyhow!("--set {s:?}: expected KEY=VALUE"))?;
+        let value: toml::Value = toml::from_str::<toml::Table>(&format!("v = {value}"))
+            .map_err(|e| anyhow::anyhow!("--set {s:?}: the value is not TOML: {e}"))?
+            .remove("v")
+            .ok_or_else(|| anyhow::anyhow!("--set {s:?}: no value"))?;
+        plumetrace_campaign::spec::set_key(&mut table, key.trim(), value)
+            .map_err(|e| anyhow::anyhow!("--set {s:?}: {e}"))?;
+    }
+    Ok(plumetrace_scenario::from_table(
+        table,
+        &plumetrace_scenario::Origin::Preset(preset.to_string()),
+    )?)
 }
 
 /// Flies `runs` missions of the preset on each thread count, as a campaign does (no mean-plume
@@ -188,7 +268,7 @@ fn missions(a: &MissionBenchArgs) -> Result<MissionBench> {
     if a.runs == 0 || a.threads.is_empty() || a.threads.contains(&0) {
         bail!("--runs and every --threads value must be at least 1");
     }
-    let cfg = plumetrace_scenario::load_preset(&a.preset)?;
+    let cfg = preset_with_sets(&a.preset, &a.set)?;
     let origin = plumetrace_scenario::Origin::Preset(a.preset.clone());
     if plumetrace_scenario::build(&cfg, &origin, None)?
         .mission
@@ -203,25 +283,41 @@ fn missions(a: &MissionBenchArgs) -> Result<MissionBench> {
     };
     let mut results = Vec::new();
     let mut sim_s = 0.0;
-    for &t in &a.threads {
+    let mut stages = StageSplit::default();
+    for (row, &t) in a.threads.iter().enumerate() {
         let pool = rayon::ThreadPoolBuilder::new().num_threads(t).build()?;
         let started = Instant::now();
-        let times: Vec<Result<f64>> = pool.install(|| {
+        let cpu = ProcessTime::now();
+        let runs: Vec<Result<plumetrace_mission::MissionRun>> = pool.install(|| {
             (0..a.runs)
                 .into_par_iter()
                 .map(|i| {
                     let seed = plumetrace_env::derive_seed(a.seed, i);
                     let sc = plumetrace_scenario::build(&cfg, &origin, Some(seed))?;
-                    let run = plumetrace_mission::run_mission_with(sc, options, &mut |_, _| {})?;
-                    Ok(run.summary.sim_time_s)
+                    Ok(plumetrace_mission::run_mission_with(
+                        sc,
+                        options,
+                        &mut |_, _| {},
+                    )?)
                 })
                 .collect()
         });
+        let cpu_s = cpu.elapsed().as_secs_f64();
         let wall = started.elapsed().as_secs_f64();
-        sim_s = times.into_iter().sum::<Result<f64>>()?;
+        sim_s = 0.0;
+        for run in runs {
+            let run = run?;
+            sim_s += run.summary.sim_time_s;
+            if row == 0 {
+                stages.add(&run, 1.0 / a.runs as f64);
+            }
+        }
         results.push(MissionBenchRow {
             threads: t,
             wall_s: wall,
+            cpu_s,
+            cpu_per_mission_s: cpu_s / a.runs as f64,
+            cpu_per_mission_second_ms: cpu_s / sim_s * 1e3,
             missions_per_s: a.runs as f64 / wall,
             real_time_factor: sim_s / wall,
         });
@@ -230,10 +326,13 @@ fn missions(a: &MissionBenchArgs) -> Result<MissionBench> {
     let last = results.last().map_or(f64::NAN, |r| r.missions_per_s);
     Ok(MissionBench {
         preset: a.preset.clone(),
+        set: a.set.clone(),
         runs: a.runs,
         mean_mission_s: sim_s / a.runs as f64,
         results,
         scaling: last / first,
+        stages_s_per_mission: stages,
+        load_average: load_average(),
     })
 }
 

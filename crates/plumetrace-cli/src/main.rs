@@ -286,8 +286,31 @@ fn check(file: &std::path::Path) -> Result<()> {
             None => format!("{} has no planner", v.name),
         })
         .collect();
+    let env = &setup.env;
+    let flow = plumetrace_env::FlowField::max_stable_dt_s(env.flow());
+    let sub = |step: f64| plumetrace_env::environment::flow_substeps(env.flow(), step);
+    let plume_steps = format!(
+        "plume steps of {} s, {} s in the spin-up{}",
+        env.dt_s(),
+        setup.spec.spinup_dt_s,
+        match flow {
+            Some(limit) => format!(
+                " (the flow's stable limit {limit:.1} s: {} and {} flow sub-steps per step)",
+                sub(env.dt_s()),
+                sub(setup.spec.spinup_dt_s)
+            ),
+            None => String::new(),
+        }
+    );
+    let dropping = match env.plume().filaments().and_then(|p| p.sink()) {
+        Some(s) => format!(
+            "; filaments out of reach dropped downflow (towards {:.0} deg)",
+            s.dir[0].atan2(s.dir[1]).to_degrees().rem_euclid(360.0)
+        ),
+        None => String::new(),
+    };
     crate::outln!(
-        "{}: ok (mission of up to {} s after {} s of plume spin-up, steps of {dt} s; {})",
+        "{}: ok (mission of up to {} s after {} s of plume spin-up, steps of {dt} s, {plume_steps}{dropping}; {})",
         file.display(),
         setup.spec.time_limit_s,
         setup.spec.spinup_s,

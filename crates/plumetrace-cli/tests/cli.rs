@@ -351,7 +351,7 @@ fn check_names_bad_planner_and_mission_keys() {
             "mission.time_limit_s",
         ),
         (
-            demo.replace("env_dt_s = 0.5", "env_dt_s = 0.25"),
+            demo.replace("env_dt_s = 5.0", "env_dt_s = 0.25"),
             "mission.env_dt_s",
         ),
     ];

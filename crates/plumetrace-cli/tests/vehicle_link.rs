@@ -134,7 +134,8 @@ fn no_unsafe_commands(fs: &Value) {
 #[test]
 fn bluefin_over_tcp_in_lock_step_declares_and_replays_exactly_and_again_the_same() {
     let dir = tempfile::tempdir().unwrap();
-    let (ob, fs) = fly(dir.path(), &["--listen", "127.0.0.1:0", "--no-flow"]);
+    // The front seat sends its current meter's readings, as a vehicle's ADCP would.
+    let (ob, fs) = fly(dir.path(), &["--listen", "127.0.0.1:0"]);
     assert_eq!(ob["end"], "finished", "{ob}");
     let error = declared_near_the_source(&ob);
     println!("Bluefin: declared {error:.1} m from the source: {ob}");
@@ -143,7 +144,13 @@ fn bluefin_over_tcp_in_lock_step_declares_and_replays_exactly_and_again_the_same
     assert_eq!(ob["commands_rejected"], 0);
     no_unsafe_commands(&fs);
     assert_eq!(fs["finished"], true);
-    assert_eq!(fs["nav_records"], ob["nav_records"]);
+    // Every record was read, bar one the front seat may send after the back seat's final stop
+    // and before it sees the line close.
+    let (sent, read) = (
+        fs["nav_records"].as_u64().unwrap(),
+        ob["nav_records"].as_u64().unwrap(),
+    );
+    assert!(sent == read || sent == read + 1, "sent {sent}, read {read}");
     // The logged decisions come out again from the same planner.
     let log = dir.path().join("ob").join("snapshots.jsonl.gz");
     let out = common::run_ok(&["replay", log.to_str().unwrap()]);
@@ -179,7 +186,7 @@ fn bluefin_over_tcp_in_lock_step_declares_and_replays_exactly_and_again_the_same
     );
     // Lock-step is deterministic: a second flight logs the same decisions.
     let again = tempfile::tempdir().unwrap();
-    let (ob2, _) = fly(again.path(), &["--listen", "127.0.0.1:0", "--no-flow"]);
+    let (ob2, _) = fly(again.path(), &["--listen", "127.0.0.1:0"]);
     assert_eq!(ob2["declarations"], ob["declarations"]);
     let lines = |p: &Path| -> Vec<String> {
         let r = plumetrace_onboard_log(p);
@@ -274,7 +281,6 @@ fn a_front_seat_restart_pauses_the_planner_which_reconnects_and_goes_on() {
         &[
             "--listen",
             "127.0.0.1:0",
-            "--no-flow",
             "--restart-at",
             "200",
             "--restart-for",
@@ -356,8 +362,19 @@ fn fly_iver(dir: &Path, extra: &[&str], edit: impl Fn(String) -> String) -> (Val
 /// declaration near the source, and a log that replays to the same decisions.
 fn iver_flight_declares_and_replays(dir: &Path, ob: &Value, fs: &Value) -> f64 {
     no_unsafe_commands(fs);
-    assert_eq!(fs["unanswered"], 0, "{fs}");
-    assert_eq!(fs["nav_records"], ob["nav_records"], "{fs} {ob}");
+    // Every poll was answered, bar one the front seat may make after the back seat's final stop
+    // and before it sees the line close (a busy machine's timing).
+    let unanswered = fs["unanswered"].as_u64().unwrap();
+    assert!(
+        unanswered == 0 || (unanswered == 1 && fs["back_seat_gone"] == true),
+        "{fs}"
+    );
+    // Likewise every record was read, bar that last one.
+    let (sent, read) = (
+        fs["nav_records"].as_u64().unwrap(),
+        ob["nav_records"].as_u64().unwrap(),
+    );
+    assert!(sent == read || sent == read + 1, "{fs} {ob}");
     assert_eq!(ob["commands_rejected"], 0);
     let error = declared_near_the_source(ob);
     assert!(error < 30.0, "declared {error:.1} m from the source");

@@ -6,6 +6,7 @@ use crate::obstacle::ObstacleSet;
 use crate::plume::FilamentPlume;
 use crate::{EnvError, Rect, SimRng, StreamId, stream_rng};
 use plumetrace_core::{Vec2, Vec3};
+use rand::RngCore;
 
 /// The plume models: a live filament plume or a steady field.
 pub enum Plume {
@@ -51,7 +52,9 @@ impl ConcentrationField for Plume {
 
 /// The simulated ocean: domain, flow, plume and obstacles, stepped at a fixed `dt`.
 ///
-/// Time is the integer step count times `dt`. The flow and the plume each draw from their own
+/// Time is the integer step count times `dt`. The plume steps at `dt` (and the spin-up's step);
+/// a flow with a stability limit (the Farrell grid) is advanced in as many equal sub-steps as
+/// keep each at most half its limit ([`flow_substeps`]), so the plume's step is free of it. The flow and the plume each draw from their own
 /// random stream, so what vehicles do never changes the plume they meet.
 #[derive(Debug)]
 pub struct Environment {
@@ -78,13 +81,9 @@ impl Environment {
         seed: u64,
     ) -> Result<Self, EnvError> {
         crate::error::require_positive("sim.dt_s", dt_s)?;
-        if let Some(limit) = flow.max_stable_dt_s()
-            && dt_s > limit
-        {
-            return Err(EnvError::invalid(
-                "sim.dt_s",
-                format!("{dt_s} s is above the flow model's stable limit of {limit:.4} s"),
-            ));
+        let mut plume = plume;
+        if let Plume::Filaments(p) = &mut plume {
+            p.set_key_seed(stream_rng(seed, StreamId::PlumeKeys).next_u64());
         }
         Ok(Environment {
             domain,
@@ -106,24 +105,28 @@ impl Environment {
     pub fn spin_up(&mut self, duration_s: f64, dt_s: f64) -> Result<(), EnvError> {
         crate::error::require_non_negative("mission.spinup_s", duration_s)?;
         crate::error::require_positive("mission.spinup_dt_s", dt_s)?;
-        if let Some(limit) = self.flow.max_stable_dt_s()
-            && dt_s > limit
-        {
-            return Err(EnvError::invalid(
-                "mission.spinup_dt_s",
-                format!("{dt_s} s is above the flow model's stable limit of {limit:.4} s"),
-            ));
-        }
         let n = (duration_s / dt_s).round() as u64;
         let start = self.elapsed_s();
         for k in 1..=n {
             let t = start + k as f64 * dt_s;
-            self.flow.advance(t, dt_s, &mut self.flow_rng)?;
-            if let Plume::Filaments(p) = &mut self.plume {
-                p.step(&self.flow, t, dt_s, &mut self.plume_rng);
-            }
+            self.advance(t, dt_s)?;
         }
         self.spinup_s += n as f64 * dt_s;
+        Ok(())
+    }
+
+    /// Advances the flow (in its own sub-steps) and then the plume (in one step) to `t_new_s`.
+    fn advance(&mut self, t_new_s: f64, dt_s: f64) -> Result<(), EnvError> {
+        let n = flow_substeps(&self.flow, dt_s);
+        let h = dt_s / n as f64;
+        let t0 = t_new_s - dt_s;
+        for k in 1..=n {
+            let t = if k == n { t_new_s } else { t0 + k as f64 * h };
+            self.flow.advance(t, h, &mut self.flow_rng)?;
+        }
+        if let Plume::Filaments(p) = &mut self.plume {
+            p.step(&self.flow, t_new_s, dt_s, &mut self.plume_rng);
+        }
         Ok(())
     }
 
@@ -170,10 +173,7 @@ impl Environment {
     /// Advances the flow, then the plume, by one step.
     pub fn step(&mut self) -> Result<(), EnvError> {
         let t_new = self.spinup_s + (self.step + 1) as f64 * self.dt_s;
-        self.flow.advance(t_new, self.dt_s, &mut self.flow_rng)?;
-        if let Plume::Filaments(p) = &mut self.plume {
-            p.step(&self.flow, t_new, self.dt_s, &mut self.plume_rng);
-        }
+        self.advance(t_new, self.dt_s)?;
         self.step += 1;
         Ok(())
     }
@@ -226,5 +226,18 @@ impl Environment {
     /// Concentration at `p`.
     pub fn concentration_at(&self, p: Vec3) -> f64 {
         self.plume.concentration(p)
+    }
+}
+
+/// The number of equal sub-steps a flow takes for an environment step of `dt_s`: one when `dt_s`
+/// is at most half the flow's stable limit (or it has none), else the fewest that make each
+/// sub-step at most half the limit (strictly below it, where the explicit scheme is stable with
+/// margin).
+pub fn flow_substeps(flow: &dyn FlowField, dt_s: f64) -> u64 {
+    match flow.max_stable_dt_s() {
+        Some(limit) if limit > 0.0 && dt_s > 0.5 * limit => {
+            ((dt_s / (0.5 * limit)).ceil() as u64).max(1)
+        }
+        _ => 1,
     }
 }

@@ -17,6 +17,7 @@ pub mod field;
 pub mod flow;
 pub mod input;
 pub mod kelp;
+pub mod normal;
 pub mod obstacle;
 pub mod plume;
 pub mod rng;
@@ -29,5 +30,7 @@ pub use field::{ConcentrationField, GridSpec, MeanConcentrationGrid};
 pub use flow::{FlowField, FlowModel};
 pub use kelp::{KelpFieldParams, kelp_field};
 pub use obstacle::{ObstacleSet, SoftObstacle};
-pub use plume::{FilamentParams, FilamentPlume, PlumeStats, Source, VerticalBoundary};
+pub use plume::{
+    DownflowSink, FilamentParams, FilamentPlume, PlumeStats, Source, VerticalBoundary,
+};
 pub use rng::{SimRng, StreamId, derive_seed, stream_rng};

@@ -19,6 +19,8 @@ pub enum StreamId {
     Flow,
     /// The plume's release and dispersion.
     Plume,
+    /// The seed of the plume filaments' noise keys.
+    PlumeKeys,
     /// A vehicle's motion noise, by vehicle index.
     Vehicle(u32),
     /// A sensor's noise, by vehicle index and sensor index.
@@ -32,6 +34,7 @@ impl StreamId {
         match self {
             StreamId::Flow => 1,
             StreamId::Plume => 2,
+            StreamId::PlumeKeys => 6 << 56,
             StreamId::Vehicle(v) => (3 << 56) | u64::from(v),
             StreamId::Sensor(v, s) => (4 << 56) | (u64::from(v) << 16) | u64::from(s & 0xffff),
             StreamId::Custom(c) => (5 << 56) ^ c,

@@ -175,8 +175,10 @@ fn profile_variance(grid: &MeanConcentrationGrid) -> f64 {
     m2 / m0 - mu * mu
 }
 
-#[test]
-fn mean_crossflow_profile_widens_as_diffusivity_predicts() {
+/// The time-averaged cross-flow variance of a plume in a uniform 1 m/s current at 25, 55 and
+/// 85 m from the source (5 m), the plume stepped at `dt` and sampled after each of `steps`
+/// steps, with the theory `2 K t + r0^2 + gamma t` beside each.
+fn crossflow_variances(dt: f64, steps: usize) -> Vec<(f64, f64, f64)> {
     let (k_h, gamma, u) = (0.05, 0.001, 1.0);
     let domain = rect(0.0, 100.0, -50.0, 50.0);
     let src = Source {
@@ -194,7 +196,7 @@ fn mean_crossflow_profile_widens_as_diffusivity_predicts() {
         ..FilamentParams::default()
     };
     let flow = FlowModel::Uniform(UniformFlow::new(east(u)).unwrap());
-    let mut env = filament_env(domain, flow, src, params, 0.05, 3);
+    let mut env = filament_env(domain, flow, src, params, dt, 3);
     run(&mut env, 100.0);
     let xs = [25.0, 55.0, 85.0];
     let mut grids: Vec<MeanConcentrationGrid> = xs
@@ -212,17 +214,27 @@ fn mean_crossflow_profile_widens_as_diffusivity_predicts() {
             MeanConcentrationGrid::new(spec, 0.0)
         })
         .collect();
-    for _ in 0..6000 {
+    for _ in 0..steps {
         env.step().unwrap();
         for g in &mut grids {
             g.accumulate(env.plume());
         }
     }
+    grids
+        .iter()
+        .zip(xs)
+        .map(|(g, x)| {
+            let t = (x - 5.0) / u;
+            let theory = 2.0 * k_h * t + params.init_radius_m.powi(2) + gamma * t;
+            (x, profile_variance(g), theory)
+        })
+        .collect()
+}
+
+#[test]
+fn mean_crossflow_profile_widens_as_diffusivity_predicts() {
     let mut previous = 0.0;
-    for (g, x) in grids.iter().zip(xs) {
-        let t = (x - 5.0) / u;
-        let theory = 2.0 * k_h * t + params.init_radius_m.powi(2) + gamma * t;
-        let got = profile_variance(g);
+    for (x, got, theory) in crossflow_variances(0.05, 6000) {
         eprintln!("x = {x} m: profile variance {got:.3} m^2, theory {theory:.3} m^2");
         assert!(
             (got - theory).abs() / theory < 0.10,
@@ -230,6 +242,131 @@ fn mean_crossflow_profile_widens_as_diffusivity_predicts() {
         );
         assert!(got > previous);
         previous = got;
+    }
+}
+
+#[test]
+fn a_coarse_plume_step_keeps_the_crossflow_spread() {
+    // Steps 40 times longer (2 s: a filament moves 2 m per step, 4 % of the way to the
+    // farthest section), sampled over 1,200 s: the same spread as theory within 10 %.
+    for (x, got, theory) in crossflow_variances(2.0, 600) {
+        eprintln!("dt 2 s, x = {x} m: profile variance {got:.3} m^2, theory {theory:.3} m^2");
+        assert!(
+            (got - theory).abs() / theory < 0.10,
+            "x = {x}: variance {got}, theory {theory}"
+        );
+    }
+}
+
+#[test]
+fn a_long_step_releases_a_stream_not_a_clump() {
+    // 50 filaments/s for one 10 s step in a 0.2 m/s current: births spread over the step, each
+    // filament carried for its own age, so the new filaments lie along the 2 m the water moved.
+    let domain = rect(0.0, 100.0, -50.0, 50.0);
+    let src = Source {
+        pos_m: Vec3::new(10.0, 0.0, 5.0),
+        mass_rate_per_s: 1.0,
+        filament_rate_hz: 50.0,
+    };
+    let params = FilamentParams {
+        dispersion: Dispersion::Physical {
+            horizontal_m2ps: 1e-6,
+            vertical_m2ps: 1e-6,
+        },
+        ..FilamentParams::default()
+    };
+    let flow = FlowModel::Uniform(UniformFlow::new(east(0.2)).unwrap());
+    let mut env = filament_env(domain, flow, src, params, 10.0, 4);
+    env.step().unwrap();
+    let p = filaments(&env);
+    let d: Vec<f64> = p.filaments().map(|(q, _)| q.x - 10.0).collect();
+    assert!(d.len() > 400, "{} filaments", d.len());
+    let mean = d.iter().sum::<f64>() / d.len() as f64;
+    let (lo, hi) = d
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), x| {
+            (a.min(*x), b.max(*x))
+        });
+    // Uniform over [0, 2 m]: mean 1 m (sd of the mean 0.03 m), extremes near the ends.
+    assert!((mean - 1.0).abs() < 0.15, "mean distance {mean}");
+    assert!(
+        (-0.01..0.05).contains(&lo) && hi > 1.95 && hi <= 2.01,
+        "{lo} .. {hi}"
+    );
+    // Their radii follow their own ages: from r0 up to the radius after 10 s.
+    let r2: Vec<f64> = p.filaments().map(|(_, r2)| r2).collect();
+    let r0sq = params.init_radius_m.powi(2);
+    let oldest = r0sq + params.growth_rate_m2ps * 10.0;
+    assert!(r2.iter().all(|r| *r >= r0sq && *r <= oldest + 1e-12));
+    assert!(r2.iter().any(|r| *r < r0sq + 0.1 * (oldest - r0sq)));
+}
+
+#[test]
+fn dropping_filaments_beyond_the_sink_changes_no_other_filament() {
+    // The same plume with and without a sink 300 m downflow (source at 50 m, 0.1 m/s east):
+    // each filament's random walk depends on its own key only, so the plume that keeps its
+    // filaments holds, in order, every filament of the one that drops them, bit for bit, and
+    // readings short of the sink are the same bits.
+    let domain = rect(0.0, 1000.0, -100.0, 100.0);
+    let src = Source {
+        pos_m: Vec3::new(50.0, 0.0, 0.0),
+        mass_rate_per_s: 2.0,
+        filament_rate_hz: 2.0,
+    };
+    let flow = || FlowModel::Uniform(UniformFlow::new(east(0.1)).unwrap());
+    let params = FilamentParams {
+        dispersion: Dispersion::Physical {
+            horizontal_m2ps: 0.05,
+            vertical_m2ps: 0.002,
+        },
+        growth_rate_m2ps: 0.002,
+        init_radius_m: 0.1,
+        ..FilamentParams::default()
+    };
+    let mut keep = filament_env(domain, flow(), src, params, 1.0, 8);
+    let mut drop = filament_env(domain, flow(), src, params, 1.0, 8);
+    if let Plume::Filaments(p) = drop.plume_mut() {
+        p.set_sink(Some(plumetrace_env::DownflowSink {
+            dir: [1.0, 0.0],
+            beyond_m: 300.0,
+        }));
+    }
+    run(&mut keep, 4000.0);
+    run(&mut drop, 4000.0);
+    let (a, b) = (filaments(&keep), filaments(&drop));
+    assert!(b.stats().dropped > 500, "{:?}", b.stats());
+    assert_eq!(a.stats().released, b.stats().released);
+    // Every filament is accounted for: live, exited or dropped, and so is the mass.
+    let sb = b.stats();
+    assert_eq!(sb.released, sb.live as u64 + sb.exited + sb.dropped);
+    let accounted = b.live_mass() + sb.exited_mass + sb.dropped_mass;
+    assert!((accounted - sb.released_mass).abs() <= 1e-9 * sb.released_mass);
+    // Filaments beyond the sink go in batches (when they are a thirty-second of the plume), so
+    // a few may still be there, none of them within reach of x < 300 m.
+    let widest = (0.1f64.powi(2) + 0.002 * 4000.0).sqrt() * 3.0;
+    let lingering = b
+        .filaments()
+        .filter(|(q, r2)| q.x - 3.0 * r2.sqrt() > 300.0 + widest)
+        .count();
+    assert!(lingering * 32 <= b.len(), "{lingering} of {}", b.len());
+    let mut all = a.filaments();
+    let mut matched = 0;
+    for (q, r2) in b.filaments() {
+        assert!(
+            all.any(|(p, s2)| p == q && s2 == r2),
+            "filament {q:?} of the dropping plume is not in the other"
+        );
+        matched += 1;
+    }
+    assert_eq!(matched, b.len());
+    assert!(a.len() > b.len() + 500);
+    for k in 0..400 {
+        let p = Vec3::new(60.0 + 0.6 * k as f64, -3.0 + 0.015 * k as f64, 0.5);
+        assert_eq!(
+            keep.sample_concentration(p).to_bits(),
+            drop.sample_concentration(p).to_bits(),
+            "at {p:?}"
+        );
     }
 }
 

@@ -103,6 +103,10 @@ pub const CAMPAIGNS: &[(&str, &str)] = &[
         "meander-noise",
         include_str!("../../../examples/campaigns/meander-noise.toml"),
     ),
+    (
+        "plume-steps",
+        include_str!("../../../examples/campaigns/plume-steps.toml"),
+    ),
 ];
 
 /// The example families (`examples/families/*.family.toml`; a test checks the list is complete).

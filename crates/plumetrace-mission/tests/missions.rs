@@ -722,3 +722,44 @@ fn missions_flown_in_one_environment_give_what_they_give_alone() {
     }
     assert_ne!(alone[0].1, alone[1].1);
 }
+
+#[test]
+fn dropping_unreachable_filaments_changes_no_reading() {
+    // duck-2003-st's plume reaches the domain's edge, some 360 m beyond the op-area's downflow
+    // edge; by default filaments more than 230 m beyond it (the cage's 30 m and the 200 m
+    // margin) are dropped. A mission with a margin too large to drop anything reads the same
+    // plume: every reading, track and event is the same bits.
+    let setup = |margin: Option<f64>| {
+        let mut cfg = load_preset("duck-2003-st").unwrap();
+        let m = cfg.mission.as_mut().unwrap();
+        m.time_limit_s = 900.0;
+        m.drop_margin_m = margin;
+        let mut s = MissionSetup::new(
+            build(&cfg, &Origin::Preset("duck-2003-st".into()), Some(5)).unwrap(),
+        )
+        .unwrap();
+        s.spin_up().unwrap();
+        s
+    };
+    let dropped = |s: &MissionSetup| s.env.plume().filaments().unwrap().stats().dropped;
+    let (with, without) = (setup(None), setup(Some(1e6)));
+    assert!(dropped(&with) > 1000, "dropped {}", dropped(&with));
+    assert_eq!(dropped(&without), 0);
+    assert!(
+        with.env.plume().filaments().unwrap().len() + 1000
+            < without.env.plume().filaments().unwrap().len()
+    );
+    let fly = |s: MissionSetup| {
+        let mut m = Mission::new(s, MissionOptions::default()).unwrap();
+        m.run(&mut |_, _| {}).unwrap();
+        let r = m.finish().unwrap();
+        (
+            serde_json::to_string(&r.summary).unwrap(),
+            serde_json::to_string(&r.trajectory).unwrap(),
+            serde_json::to_string(&r.events).unwrap(),
+        )
+    };
+    let (a, b) = (fly(with), fly(without));
+    assert!(a.2.contains("detection"), "the mission met the plume");
+    assert!(a == b, "the missions differ");
+}

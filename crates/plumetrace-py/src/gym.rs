@@ -146,15 +146,47 @@ struct Maker {
     source: Source,
     overrides: Vec<(String, toml::Value)>,
     settings: Settings,
+    /// The spun-up environments of the last few seeds reset to, newest last: a reset to one of
+    /// them starts from a copy (the same bits as spinning up again) instead of spinning up.
+    spun: Mutex<VecDeque<(u64, plumetrace_env::Environment)>>,
 }
 
+/// How many spun-up environments a [`Maker`] keeps (a Duck-sized plume is about 2 MB).
+const SPUN_UP_KEPT: usize = 8;
+
 impl Maker {
+    /// Spins `setup` up, or gives it a copy of the environment kept for `seed`.
+    fn spin_up(&self, seed: u64, setup: &mut MissionSetup) -> Result<(), String> {
+        let kept = {
+            let spun = self.spun.lock().map_err(|_| "the spin-up cache is poisoned")?;
+            spun.iter()
+                .find(|(s, _)| *s == seed)
+                .and_then(|(_, env)| env.try_clone())
+        };
+        match kept {
+            Some(env) => setup.use_spun_up(env),
+            None => {
+                setup.spin_up().map_err(|e| crate::error::located(&e))?;
+                if let Some(copy) = setup.env.try_clone() {
+                    let mut spun = self.spun.lock().map_err(|_| "the spin-up cache is poisoned")?;
+                    spun.retain(|(s, _)| *s != seed);
+                    spun.push_back((seed, copy));
+                    while spun.len() > SPUN_UP_KEPT {
+                        spun.pop_front();
+                    }
+                }
+            }
+        }
+        Ok(())
+    }
+
     fn episode(&self, seed: u64) -> Result<(Episode, [f32; 12]), String> {
         let sc = self
             .source
             .build(Some(seed), &self.overrides)
             .map_err(|e| e.to_string())?;
-        let setup = MissionSetup::new(sc).map_err(|e| crate::error::located(&e))?;
+        let mut setup = MissionSetup::new(sc).map_err(|e| crate::error::located(&e))?;
+        self.spin_up(seed, &mut setup)?;
         let k = self.settings.vehicle;
         let v = setup.vehicles.get(k).ok_or_else(|| {
             format!(
@@ -415,6 +447,7 @@ fn maker(
         source: Source::open(scenario)?,
         overrides: overrides(set, rest.as_ref())?,
         settings,
+        spun: Mutex::new(VecDeque::new()),
     })
 }
 

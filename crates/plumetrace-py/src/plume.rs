@@ -308,8 +308,8 @@ impl Plume {
         Ok((mean.into_pyarray(py), inter.into_pyarray(py)))
     }
 
-    /// Filament statistics: live, released, exited, suppressed (a filament plume), or an empty
-    /// dict (a steady plume).
+    /// Filament statistics: live, released, exited, dropped (beyond a mission's downflow sink),
+    /// suppressed (a filament plume), or an empty dict (a steady plume).
     fn stats<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
         let d = PyDict::new(py);
         if let Some(f) = self.env.plume().filaments() {
@@ -319,6 +319,8 @@ impl Plume {
             d.set_item("released_mass", s.released_mass)?;
             d.set_item("exited", s.exited)?;
             d.set_item("exited_mass", s.exited_mass)?;
+            d.set_item("dropped", s.dropped)?;
+            d.set_item("dropped_mass", s.dropped_mass)?;
             d.set_item("suppressed", s.suppressed)?;
         }
         Ok(d)

@@ -240,14 +240,7 @@ pub fn build(
             let m = mean(true)?.ok_or_else(|| invalid("flow.mean", "missing".into()))?;
             let params = cfg.flow.farrell.unwrap_or_default();
             FlowModel::Farrell(Box::new(
-                FarrellFlow::new(domain, m, params, env_dt_s).map_err(|e| match e {
-                    EnvError::InvalidParameter { key, message }
-                        if key == "sim.dt_s" && env_dt_s != dt_s =>
-                    {
-                        invalid("mission.env_dt_s", message)
-                    }
-                    other => env_err(other),
-                })?,
+                FarrellFlow::substepped(domain, m, params).map_err(env_err)?,
             ))
         }
         FlowKind::Gridded => {
@@ -542,7 +535,7 @@ pub fn build(
         .map_err(env_err)?;
 
     let seed = seed.unwrap_or(cfg.seed);
-    let env = Environment::new(
+    let mut env = Environment::new(
         domain,
         flow,
         plume,
@@ -551,6 +544,20 @@ pub fn build(
         seed,
     )
     .map_err(env_err)?;
+    // The flow takes sub-steps within its stable limit: bound the run's number of them.
+    let flow_steps = duration / env_dt_s
+        * plumetrace_env::environment::flow_substeps(env.flow(), env_dt_s) as f64;
+    if flow_steps > crate::limits::MAX_STEPS {
+        return Err(invalid(
+            "flow.farrell",
+            format!(
+                "the flow grid's stable step is {:.4e} s, so the run would take {flow_steps:.3e} \
+                 flow steps; at most {:.0e}: use a coarser grid or larger diffusivities",
+                plumetrace_env::FlowField::max_stable_dt_s(env.flow()).unwrap_or(f64::INFINITY),
+                crate::limits::MAX_STEPS
+            ),
+        ));
+    }
 
     let flown = vehicles.iter().any(|v| v.planner.is_some());
     let mission = match &cfg.mission {
@@ -564,19 +571,21 @@ pub fn build(
             None
         }
         Some(m) => Some(
-            mission_spec(
-                m,
-                &domain,
-                env_dt_s,
-                dt_s,
-                plumetrace_env::FlowField::max_stable_dt_s(env.flow()),
-            )
-            .map_err(|e| match e {
+            mission_spec(m, &domain, env_dt_s, dt_s, env.flow()).map_err(|e| match e {
                 EnvError::InvalidParameter { key, message } => invalid(&key, message),
                 other => invalid("mission", other.to_string()),
             })?,
         ),
     };
+    if let (Some(spec), Some(m), Some(mean)) = (&mission, &cfg.mission, mean(false)?)
+        && !matches!(cfg.flow.model, FlowKind::Gridded)
+        && vehicles.iter().all(|v| v.planner.is_some())
+        && let plumetrace_env::Plume::Filaments(plume) = env.plume_mut()
+    {
+        let starts: Vec<Vec2> = vehicles.iter().map(|v| v.vehicle.state.pos_m).collect();
+        let margin = m.drop_margin_m.unwrap_or(DEFAULT_DROP_MARGIN_M);
+        plume.set_sink(downflow_sink(&mean, spec, &starts, margin));
+    }
     if mission.is_some() && !flown {
         return Err(invalid(
             if cfg.vehicles.is_empty() {
@@ -1188,7 +1197,7 @@ fn mission_spec(
     domain: &Rect,
     env_dt_s: f64,
     dt_s: f64,
-    stable_dt_s: Option<f64>,
+    flow: &dyn plumetrace_env::FlowField,
 ) -> Result<MissionSpec, EnvError> {
     let op_area = match &m.op_area {
         Some(v) => polygon(v, "mission.op_area")?,
@@ -1245,18 +1254,6 @@ fn mission_spec(
         ),
     };
     plumetrace_env::error::require_positive(&spinup_key, spinup_dt_s)?;
-    if let Some(limit) = stable_dt_s
-        && spinup_dt_s > limit
-    {
-        return Err(EnvError::invalid(
-            spinup_key,
-            format!(
-                "{} s is above the flow's stable step of {limit:.4} s (set by the [flow.farrell] \
-                 grid and noise keys): give a smaller mission.spinup_dt_s",
-                crate::limits::show(spinup_dt_s)
-            ),
-        ));
-    }
     let spinup_steps = m.spinup_s / spinup_dt_s;
     if spinup_steps > crate::limits::MAX_SPINUP_STEPS {
         return Err(EnvError::invalid(
@@ -1264,6 +1261,21 @@ fn mission_spec(
             format!(
                 "mission.spinup_s / spin-up step = {spinup_steps:.3e} steps; at most {:.0e}",
                 crate::limits::MAX_SPINUP_STEPS
+            ),
+        ));
+    }
+    // The flow takes sub-steps within its stable limit: bound their number too.
+    let sub = |dt: f64| plumetrace_env::environment::flow_substeps(flow, dt) as f64;
+    let flow_steps = spinup_steps * sub(spinup_dt_s) + m.time_limit_s / env_dt_s * sub(env_dt_s);
+    if flow_steps > crate::limits::MAX_STEPS {
+        let limit = flow.max_stable_dt_s().unwrap_or(f64::INFINITY);
+        return Err(EnvError::invalid(
+            "flow.farrell",
+            format!(
+                "the flow grid's stable step is {limit:.4e} s, so spin-up and mission would take \
+                 {flow_steps:.3e} flow steps; at most {:.0e}: use a coarser grid or larger \
+                 diffusivities",
+                crate::limits::MAX_STEPS
             ),
         ));
     }
@@ -1277,5 +1289,70 @@ fn mission_spec(
         spinup_dt_s,
         prior_flow_toward_deg: prior,
         prior_flow_given: m.prior_flow_toward_deg.is_some(),
+    })
+}
+
+/// The default of `mission.drop_margin_m`, m.
+pub const DEFAULT_DROP_MARGIN_M: f64 = 200.0;
+
+/// How far outside the op-area a vehicle can be: the cage aborts a planner whose vehicle is more
+/// than 30 m out (`plumetrace-guidance`'s `ABORT_DISTANCE_M`).
+const CAGE_REACH_M: f64 = 30.0;
+
+/// Where the plume's filaments can be dropped as out of every sensor's reach, if anywhere.
+///
+/// The condition: the mean flow always has a component of at least `u_min > 0` along one
+/// direction `d` (a steady flow, or a tidal one whose direction swings by less than 120
+/// degrees in all, `d` the middle of the swing: `u_min = speed_min cos(half swing)`); every
+/// vehicle flies a planner, so it stays within the cage's 30 m of the op-area once there, and
+/// it starts somewhere known. Then nothing samples the plume farther along `d` than the
+/// farthest op-area or subregion vertex or start (`reach`) plus 30 m, and a filament whose
+/// cut-off sphere lies more than `margin_m` beyond that is carried on away from it by the mean
+/// flow; to come back it would have to travel the margin against the flow, which the meander
+/// (zero-mean, correlated over minutes) and the random walk (`exp(-u_min margin / K)`, the
+/// chance that drifting diffusion ever goes that far back) practically never do.
+fn downflow_sink(
+    mean: &MeanFlow,
+    spec: &MissionSpec,
+    starts: &[Vec2],
+    margin_m: f64,
+) -> Option<plumetrace_env::DownflowSink> {
+    let (toward_deg, u_min) = match *mean {
+        MeanFlow::Steady {
+            speed_mps,
+            toward_deg,
+        } => (toward_deg, speed_mps),
+        MeanFlow::Tidal {
+            speed_min_mps,
+            toward_min_deg,
+            toward_max_deg,
+            ..
+        } => {
+            let swing = (toward_max_deg - toward_min_deg).rem_euclid(360.0);
+            if swing >= 120.0 {
+                return None;
+            }
+            let half = 0.5 * swing;
+            (
+                toward_min_deg + half,
+                speed_min_mps * half.to_radians().cos(),
+            )
+        }
+    };
+    if !(u_min > 0.0 && margin_m.is_finite()) {
+        return None;
+    }
+    let h = toward_deg.to_radians();
+    let dir = [h.sin(), h.cos()];
+    let reach = spec
+        .op_area
+        .iter()
+        .chain(spec.subregions.iter().flatten())
+        .chain(starts)
+        .map(|p| dir[0] * p.x + dir[1] * p.y)
+        .fold(f64::NEG_INFINITY, f64::max);
+    reach.is_finite().then_some(plumetrace_env::DownflowSink {
+        dir,
+        beyond_m: reach + CAGE_REACH_M + margin_m,
     })
 }

@@ -523,6 +523,9 @@ pub struct MissionConfig {
     /// Flow direction the planner assumes before its first flow measurement, deg (not given:
     /// North, with a warning).
     pub prior_flow_toward_deg: Option<f64>,
+    /// Filaments farther than this beyond the downflow edge of every vehicle's reach are
+    /// dropped, m (default 200; see the README's plume model).
+    pub drop_margin_m: Option<f64>,
 }
 
 /// `[comms]`: one channel model per link kind (absent: ideal, no delay and no loss).

@@ -545,6 +545,12 @@ pub const LIMITS: &[Limit] = &[
         "a step of more than a minute skips the plume's motion",
     ),
     num("mission.prior_flow_toward_deg", -TURNS, TURNS, ANGLE_WHY),
+    num(
+        "mission.drop_margin_m",
+        50.0,
+        COORD,
+        "filaments this far beyond every vehicle's reach are dropped; at least 50 m",
+    ),
     num("comms.acoustic.latency_s", 0.0, 1e5, "a day at most"),
     pos("comms.acoustic.sound_speed_mps", 1e9, "finite"),
     num("comms.acoustic.loss_probability", 0.0, 1.0, "a probability"),

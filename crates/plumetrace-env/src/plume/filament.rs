@@ -6,7 +6,8 @@ use crate::field::ConcentrationField;
 use crate::flow::FlowField;
 use crate::{Rect, SimRng};
 use plumetrace_core::Vec3;
-use rand_distr::{Distribution, Poisson, StandardNormal};
+use rand::{Rng, RngCore};
+use rand_distr::{Distribution, Poisson};
 use serde::{Deserialize, Serialize};
 use std::sync::OnceLock;
 
@@ -133,6 +134,26 @@ pub struct PlumeStats {
     pub exited_mass: f64,
     /// Releases suppressed by `max_filaments`.
     pub suppressed: u64,
+    /// Filaments dropped beyond the downflow sink (out of every sensor's reach).
+    pub dropped: u64,
+    /// Mass dropped beyond the downflow sink.
+    pub dropped_mass: f64,
+}
+
+/// A half-plane far downflow of everything that samples the plume: a filament whose cut-off
+/// sphere lies entirely beyond it is dropped ([`FilamentPlume::set_sink`]).
+///
+/// Dropping is exact (the readings elsewhere are the same bits) as long as no dropped filament
+/// would ever have come back within reach: the caller places the sink where the mean flow
+/// carries filaments away from every sensor and never back ([`DownflowSink`]'s use in a
+/// mission is documented with the scenario key that sets its margin). Each filament's random
+/// walk depends only on its own key and the step count, so removing one changes no other.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct DownflowSink {
+    /// Unit vector `(east, north)` of the direction filaments are carried away in.
+    pub dir: [f64; 2],
+    /// A filament is dropped when `dir . (x, y) - cut-off radius > beyond_m`, m.
+    pub beyond_m: f64,
 }
 
 /// The filament plume: filaments stored as parallel arrays (structure of arrays).
@@ -151,17 +172,39 @@ pub struct FilamentPlume {
     pub(crate) birth_s: Vec<f64>,
     pub(crate) mass: Vec<f64>,
     pub(crate) source: Vec<u16>,
+    /// Each filament's noise key, drawn at its release: its random walk at transport step `n`
+    /// comes from `key + n` alone (see [`FilamentPlume::step`]), so it does not depend on which
+    /// other filaments exist.
+    key: Vec<u64>,
+    /// The seed of the keys ([`FilamentPlume::set_key_seed`]).
+    key_seed: u64,
+    /// Keys given so far.
+    keys_given: u64,
+    /// Transport steps taken (the counter of the filaments' noise).
+    transport_steps: u64,
+    /// Where filaments are dropped as out of every sensor's reach, if anywhere.
+    sink: Option<DownflowSink>,
     /// Plume time, s (the end of the last step).
     time_s: f64,
     stats: PlumeStats,
     index: OnceLock<CellIndex>,
-    /// Bounding boxes of consecutive blocks of filaments, for the sensor's scan (built by the
-    /// first scan after a change, so stepping alone never pays for them).
-    boxes: OnceLock<Vec<BlockBox>>,
+    /// Bounding boxes of consecutive blocks of filaments and of runs of [`SCAN_GROUP`] blocks,
+    /// for the sensor's scan (built by the first scan after a change, so stepping alone never
+    /// pays for them).
+    boxes: OnceLock<ScanBoxes>,
 }
 
 /// Filaments per block of the sensor scan's pruning boxes.
 pub const SCAN_BLOCK: usize = 64;
+/// Blocks per group: the scan tests a group's box before its blocks' boxes.
+pub const SCAN_GROUP: usize = 16;
+
+/// The sensor scan's two levels of boxes.
+#[derive(Debug)]
+struct ScanBoxes {
+    blocks: Vec<BlockBox>,
+    groups: Vec<BlockBox>,
+}
 
 /// The horizontal extent and the oldest release time of a block of [`SCAN_BLOCK`] consecutive
 /// filaments: no filament of the block reaches a point farther from the box than the cut-off of
@@ -173,6 +216,39 @@ struct BlockBox {
     y_min: f64,
     y_max: f64,
     birth_min_s: f64,
+}
+
+impl BlockBox {
+    const EMPTY: BlockBox = BlockBox {
+        x_min: f64::INFINITY,
+        x_max: f64::NEG_INFINITY,
+        y_min: f64::INFINITY,
+        y_max: f64::NEG_INFINITY,
+        birth_min_s: f64::INFINITY,
+    };
+
+    /// The box of this one and `o`.
+    fn union(self, o: BlockBox) -> BlockBox {
+        BlockBox {
+            x_min: self.x_min.min(o.x_min),
+            x_max: self.x_max.max(o.x_max),
+            y_min: self.y_min.min(o.y_min),
+            y_max: self.y_max.max(o.y_max),
+            birth_min_s: self.birth_min_s.min(o.birth_min_s),
+        }
+    }
+
+    /// Whether no filament of the box reaches `p` (`(r0^2, gamma, t, cutoff^2)` of the plume):
+    /// `p` is farther from the box than the cut-off of its oldest filament. Differences,
+    /// squares and sums are monotone in floating point, so a box holding another's filaments
+    /// is beyond `p` only if the other is too.
+    #[inline]
+    fn beyond(&self, p: Vec3, (r0sq, gamma, t, cut2): (f64, f64, f64, f64)) -> bool {
+        let ddx = (self.x_min - p.x).max(p.x - self.x_max).max(0.0);
+        let ddy = (self.y_min - p.y).max(p.y - self.y_max).max(0.0);
+        let widest = r0sq + gamma * (t - self.birth_min_s).max(0.0);
+        ddx * ddx + ddy * ddy > cut2 * widest
+    }
 }
 
 impl FilamentPlume {
@@ -223,6 +299,11 @@ impl FilamentPlume {
             birth_s: Vec::new(),
             mass: Vec::new(),
             source: Vec::new(),
+            key: Vec::new(),
+            key_seed: 0,
+            keys_given: 0,
+            transport_steps: 0,
+            sink: None,
             time_s: 0.0,
             stats: PlumeStats::default(),
             index: OnceLock::new(),
@@ -245,6 +326,11 @@ impl FilamentPlume {
             birth_s: self.birth_s.clone(),
             mass: self.mass.clone(),
             source: self.source.clone(),
+            key: self.key.clone(),
+            key_seed: self.key_seed,
+            keys_given: self.keys_given,
+            transport_steps: self.transport_steps,
+            sink: self.sink,
             time_s: self.time_s,
             stats: self.stats,
             index: OnceLock::new(),
@@ -307,6 +393,34 @@ impl FilamentPlume {
         self.time_s
     }
 
+    /// Seeds the filaments' noise keys (an [`crate::Environment`] does it from its run seed)
+    /// and re-keys the filaments already there, in order.
+    pub fn set_key_seed(&mut self, seed: u64) {
+        self.key_seed = seed;
+        self.keys_given = 0;
+        for k in 0..self.key.len() {
+            self.key[k] = self.next_key();
+        }
+    }
+
+    /// The next filament's noise key.
+    fn next_key(&mut self) -> u64 {
+        let k = splitmix64_mix(self.key_seed ^ self.keys_given.wrapping_mul(0x9e37_79b9_7f4a_7c15));
+        self.keys_given += 1;
+        k
+    }
+
+    /// Drops filaments beyond `sink` from the next step on (`None`: keep every filament until it
+    /// leaves the domain).
+    pub fn set_sink(&mut self, sink: Option<DownflowSink>) {
+        self.sink = sink;
+    }
+
+    /// The downflow sink, if any.
+    pub fn sink(&self) -> Option<DownflowSink> {
+        self.sink
+    }
+
     /// Releases `n` filaments at source `k` now (also used to seed a plume at t = 0).
     pub fn release_at_source(&mut self, k: usize, n: u64) {
         self.release_at(k, n, self.time_s);
@@ -330,6 +444,10 @@ impl FilamentPlume {
             0.0
         };
         for _ in 0..take {
+            // Keys follow the release count, so a plume's filaments get the same keys whatever
+            // happens to them; spread by SplitMix64 so that neighbouring keys are unrelated.
+            let key = self.next_key();
+            self.key.push(key);
             self.x.push(s.pos_m.x);
             self.y.push(s.pos_m.y);
             self.z.push(s.pos_m.z);
@@ -342,16 +460,42 @@ impl FilamentPlume {
     }
 
     /// Advances the plume by one step of `dt_s` to time `t_new_s`, in `flow` (already advanced to
-    /// the new time). Filaments released in the step are born at its start and move with it, as
-    /// in the reference implementation.
+    /// the new time).
+    ///
+    /// With physical dispersion, the filaments a source releases during the step are born at
+    /// uniformly drawn times within it (with their Poisson count, a Poisson process) and placed
+    /// where they are at its end: carried by the flow at the source for their age and spread by
+    /// the random walk of that age. A long step therefore releases a stream, not a clump of
+    /// filaments of one age at one point, and the plume does not depend on the step. With
+    /// pompy's dispersion they are born at the step's start and move with the whole step, as in
+    /// the reference implementation.
     pub fn step(&mut self, flow: &dyn FlowField, t_new_s: f64, dt_s: f64, rng: &mut SimRng) {
-        /// Filaments per velocity batch: small enough for the batch to stay in L1 cache.
-        const CHUNK: usize = 256;
         self.index = OnceLock::new();
         self.boxes = OnceLock::new();
-        self.release(t_new_s - dt_s, dt_s, rng);
+        let spread = match self.params.dispersion {
+            Dispersion::Physical { .. } => true,
+            Dispersion::PompyCompatible { .. } => false,
+        };
+        if !spread {
+            self.release(t_new_s - dt_s, dt_s, rng);
+        }
         self.time_s = t_new_s;
-        let (sx, sy, sz) = match self.params.dispersion {
+        let (mut left, beyond) = self.transport(flow, dt_s);
+        if spread {
+            left |= self.release_spread(flow, t_new_s, dt_s, rng);
+        }
+        // Filaments out of the domain go at once; those beyond the sink can wait until they
+        // are a thirty-second of the plume (they reach nothing meanwhile, and a filament's walk
+        // does not depend on the others), so the arrays are compacted now and then, not at
+        // every step.
+        if left || beyond * 32 > self.x.len() {
+            self.remove_outside();
+        }
+    }
+
+    /// The random walk's standard deviations per axis over `dt_s`.
+    fn walk_sd(&self, dt_s: f64) -> (f64, f64, f64) {
+        match self.params.dispersion {
             Dispersion::Physical {
                 horizontal_m2ps,
                 vertical_m2ps,
@@ -364,27 +508,55 @@ impl FilamentPlume {
                 scale_mps[1] * dt_s,
                 scale_mps[2] * dt_s,
             ),
-        };
-        let (floor, ceiling) = match self.params.vertical {
+        }
+    }
+
+    /// The heights where filaments reflect.
+    fn floor_ceiling(&self) -> (f64, f64) {
+        match self.params.vertical {
             VerticalBoundary::Reflecting { depth_m } => (0.0, depth_m.unwrap_or(f64::INFINITY)),
             VerticalBoundary::Unbounded => (f64::NEG_INFINITY, f64::INFINITY),
-        };
+        }
+    }
+
+    /// Moves every filament by the flow and the random walk over `dt_s`; whether any left the
+    /// domain, and how many certainly lie beyond the sink (beyond it by more than the cut-off
+    /// radius a filament as old as the plume's clock would have).
+    fn transport(&mut self, flow: &dyn FlowField, dt_s: f64) -> (bool, usize) {
+        /// Filaments per velocity batch: small enough for the batch to stay in L1 cache.
+        const CHUNK: usize = 256;
+        let (sx, sy, sz) = self.walk_sd(dt_s);
+        let (floor, ceiling) = self.floor_ceiling();
         let d = self.domain;
         let mut left = false;
         let mut u = [0.0; CHUNK];
         let mut v = [0.0; CHUNK];
         let mut noise = [0.0; 3 * CHUNK];
-        for ((xs, ys), zs) in self
+        // The step's offset of every filament's noise counter (SplitMix64's increment).
+        let offset = self.transport_steps.wrapping_mul(0x9e37_79b9_7f4a_7c15);
+        self.transport_steps += 1;
+        // The sink's line moved out by the widest filament's cut-off (none: nothing beyond).
+        let (sink_dir, sink_line) = match self.sink {
+            Some(s) => {
+                // No filament is older than the plume's clock.
+                let widest = self.params.init_radius_m.powi(2)
+                    + self.params.growth_rate_m2ps * self.time_s.max(0.0);
+                (s.dir, s.beyond_m + self.params.cutoff_radii * widest.sqrt())
+            }
+            None => ([0.0, 0.0], f64::INFINITY),
+        };
+        let mut beyond = 0usize;
+        for (((xs, ys), zs), keys) in self
             .x
             .chunks_mut(CHUNK)
             .zip(self.y.chunks_mut(CHUNK))
             .zip(self.z.chunks_mut(CHUNK))
+            .zip(self.key.chunks(CHUNK))
         {
             let m = xs.len();
             flow.velocities(xs, ys, &mut u[..m], &mut v[..m]);
-            for n in &mut noise[..3 * m] {
-                *n = StandardNormal.sample(rng);
-            }
+            let mut words = keys.iter().map(|k| splitmix64_mix(k.wrapping_add(offset)));
+            crate::normal::fill_normals(&mut noise[..3 * m], || words.next().unwrap_or(0));
             let cols = xs
                 .iter_mut()
                 .zip(ys.iter_mut())
@@ -392,41 +564,88 @@ impl FilamentPlume {
                 .zip(&u[..m])
                 .zip(&v[..m]);
             for (((((x, y), z), u), v), n) in cols.zip(noise.chunks_exact(3)) {
-                let (nx, ny, nz) = (n[0], n[1], n[2]);
-                *x += u * dt_s + sx * nx;
-                *y += v * dt_s + sy * ny;
-                let mut zn = *z + sz * nz;
-                if zn < floor {
-                    zn = 2.0 * floor - zn;
-                }
-                if zn > ceiling {
-                    zn = (2.0 * ceiling - zn).max(floor);
-                }
-                *z = zn;
+                *x += u * dt_s + sx * n[0];
+                *y += v * dt_s + sy * n[1];
+                *z = reflect(*z + sz * n[2], floor, ceiling);
                 left |= !d.contains_xy(*x, *y);
+                beyond += usize::from(sink_dir[0] * *x + sink_dir[1] * *y > sink_line);
             }
         }
-        if left {
-            self.remove_outside();
+        (left, beyond)
+    }
+
+    /// Whether filament `k`'s cut-off sphere lies beyond `sink`.
+    #[inline]
+    fn is_beyond(&self, sink: &DownflowSink, k: usize) -> bool {
+        let along = sink.dir[0] * self.x[k] + sink.dir[1] * self.y[k];
+        along > sink.beyond_m && {
+            let reach = self.params.cutoff_radii * self.radius_sq(k).sqrt();
+            along - reach > sink.beyond_m
         }
     }
 
-    /// Removes the filaments outside the domain, keeping the others in order.
+    /// Releases the step's filaments at uniformly drawn birth times within it, each placed where
+    /// its age has taken it (see [`FilamentPlume::step`]); whether any is outside the domain.
+    fn release_spread(
+        &mut self,
+        flow: &dyn FlowField,
+        t_new_s: f64,
+        dt_s: f64,
+        rng: &mut SimRng,
+    ) -> bool {
+        self.update_release_rates(dt_s);
+        let (floor, ceiling) = self.floor_ceiling();
+        let mut left = false;
+        for k in 0..self.sources.len() {
+            let n = match &self.release[k] {
+                Some(p) => p.sample(rng) as u64,
+                None => 0,
+            };
+            if n == 0 {
+                continue;
+            }
+            let src = self.sources[k].pos_m;
+            let vel = flow.velocity(plumetrace_core::Vec2::new(src.x, src.y));
+            let first = self.x.len();
+            self.release_at(k, n, t_new_s);
+            for i in first..self.x.len() {
+                let age = dt_s * rng.random::<f64>();
+                let (sx, sy, sz) = self.walk_sd(age);
+                let n3 = crate::normal::normal_triple(rng.next_u64());
+                self.birth_s[i] = t_new_s - age;
+                self.x[i] = src.x + vel.x * age + sx * n3[0];
+                self.y[i] = src.y + vel.y * age + sy * n3[1];
+                self.z[i] = reflect(src.z + sz * n3[2], floor, ceiling);
+                left |= !self.domain.contains_xy(self.x[i], self.y[i]);
+            }
+        }
+        left
+    }
+
+    /// Removes the filaments outside the domain or beyond the sink, keeping the others in
+    /// order.
     fn remove_outside(&mut self) {
         let d = self.domain;
+        let sink = self.sink;
         let mut keep = 0usize;
         for k in 0..self.x.len() {
-            if d.contains_xy(self.x[k], self.y[k]) {
+            let outside = !d.contains_xy(self.x[k], self.y[k]);
+            let beyond = !outside && sink.is_some_and(|s| self.is_beyond(&s, k));
+            if outside {
+                self.stats.exited += 1;
+                self.stats.exited_mass += self.mass[k];
+            } else if beyond {
+                self.stats.dropped += 1;
+                self.stats.dropped_mass += self.mass[k];
+            } else {
                 self.x[keep] = self.x[k];
                 self.y[keep] = self.y[k];
                 self.z[keep] = self.z[k];
                 self.birth_s[keep] = self.birth_s[k];
                 self.mass[keep] = self.mass[k];
                 self.source[keep] = self.source[k];
+                self.key[keep] = self.key[k];
                 keep += 1;
-            } else {
-                self.stats.exited += 1;
-                self.stats.exited_mass += self.mass[k];
             }
         }
         for v in [
@@ -439,9 +658,11 @@ impl FilamentPlume {
             v.truncate(keep);
         }
         self.source.truncate(keep);
+        self.key.truncate(keep);
     }
 
-    fn release(&mut self, t_s: f64, dt_s: f64, rng: &mut SimRng) {
+    /// The Poisson release counts for a step of `dt_s` (rebuilt when the step changes).
+    fn update_release_rates(&mut self, dt_s: f64) {
         if dt_s != self.release_dt_s {
             self.release_dt_s = dt_s;
             self.release = self
@@ -450,6 +671,10 @@ impl FilamentPlume {
                 .map(|s| Poisson::new(s.filament_rate_hz * dt_s).ok())
                 .collect();
         }
+    }
+
+    fn release(&mut self, t_s: f64, dt_s: f64, rng: &mut SimRng) {
+        self.update_release_rates(dt_s);
         for k in 0..self.sources.len() {
             let n = match &self.release[k] {
                 Some(p) => p.sample(rng),
@@ -472,21 +697,14 @@ impl FilamentPlume {
         })
     }
 
-    /// The blocks' bounding boxes, built on first use after a change.
-    fn boxes(&self) -> &[BlockBox] {
+    /// The blocks' and groups' bounding boxes, built on first use after a change.
+    fn boxes(&self) -> &ScanBoxes {
         self.boxes.get_or_init(|| {
             let n = self.x.len();
-            (0..n.div_ceil(SCAN_BLOCK))
+            let blocks: Vec<BlockBox> = (0..n.div_ceil(SCAN_BLOCK))
                 .map(|b| {
-                    let r = b * SCAN_BLOCK..((b + 1) * SCAN_BLOCK).min(n);
-                    let mut bb = BlockBox {
-                        x_min: f64::INFINITY,
-                        x_max: f64::NEG_INFINITY,
-                        y_min: f64::INFINITY,
-                        y_max: f64::NEG_INFINITY,
-                        birth_min_s: f64::INFINITY,
-                    };
-                    for k in r {
+                    let mut bb = BlockBox::EMPTY;
+                    for k in b * SCAN_BLOCK..((b + 1) * SCAN_BLOCK).min(n) {
                         bb.x_min = bb.x_min.min(self.x[k]);
                         bb.x_max = bb.x_max.max(self.x[k]);
                         bb.y_min = bb.y_min.min(self.y[k]);
@@ -495,28 +713,39 @@ impl FilamentPlume {
                     }
                     bb
                 })
-                .collect()
+                .collect();
+            let groups = blocks
+                .chunks(SCAN_GROUP)
+                .map(|g| g.iter().fold(BlockBox::EMPTY, |a, b| a.union(*b)))
+                .collect();
+            ScanBoxes { blocks, groups }
         })
     }
 
     /// Concentration at `p` by scanning the filaments (no index): for a few points per step
-    /// this is cheaper than building the index. Blocks of filaments whose bounding box is
-    /// beyond the cut-off of their oldest filament are skipped; every filament of such a block
-    /// would have been skipped by the full scan too (the test is conservative in floating
-    /// point: differences, squares and sums are monotone), and the others are summed in the
-    /// same order, so the result is bit for bit [`FilamentPlume::concentration_full_scan`]'s.
+    /// this is cheaper than building the index. Groups of blocks, then blocks of filaments,
+    /// whose bounding box is beyond the cut-off of their oldest filament are skipped; every
+    /// filament of such a box would have been skipped by the full scan too (the test is
+    /// conservative in floating point: differences, squares and sums are monotone, and a
+    /// group's box holds its blocks'), and the others are summed in the same order, so the
+    /// result is bit for bit [`FilamentPlume::concentration_full_scan`]'s.
     pub fn concentration_scan(&self, p: Vec3) -> f64 {
-        let (r0sq, gamma, t, cut2) = self.scan_constants();
+        let k = self.scan_constants();
+        let boxes = self.boxes();
         let mut c = 0.0;
-        for (b, bb) in self.boxes().iter().enumerate() {
-            let ddx = (bb.x_min - p.x).max(p.x - bb.x_max).max(0.0);
-            let ddy = (bb.y_min - p.y).max(p.y - bb.y_max).max(0.0);
-            let widest = r0sq + gamma * (t - bb.birth_min_s).max(0.0);
-            if ddx * ddx + ddy * ddy > cut2 * widest {
+        for (g, gb) in boxes.groups.iter().enumerate() {
+            if gb.beyond(p, k) {
                 continue;
             }
-            let end = ((b + 1) * SCAN_BLOCK).min(self.x.len());
-            c = self.sum_filaments(p, b * SCAN_BLOCK..end, c);
+            let first = g * SCAN_GROUP;
+            let last = (first + SCAN_GROUP).min(boxes.blocks.len());
+            for b in first..last {
+                if boxes.blocks[b].beyond(p, k) {
+                    continue;
+                }
+                let end = ((b + 1) * SCAN_BLOCK).min(self.x.len());
+                c = self.sum_filaments(p, b * SCAN_BLOCK..end, c);
+            }
         }
         c
     }
@@ -581,6 +810,30 @@ impl FilamentPlume {
     pub fn prepare_queries(&self) {
         let _ = self.index();
     }
+}
+
+/// SplitMix64's output function: a bijective mix of 64 bits, so `mix(key + n * gamma)` over
+/// `n` is a SplitMix64 stream starting at `key`.
+#[inline(always)]
+fn splitmix64_mix(z: u64) -> u64 {
+    let z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+    let z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+    z ^ (z >> 31)
+}
+
+/// A height reflected at the seabed `floor` and the surface `ceiling` (once each: a step moves a
+/// filament far less than the water's depth).
+#[inline(always)]
+fn reflect(z: f64, floor: f64, ceiling: f64) -> f64 {
+    let mut z = z;
+    if z < floor {
+        z = 2.0 * floor - z;
+    }
+    if z > ceiling {
+        let down = 2.0 * ceiling - z;
+        z = if down > floor { down } else { floor };
+    }
+    z
 }
 
 impl ConcentrationField for FilamentPlume {

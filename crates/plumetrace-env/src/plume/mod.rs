@@ -30,5 +30,5 @@ mod filament;
 mod index;
 
 pub use filament::{
-    Dispersion, FilamentParams, FilamentPlume, PlumeStats, Source, VerticalBoundary,
+    Dispersion, DownflowSink, FilamentParams, FilamentPlume, PlumeStats, Source, VerticalBoundary,
 };
