@@ -148,6 +148,33 @@ pub fn shortest_csc(start: Pose, end: Pose, radius_m: f64) -> Option<CscPath> {
 /// Spacing of the points the pursuit follows, m.
 const SAMPLE_STEP_M: f64 = 0.5;
 
+/// The sample of `path` nearest `pos`, among those every [`SAMPLE_STEP_M`] from `progress_m`
+/// over `window_m` (clamped to the path's end): `(distance along, distance away)`.
+///
+/// Every fourth sample first, then the samples around the nearest of those: the same sample as
+/// scanning them all wherever the distance has one minimum in the window (the path does not
+/// come back near `pos` within the window), for about a third of the samples.
+fn nearest_sample(path: &CscPath, progress_m: f64, window_m: f64, pos: Vec2) -> (f64, f64) {
+    const COARSE: usize = 4;
+    let len = path.length_m();
+    let steps = (window_m / SAMPLE_STEP_M).ceil() as usize;
+    let at = |k: usize| {
+        let s_m = (progress_m + k as f64 * SAMPLE_STEP_M).min(len);
+        (s_m, (path.sample(s_m).pos_m - pos).norm())
+    };
+    // The first strictly nearest, as a scan in order finds it.
+    let nearest = |ks: &mut dyn Iterator<Item = usize>| {
+        ks.map(|k| (k, at(k)))
+            .fold((0, (progress_m, f64::INFINITY)), |best, c| {
+                if c.1.1 < best.1.1 { c } else { best }
+            })
+    };
+    let (kc, _) = nearest(&mut (0..=steps).step_by(COARSE).chain([steps]));
+    let lo = kc.saturating_sub(COARSE - 1);
+    let hi = (kc + COARSE - 1).min(steps);
+    nearest(&mut (lo..=hi)).1
+}
+
 /// Drive to a position with a given heading on arrival, along the shortest CSC path with the
 /// minimum turning radius, followed by pursuit of a point a look-ahead distance along the path.
 /// The path is planned from the vehicle's pose on the first decision and planned again when a
@@ -231,15 +258,9 @@ impl GoToPointWithHeading {
         if let Some(path) = &self.plan {
             // Nearest point within a window ahead of the progress so far (the window keeps it from
             // jumping to a later part of the path that passes close by); cost is constant.
-            let len = path.length_m();
             let window = 4.0 * self.min_turn_radius_m.max(self.radius_m);
-            let steps = (window / SAMPLE_STEP_M).ceil() as usize;
-            let (best_s, best_d) = (0..=steps)
-                .map(|k| (self.progress_m + k as f64 * SAMPLE_STEP_M).min(len))
-                .map(|s_m| (s_m, (path.sample(s_m).pos_m - pose.pos_m).norm()))
-                .fold((self.progress_m, f64::INFINITY), |best, c| {
-                    if c.1 < best.1 { c } else { best }
-                });
+            let (best_s, best_d) = nearest_sample(path, self.progress_m, window, pose.pos_m);
+            let len = path.length_m();
             self.progress_m = best_s;
             need_plan = best_d > self.replan_offtrack_m || best_s >= len - SAMPLE_STEP_M;
         }
@@ -267,6 +288,32 @@ impl GoToPointWithHeading {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_coarse_then_fine_search_finds_the_nearest_sample_of_a_full_scan() {
+        // Vehicles off an LSR-like path by up to a turning radius, at every stage of it: the
+        // sample found is the one a scan of every sample finds.
+        let path = shortest_csc(pose(0.0, 0.0, 0.0), pose(60.0, 40.0, 180.0), 10.0)
+            .unwrap_or_else(|| panic!("no path"));
+        let len = path.length_m();
+        let window = 40.0;
+        let mut checked = 0;
+        for i in 0..200 {
+            let progress = len * f64::from(i) / 200.0;
+            let on = path.sample((progress + 3.0).min(len)).pos_m;
+            for (dx, dy) in [(0.0, 0.0), (4.0, -3.0), (-7.0, 2.0), (1.0, 9.0), (-9.5, -0.5)] {
+                let p = Vec2::new(on.x + dx, on.y + dy);
+                let steps = (window / SAMPLE_STEP_M).ceil() as usize;
+                let full = (0..=steps)
+                    .map(|k| (progress + k as f64 * SAMPLE_STEP_M).min(len))
+                    .map(|s| (s, (path.sample(s).pos_m - p).norm()))
+                    .fold((progress, f64::INFINITY), |b, c| if c.1 < b.1 { c } else { b });
+                assert_eq!(nearest_sample(&path, progress, window, p), full, "at {p:?}");
+                checked += 1;
+            }
+        }
+        assert_eq!(checked, 1000);
+    }
 
     fn pose(x: f64, y: f64, h: f64) -> Pose {
         Pose {
