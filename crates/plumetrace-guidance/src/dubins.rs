@@ -301,13 +301,22 @@ mod tests {
         for i in 0..200 {
             let progress = len * f64::from(i) / 200.0;
             let on = path.sample((progress + 3.0).min(len)).pos_m;
-            for (dx, dy) in [(0.0, 0.0), (4.0, -3.0), (-7.0, 2.0), (1.0, 9.0), (-9.5, -0.5)] {
+            for (dx, dy) in [
+                (0.0, 0.0),
+                (4.0, -3.0),
+                (-7.0, 2.0),
+                (1.0, 9.0),
+                (-9.5, -0.5),
+            ] {
                 let p = Vec2::new(on.x + dx, on.y + dy);
                 let steps = (window / SAMPLE_STEP_M).ceil() as usize;
                 let full = (0..=steps)
                     .map(|k| (progress + k as f64 * SAMPLE_STEP_M).min(len))
                     .map(|s| (s, (path.sample(s).pos_m - p).norm()))
-                    .fold((progress, f64::INFINITY), |b, c| if c.1 < b.1 { c } else { b });
+                    .fold(
+                        (progress, f64::INFINITY),
+                        |b, c| if c.1 < b.1 { c } else { b },
+                    );
                 assert_eq!(nearest_sample(&path, progress, window, p), full, "at {p:?}");
                 checked += 1;
             }
