@@ -158,7 +158,10 @@ impl Maker {
     /// Spins `setup` up, or gives it a copy of the environment kept for `seed`.
     fn spin_up(&self, seed: u64, setup: &mut MissionSetup) -> Result<(), String> {
         let kept = {
-            let spun = self.spun.lock().map_err(|_| "the spin-up cache is poisoned")?;
+            let spun = self
+                .spun
+                .lock()
+                .map_err(|_| "the spin-up cache is poisoned")?;
             spun.iter()
                 .find(|(s, _)| *s == seed)
                 .and_then(|(_, env)| env.try_clone())
@@ -168,7 +171,10 @@ impl Maker {
             None => {
                 setup.spin_up().map_err(|e| crate::error::located(&e))?;
                 if let Some(copy) = setup.env.try_clone() {
-                    let mut spun = self.spun.lock().map_err(|_| "the spin-up cache is poisoned")?;
+                    let mut spun = self
+                        .spun
+                        .lock()
+                        .map_err(|_| "the spin-up cache is poisoned")?;
                     spun.retain(|(s, _)| *s != seed);
                     spun.push_back((seed, copy));
                     while spun.len() > SPUN_UP_KEPT {
