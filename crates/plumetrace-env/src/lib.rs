@@ -21,6 +21,7 @@ pub mod normal;
 pub mod obstacle;
 pub mod plume;
 pub mod rng;
+mod simd;
 pub mod steady;
 
 pub use domain::Rect;

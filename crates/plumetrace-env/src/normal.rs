@@ -41,9 +41,9 @@ struct Tables {
     /// Per bucket, the line through the inverse at its two edges `i / 2048` and
     /// `(i + 1) / 2048` as `[value at the middle of the first place, rise per place]`, scaled to
     /// unit variance; the outer buckets' entries are unused.
-    lines: Vec<[f32; 2]>,
+    lines: Box<[[f32; 2]; BUCKETS]>,
     /// The inverse at the places of the lowest bucket, scaled (the highest is its mirror image).
-    low_tail: Vec<f32>,
+    low_tail: Box<[f32; PLACES]>,
 }
 
 fn tables() -> &'static Tables {
@@ -77,30 +77,28 @@ fn tables() -> &'static Tables {
         }
         let scale = (n / sum_sq).sqrt();
         Tables {
-            lines: lines
-                .iter()
-                .map(|l| [(l[0] * scale) as f32, (l[1] * scale) as f32])
-                .collect(),
-            low_tail: low_tail.iter().map(|z| (z * scale) as f32).collect(),
+            lines: Box::new(std::array::from_fn(|i| {
+                [(lines[i][0] * scale) as f32, (lines[i][1] * scale) as f32]
+            })),
+            low_tail: Box::new(std::array::from_fn(|f| (low_tail[f] * scale) as f32)),
         }
     })
 }
 
 impl Tables {
     /// The normal value of the 21-bit number `k`.
+    /// Draw number `k` (its low 21 bits). Branch-free (both tables are read, the right value
+    /// kept), so that a loop of draws can run in vector lanes.
     #[inline(always)]
     fn draw(&self, k: u32) -> f64 {
-        let bucket = (k >> PLACE_BITS) as usize;
+        let bucket = (k >> PLACE_BITS) as usize & (BUCKETS - 1);
         let place = (k as usize) & (PLACES - 1);
-        // One comparison for the inner buckets (all but 1 in 2,048 draws).
-        let z = if bucket.wrapping_sub(1) < BUCKETS - 2 {
-            let [a, rise] = self.lines[bucket];
-            a + rise * place as f32
-        } else if bucket == 0 {
-            self.low_tail[place]
-        } else {
-            -self.low_tail[PLACES - 1 - place]
-        };
+        let [a, rise] = self.lines[bucket];
+        let line = a + rise * place as f32;
+        let high = bucket == BUCKETS - 1;
+        let tail = self.low_tail[if high { PLACES - 1 - place } else { place }];
+        let tail = if high { -tail } else { tail };
+        let z = if high || bucket == 0 { tail } else { line };
         f64::from(z)
     }
 }
@@ -111,20 +109,24 @@ pub fn normal_triple(word: u64) -> [f64; 3] {
     tables().triple(word)
 }
 
-/// Fills `out` with standard normal draws, three per word taken from `words`.
-pub fn fill_normals(out: &mut [f64], mut words: impl FnMut() -> u64) {
+/// Three columns of standard normal draws, row `k` from `words[k]` (as [`normal_triple`]);
+/// the columns are as long as `words`. A loop without branches or bounds checks, so that
+/// compiled for a vector unit it draws several rows at once.
+#[inline(always)]
+pub fn fill_normal_columns(
+    words: &[u64],
+    first: &mut [f64],
+    second: &mut [f64],
+    third: &mut [f64],
+) {
     let t = tables();
-    let mut chunks = out.chunks_exact_mut(3);
-    for c in &mut chunks {
-        let [a, b, d] = t.triple(words());
-        c[0] = a;
-        c[1] = b;
-        c[2] = d;
-    }
-    let rest = chunks.into_remainder();
-    if !rest.is_empty() {
-        let n = rest.len();
-        rest.copy_from_slice(&t.triple(words())[..n]);
+    let n = words.len();
+    let (first, second, third) = (&mut first[..n], &mut second[..n], &mut third[..n]);
+    for k in 0..n {
+        let [a, b, c] = t.triple(words[k]);
+        first[k] = a;
+        second[k] = b;
+        third[k] = c;
     }
 }
 
@@ -240,19 +242,23 @@ mod tests {
     }
 
     #[test]
-    fn triples_use_every_bit_group_and_fill_any_length() {
+    fn triples_use_every_bit_group_and_columns_hold_them() {
         let w = 0x8000_0000_0000_0000u64;
         // Only the first draw's top bit set: the first draw is in the upper half, the other two
         // at the bottom of the range.
         let [a, b, c] = normal_triple(w);
         assert!(a > 0.0 && b < -4.9 && c < -4.9, "{a} {b} {c}");
-        let mut out = [0.0; 7];
-        let mut n = 0u64;
-        fill_normals(&mut out, || {
-            n += 1;
-            n.wrapping_mul(0x9e37_79b9_7f4a_7c15)
-        });
-        assert_eq!(n, 3);
-        assert!(out.iter().all(|z| z.is_finite() && *z != 0.0));
+        // The columns hold the triples of their words, row by row.
+        let words: Vec<u64> = (1..=7u64)
+            .map(|n| n.wrapping_mul(0x9e37_79b9_7f4a_7c15))
+            .collect();
+        let mut cols = [[0.0; 7]; 3];
+        let [c0, c1, c2] = &mut cols;
+        fill_normal_columns(&words, c0, c1, c2);
+        for (k, w) in words.iter().enumerate() {
+            let row = [cols[0][k], cols[1][k], cols[2][k]];
+            assert_eq!(row, normal_triple(*w), "row {k}");
+            assert!(row.iter().all(|z| z.is_finite() && *z != 0.0));
+        }
     }
 }

@@ -608,6 +608,70 @@ fn bilinear(c: &Cell, x: f64, y: f64) -> (f64, f64) {
     (a, b)
 }
 
+/// The velocities at many points, as a [`pulp::WithSimd`] operation (see
+/// [`FlowField::velocities`]).
+struct Velocities<'a> {
+    flow: &'a FarrellFlow,
+    x: &'a [f64],
+    y: &'a [f64],
+    u: &'a mut [f64],
+    v: &'a mut [f64],
+}
+
+impl pulp::WithSimd for Velocities<'_> {
+    type Output = ();
+
+    #[inline(always)]
+    fn with_simd<S: pulp::Simd>(self, _simd: S) {
+        // Two passes per batch: the cells and fractions first, in floating point only (a loop
+        // the compiler vectorises), then the lookups; the same numbers as `interp`.
+        const BATCH: usize = 64;
+        let Velocities { flow, x, y, u, v } = self;
+        let (nx, ny) = (flow.params.nx, flow.params.ny);
+        let mut cell = [0.0; BATCH];
+        let mut tx = [0.0; BATCH];
+        let mut ty = [0.0; BATCH];
+        let (x0, y0) = (flow.region.x_min_m, flow.region.y_min_m);
+        let (lx, ly) = ((nx - 1) as f64, (ny - 1) as f64);
+        let row = (nx - 1) as f64;
+        let (inv_dx, inv_dy) = (flow.inv_dx, flow.inv_dy);
+        let cells = &flow.cells[..];
+        for (((xs, ys), us), vs) in x
+            .chunks(BATCH)
+            .zip(y.chunks(BATCH))
+            .zip(u.chunks_mut(BATCH))
+            .zip(v.chunks_mut(BATCH))
+        {
+            let m = xs.len().min(ys.len());
+            for k in 0..m {
+                let (i, fx) = grid_floor(xs[k], x0, inv_dx, lx);
+                let (j, fy) = grid_floor(ys[k], y0, inv_dy, ly);
+                cell[k] = j * row + i;
+                tx[k] = fx;
+                ty[k] = fy;
+            }
+            for (k, (u, v)) in us.iter_mut().zip(vs.iter_mut()).enumerate().take(m) {
+                // A whole number below the cell count, exactly.
+                let c = &cells[(cell[k] as usize).min(cells.len() - 1)];
+                (*u, *v) = bilinear(c, tx[k], ty[k]);
+            }
+        }
+    }
+}
+
+impl FarrellFlow {
+    /// [`FlowField::velocities`] on the vector unit `arch` (see [`crate::simd`]).
+    fn velocities_on(&self, arch: pulp::Arch, x: &[f64], y: &[f64], u: &mut [f64], v: &mut [f64]) {
+        arch.dispatch(Velocities {
+            flow: self,
+            x,
+            y,
+            u,
+            v,
+        });
+    }
+}
+
 impl FlowField for FarrellFlow {
     fn name(&self) -> &'static str {
         "farrell"
@@ -620,36 +684,7 @@ impl FlowField for FarrellFlow {
         Vec2::new(u, v)
     }
     fn velocities(&self, x: &[f64], y: &[f64], u: &mut [f64], v: &mut [f64]) {
-        // Two passes per batch: the cells and fractions first, in floating point only (a loop
-        // the compiler vectorises), then the lookups; the same numbers as `interp`.
-        const BATCH: usize = 64;
-        let (nx, ny) = (self.params.nx, self.params.ny);
-        let mut cell = [0.0; BATCH];
-        let mut tx = [0.0; BATCH];
-        let mut ty = [0.0; BATCH];
-        let (x0, y0) = (self.region.x_min_m, self.region.y_min_m);
-        let (lx, ly) = ((nx - 1) as f64, (ny - 1) as f64);
-        let row = (nx - 1) as f64;
-        for (((xs, ys), us), vs) in x
-            .chunks(BATCH)
-            .zip(y.chunks(BATCH))
-            .zip(u.chunks_mut(BATCH))
-            .zip(v.chunks_mut(BATCH))
-        {
-            let m = xs.len().min(ys.len());
-            for k in 0..m {
-                let (i, fx) = grid_floor(xs[k], x0, self.inv_dx, lx);
-                let (j, fy) = grid_floor(ys[k], y0, self.inv_dy, ly);
-                cell[k] = j * row + i;
-                tx[k] = fx;
-                ty[k] = fy;
-            }
-            for (k, (u, v)) in us.iter_mut().zip(vs.iter_mut()).enumerate().take(m) {
-                // A whole number below the cell count, exactly.
-                let c = &self.cells[(cell[k] as usize).min(self.cells.len() - 1)];
-                (*u, *v) = bilinear(c, tx[k], ty[k]);
-            }
-        }
+        self.velocities_on(crate::simd::best(), x, y, u, v);
     }
     fn advance(&mut self, t_new_s: f64, dt_s: f64, rng: &mut SimRng) -> Result<(), EnvError> {
         self.noise.update(dt_s, rng);
@@ -995,7 +1030,8 @@ mod tests {
     #[test]
     fn batch_velocities_are_the_single_point_ones_bit_for_bit() {
         // The batch path (floors in floating point) and the single-point path (integer
-        // floors) give the same bits everywhere: inside, on nodes, outside the grid, NaN.
+        // floors) give the same bits everywhere: inside, on nodes, outside the grid, NaN; and
+        // so does the batch path on every vector unit this CPU has.
         let mut f = FarrellFlow::new(
             pompy_region(),
             steady(1.0, 60.0),
@@ -1017,18 +1053,21 @@ mod tests {
         }
         xs.extend([0.0, 5.0, 100.0, 99.999_999, f64::NAN, 50.0, f64::INFINITY]);
         ys.extend([0.0, -50.0, 50.0, 12.5, 3.0, f64::NAN, f64::NEG_INFINITY]);
-        let mut u = vec![0.0; xs.len()];
-        let mut v = vec![0.0; xs.len()];
-        f.velocities(&xs, &ys, &mut u, &mut v);
-        for k in 0..xs.len() {
-            let w = f.velocity(Vec2::new(xs[k], ys[k]));
-            assert_eq!(
-                (u[k].to_bits(), v[k].to_bits()),
-                (w.x.to_bits(), w.y.to_bits()),
-                "at ({}, {})",
-                xs[k],
-                ys[k]
-            );
+        let archs = crate::simd::every();
+        for arch in archs {
+            let mut u = vec![0.0; xs.len()];
+            let mut v = vec![0.0; xs.len()];
+            f.velocities_on(arch, &xs, &ys, &mut u, &mut v);
+            for k in 0..xs.len() {
+                let w = f.velocity(Vec2::new(xs[k], ys[k]));
+                assert_eq!(
+                    (u[k].to_bits(), v[k].to_bits()),
+                    (w.x.to_bits(), w.y.to_bits()),
+                    "at ({}, {}) on {arch:?}",
+                    xs[k],
+                    ys[k]
+                );
+            }
         }
     }
 

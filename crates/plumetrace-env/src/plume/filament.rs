@@ -523,15 +523,13 @@ impl FilamentPlume {
     /// domain, and how many certainly lie beyond the sink (beyond it by more than the cut-off
     /// radius a filament as old as the plume's clock would have).
     fn transport(&mut self, flow: &dyn FlowField, dt_s: f64) -> (bool, usize) {
-        /// Filaments per velocity batch: small enough for the batch to stay in L1 cache.
-        const CHUNK: usize = 256;
+        self.transport_on(crate::simd::best(), flow, dt_s)
+    }
+
+    /// [`FilamentPlume::transport`] on the vector unit `arch` (see [`crate::simd`]).
+    fn transport_on(&mut self, arch: pulp::Arch, flow: &dyn FlowField, dt_s: f64) -> (bool, usize) {
         let (sx, sy, sz) = self.walk_sd(dt_s);
         let (floor, ceiling) = self.floor_ceiling();
-        let d = self.domain;
-        let mut left = false;
-        let mut u = [0.0; CHUNK];
-        let mut v = [0.0; CHUNK];
-        let mut noise = [0.0; 3 * CHUNK];
         // The step's offset of every filament's noise counter (SplitMix64's increment).
         let offset = self.transport_steps.wrapping_mul(0x9e37_79b9_7f4a_7c15);
         self.transport_steps += 1;
@@ -545,32 +543,19 @@ impl FilamentPlume {
             }
             None => ([0.0, 0.0], f64::INFINITY),
         };
-        let mut beyond = 0usize;
-        for (((xs, ys), zs), keys) in self
-            .x
-            .chunks_mut(CHUNK)
-            .zip(self.y.chunks_mut(CHUNK))
-            .zip(self.z.chunks_mut(CHUNK))
-            .zip(self.key.chunks(CHUNK))
-        {
-            let m = xs.len();
-            flow.velocities(xs, ys, &mut u[..m], &mut v[..m]);
-            let mut words = keys.iter().map(|k| splitmix64_mix(k.wrapping_add(offset)));
-            crate::normal::fill_normals(&mut noise[..3 * m], || words.next().unwrap_or(0));
-            let cols = xs
-                .iter_mut()
-                .zip(ys.iter_mut())
-                .zip(zs.iter_mut())
-                .zip(&u[..m])
-                .zip(&v[..m]);
-            for (((((x, y), z), u), v), n) in cols.zip(noise.chunks_exact(3)) {
-                *x += u * dt_s + sx * n[0];
-                *y += v * dt_s + sy * n[1];
-                *z = reflect(*z + sz * n[2], floor, ceiling);
-                left |= !d.contains_xy(*x, *y);
-                beyond += usize::from(sink_dir[0] * *x + sink_dir[1] * *y > sink_line);
-            }
-        }
+        let (left, beyond) = arch.dispatch(Transport {
+            x: &mut self.x,
+            y: &mut self.y,
+            z: &mut self.z,
+            key: &self.key,
+            flow,
+            dt_s,
+            sd: [sx, sy, sz],
+            floor_ceiling: (floor, ceiling),
+            domain: self.domain,
+            offset,
+            sink: (sink_dir, sink_line),
+        });
         (left, beyond)
     }
 
@@ -812,6 +797,78 @@ impl FilamentPlume {
     }
 }
 
+/// One transport pass over the filament columns (see `FilamentPlume::transport`), as a
+/// [`pulp::WithSimd`] operation so that all of it is compiled for the vector unit chosen.
+struct Transport<'a> {
+    x: &'a mut [f64],
+    y: &'a mut [f64],
+    z: &'a mut [f64],
+    key: &'a [u64],
+    flow: &'a dyn FlowField,
+    dt_s: f64,
+    sd: [f64; 3],
+    floor_ceiling: (f64, f64),
+    domain: Rect,
+    offset: u64,
+    sink: ([f64; 2], f64),
+}
+
+impl pulp::WithSimd for Transport<'_> {
+    type Output = (bool, usize);
+
+    #[inline(always)]
+    fn with_simd<S: pulp::Simd>(self, _simd: S) -> (bool, usize) {
+        /// Filaments per velocity batch: small enough for the batch to stay in L1 cache.
+        const CHUNK: usize = 256;
+        let Transport {
+            x,
+            y,
+            z,
+            key,
+            flow,
+            dt_s,
+            sd: [sx, sy, sz],
+            floor_ceiling: (floor, ceiling),
+            domain: d,
+            offset,
+            sink: (sink_dir, sink_line),
+        } = self;
+        let mut u = [0.0; CHUNK];
+        let mut v = [0.0; CHUNK];
+        let mut words = [0u64; CHUNK];
+        let mut n0 = [0.0; CHUNK];
+        let mut n1 = [0.0; CHUNK];
+        let mut n2 = [0.0; CHUNK];
+        let mut left = false;
+        let mut beyond = 0usize;
+        for (((xs, ys), zs), keys) in x
+            .chunks_mut(CHUNK)
+            .zip(y.chunks_mut(CHUNK))
+            .zip(z.chunks_mut(CHUNK))
+            .zip(key.chunks(CHUNK))
+        {
+            let m = xs.len();
+            flow.velocities(xs, ys, &mut u[..m], &mut v[..m]);
+            for (w, k) in words.iter_mut().zip(keys) {
+                *w = splitmix64_mix(k.wrapping_add(offset));
+            }
+            crate::normal::fill_normal_columns(&words[..m], &mut n0, &mut n1, &mut n2);
+            // Every column cut to the chunk's length, so the loop has no bounds checks.
+            let (ys, zs, u, v) = (&mut ys[..m], &mut zs[..m], &u[..m], &v[..m]);
+            let (n0, n1, n2) = (&n0[..m], &n1[..m], &n2[..m]);
+            for k in 0..m {
+                let (x, y, z) = (&mut xs[k], &mut ys[k], &mut zs[k]);
+                *x += u[k] * dt_s + sx * n0[k];
+                *y += v[k] * dt_s + sy * n1[k];
+                *z = reflect(*z + sz * n2[k], floor, ceiling);
+                left |= !d.contains_xy(*x, *y);
+                beyond += usize::from(sink_dir[0] * *x + sink_dir[1] * *y > sink_line);
+            }
+        }
+        (left, beyond)
+    }
+}
+
 /// SplitMix64's output function: a bijective mix of 64 bits, so `mix(key + n * gamma)` over
 /// `n` is a SplitMix64 stream starting at `key`.
 #[inline(always)]
@@ -839,5 +896,84 @@ fn reflect(z: f64, floor: f64, ceiling: f64) -> f64 {
 impl ConcentrationField for FilamentPlume {
     fn concentration(&self, p: Vec3) -> f64 {
         self.index().concentration(p)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::flow::{FarrellFlow, FarrellParams, MeanFlow};
+    use crate::{StreamId, stream_rng};
+
+    #[test]
+    fn every_vector_unit_steps_the_filaments_to_the_same_bits() {
+        // A Farrell flow across a 200 m square, a shallow water column (the filaments reflect
+        // at both the seabed and the surface) and a sink, so that every branch of the
+        // step is taken; then one more step on each vector unit this CPU has.
+        let region = Rect::new(0.0, 200.0, -100.0, 100.0).unwrap_or_else(|e| panic!("{e}"));
+        let mean = MeanFlow::Steady {
+            speed_mps: 0.5,
+            toward_deg: 80.0,
+        };
+        let dt = 0.2;
+        let mut flow = FarrellFlow::new(region, mean, FarrellParams::default(), dt)
+            .unwrap_or_else(|e| panic!("{e}"));
+        let params = FilamentParams {
+            vertical: VerticalBoundary::Reflecting { depth_m: Some(3.0) },
+            ..FilamentParams::default()
+        };
+        let source = Source {
+            pos_m: Vec3::new(10.0, 0.0, 1.0),
+            mass_rate_per_s: 1.0,
+            filament_rate_hz: 40.0,
+        };
+        let mut plume =
+            FilamentPlume::new(region, vec![source], params).unwrap_or_else(|e| panic!("{e}"));
+        plume.set_key_seed(7);
+        let mut flow_rng = stream_rng(7, StreamId::Flow);
+        let mut rng = stream_rng(7, StreamId::Plume);
+        for k in 1..=600u32 {
+            let t = f64::from(k) * dt;
+            flow.advance(t, dt, &mut flow_rng)
+                .unwrap_or_else(|e| panic!("{e}"));
+            plume.step(&flow, t, dt, &mut rng);
+        }
+        // The sink set now, so that none has been dropped yet.
+        plume.set_sink(Some(DownflowSink {
+            dir: [1.0, 0.0],
+            beyond_m: 30.0,
+        }));
+        // Several chunks of 256, the last one partial.
+        assert!(
+            plume.len() > 600 && !plume.len().is_multiple_of(256),
+            "{} filaments",
+            plume.len()
+        );
+        let bits = |p: &FilamentPlume| -> Vec<[u64; 3]> {
+            (0..p.len())
+                .map(|k| [p.x[k].to_bits(), p.y[k].to_bits(), p.z[k].to_bits()])
+                .collect()
+        };
+        let mut reference = None;
+        for arch in crate::simd::every() {
+            let mut p = plume.copy_state();
+            let out = p.transport_on(arch, &flow, dt);
+            let got = (out, bits(&p));
+            match &reference {
+                None => {
+                    // The step moved the filaments and found some beyond the sink.
+                    assert_ne!(got.1, bits(&plume));
+                    assert!(out.1 > 0, "{out:?}");
+                    reference = Some(got);
+                }
+                Some(r) => assert!(*r == got, "{arch:?} differs from the portable version"),
+            }
+        }
+        // Where the CPU has AVX2 and FMA, more than the portable version was compared.
+        #[cfg(target_arch = "x86_64")]
+        if std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma")
+        {
+            assert!(crate::simd::every().len() >= 2);
+        }
     }
 }

@@ -1,0 +1,32 @@
+//! The vector unit the hot loops run on.
+//!
+//! The filament step and the flow's batch lookup are compiled more than once: for any CPU of the
+//! target, and for x86-64 CPUs with AVX2 and FMA (x86-64-v3) and with AVX-512 (x86-64-v4); the
+//! widest the CPU has is chosen at run time. The loops are written without branches or bounds
+//! checks so that the compiler can run them in vector lanes. Every version does the same
+//! floating-point operations in the same order (Rust never fuses a multiply and an add unless
+//! told to), so results are the same bits on any CPU; tests run every version this CPU has and
+//! compare them.
+
+/// The widest vector unit this CPU has (detected once, then cached by the standard library).
+#[inline]
+pub(crate) fn best() -> pulp::Arch {
+    pulp::Arch::new()
+}
+
+/// Every version this CPU can run, the portable one first (for tests).
+#[cfg(test)]
+pub(crate) fn every() -> Vec<pulp::Arch> {
+    #[allow(unused_mut)]
+    let mut all = vec![pulp::Arch::Scalar];
+    #[cfg(target_arch = "x86_64")]
+    {
+        if let Some(v3) = pulp::x86::V3::try_new() {
+            all.push(pulp::Arch::V3(v3));
+        }
+        if let Some(v4) = pulp::x86::V4::try_new() {
+            all.push(pulp::Arch::V4(v4));
+        }
+    }
+    all
+}
