@@ -15,6 +15,11 @@ import numpy as np
 from pompy import models, processors
 
 SLABS = (25.0, 50.0, 75.0)
+# Intermittency: the fraction of 10 Hz samples on the centreline (y = 0, z = 0) at each slab's
+# distance whose concentration exceeds THRESHOLD (both models: one unit of chemical per puff;
+# the threshold is well above a puff's value at plumetrace's cut-off of 3 radii, so the cut-off
+# does not count).
+THRESHOLD = 0.2
 
 
 def make_pompy(rate, seed):
@@ -50,6 +55,8 @@ def pompy_run(rate, seed, dt, warmup, duration, queries):
     live = 0
     blocks, b_cpu, b_live = [], 0.0, 0
     moments = {x: [0.0, 0.0, 0.0] for x in SLABS}
+    hits = {x: [0, 0] for x in SLABS}
+    calc = processors.ConcentrationValueCalculator(1.0)
     for k in range(steps):
         t0 = time.process_time()
         wind.update(dt)
@@ -70,11 +77,16 @@ def pompy_run(rate, seed, dt, warmup, duration, queries):
                 m[0] += len(ys)
                 m[1] += float(ys.sum())
                 m[2] += float((ys * ys).sum())
-    out = {"cpu_s": cpu, "steps": steps, "live_sum": live, "moments": moments,
+        if not queries and k % (every // 10) == 0:
+            arr = plume.puff_array
+            for x in SLABS:
+                h = hits[x]
+                h[0] += 1
+                h[1] += int(len(arr) > 0 and calc.calc_conc_point(arr, x, 0.0, 0.0) > THRESHOLD)
+    out = {"cpu_s": cpu, "steps": steps, "live_sum": live, "moments": moments, "hits": hits,
            "final_live": len(plume.puffs), "blocks": blocks}
     if queries:
         arr = plume.puff_array
-        calc = processors.ConcentrationValueCalculator(1.0)
         qrng = np.random.RandomState(seed + 1)
         idx = qrng.randint(0, len(arr), size=queries)
         pts = arr[idx, :2] + qrng.uniform(-0.5, 0.5, size=(queries, 2))
@@ -92,6 +104,35 @@ def plumetrace_run(exe, rate, seed, dt, warmup, duration, queries):
     args = [exe, "bench", "plume", "--release-rate", str(rate), "--seed", str(seed),
             f"--dt={dt}", f"--warmup={warmup}", f"--duration={duration}", "--queries", str(queries)]
     return json.loads(subprocess.run(args, check=True, capture_output=True, text=True).stdout)
+
+
+def plumetrace_hits(exe, seed, warmup, duration, workdir):
+    """Centreline samples above THRESHOLD from a `run` of the pompy preset with probes."""
+    import os
+    import re
+    here = os.path.dirname(os.path.abspath(__file__))
+    with open(os.path.join(here, "..", "crates", "plumetrace-scenario", "presets", "pompy.toml")) as f:
+        text = f.read()
+    text = re.sub(r"duration_s = [0-9.]+", f"duration_s = {warmup + duration}", text)
+    text = text.split("[output]")[0] + (
+        "[output]\nnx = 2\nny = 2\nz_m = 0.0\n"
+        f"probes = [{', '.join(f'[{x}, 0.0, 0.0]' for x in SLABS)}]\nprobe_interval_s = 0.1\n")
+    scen = os.path.join(workdir, f"pompy-{seed}.toml")
+    with open(scen, "w") as f:
+        f.write(text)
+    out = os.path.join(workdir, f"run-{seed}")
+    subprocess.run([exe, "run", scen, "--seed", str(seed), "--out", out], check=True, capture_output=True)
+    hits = {x: [0, 0] for x in SLABS}
+    with open(os.path.join(out, "probes.csv")) as f:
+        next(f)
+        for line in f:
+            t, _probe, x, _y, _z, c = line.strip().split(",")
+            if float(t) < warmup - 1e-9:
+                continue
+            h = hits[float(x)]
+            h[0] += 1
+            h[1] += int(float(c) > THRESHOLD)
+    return hits
 
 
 def pooled(parts):
@@ -178,6 +219,31 @@ def statistics(a, dt, warmup, seeds, stats_duration):
         ps, rs = pooled(pp), pooled(rp)
         worst = max(worst, abs(rs / ps - 1))
         print(f"| cross-flow spread at x = {x:.0f} m (m) | {ps:.2f} | {rs:.2f} | {100 * (rs / ps - 1):+.1f} % |")
+    import tempfile
+    with tempfile.TemporaryDirectory() as work:
+        rhits = [plumetrace_hits(a.plumetrace, 100 + s, warmup, stats_duration, work) for s in range(4 * seeds)]
+    def seed_se(fracs):
+        """Standard error of the mean of per-seed fractions (the seeds are the independent units:
+        within a seed the meander correlates the samples)."""
+        if len(fracs) < 2:
+            return float("nan")
+        m = sum(fracs) / len(fracs)
+        var = sum((f - m) ** 2 for f in fracs) / (len(fracs) - 1)
+        return (var / len(fracs)) ** 0.5
+
+    for x in SLABS:
+        pn = sum(p["hits"][x][0] for p in pres)
+        ph = sum(p["hits"][x][1] for p in pres)
+        rn = sum(r[x][0] for r in rhits)
+        rh = sum(r[x][1] for r in rhits)
+        pf, rf = ph / max(pn, 1), rh / max(rn, 1)
+        pse = seed_se([p["hits"][x][1] / max(p["hits"][x][0], 1) for p in pres])
+        rse = seed_se([r[x][1] / max(r[x][0], 1) for r in rhits])
+        # Reported with the standard errors between seeds, not part of the 10 % verdict: a
+        # decisive comparison at 10 % needs about a hundred pompy seeds.
+        print(f"| intermittency at x = {x:.0f} m, y = 0 (fraction of 10 Hz samples above {THRESHOLD}) "
+              f"| {pf:.3f} +- {pse:.3f} (n {pn}) | {rf:.3f} +- {rse:.3f} (n {rn}) "
+              f"| {100 * (rf / pf - 1) if pf > 0 else float('nan'):+.1f} % |")
     verdict = "within" if worst <= 0.10 else "NOT within"
     print(f"\nlargest difference {100 * worst:.1f} %: {verdict} 10 %")
     return 0 if worst <= 0.10 else 1

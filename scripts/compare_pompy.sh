@@ -4,10 +4,11 @@
 #
 # Installs pompy 0.1.1 with numpy < 2.4 (pompy fails on numpy 2.4) and scipy into a virtual
 # environment under scripts/.venv, builds plumetrace in release mode, times both in the same run
-# and prints the ratios, then compares mean live puff counts and cross-flow spreads.
+# and prints the ratios, then compares mean live puff counts, cross-flow spreads and the
+# intermittency on the centreline.
 #
 # Usage: scripts/compare_pompy.sh [--quick] [--seeds N] [--stats-duration S] [--jobs J]
-# The full run takes about half an hour on 2 cores (pompy is slow); --quick takes a few minutes.
+# The full run takes about fifty minutes on 2 cores (pompy is slow); --quick takes a few minutes.
 set -euo pipefail
 here=$(cd "$(dirname "$0")" && pwd)
 root=$(cd "$here/.." && pwd)

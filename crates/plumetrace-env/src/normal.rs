@@ -41,7 +41,9 @@ struct Tables {
     /// Per bucket, the line through the inverse at its two edges `i / 2048` and
     /// `(i + 1) / 2048` as `[value at the middle of the first place, rise per place]`, scaled to
     /// unit variance; the outer buckets' entries are unused.
-    lines: Box<[[f32; 2]; BUCKETS]>,
+    /// Packed in one 64-bit word per bucket (the value's bits low, the rise's high), so that a
+    /// vector of draws gathers each line in one read.
+    lines: Box<[u64; BUCKETS]>,
     /// The inverse at the places of the lowest bucket, scaled (the highest is its mirror image).
     low_tail: Box<[f32; PLACES]>,
 }
@@ -78,7 +80,9 @@ fn tables() -> &'static Tables {
         let scale = (n / sum_sq).sqrt();
         Tables {
             lines: Box::new(std::array::from_fn(|i| {
-                [(lines[i][0] * scale) as f32, (lines[i][1] * scale) as f32]
+                let a = (lines[i][0] * scale) as f32;
+                let rise = (lines[i][1] * scale) as f32;
+                u64::from(a.to_bits()) | (u64::from(rise.to_bits()) << 32)
             })),
             low_tail: Box::new(std::array::from_fn(|f| (low_tail[f] * scale) as f32)),
         }
@@ -93,7 +97,11 @@ impl Tables {
     fn draw(&self, k: u32) -> f64 {
         let bucket = (k >> PLACE_BITS) as usize & (BUCKETS - 1);
         let place = (k as usize) & (PLACES - 1);
-        let [a, rise] = self.lines[bucket];
+        let packed = self.lines[bucket];
+        let (a, rise) = (
+            f32::from_bits(packed as u32),
+            f32::from_bits((packed >> 32) as u32),
+        );
         let line = a + rise * place as f32;
         let high = bucket == BUCKETS - 1;
         let tail = self.low_tail[if high { PLACES - 1 - place } else { place }];
@@ -110,8 +118,10 @@ pub fn normal_triple(word: u64) -> [f64; 3] {
 }
 
 /// Three columns of standard normal draws, row `k` from `words[k]` (as [`normal_triple`]);
-/// the columns are as long as `words`. A loop without branches or bounds checks, so that
-/// compiled for a vector unit it draws several rows at once.
+/// the columns are as long as `words`. Loops without branches or bounds checks, so that
+/// compiled for a vector unit they draw several rows at once: every draw is first read from its
+/// bucket's line, then the rows of any group of eight with a draw in a tail bucket (one draw in
+/// 1,024) are drawn again in full.
 #[inline(always)]
 pub fn fill_normal_columns(
     words: &[u64],
@@ -119,18 +129,66 @@ pub fn fill_normal_columns(
     second: &mut [f64],
     third: &mut [f64],
 ) {
+    const GROUP: usize = 8;
     let t = tables();
     let n = words.len();
     let (first, second, third) = (&mut first[..n], &mut second[..n], &mut third[..n]);
     for k in 0..n {
-        let [a, b, c] = t.triple(words[k]);
+        let [a, b, c] = t.triple_from_lines(words[k]);
         first[k] = a;
         second[k] = b;
         third[k] = c;
     }
+    for (g, group) in words.chunks(GROUP).enumerate() {
+        let mut tails = false;
+        for w in group {
+            tails |= in_a_tail(*w);
+        }
+        if tails {
+            for (j, w) in group.iter().enumerate() {
+                let k = g * GROUP + j;
+                [first[k], second[k], third[k]] = t.triple(*w);
+            }
+        }
+    }
+}
+
+/// Whether any of the three draws of `word` lies in a tail bucket.
+#[inline(always)]
+fn in_a_tail(word: u64) -> bool {
+    let mask = (1u64 << BITS) - 1;
+    let tail = |k: u64| {
+        let bucket = (k >> PLACE_BITS) & (BUCKETS as u64 - 1);
+        (bucket + 1) & (BUCKETS as u64 - 1) <= 1
+    };
+    tail(word >> 43) | tail((word >> 22) & mask) | tail((word >> 1) & mask)
 }
 
 impl Tables {
+    /// Draw `k` read from its bucket's line: the draw itself unless the bucket is a tail one.
+    #[inline(always)]
+    fn line(&self, k: u32) -> f64 {
+        let bucket = (k >> PLACE_BITS) as usize & (BUCKETS - 1);
+        let place = (k as usize) & (PLACES - 1);
+        let packed = self.lines[bucket];
+        let (a, rise) = (
+            f32::from_bits(packed as u32),
+            f32::from_bits((packed >> 32) as u32),
+        );
+        f64::from(a + rise * place as f32)
+    }
+
+    /// [`Tables::triple`] read from the lines only (see [`Tables::line`]).
+    #[inline(always)]
+    fn triple_from_lines(&self, word: u64) -> [f64; 3] {
+        let mask = (1u64 << BITS) - 1;
+        [
+            self.line((word >> 43) as u32),
+            self.line(((word >> 22) & mask) as u32),
+            self.line(((word >> 1) & mask) as u32),
+        ]
+    }
+
     #[inline(always)]
     fn triple(&self, word: u64) -> [f64; 3] {
         let mask = (1u64 << BITS) - 1;
@@ -242,17 +300,42 @@ mod tests {
     }
 
     #[test]
+    fn the_lines_give_every_draw_outside_the_tail_buckets() {
+        let t = tables();
+        let mut tails = 0;
+        // A word whose first two draws are at the middle (bucket 1,024) and whose third is `k`.
+        let middle = 1u64 << (BITS - 1);
+        let word = |k: u32| (middle << 43) | (middle << 22) | (u64::from(k) << 1);
+        for k in 0..(1u32 << BITS) {
+            let bucket = k >> PLACE_BITS;
+            if bucket == 0 || bucket == BUCKETS as u32 - 1 {
+                tails += 1;
+                assert!(in_a_tail(word(k)), "k {k}");
+            } else {
+                assert_eq!(t.line(k).to_bits(), t.draw(k).to_bits(), "k {k}");
+                assert!(!in_a_tail(word(k)), "k {k}");
+            }
+        }
+        assert_eq!(tails, 2 * PLACES);
+    }
+
+    #[test]
     fn triples_use_every_bit_group_and_columns_hold_them() {
         let w = 0x8000_0000_0000_0000u64;
         // Only the first draw's top bit set: the first draw is in the upper half, the other two
         // at the bottom of the range.
         let [a, b, c] = normal_triple(w);
         assert!(a > 0.0 && b < -4.9 && c < -4.9, "{a} {b} {c}");
-        // The columns hold the triples of their words, row by row.
-        let words: Vec<u64> = (1..=7u64)
+        // The columns hold the triples of their words, row by row: 21 rows, the first group of
+        // eight with no draw in a tail bucket, the second with `w` (two tail draws) and the
+        // third partial.
+        let mut words: Vec<u64> = (1..=21u64)
             .map(|n| n.wrapping_mul(0x9e37_79b9_7f4a_7c15))
             .collect();
-        let mut cols = [[0.0; 7]; 3];
+        words[11] = w;
+        assert!(!words[..8].iter().any(|w| in_a_tail(*w)));
+        assert!(in_a_tail(w));
+        let mut cols = [[0.0; 21]; 3];
         let [c0, c1, c2] = &mut cols;
         fill_normal_columns(&words, c0, c1, c2);
         for (k, w) in words.iter().enumerate() {
