@@ -66,8 +66,7 @@ fn tables() -> &'static Tables {
         // Scale to unit variance over all 2^21 values (computed in double precision).
         let mut sum_sq = 0.0;
         for k in 0..(1u32 << BITS) {
-            let bucket = (k >> PLACE_BITS) as usize;
-            let place = (k as usize) & (PLACES - 1);
+            let (bucket, place) = (bucket(k), place(k));
             let z = if bucket == 0 {
                 low_tail[place]
             } else if bucket == BUCKETS - 1 {
@@ -90,25 +89,41 @@ fn tables() -> &'static Tables {
 }
 
 impl Tables {
-    /// The normal value of the 21-bit number `k`.
-    /// Draw number `k` (its low 21 bits). Branch-free (both tables are read, the right value
-    /// kept), so that a loop of draws can run in vector lanes.
+    /// The normal value of the 21-bit number `k` (its low 21 bits).
     #[inline(always)]
     fn draw(&self, k: u32) -> f64 {
-        let bucket = (k >> PLACE_BITS) as usize & (BUCKETS - 1);
-        let place = (k as usize) & (PLACES - 1);
-        let packed = self.lines[bucket];
-        let (a, rise) = (
-            f32::from_bits(packed as u32),
-            f32::from_bits((packed >> 32) as u32),
-        );
-        let line = a + rise * place as f32;
-        let high = bucket == BUCKETS - 1;
-        let tail = self.low_tail[if high { PLACES - 1 - place } else { place }];
-        let tail = if high { -tail } else { tail };
-        let z = if high || bucket == 0 { tail } else { line };
-        f64::from(z)
+        let bucket = bucket(k);
+        if bucket == 0 {
+            f64::from(self.low_tail[place(k)])
+        } else if bucket == BUCKETS - 1 {
+            -f64::from(self.low_tail[PLACES - 1 - place(k)])
+        } else {
+            self.line(k)
+        }
     }
+}
+
+/// The bucket of the 21-bit number `k`.
+#[inline(always)]
+fn bucket(k: u32) -> usize {
+    (k >> PLACE_BITS) as usize & (BUCKETS - 1)
+}
+
+/// The place within its bucket of the 21-bit number `k`.
+#[inline(always)]
+fn place(k: u32) -> usize {
+    (k as usize) & (PLACES - 1)
+}
+
+/// The three 21-bit numbers of a 64-bit word (its top 63 bits).
+#[inline(always)]
+fn parts(word: u64) -> [u32; 3] {
+    let mask = (1u64 << BITS) - 1;
+    [
+        (word >> 43) as u32,
+        ((word >> 22) & mask) as u32,
+        ((word >> 1) & mask) as u32,
+    ]
 }
 
 /// Three standard normal draws from the 64-bit word `word` (its top 63 bits, 21 per draw).
@@ -156,47 +171,32 @@ pub fn fill_normal_columns(
 /// Whether any of the three draws of `word` lies in a tail bucket.
 #[inline(always)]
 fn in_a_tail(word: u64) -> bool {
-    let mask = (1u64 << BITS) - 1;
-    let tail = |k: u64| {
-        let bucket = (k >> PLACE_BITS) & (BUCKETS as u64 - 1);
-        (bucket + 1) & (BUCKETS as u64 - 1) <= 1
-    };
-    tail(word >> 43) | tail((word >> 22) & mask) | tail((word >> 1) & mask)
+    let [a, b, c] = parts(word).map(|k| (bucket(k) + 1) & (BUCKETS - 1) <= 1);
+    a | b | c
 }
 
 impl Tables {
     /// Draw `k` read from its bucket's line: the draw itself unless the bucket is a tail one.
     #[inline(always)]
     fn line(&self, k: u32) -> f64 {
-        let bucket = (k >> PLACE_BITS) as usize & (BUCKETS - 1);
-        let place = (k as usize) & (PLACES - 1);
-        let packed = self.lines[bucket];
+        let packed = self.lines[bucket(k)];
         let (a, rise) = (
             f32::from_bits(packed as u32),
             f32::from_bits((packed >> 32) as u32),
         );
-        f64::from(a + rise * place as f32)
+        f64::from(a + rise * place(k) as f32)
     }
 
     /// [`Tables::triple`] read from the lines only (see [`Tables::line`]).
     #[inline(always)]
     fn triple_from_lines(&self, word: u64) -> [f64; 3] {
-        let mask = (1u64 << BITS) - 1;
-        [
-            self.line((word >> 43) as u32),
-            self.line(((word >> 22) & mask) as u32),
-            self.line(((word >> 1) & mask) as u32),
-        ]
+        parts(word).map(|k| self.line(k))
     }
 
+    /// The three draws of `word`.
     #[inline(always)]
     fn triple(&self, word: u64) -> [f64; 3] {
-        let mask = (1u64 << BITS) - 1;
-        [
-            self.draw((word >> 43) as u32),
-            self.draw(((word >> 22) & mask) as u32),
-            self.draw(((word >> 1) & mask) as u32),
-        ]
+        parts(word).map(|k| self.draw(k))
     }
 }
 
