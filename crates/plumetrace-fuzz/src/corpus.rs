@@ -107,6 +107,14 @@ pub const CAMPAIGNS: &[(&str, &str)] = &[
         "plume-steps",
         include_str!("../../../examples/campaigns/plume-steps.toml"),
     ),
+    (
+        "map-declaration-duck-like",
+        include_str!("../../../examples/campaigns/map-declaration-duck-like.toml"),
+    ),
+    (
+        "map-mixing",
+        include_str!("../../../examples/campaigns/map-mixing.toml"),
+    ),
 ];
 
 /// The example families (`examples/families/*.family.toml`; a test checks the list is complete).

@@ -30,6 +30,10 @@
 //! and a threshold detector bring chemical to the vehicle's altitude sooner than diffusion of
 //! the filaments' centres alone (on Duck-like sites whose plume diffuses vertically at
 //! 0.001 m^2/s, a map with `K_z` of 0.001-0.003 placed the source 10-100 m upflow of it).
+//! With `vertical_mixing_length_m` positive, `K_z` is that length times the measured flow speed
+//! instead (a bottom boundary layer mixes in proportion to its friction velocity, itself about
+//! proportional to the current), so the distance downflow at which the chemical reaches the
+//! vehicle, about `z^2 / (4 l)`, no longer depends on the current.
 //!
 //! **Dilution.** The mean concentration of a plume from a point source falls as its cross-section
 //! grows, about as one over travel time once diffusion dominates: beyond `dilution_s` the chance
@@ -44,9 +48,15 @@
 //! lowers a cell only by `1 - p_detect` at most), and `p_false` is the chance of a detection from
 //! a source elsewhere (background, another source, a spike). A detection multiplies each cell by
 //! `P(c)`, a non-detection by `1 - P(c)`; cells outside the footprint take the same factor,
-//! which normalisation removes, so only footprint cells are touched. Samples closer together than
-//! `correlation_s` are not independent (the vehicle sees the same filament): each sample's log
-//! likelihood is weighed by the time since the previous one over `correlation_s` (at most 1).
+//! which normalisation removes, so only footprint cells are touched. Samples of the same outcome
+//! closer together than `correlation_s` are not independent (the vehicle sees the same filament,
+//! or the same stretch of clean water): each sample's log likelihood is weighed by the time since
+//! the previous sample *of the same outcome* over `correlation_s` (at most 1). A detection after a
+//! quiet spell is therefore a whole look, however many non-detections came before it, and a spell
+//! inside the plume or out of it adds about one look per `correlation_s`. (Weighing every sample by
+//! the time since the previous one, whatever it read, made a contact of a second or two count as a
+//! tenth of a look against minutes of non-detections: the map then placed the source downflow of
+//! the most upflow detections.)
 //!
 //! A non-detection's factor is at most that of the cells it says nothing about, so it never
 //! raises a cell relative to them; a detection's is at least theirs.
@@ -68,6 +78,9 @@ pub struct MapModel {
     pub diffusivity_m2ps: f64,
     /// Vertical diffusivity for the bottom source's mixing up to the vehicle (0: off), m^2/s.
     pub vertical_diffusivity_m2ps: f64,
+    /// When positive, the vertical diffusivity is this length times the measured flow speed
+    /// instead of `vertical_diffusivity_m2ps` (bottom boundary-layer mixing), m.
+    pub vertical_mixing_length_m: f64,
     /// Probability that a sample inside the plume detects (intermittency).
     pub p_detect: f64,
     /// Probability that a sample detects with the source elsewhere.
@@ -77,6 +90,9 @@ pub struct MapModel {
     /// Dilution: beyond this travel time the chance of a detection falls as `dilution_s / T`
     /// (the mean concentration of a diffusing plume falls as one over travel time; 0: off), s.
     pub dilution_s: f64,
+    /// When positive, dilution begins this far downflow instead (after `dilution_m` over the
+    /// measured flow speed, replacing `dilution_s`), m.
+    pub dilution_m: f64,
 }
 
 impl Default for MapModel {
@@ -87,10 +103,12 @@ impl Default for MapModel {
             spread0_m: 3.0,
             diffusivity_m2ps: 0.1,
             vertical_diffusivity_m2ps: 0.01,
+            vertical_mixing_length_m: 0.0,
             p_detect: 0.1,
             p_false: 0.002,
             correlation_s: 10.0,
             dilution_s: 60.0,
+            dilution_m: 0.0,
         }
     }
 }
@@ -158,7 +176,8 @@ pub struct SourceMap {
     /// Its probability.
     p: Vec<f64>,
     flow: FlowHistory,
-    last_sample_s: Option<f64>,
+    /// Time of the last sample of each outcome: `[non-detection, detection]`.
+    last_sample_s: [Option<f64>; 2],
     /// Scratch: footprint value per candidate (zero outside the last footprint) and the touched
     /// candidates.
     scratch: Vec<f64>,
@@ -225,7 +244,7 @@ impl SourceMap {
             log_p: vec![lp; n],
             p: vec![1.0 / n as f64; n],
             flow: FlowHistory::default(),
-            last_sample_s: None,
+            last_sample_s: [None; 2],
             scratch: vec![0.0; n],
             touched: Vec::new(),
             gx: Vec::new(),
@@ -315,9 +334,18 @@ impl SourceMap {
         self.touched.clear();
         let m = self.model;
         let r = m.resolution_m;
-        let kz = m.vertical_diffusivity_m2ps;
         let z2 = altitude_m.filter(|z| z.is_finite()).map_or(0.0, |z| z * z);
         let speed = self.flow.speed_mps().max(0.01);
+        let kz = if m.vertical_mixing_length_m > 0.0 {
+            m.vertical_mixing_length_m * speed
+        } else {
+            m.vertical_diffusivity_m2ps
+        };
+        let dilution_s = if m.dilution_m > 0.0 {
+            m.dilution_m / speed
+        } else {
+            m.dilution_s
+        };
         let x_now = self.flow.at(t_s);
         let mut travel = 0.0_f64;
         while travel <= m.window_s {
@@ -331,8 +359,8 @@ impl SourceMap {
             } else {
                 1.0
             };
-            let dilution = if m.dilution_s > 0.0 && travel > m.dilution_s {
-                m.dilution_s / travel
+            let dilution = if dilution_s > 0.0 && travel > dilution_s {
+                dilution_s / travel
             } else {
                 1.0
             };
@@ -395,13 +423,14 @@ impl SourceMap {
         if !(pos_m.x.is_finite() && pos_m.y.is_finite() && t_s.is_finite()) {
             return;
         }
-        let weight = match self.last_sample_s {
+        let last = &mut self.last_sample_s[usize::from(detected)];
+        let weight = match *last {
             Some(l) if self.model.correlation_s > 0.0 => {
                 ((t_s - l) / self.model.correlation_s).clamp(0.0, 1.0)
             }
             _ => 1.0,
         };
-        self.last_sample_s = Some(t_s);
+        *last = Some(t_s);
         self.updates += 1;
         if weight <= 0.0 {
             return;
@@ -652,6 +681,77 @@ mod tests {
         let p = m.probabilities();
         let (near, mid) = (p[i_near], p[i_mid]);
         assert!(mid > 5.0 * near, "{mid} vs {near}");
+    }
+
+    #[test]
+    fn a_mixing_length_makes_the_vertical_diffusivity_follow_the_measured_current() {
+        // The same samples in currents of 0.1 and 0.3 m/s: with a mixing length of 0.1 m the map
+        // equals one with a fixed diffusivity of 0.1 m x the current (the fixed key is then
+        // ignored), and the vertical diffusivity changes the map.
+        let fly = |speed: f64, model: MapModel| {
+            let mut m = SourceMap::new(&area(), model).unwrap_or_else(|| panic!("no map"));
+            for k in 0..200 {
+                let t = k as f64;
+                m.add_flow(t, Vec2::new(speed, 0.0));
+                m.observe(Vec2::new(300.0, 90.0 + 0.1 * t), t, Some(2.0), k % 7 == 0);
+            }
+            m.log_probabilities().to_vec()
+        };
+        let mixing = MapModel {
+            vertical_mixing_length_m: 0.1,
+            vertical_diffusivity_m2ps: 0.5,
+            ..model()
+        };
+        for speed in [0.1, 0.3] {
+            let fixed = MapModel {
+                vertical_diffusivity_m2ps: 0.1 * speed,
+                ..model()
+            };
+            assert_eq!(fly(speed, mixing), fly(speed, fixed), "at {speed} m/s");
+        }
+        let (slow, fast) = (
+            MapModel {
+                vertical_diffusivity_m2ps: 0.01,
+                ..model()
+            },
+            MapModel {
+                vertical_diffusivity_m2ps: 0.03,
+                ..model()
+            },
+        );
+        assert_ne!(fly(0.1, slow), fly(0.1, fast));
+    }
+
+    #[test]
+    fn a_detection_after_a_quiet_spell_counts_as_a_whole_look() {
+        // A minute of non-detections at 10 Hz far across the flow, then one detection: the
+        // detection weighs as much as it would alone (the non-detections do not make it a
+        // repeat of them); two cells upflow of it, out of the non-detections' reach, compare the
+        // same in both maps.
+        let mut quiet = SourceMap::new(&area(), model()).unwrap_or_else(|| panic!("no map"));
+        let mut alone = SourceMap::new(&area(), model()).unwrap_or_else(|| panic!("no map"));
+        for k in 0..600 {
+            let t = k as f64 * 0.1;
+            quiet.add_flow(t, Vec2::new(0.2, 0.0));
+            quiet.observe(Vec2::new(300.0, 10.0), t, Some(2.0), false);
+        }
+        let t = 60.0;
+        quiet.add_flow(t, Vec2::new(0.2, 0.0));
+        alone.add_flow(0.0, Vec2::new(0.2, 0.0));
+        quiet.observe(Vec2::new(300.0, 170.0), t, Some(2.0), true);
+        alone.observe(Vec2::new(300.0, 170.0), t, Some(2.0), true);
+        let (near, far) = (Vec2::new(290.0, 170.0), Vec2::new(150.0, 170.0));
+        let ratio = |m: &mut SourceMap| {
+            let (a, b) = (
+                m.candidate_at(near).unwrap_or(0),
+                m.candidate_at(far).unwrap_or(0),
+            );
+            let lp = m.log_probabilities();
+            lp[b] - lp[a]
+        };
+        let (q, a) = (ratio(&mut quiet), ratio(&mut alone));
+        assert!(a.abs() > 0.5, "the detection tells the cells apart: {a}");
+        assert!((q - a).abs() < 1e-9, "{q} vs {a}");
     }
 
     #[test]

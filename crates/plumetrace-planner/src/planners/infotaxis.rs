@@ -73,12 +73,16 @@ plumetrace_core::params! {
         map_correlation_s: f64 = 10.0, "s", Bounds::closed(0.0, 3600.0);
         /// Source map: growth of the back-projection spread, sigma^2 = (3 m)^2 + 2 D T.
         map_diffusivity_m2ps: f64 = 0.1, "m^2/s", Bounds::closed(0.0, 1000.0);
-        /// Source map: vertical diffusivity that mixes a bottom source up to the vehicle's altitude (0: no vertical model).
+        /// Source map: vertical diffusivity that mixes a bottom source up to the vehicle's altitude, when map_mixing_length_m is 0 (0: no vertical model).
         map_vertical_diffusivity_m2ps: f64 = 0.01, "m^2/s", Bounds::closed(0.0, 100.0);
+        /// Source map: when positive, the vertical diffusivity is this mixing length times the measured flow speed (bottom boundary-layer mixing grows with the current), replacing map_vertical_diffusivity_m2ps.
+        map_mixing_length_m: f64 = 0.0, "m", Bounds::closed(0.0, 100.0);
         /// Source map: longest travel time a sample is back-projected over.
         map_window_s: f64 = 3600.0, "s", Bounds::closed(1.0, 1e6);
-        /// Source map: travel time beyond which the chance of a detection falls as one over travel time (plume dilution; 0: off).
+        /// Source map: travel time beyond which the chance of a detection falls as one over travel time (plume dilution; 0: off), when map_dilution_m is 0.
         map_dilution_s: f64 = 60.0, "s", Bounds::closed(0.0, 1e6);
+        /// Source map: when positive, the distance downflow beyond which the chance of a detection falls as one over the distance (plume dilution measured along the flow, at the measured flow speed), replacing map_dilution_s.
+        map_dilution_m: f64 = 0.0, "m", Bounds::closed(0.0, 1e6);
     }
 }
 
@@ -124,15 +128,19 @@ pub(crate) fn build_tracker(
 
 impl InfotaxisParams {
     fn tracker(&self, area: &OpArea) -> Result<MapTracker, ParamError> {
-        let model = map_model(
-            self.map_resolution_m,
-            self.map_p_detect,
-            self.map_diffusivity_m2ps,
-            self.map_vertical_diffusivity_m2ps,
-            self.map_window_s,
-            self.map_correlation_s,
-            self.map_dilution_s,
-        );
+        let model = MapModel {
+            vertical_mixing_length_m: self.map_mixing_length_m,
+            dilution_m: self.map_dilution_m,
+            ..map_model(
+                self.map_resolution_m,
+                self.map_p_detect,
+                self.map_diffusivity_m2ps,
+                self.map_vertical_diffusivity_m2ps,
+                self.map_window_s,
+                self.map_correlation_s,
+                self.map_dilution_s,
+            )
+        };
         let rule = MapRule {
             radius_m: self.map_radius_m,
             mass: self.map_mass,
@@ -425,12 +433,13 @@ mod tests {
     /// Flies the planner with a kinematic vehicle (no dynamics) in a straight-edged plume: a
     /// band 20 m wide along y = 100 East of x = 80 (source at (80, 100)), where every second
     /// sample detects, however far from the source (so the map's model has no vertical mixing
-    /// and no dilution either).
+    /// and no dilution either, and a sample in the plume detects half the time).
     fn fly(objective: Objective) -> (Vec<PlannerEvent>, Vec<Telemetry>) {
         let params = InfotaxisParams {
             objective,
             map_vertical_diffusivity_m2ps: 0.0,
             map_dilution_s: 0.0,
+            map_p_detect: 0.5,
             ..InfotaxisParams::default()
         };
         let mut planner = params.build(&ctx()).unwrap_or_else(|e| panic!("{e}"));
