@@ -86,27 +86,25 @@ plumetrace_core::params! {
     }
 }
 
-/// The map model of a planner's `map_*` keys (the rest at the model's defaults).
-pub(crate) fn map_model(
-    resolution_m: f64,
-    p_detect: f64,
-    diffusivity_m2ps: f64,
-    vertical_diffusivity_m2ps: f64,
-    window_s: f64,
-    correlation_s: f64,
-    dilution_s: f64,
-) -> MapModel {
-    MapModel {
-        resolution_m,
-        p_detect,
-        diffusivity_m2ps,
-        vertical_diffusivity_m2ps,
-        window_s,
-        correlation_s,
-        dilution_s,
-        ..MapModel::default()
-    }
+/// The map model of a planner's `map_*` keys (the rest at the model's defaults): `$p` is a
+/// planner's parameters with the source map's keys (`InfotaxisParams`, `AmpParams`).
+macro_rules! map_model {
+    ($p:expr) => {
+        $crate::estimate::MapModel {
+            resolution_m: $p.map_resolution_m,
+            p_detect: $p.map_p_detect,
+            diffusivity_m2ps: $p.map_diffusivity_m2ps,
+            vertical_diffusivity_m2ps: $p.map_vertical_diffusivity_m2ps,
+            vertical_mixing_length_m: $p.map_mixing_length_m,
+            window_s: $p.map_window_s,
+            correlation_s: $p.map_correlation_s,
+            dilution_s: $p.map_dilution_s,
+            dilution_m: $p.map_dilution_m,
+            ..$crate::estimate::MapModel::default()
+        }
+    };
 }
+pub(crate) use map_model;
 
 /// A planner's map tracker over `area`; the error names `map_resolution_m` when the map does
 /// not fit.
@@ -128,19 +126,7 @@ pub(crate) fn build_tracker(
 
 impl InfotaxisParams {
     fn tracker(&self, area: &OpArea) -> Result<MapTracker, ParamError> {
-        let model = MapModel {
-            vertical_mixing_length_m: self.map_mixing_length_m,
-            dilution_m: self.map_dilution_m,
-            ..map_model(
-                self.map_resolution_m,
-                self.map_p_detect,
-                self.map_diffusivity_m2ps,
-                self.map_vertical_diffusivity_m2ps,
-                self.map_window_s,
-                self.map_correlation_s,
-                self.map_dilution_s,
-            )
-        };
+        let model = map_model!(self);
         let rule = MapRule {
             radius_m: self.map_radius_m,
             mass: self.map_mass,

@@ -229,19 +229,7 @@ impl AmpParams {
         if self.map_declaration == MapDeclaration::Off {
             return Ok(None);
         }
-        let model = crate::estimate::MapModel {
-            vertical_mixing_length_m: self.map_mixing_length_m,
-            dilution_m: self.map_dilution_m,
-            ..crate::planners::infotaxis::map_model(
-                self.map_resolution_m,
-                self.map_p_detect,
-                self.map_diffusivity_m2ps,
-                self.map_vertical_diffusivity_m2ps,
-                self.map_window_s,
-                self.map_correlation_s,
-                self.map_dilution_s,
-            )
-        };
+        let model = crate::planners::infotaxis::map_model!(self);
         let rule = MapRule {
             radius_m: self.map_radius_m,
             mass: self.map_mass,
