@@ -17,9 +17,11 @@ fn run_seeds(preset: &str, n: u64) -> Vec<(u64, Summary)> {
 /// [`run_seeds`] with the preset's planner keys `planner` set.
 fn run_seeds_with(preset: &str, n: u64, planner: &[(&str, toml::Value)]) -> Vec<(u64, Summary)> {
     let mut cfg = load_preset(preset).unwrap();
-    let table = cfg.planner.get_or_insert_with(toml::Table::new);
-    for (key, value) in planner {
-        table.insert((*key).into(), value.clone());
+    if !planner.is_empty() {
+        let table = cfg.planner.get_or_insert_with(toml::Table::new);
+        for (key, value) in planner {
+            table.insert((*key).into(), value.clone());
+        }
     }
     let seeds: Vec<u64> = (1..=n).collect();
     let results = std::sync::Mutex::new(Vec::new());
