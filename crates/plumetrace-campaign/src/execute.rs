@@ -97,8 +97,8 @@ pub fn claim_dir(c: &Campaign, out: &Path) -> Result<(), CampaignError> {
                 line: None,
                 message: format!(
                     "{} holds results of a different campaign ('{}', fingerprint {}; this one is \
-                     '{}', {}): the campaign file or one of its scenarios changed. Use a new \
-                     --out directory.",
+                     '{}', {}): the campaign file, one of its scenarios or a planner's defaults \
+                     changed. Use a new --out directory.",
                     out.display(),
                     old.name,
                     old.fingerprint,

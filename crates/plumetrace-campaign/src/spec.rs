@@ -612,9 +612,15 @@ impl Campaign {
     }
 
     /// A digest of everything that decides the runs' results except the number of seeds: seed,
-    /// scenarios' TOML, configurations, sweep, success radius. Resuming or merging requires equal
-    /// fingerprints.
+    /// scenarios' TOML, configurations, sweep, success radius, and every planner's defaults (a
+    /// build whose defaults differ does not resume or merge results recorded by another).
+    /// Resuming or merging requires equal fingerprints.
     pub fn fingerprint(&self) -> String {
+        self.fingerprint_with(plumetrace_mission::planner_defaults())
+    }
+
+    /// [`Campaign::fingerprint`] with the planners' defaults given.
+    fn fingerprint_with(&self, planner_defaults: toml::Table) -> String {
         #[derive(Serialize)]
         struct Canon<'a> {
             seed: u64,
@@ -624,6 +630,7 @@ impl Campaign {
             configs: &'a [ConfigFile],
             sweep: &'a toml::Table,
             success_radius_m: Option<f64>,
+            planner_defaults: toml::Table,
         }
         let canon = Canon {
             seed: self.file.seed,
@@ -640,6 +647,7 @@ impl Campaign {
             configs: &self.configs,
             sweep: &self.file.sweep,
             success_radius_m: self.file.success_radius_m,
+            planner_defaults,
         };
         let text = serde_json::to_string(&canon).unwrap_or_default();
         format!("{:016x}", fnv1a(text.as_bytes()))
@@ -826,6 +834,22 @@ mod tests {
             e.contains("planner.beta_deg") && e.contains("unknown field"),
             "{e}"
         );
+    }
+
+    #[test]
+    fn the_fingerprint_changes_with_a_planners_default() {
+        let text = "name = \"c\"\nseed = 1\nseeds = 1\nscenarios = [\"demo\"]\n\
+                    [[configs]]\nname = \"amp\"\n[configs.planner]\nkind = \"amp\"\n";
+        let path = Path::new("c.toml");
+        let file = parse_campaign(text, path).unwrap();
+        let c = Campaign::resolve(file, path, text.to_string(), true).unwrap();
+        let defaults = plumetrace_mission::planner_defaults();
+        assert_eq!(c.fingerprint(), c.fingerprint_with(defaults.clone()));
+        let mut other = defaults;
+        if let Some(toml::Value::Table(amp)) = other.get_mut("amp") {
+            amp.insert("map_mass".into(), toml::Value::Float(0.123));
+        }
+        assert_ne!(c.fingerprint(), c.fingerprint_with(other));
     }
 
     #[test]

@@ -115,6 +115,14 @@ pub const CAMPAIGNS: &[(&str, &str)] = &[
         "map-mixing",
         include_str!("../../../examples/campaigns/map-mixing.toml"),
     ),
+    (
+        "map-rule",
+        include_str!("../../../examples/campaigns/map-rule.toml"),
+    ),
+    (
+        "track-altitude",
+        include_str!("../../../examples/campaigns/track-altitude.toml"),
+    ),
 ];
 
 /// The example families (`examples/families/*.family.toml`; a test checks the list is complete).

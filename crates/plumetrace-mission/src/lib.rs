@@ -40,6 +40,7 @@ pub use mission::{
     run_mission, run_mission_with,
 };
 pub use outcome::{EndReason, MissionEnd, MissionEvent, Outcome, VehicleStatus};
+pub use plumetrace_planner::registry_defaults as planner_defaults;
 pub use record::{
     EventKind, EventRecord, Observer, PlumeFrame, PlumeFrames, StepView, TrajectoryRow,
 };

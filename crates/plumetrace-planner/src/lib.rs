@@ -35,5 +35,5 @@ pub use planners::formation::{
 pub use planners::moth::{self, Moth, MothParams, MothStrategy};
 pub use planners::{
     BuildContext, CommonParams, MissionGeometry, PLANNERS, PlannerConfig, PlannerEntry,
-    PlannerKind, PlannerParams, PlannerSpec, registry_markdown,
+    PlannerKind, PlannerParams, PlannerSpec, registry_defaults, registry_markdown,
 };

@@ -886,3 +886,30 @@ fn mapping_from_a_declaration_near_the_upflow_edge_is_flown_without_fixes() {
     );
     assert!(lowest > 0.0, "stays inside the op-area: y down to {lowest}");
 }
+
+#[test]
+fn tracing_flies_at_the_track_altitude_and_the_search_at_the_altitude() {
+    use plumetrace_core::VerticalCommand;
+    let altitude = |d: &plumetrace_core::Decision| match d.command.vertical {
+        VerticalCommand::Altitude(a) => a,
+        v => panic!("{v:?}"),
+    };
+    let mut a = amp_with(AmpParams {
+        track_altitude_m: 1.0,
+        ..AmpParams::default()
+    });
+    let d = a.decide(&snap(0.0, (200.0, 500.0), 0.0, false));
+    assert_eq!(altitude(&d), 2.0);
+    let d = a.decide(&snap(1.0, (200.0, 500.0), 170.0, true));
+    assert_eq!(a.behaviour(), BehaviourKind::TrackIn);
+    assert_eq!(altitude(&d), 1.0);
+    let d = a.decide(&snap(7.0, (200.0, 495.0), 170.0, false));
+    assert_eq!(a.behaviour(), BehaviourKind::TrackOut);
+    assert_eq!(altitude(&d), 1.0);
+    // At 0 (the default) the whole mission flies at altitude_m.
+    let mut a = amp();
+    a.decide(&snap(0.0, (200.0, 500.0), 0.0, false));
+    let d = a.decide(&snap(1.0, (200.0, 500.0), 170.0, true));
+    assert_eq!(a.behaviour(), BehaviourKind::TrackIn);
+    assert_eq!(altitude(&d), 2.0);
+}

@@ -46,6 +46,9 @@ fn amp(mode: MapDeclaration, map_can_declare: bool) -> Amp {
         map_check_s: 0.0,
         // At once (the hold has its own tests with the map's tracker).
         map_hold_s: 0.0,
+        // The most likely cell's centre is declared (the local mean has its own test with the
+        // map).
+        map_estimate_radius_m: 0.0,
         ..AmpParams::default()
     };
     let area = OpArea::rectangle(0.0, 400.0, 0.0, 1000.0).unwrap();

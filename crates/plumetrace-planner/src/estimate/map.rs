@@ -542,6 +542,24 @@ impl SourceMap {
 
     /// The posterior mass within `radius_m` of `centre`.
     pub fn mass_within(&mut self, centre: Vec2, radius_m: f64) -> f64 {
+        self.within(centre, radius_m).0
+    }
+
+    /// The posterior mean of the candidates within `radius_m` of `centre` (`centre` itself when
+    /// they hold no mass): the source position the map gives once it has settled on a region,
+    /// not bound to a cell centre.
+    pub fn mean_within(&mut self, centre: Vec2, radius_m: f64) -> Vec2 {
+        let (m, sum) = self.within(centre, radius_m);
+        if m > 0.0 && m.is_finite() {
+            centre + sum / m
+        } else {
+            centre
+        }
+    }
+
+    /// Mass within `radius_m` of `centre` and the mass-weighted sum of the candidates' offsets
+    /// from it.
+    fn within(&mut self, centre: Vec2, radius_m: f64) -> (f64, Vec2) {
         self.normalise();
         let r = self.model.resolution_m;
         let i_lo = ((centre.x - radius_m - self.x0) / r).floor().max(0.0) as usize;
@@ -553,15 +571,22 @@ impl SourceMap {
             .ceil()
             .clamp(0.0, self.ny as f64) as usize;
         let mut m = 0.0;
+        let mut sum = Vec2::zeros();
         for j in j_lo..j_hi {
             for i in i_lo..i_hi {
                 let k = self.index[j * self.nx + i];
-                if k != u32::MAX && (self.centres[k as usize] - centre).norm() <= radius_m {
-                    m += self.p[k as usize];
+                if k == u32::MAX {
+                    continue;
+                }
+                let d = self.centres[k as usize] - centre;
+                if d.norm() <= radius_m {
+                    let p = self.p[k as usize];
+                    m += p;
+                    sum += d * p;
                 }
             }
         }
-        m
+        (m, sum)
     }
 }
 
@@ -611,6 +636,32 @@ mod tests {
             "upflow of where the vehicle sampled: {best:?}"
         );
         assert!(upflow_mass > 0.3, "{upflow_mass}");
+    }
+
+    #[test]
+    fn the_local_mean_is_the_posterior_mean_of_the_cells_within_the_radius() {
+        let mut m = SourceMap::new(&area(), model()).unwrap_or_else(|| panic!("no map"));
+        detections(&mut m, 1500, &mut |_| {});
+        let (best, _) = m.most_likely();
+        let mean = m.mean_within(best, 10.0);
+        // By brute force over every candidate.
+        let p = m.probabilities().to_vec();
+        let (mut w, mut sum) = (0.0, Vec2::zeros());
+        for (c, p) in m.centres().iter().zip(&p) {
+            if (c - best).norm() <= 10.0 {
+                w += p;
+                sum += c * *p;
+            }
+        }
+        assert!((mean - sum / w).norm() < 1e-9, "{mean:?} vs {:?}", sum / w);
+        assert!((mean - best).norm() <= 10.0);
+        assert!(
+            (mean - best).norm() > 1e-6,
+            "the mean is not bound to a cell centre"
+        );
+        // No candidate within the radius: the centre itself.
+        let outside = Vec2::new(-100.0, -100.0);
+        assert_eq!(m.mean_within(outside, 10.0), outside);
     }
 
     #[test]

@@ -38,6 +38,9 @@ pub struct MapRule {
     /// How long the rule must hold, the most likely cell staying within `radius_m` of where it
     /// was when the rule first held, before it declares (0: at once), s.
     pub hold_s: f64,
+    /// The declared position: the posterior mean within this radius of the most likely cell
+    /// (0: that cell's centre), m.
+    pub estimate_radius_m: f64,
 }
 
 /// A planner's map with its declaration rule.
@@ -60,6 +63,9 @@ pub struct MapRead {
     pub entropy_bits: f64,
     /// Centre of the most likely cell.
     pub peak_m: Vec2,
+    /// The source position the map gives: the posterior mean within the rule's
+    /// `estimate_radius_m` of the peak (the peak itself when that is 0).
+    pub estimate_m: Vec2,
     /// Mass within the rule's radius of it.
     pub mass: f64,
     /// Detections taken in so far.
@@ -130,9 +136,15 @@ impl MapTracker {
     pub fn read(&mut self, t_s: f64) -> MapRead {
         self.last_read_s = Some(t_s);
         let (peak_m, _) = self.map.most_likely();
+        let estimate_m = if self.rule.estimate_radius_m > 0.0 {
+            self.map.mean_within(peak_m, self.rule.estimate_radius_m)
+        } else {
+            peak_m
+        };
         MapRead {
             entropy_bits: self.map.entropy_bits(),
             peak_m,
+            estimate_m,
             mass: self.map.mass_within(peak_m, self.rule.radius_m),
             detections: self.detections,
         }
@@ -185,6 +197,7 @@ mod tests {
             check_period_s: 5.0,
             min_detections: 2,
             hold_s,
+            estimate_radius_m: 0.0,
         };
         MapTracker::new(&area, MapModel::default(), rule, 0.2).unwrap_or_else(|| panic!("no map"))
     }
@@ -193,6 +206,7 @@ mod tests {
         MapRead {
             entropy_bits: 1.0,
             peak_m: Vec2::new(x, 50.0),
+            estimate_m: Vec2::new(x, 50.0),
             mass,
             detections: 5,
         }

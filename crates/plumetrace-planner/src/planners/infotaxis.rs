@@ -63,6 +63,8 @@ plumetrace_core::params! {
         map_min_detections: u32 = 50, "", Bounds::whole(0, 1_000_000);
         /// Declaration: how long the rule must hold with the map's most likely cell staying within map_radius_m.
         map_hold_s: f64 = 0.0, "s", Bounds::closed(0.0, 1e5);
+        /// Map declaration: the declared position is the posterior mean within this radius of the most likely cell (0: that cell's centre, which leaves up to half a cell of error in each axis).
+        map_estimate_radius_m: f64 = 0.0, "m", Bounds::closed(0.0, 10_000.0);
         /// Time between reads of the map for the declaration.
         map_check_s: f64 = 5.0, "s", Bounds::closed(0.0, 3600.0);
         /// Source map: cell size.
@@ -133,6 +135,7 @@ impl InfotaxisParams {
             check_period_s: self.map_check_s,
             min_detections: u64::from(self.map_min_detections),
             hold_s: self.map_hold_s,
+            estimate_radius_m: self.map_estimate_radius_m,
         };
         build_tracker(area, model, rule, self.threshold_v)
     }
@@ -307,9 +310,11 @@ impl Planner for Infotaxis {
         {
             self.declared = true;
             self.tracker.report(t, &r, &mut telemetry, true);
-            telemetry.push(Telemetry::SourceEstimate { pos_m: r.peak_m });
+            telemetry.push(Telemetry::SourceEstimate {
+                pos_m: r.estimate_m,
+            });
             events.push(PlannerEvent::Declared {
-                pos_m: r.peak_m,
+                pos_m: r.estimate_m,
                 rule: DeclarationKind::SourceMap,
             });
             events.push(PlannerEvent::Behaviour {

@@ -413,6 +413,25 @@ impl Planner for Periodic {
     }
 }
 
+/// Every planner's parameters at their defaults, by kind name (campaigns digest it, so results
+/// recorded under other defaults are never resumed or merged with new ones).
+pub fn registry_defaults() -> toml::Table {
+    let mut out = toml::Table::new();
+    for kind in PlannerKind::ALL {
+        let mut t = toml::Table::new();
+        t.insert("kind".into(), toml::Value::String(kind.name().into()));
+        let resolved = PlannerConfig::from_table(&t, "planner")
+            .map_err(|e| e.to_string())
+            .and_then(|c| c.to_table());
+        let value = match resolved {
+            Ok(t) => toml::Value::Table(t),
+            Err(e) => toml::Value::String(e),
+        };
+        out.insert(kind.name().into(), value);
+    }
+    out
+}
+
 /// Every planner with its keys as Markdown (the README's planner section is this text).
 pub fn registry_markdown() -> String {
     let mut out = String::new();
@@ -439,6 +458,20 @@ mod tests {
 
     fn table(text: &str) -> toml::Table {
         text.parse().unwrap_or_else(|e| panic!("{e}"))
+    }
+
+    #[test]
+    fn the_registry_defaults_hold_every_planner_with_every_key() {
+        let d = registry_defaults();
+        for p in PLANNERS {
+            let t = d[p.kind.name()]
+                .as_table()
+                .unwrap_or_else(|| panic!("{}: {:?}", p.kind, d[p.kind.name()]));
+            for k in (p.keys)() {
+                assert!(t.contains_key(k.name), "{}: {}", p.kind, k.name);
+            }
+        }
+        assert_eq!(d["amp"]["lambda_s"].as_float(), Some(5.0));
     }
 
     #[test]
