@@ -66,6 +66,11 @@ impl Autopilot {
         }
     }
 
+    /// Sets the vertical command sent from now on (a planner that changes altitude by behaviour).
+    pub fn set_vertical(&mut self, vertical: VerticalCommand) {
+        self.vertical = vertical;
+    }
+
     /// The cage.
     pub fn cage(&self) -> &Cage {
         &self.cage

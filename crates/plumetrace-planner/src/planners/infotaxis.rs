@@ -88,25 +88,39 @@ plumetrace_core::params! {
     }
 }
 
-/// The map model of a planner's `map_*` keys (the rest at the model's defaults): `$p` is a
-/// planner's parameters with the source map's keys (`InfotaxisParams`, `AmpParams`).
-macro_rules! map_model {
-    ($p:expr) => {
-        $crate::estimate::MapModel {
-            resolution_m: $p.map_resolution_m,
-            p_detect: $p.map_p_detect,
-            diffusivity_m2ps: $p.map_diffusivity_m2ps,
-            vertical_diffusivity_m2ps: $p.map_vertical_diffusivity_m2ps,
-            vertical_mixing_length_m: $p.map_mixing_length_m,
-            window_s: $p.map_window_s,
-            correlation_s: $p.map_correlation_s,
-            dilution_s: $p.map_dilution_s,
-            dilution_m: $p.map_dilution_m,
-            ..$crate::estimate::MapModel::default()
-        }
+/// The source map and its declaration rule from a planner's `map_*` keys and `threshold_v`
+/// (the rest of the model at its defaults), over `$area`: `$p` is a planner's parameters with
+/// the source map's keys (`InfotaxisParams`, `AmpParams`). The error names `map_resolution_m`
+/// when the map does not fit.
+macro_rules! map_tracker {
+    ($p:expr, $area:expr) => {
+        $crate::planners::infotaxis::build_tracker(
+            $area,
+            $crate::estimate::MapModel {
+                resolution_m: $p.map_resolution_m,
+                p_detect: $p.map_p_detect,
+                diffusivity_m2ps: $p.map_diffusivity_m2ps,
+                vertical_diffusivity_m2ps: $p.map_vertical_diffusivity_m2ps,
+                vertical_mixing_length_m: $p.map_mixing_length_m,
+                window_s: $p.map_window_s,
+                correlation_s: $p.map_correlation_s,
+                dilution_s: $p.map_dilution_s,
+                dilution_m: $p.map_dilution_m,
+                ..$crate::estimate::MapModel::default()
+            },
+            $crate::estimate::MapRule {
+                radius_m: $p.map_radius_m,
+                mass: $p.map_mass,
+                check_period_s: $p.map_check_s,
+                min_detections: u64::from($p.map_min_detections),
+                hold_s: $p.map_hold_s,
+                estimate_radius_m: $p.map_estimate_radius_m,
+            },
+            $p.threshold_v,
+        )
     };
 }
-pub(crate) use map_model;
+pub(crate) use map_tracker;
 
 /// A planner's map tracker over `area`; the error names `map_resolution_m` when the map does
 /// not fit.
@@ -128,16 +142,7 @@ pub(crate) fn build_tracker(
 
 impl InfotaxisParams {
     fn tracker(&self, area: &OpArea) -> Result<MapTracker, ParamError> {
-        let model = map_model!(self);
-        let rule = MapRule {
-            radius_m: self.map_radius_m,
-            mass: self.map_mass,
-            check_period_s: self.map_check_s,
-            min_detections: u64::from(self.map_min_detections),
-            hold_s: self.map_hold_s,
-            estimate_radius_m: self.map_estimate_radius_m,
-        };
-        build_tracker(area, model, rule, self.threshold_v)
+        map_tracker!(self, area)
     }
 }
 

@@ -37,13 +37,13 @@ pub use mapping::MappingParams;
 
 use crate::behaviour::{Arbiter, Behaviour, EventLog, GoTo, Idle, Legs, LineParams, Percept};
 use crate::behaviour::{Proposal, Reached};
-use crate::estimate::{MapRule, MapTracker};
+use crate::estimate::MapTracker;
 use crate::flow::FlowEstimate;
 use crate::planners::{BuildContext, PlannerParams};
 use behaviours::{Find, Reacquire, TrackIn, TrackOut};
 use plumetrace_core::params::{Bounds, Choice, ParamError};
 use plumetrace_core::{
-    BehaviourKind, Command, Decision, DeclarationKind, Heading, PlanStatus, Planner, PlannerEvent,
+    BehaviourKind, Decision, DeclarationKind, Heading, PlanStatus, Planner, PlannerEvent,
     RegionEvent, SensorSnapshot, Telemetry, Vec2, VerticalCommand, wrap_deg_360,
 };
 use plumetrace_guidance::{Autopilot, AutopilotParams, FollowLine, GoToPoint, OpArea, Steer};
@@ -233,16 +233,7 @@ impl AmpParams {
         if self.map_declaration == MapDeclaration::Off {
             return Ok(None);
         }
-        let model = crate::planners::infotaxis::map_model!(self);
-        let rule = MapRule {
-            radius_m: self.map_radius_m,
-            mass: self.map_mass,
-            check_period_s: self.map_check_s,
-            min_detections: u64::from(self.map_min_detections),
-            hold_s: self.map_hold_s,
-            estimate_radius_m: self.map_estimate_radius_m,
-        };
-        crate::planners::infotaxis::build_tracker(area, model, rule, self.threshold_v).map(Some)
+        crate::planners::infotaxis::map_tracker!(self, area).map(Some)
     }
 
     /// The declaration rule the keys describe.
@@ -1013,6 +1004,16 @@ impl Planner for Amp {
             telemetry.extend(estimate.map(|pos_m| Telemetry::SourceEstimate { pos_m }));
         }
         let flow = self.m.flow.velocity_mps();
+        let tracing = matches!(
+            self.switching.active(),
+            BehaviourKind::TrackIn | BehaviourKind::TrackOut | BehaviourKind::Reacquire
+        );
+        let altitude_m = match self.m.p.track_altitude_m {
+            a if tracing && a > 0.0 => a,
+            _ => self.m.p.altitude_m,
+        };
+        self.autopilot
+            .set_vertical(VerticalCommand::Altitude(altitude_m));
         let (command, status) = match self.autopilot.command_nav(t, &s.nav, steer, flow) {
             Ok(c) => (c, status),
             Err(abort) => {
@@ -1021,21 +1022,6 @@ impl Planner for Amp {
                 });
                 (abort.command, PlanStatus::Abort)
             }
-        };
-        let tracing = matches!(
-            self.switching.active(),
-            BehaviourKind::TrackIn | BehaviourKind::TrackOut | BehaviourKind::Reacquire
-        );
-        let command = if tracing && self.m.p.track_altitude_m > 0.0 {
-            match command.vertical {
-                VerticalCommand::Altitude(_) => Command {
-                    vertical: VerticalCommand::Altitude(self.m.p.track_altitude_m),
-                    ..command
-                },
-                _ => command,
-            }
-        } else {
-            command
         };
         telemetry.append(&mut self.m.map_telemetry);
         Decision {
