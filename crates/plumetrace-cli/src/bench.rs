@@ -4,10 +4,11 @@
 //! source-likelihood map's update at the Duck op-area size. Each prints one JSON object.
 //!
 //! The pompy case is pompy's own scenario (x 0-100 m, y -50-50 m, 21 x 21 Farrell grid, 1 m/s,
-//! source at (5, 0), dt 0.01 s); the field case is the `field-scale` preset. After a warm-up the
-//! environment is stepped for `--duration` simulated seconds; the CPU time of those steps over the
-//! sum of live filaments gives the cost per filament-step (flow update included, as in pompy's
-//! figure). Point queries are then timed on the final filament set, apart from the one-off index
+//! source at (5, 0), dt 0.01 s; the `pompy` preset, whose grid advances every 0.05 s, pompy's
+//! at every step: `--flow-step 0` for that); the field case is the `field-scale` preset. After a
+//! warm-up the environment is stepped for `--duration` simulated seconds; the CPU time of those
+//! steps over the sum of live filaments gives the cost per filament-step (flow update included,
+//! as in pompy's figure; `flow_ns_per_step` gives its share). Point queries are then timed on the final filament set, apart from the one-off index
 //! build, at points drawn around live filaments (inside the plume, the costly case) and uniformly
 //! over the domain. Cross-flow spread statistics at x = 25, 50 and 75 m are gathered every
 //! simulated second for the comparison with pompy.
@@ -371,6 +372,10 @@ pub struct PlumeBenchArgs {
     /// Use physical dispersion in the pompy case instead of pompy's scaling.
     #[arg(long, conflicts_with = "pompy_compatible")]
     physical: bool,
+    /// The flow grid's own step, s (`flow.farrell.step_s`; default: the scenario's, 0.05 s in
+    /// the pompy case; 0 steps the grid with the plume).
+    #[arg(long, allow_hyphen_values = true, value_parser = crate::args::number)]
+    flow_step: Option<f64>,
     /// Number of point queries to time.
     #[arg(long, default_value_t = 200_000)]
     queries: usize,
@@ -397,6 +402,13 @@ struct PlumeBench {
     ns_per_filament_step_min: f64,
     ns_per_filament_step_blocks: Vec<f64>,
     ns_per_step: f64,
+    /// Of `ns_per_step`, the flow's own update (a copy of the flow stepped as the environment
+    /// steps it, on its own), per plume step: the fixed cost per step that the filaments share.
+    flow_ns_per_step: f64,
+    /// The flow advances once every this many plume steps (`flow.farrell.step_s`).
+    flow_every_steps: u64,
+    /// Flow sub-steps per advance.
+    flow_substeps: u64,
     mean_live_filaments: f64,
     final_live_filaments: usize,
     sim_s_per_cpu_s: f64,
@@ -471,6 +483,15 @@ fn build_env(a: &PlumeBenchArgs) -> Result<(Environment, bool, f64, f64, f64)> {
             // Keep one mass unit per filament, as in pompy.
             s.filament_rate_hz = rate;
             s.mass_rate_per_s = rate;
+        }
+    }
+    if let Some(step) = a.flow_step {
+        if !(step.is_finite() && step >= 0.0) {
+            bail!("--flow-step must be a finite number >= 0, got {step}");
+        }
+        match cfg.flow.farrell.as_mut() {
+            Some(f) => f.step_s = step,
+            None => bail!("--flow-step needs a Farrell flow; the {name} case has none"),
         }
     }
     if a.pompy_compatible {
@@ -624,6 +645,8 @@ fn plume(a: &PlumeBenchArgs) -> Result<PlumeBench> {
         }
     }
     let mean_live = live_sum as f64 / timed_steps as f64;
+    let (flow_every_steps, flow_substeps) = plumetrace_env::flow_schedule(env.flow(), env.dt_s());
+    let flow_ns_per_step = time_flow(&env, timed_steps, blocks as usize)?;
     Ok(PlumeBench {
         case: a.case,
         pompy_compatible,
@@ -639,6 +662,9 @@ fn plume(a: &PlumeBenchArgs) -> Result<PlumeBench> {
         ns_per_filament_step_min: per_block.iter().copied().fold(f64::INFINITY, f64::min),
         ns_per_filament_step_blocks: per_block.clone(),
         ns_per_step: cpu * 1e9 / timed_steps as f64,
+        flow_ns_per_step,
+        flow_every_steps,
+        flow_substeps,
         mean_live_filaments: mean_live,
         final_live_filaments: f.len(),
         sim_s_per_cpu_s: timed_steps as f64 * dt / cpu.max(1e-12),
@@ -653,6 +679,34 @@ fn plume(a: &PlumeBenchArgs) -> Result<PlumeBench> {
         crossflow_samples: samples,
         threads: 1,
     })
+}
+
+/// CPU ns per plume step of the environment's flow alone: a copy advanced as the environment
+/// advances it over `steps` plume steps ([`plumetrace_env::flow_schedule`]), the median over
+/// `blocks`.
+fn time_flow(env: &Environment, steps: u64, blocks: usize) -> Result<f64> {
+    use plumetrace_env::FlowField;
+    let mut flow = env.flow().clone();
+    let mut rng = stream_rng(1, StreamId::Custom(78));
+    let dt = env.dt_s();
+    let (every, n) = plumetrace_env::flow_schedule(&flow, dt);
+    let h = every as f64 * dt / n as f64;
+    let mut t = flow.time_s();
+    let advances = steps.div_ceil(every).max(1);
+    let per_block = advances.div_ceil(blocks.max(1) as u64).max(1);
+    let mut ns = Vec::new();
+    let mut done = 0;
+    while done < advances {
+        let k = per_block.min(advances - done);
+        let c0 = ProcessTime::now();
+        for _ in 0..k * n {
+            t += h;
+            flow.advance(t, h, &mut rng)?;
+        }
+        ns.push(c0.elapsed().as_secs_f64() * 1e9 / (k * every) as f64);
+        done += k;
+    }
+    Ok(median(&ns))
 }
 
 /// The median of a non-empty list (NaN for an empty one).

@@ -288,14 +288,17 @@ fn check(file: &std::path::Path) -> Result<()> {
         .collect();
     let env = &setup.env;
     let flow = plumetrace_env::FlowField::max_stable_dt_s(env.flow());
-    let sub = |step: f64| plumetrace_env::environment::flow_substeps(env.flow(), step);
+    let sub = |step: f64| match plumetrace_env::flow_schedule(env.flow(), step) {
+        (1, n) => format!("{n} flow sub-steps per step"),
+        (every, _) => format!("one flow step per {every} steps"),
+    };
     let plume_steps = format!(
         "plume steps of {} s, {} s in the spin-up{}",
         env.dt_s(),
         setup.spec.spinup_dt_s,
         match flow {
             Some(limit) => format!(
-                " (the flow's stable limit {limit:.1} s: {} and {} flow sub-steps per step)",
+                " (the flow's stable limit {limit:.1} s: {} and {})",
                 sub(env.dt_s()),
                 sub(setup.spec.spinup_dt_s)
             ),

@@ -54,7 +54,9 @@ impl ConcentrationField for Plume {
 ///
 /// Time is the integer step count times `dt`. The plume steps at `dt` (and the spin-up's step);
 /// a flow with a stability limit (the Farrell grid) is advanced in as many equal sub-steps as
-/// keep each at most half its limit ([`flow_substeps`]), so the plume's step is free of it. The flow and the plume each draw from their own
+/// keep each at most half its limit ([`flow_substeps`]), so the plume's step is free of it, and
+/// a flow with a step of its own longer than the plume's advances once per block of plume steps
+/// ([`flow_schedule`]). The flow and the plume each draw from their own
 /// random stream, so what vehicles do never changes the plume they meet.
 #[derive(Debug)]
 pub struct Environment {
@@ -66,6 +68,8 @@ pub struct Environment {
     step: u64,
     /// Simulated time spent in spin-up before step 0, s.
     spinup_s: f64,
+    /// Plume steps left in the flow's current block (see [`flow_schedule`]); 0 starts a block.
+    flow_block_left: u64,
     flow_rng: SimRng,
     plume_rng: SimRng,
 }
@@ -93,6 +97,7 @@ impl Environment {
             dt_s,
             step: 0,
             spinup_s: 0.0,
+            flow_block_left: 0,
             flow_rng: stream_rng(seed, StreamId::Flow),
             plume_rng: stream_rng(seed, StreamId::Plume),
         })
@@ -115,14 +120,30 @@ impl Environment {
         Ok(())
     }
 
-    /// Advances the flow (in its own sub-steps) and then the plume (in one step) to `t_new_s`.
+    /// Advances the flow (in its own sub-steps, or once per block of steps, see
+    /// [`flow_schedule`]) and then the plume (in one step) to `t_new_s`.
     fn advance(&mut self, t_new_s: f64, dt_s: f64) -> Result<(), EnvError> {
-        let n = flow_substeps(&self.flow, dt_s);
-        let h = dt_s / n as f64;
+        let (every, n) = flow_schedule(&self.flow, dt_s);
         let t0 = t_new_s - dt_s;
-        for k in 1..=n {
-            let t = if k == n { t_new_s } else { t0 + k as f64 * h };
-            self.flow.advance(t, h, &mut self.flow_rng)?;
+        if every > 1 {
+            // At a block's first step the flow advances to the block's middle plus half a step:
+            // each filament step of the block then meets, on average, the flow of its own end,
+            // as with the flow stepped at every plume step.
+            if self.flow_block_left == 0 {
+                let h = every as f64 * dt_s;
+                let to = t0 + 0.5 * (h + dt_s);
+                let by = to - self.flow.time_s();
+                self.flow.advance(to, by, &mut self.flow_rng)?;
+                self.flow_block_left = every;
+            }
+            self.flow_block_left -= 1;
+        } else {
+            self.flow_block_left = 0;
+            let h = dt_s / n as f64;
+            for k in 1..=n {
+                let t = if k == n { t_new_s } else { t0 + k as f64 * h };
+                self.flow.advance(t, h, &mut self.flow_rng)?;
+            }
         }
         if let Plume::Filaments(p) = &mut self.plume {
             p.step(&self.flow, t_new_s, dt_s, &mut self.plume_rng);
@@ -151,6 +172,7 @@ impl Environment {
             dt_s: self.dt_s,
             step: self.step,
             spinup_s: self.spinup_s,
+            flow_block_left: self.flow_block_left,
             flow_rng: self.flow_rng.clone(),
             plume_rng: self.plume_rng.clone(),
         })
@@ -227,6 +249,32 @@ impl Environment {
     pub fn concentration_at(&self, p: Vec3) -> f64 {
         self.plume.concentration(p)
     }
+}
+
+/// How a flow is stepped along plume steps of `dt_s`: `(every, substeps)`, the flow advancing
+/// once every `every` plume steps by `every * dt_s` in `substeps` equal sub-steps.
+///
+/// A flow with its own step ([`FlowField::own_step_s`]) longer than `dt_s` (and `dt_s` within
+/// half its stable limit) advances once per block of `every` plume steps, the most whose total
+/// is at most its own step and at most half its stable limit: at the block's first step, in one
+/// step to the block's middle plus half a plume step; the filaments of the block move in that
+/// flow (on average each plume step meets the flow of its own end, as without blocks). Otherwise it advances at every plume step, in
+/// [`flow_substeps`] sub-steps.
+pub fn flow_schedule(flow: &dyn FlowField, dt_s: f64) -> (u64, u64) {
+    let n = flow_substeps(flow, dt_s);
+    let Some(own) = flow.own_step_s() else {
+        return (1, n);
+    };
+    if n > 1 || own <= dt_s {
+        return (1, n);
+    }
+    let cap = match flow.max_stable_dt_s() {
+        Some(limit) if limit > 0.0 => own.min(0.5 * limit),
+        _ => own,
+    };
+    // A whole number of steps, with a margin for steps like 0.1 / 0.01 that divide in decimal.
+    let every = (cap / dt_s * (1.0 + 1e-9)).floor();
+    (if every >= 1.0 { every as u64 } else { 1 }, 1)
 }
 
 /// The number of equal sub-steps a flow takes for an environment step of `dt_s`: one when `dt_s`

@@ -808,3 +808,101 @@ fn the_pruned_sensor_scan_is_bit_for_bit_the_full_scan() {
         );
     }
 }
+
+fn farrell_with_step(domain: Rect, mean: MeanFlow, params: FarrellParams) -> FlowModel {
+    FlowModel::Farrell(Box::new(
+        FarrellFlow::substepped(domain, mean, params).unwrap(),
+    ))
+}
+
+#[test]
+fn a_grid_with_its_own_step_advances_once_per_block_of_plume_steps() {
+    use plumetrace_env::{FlowField, flow_schedule};
+    let domain = rect(0.0, 100.0, -50.0, 50.0);
+    let with_step = |step_s| FarrellParams {
+        step_s,
+        ..FarrellParams::default()
+    };
+    let flow = farrell_with_step(domain, east(1.0), with_step(0.1));
+    // pompy's grid: stable below about 0.25 s, so 0.1 s is within half the limit.
+    let limit = flow.max_stable_dt_s().unwrap();
+    assert!(0.2 < limit && limit < 0.3, "limit {limit}");
+    assert_eq!(flow_schedule(&flow, 0.01), (10, 1));
+    assert_eq!(flow_schedule(&flow, 0.1), (1, 1));
+    assert_eq!(flow_schedule(&flow, 0.03), (3, 1));
+    // Capped at half the stable limit; a plume step beyond that takes sub-steps as before.
+    let long = farrell_with_step(domain, east(1.0), with_step(10.0));
+    let cap = (0.5 * limit / 0.01).floor() as u64;
+    assert_eq!(flow_schedule(&long, 0.01), (cap, 1));
+    assert_eq!(flow_schedule(&long, 1.0).0, 1);
+    assert!(flow_schedule(&long, 1.0).1 > 1);
+    let along = farrell_with_step(domain, east(1.0), with_step(0.0));
+    assert_eq!(flow_schedule(&along, 0.01), (1, 1));
+
+    // The environment advances the grid at the first step of each block, to the block's
+    // middle plus half a plume step.
+    let src = Source {
+        pos_m: Vec3::new(5.0, 0.0, 0.0),
+        mass_rate_per_s: 5.0,
+        filament_rate_hz: 5.0,
+    };
+    let mut env = filament_env(domain, flow, src, FilamentParams::default(), 0.01, 3);
+    let mut times = Vec::new();
+    for _ in 0..21 {
+        env.step().unwrap();
+        times.push(env.flow().time_s());
+    }
+    for (k, t) in times.iter().enumerate() {
+        let want = 0.1 * (k / 10) as f64 + 0.055;
+        assert!(
+            (t - want).abs() < 1e-9,
+            "after step {}: flow at {t} s, want {want}",
+            k + 1
+        );
+    }
+}
+
+#[test]
+fn the_grid_s_own_step_leaves_the_filaments_step_alone() {
+    // Without noise the grid keeps the uniform mean flow exactly, whatever its step: the
+    // filaments must then be the same bits whether the grid steps with them or once per block
+    // (their release, walk and removal follow the plume's step, not the grid's).
+    let domain = rect(0.0, 100.0, -50.0, 50.0);
+    let src = Source {
+        pos_m: Vec3::new(5.0, 0.0, 0.0),
+        mass_rate_per_s: 5.0,
+        filament_rate_hz: 20.0,
+    };
+    let run_with = |step_s, pompy| {
+        let fp = FarrellParams {
+            noise_gain: 0.0,
+            step_s,
+            ..FarrellParams::default()
+        };
+        let params = FilamentParams {
+            dispersion: if pompy {
+                Dispersion::PompyCompatible {
+                    scale_mps: [2.0, 2.0, 2.0],
+                }
+            } else {
+                FilamentParams::default().dispersion
+            },
+            ..FilamentParams::default()
+        };
+        let flow = farrell_with_step(domain, east(1.0), fp);
+        let mut env = filament_env(domain, flow, src, params, 0.01, 8);
+        run(&mut env, 30.0);
+        let f = filaments(&env);
+        assert!(f.len() > 300, "{} filaments", f.len());
+        f.filaments()
+            .flat_map(|(p, r2)| [p.x.to_bits(), p.y.to_bits(), p.z.to_bits(), r2.to_bits()])
+            .collect::<Vec<u64>>()
+    };
+    for pompy in [false, true] {
+        assert_eq!(
+            run_with(0.0, pompy),
+            run_with(0.1, pompy),
+            "pompy mode {pompy}"
+        );
+    }
+}

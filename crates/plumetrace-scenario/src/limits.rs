@@ -165,6 +165,12 @@ pub const LIMITS: &[Limit] = &[
         "a meander faster than 100 rad/s is not a meander",
     ),
     num(
+        "flow.farrell.step_s",
+        0.0,
+        3600.0,
+        "capped at half the grid's stable limit anyway; an hour is far past any meander's time scale",
+    ),
+    num(
         "plume.horizontal_diffusivity_m2ps",
         0.0,
         1e3,

@@ -9,6 +9,10 @@
 //!    `du/dt = -(u du/dx + v du/dy) + k_x/2 d2u/dx2 + k_y/2 d2u/dy2` (and the same for `v`) with
 //!    centred differences.
 //!
+//! The environment advances the grid with the plume, in sub-steps within its stable limit, or,
+//! with `step_s` longer than the plume's step, once per block of plume steps
+//! ([`crate::environment::flow_schedule`]).
+//!
 //! Velocities between nodes are **bilinear** interpolations of the four surrounding nodes (the
 //! reference uses a cubic spline; bilinear is cheaper and keeps the field within the range of its
 //! nodes). Positions outside the grid take the value at the nearest edge.
@@ -55,6 +59,11 @@ pub struct FarrellParams {
     pub original_noise_updates: bool,
     /// How the corner noise is integrated (ignored with `original_noise_updates`).
     pub noise_scheme: NoiseScheme,
+    /// The grid's own step, s, when the plume steps more finely: the grid then advances once
+    /// per this many seconds (a whole number of plume steps, at most half the stable limit) and
+    /// the filaments in between move in the grid of the block's end. 0 (the default): the grid
+    /// steps with the plume.
+    pub step_s: f64,
 }
 
 /// The integration of the corner noise.
@@ -81,6 +90,7 @@ impl Default for FarrellParams {
             noise_bandwidth_radps: 0.2,
             original_noise_updates: false,
             noise_scheme: NoiseScheme::Exact,
+            step_s: 0.0,
         }
     }
 }
@@ -263,7 +273,8 @@ fn oscillator_transition(z: f64, w: f64, dt: f64) -> Mat2 {
     [[c + g * z * w, g], [-g * w * w, c - g * z * w]]
 }
 
-/// One grid cell's bilinear coefficients (see `FarrellFlow::cells`).
+/// One grid cell's bilinear coefficients, `u` then `v`: `a + b tx + c ty + d tx ty` over the
+/// cell's unit square, so a lookup reads one aligned cache line (see `FarrellFlow::cells`).
 #[derive(Debug, Clone, Copy)]
 #[repr(align(64))]
 struct Cell([f64; 8]);
@@ -285,9 +296,8 @@ pub struct FarrellFlow {
     /// ring is stale until the next boundary update rewrites it).
     u_next: Vec<f64>,
     v_next: Vec<f64>,
-    /// Per grid cell `(i, j)` (index `j * (nx - 1) + i`), the bilinear coefficients of `u` then
-    /// `v`: `a + b tx + c ty + d tx ty` over the cell's unit square: a lookup reads one aligned
-    /// cache line. Rebuilt after every step.
+    /// Per grid cell `(i, j)` (index `j * (nx - 1) + i`), its coefficients ([`Cell`]), rebuilt
+    /// after every step.
     cells: Vec<Cell>,
     noise: ColouredNoise,
     time_s: f64,
@@ -365,6 +375,7 @@ impl FarrellFlow {
         require_positive("flow.farrell.diffusivity_x_m2ps", params.diffusivity_x_m2ps)?;
         require_positive("flow.farrell.diffusivity_y_m2ps", params.diffusivity_y_m2ps)?;
         require_non_negative("flow.farrell.noise_gain", params.noise_gain)?;
+        require_non_negative("flow.farrell.step_s", params.step_s)?;
         require_positive("flow.farrell.noise_damping", params.noise_damping)?;
         require_positive(
             "flow.farrell.noise_bandwidth_radps",
@@ -506,43 +517,83 @@ impl FarrellFlow {
         let hy = 0.5 * self.inv_dy * dt_s;
         let kx = 0.5 * self.params.diffusivity_x_m2ps * self.inv_dx * self.inv_dx * dt_s;
         let ky = 0.5 * self.params.diffusivity_y_m2ps * self.inv_dy * self.inv_dy * dt_s;
-        let mut max_sq: f64 = 0.0;
-        let mut finite = true;
+        // One run over the rows from the first interior node to the last, the ring's columns
+        // between them included: the values written there are never read (the next boundary
+        // update rewrites the ring before the next step, and nothing else reads it), and one
+        // long run fills the vector lanes where rows of a small grid would leave remainders.
+        // Every neighbour column is cut to the run's length, so the loop has no bounds checks.
+        let first = nx2 + 1;
+        let len = (ny - 1) * nx2 + nx;
         let (u, v) = (&self.u, &self.v);
-        for j in 1..=ny {
-            let row = |r: usize| r * nx2..(r + 1) * nx2;
-            let (us, uc, un) = (&u[row(j - 1)], &u[row(j)], &u[row(j + 1)]);
-            let (vs, vc, vn) = (&v[row(j - 1)], &v[row(j)], &v[row(j + 1)]);
-            let uo = &mut self.u_next[j * nx2 + 1..j * nx2 + 1 + nx];
-            let vo = &mut self.v_next[j * nx2 + 1..j * nx2 + 1 + nx];
-            // Node i of the interior row sits at i + 1 in the ring-padded rows.
-            let cols = uc
-                .windows(3)
-                .zip(vc.windows(3))
-                .zip(us[1..].iter().zip(&un[1..]))
-                .zip(vs[1..].iter().zip(&vn[1..]));
-            for ((((uw, vw), (u_s, u_n)), (v_s, v_n)), (o_u, o_v)) in
-                cols.zip(uo.iter_mut().zip(vo.iter_mut()))
-            {
-                let (uw0, uc0, ue0) = (uw[0], uw[1], uw[2]);
-                let (vw0, vc0, ve0) = (vw[0], vw[1], vw[2]);
-                let du = -(uc0 * (ue0 - uw0) * hx + vc0 * (u_n - u_s) * hy)
-                    + kx * (ue0 - 2.0 * uc0 + uw0)
-                    + ky * (u_n - 2.0 * uc0 + u_s);
-                let dv = -(uc0 * (ve0 - vw0) * hx + vc0 * (v_n - v_s) * hy)
-                    + kx * (ve0 - 2.0 * vc0 + vw0)
-                    + ky * (v_n - 2.0 * vc0 + v_s);
-                let (a, b) = (uc0 + du, vc0 + dv);
-                *o_u = a;
-                *o_v = b;
-                let sq = a * a + b * b;
-                finite &= sq.is_finite();
-                max_sq = max_sq.max(sq);
-            }
+        let (uw, uc, ue) = (
+            span(u, first - 1, len),
+            span(u, first, len),
+            span(u, first + 1, len),
+        );
+        let (us, un) = (span(u, first - nx2, len), span(u, first + nx2, len));
+        let (vw, vc, ve) = (
+            span(v, first - 1, len),
+            span(v, first, len),
+            span(v, first + 1, len),
+        );
+        let (vs, vn) = (span(v, first - nx2, len), span(v, first + nx2, len));
+        let uo = &mut self.u_next[first..first + len];
+        let vo = &mut self.v_next[first..first + len];
+        for i in 0..len {
+            let (uw0, uc0, ue0, u_s, u_n) = (uw[i], uc[i], ue[i], us[i], un[i]);
+            let (vw0, vc0, ve0, v_s, v_n) = (vw[i], vc[i], ve[i], vs[i], vn[i]);
+            let du = -(uc0 * (ue0 - uw0) * hx + vc0 * (u_n - u_s) * hy)
+                + kx * (ue0 - 2.0 * uc0 + uw0)
+                + ky * (u_n - 2.0 * uc0 + u_s);
+            let dv = -(uc0 * (ve0 - vw0) * hx + vc0 * (v_n - v_s) * hy)
+                + kx * (ve0 - 2.0 * vc0 + vw0)
+                + ky * (v_n - 2.0 * vc0 + v_s);
+            uo[i] = uc0 + du;
+            vo[i] = vc0 + dv;
         }
         std::mem::swap(&mut self.u, &mut self.u_next);
         std::mem::swap(&mut self.v, &mut self.v_next);
-        self.max_speed_mps = if finite { max_sq.sqrt() } else { f64::NAN };
+        self.max_speed_mps = self.largest_speed();
+    }
+
+    /// The largest node speed of the interior, NaN when any node is not finite. Reduced in
+    /// eight lanes (the largest square and the sum of squares, which is not finite exactly when
+    /// some square is not or the field has run away past 1e150 m/s), so the loop runs in vector
+    /// lanes; the maximum does not depend on the order.
+    #[inline(always)]
+    fn largest_speed(&self) -> f64 {
+        const LANES: usize = 8;
+        let (nx, ny) = (self.params.nx, self.params.ny);
+        let nx2 = nx + 2;
+        let mut top = [0.0f64; LANES];
+        let mut sum = [0.0f64; LANES];
+        let mut tail_top = 0.0f64;
+        let mut tail_sum = 0.0f64;
+        for j in 1..=ny {
+            let c = j * nx2 + 1;
+            let (u, v) = (&self.u[c..c + nx], &self.v[c..c + nx]);
+            let mut uc = u.chunks_exact(LANES);
+            let mut vc = v.chunks_exact(LANES);
+            for (a, b) in (&mut uc).zip(&mut vc) {
+                for l in 0..LANES {
+                    let sq = a[l] * a[l] + b[l] * b[l];
+                    top[l] = if sq > top[l] { sq } else { top[l] };
+                    sum[l] += sq;
+                }
+            }
+            for (a, b) in uc.remainder().iter().zip(vc.remainder()) {
+                let sq = a * a + b * b;
+                tail_top = if sq > tail_top { sq } else { tail_top };
+                tail_sum += sq;
+            }
+        }
+        let top = top.iter().fold(tail_top, |m, &t| if t > m { t } else { m });
+        let sum = sum.iter().sum::<f64>() + tail_sum;
+        if sum.is_finite() {
+            top.sqrt()
+        } else {
+            f64::NAN
+        }
     }
 
     /// Rebuilds the cells' bilinear coefficients from the interior nodes.
@@ -550,26 +601,33 @@ impl FarrellFlow {
     fn build_cells(&mut self) {
         let (nx, ny) = (self.params.nx, self.params.ny);
         let nx2 = nx + 2;
-        self.cells.clear();
-        self.cells.reserve((nx - 1) * (ny - 1));
+        let row = nx - 1;
+        self.cells.resize(row * (ny - 1), Cell([0.0; 8]));
         let (u, v) = (&self.u, &self.v);
-        for j in 0..ny - 1 {
-            for i in 0..nx - 1 {
-                // Interior node (i, j) sits at (i + 1, j + 1) in the ring-padded arrays.
-                let k00 = (j + 1) * nx2 + i + 1;
-                let (k10, k01, k11) = (k00 + 1, k00 + nx2, k00 + nx2 + 1);
-                let coeffs = |f: &[f64]| {
-                    [
-                        f[k00],
-                        f[k10] - f[k00],
-                        f[k01] - f[k00],
-                        f[k11] - f[k10] - f[k01] + f[k00],
-                    ]
-                };
-                let (cu, cv) = (coeffs(u), coeffs(v));
-                self.cells.push(Cell([
-                    cu[0], cu[1], cu[2], cu[3], cv[0], cv[1], cv[2], cv[3],
-                ]));
+        for (j, cells) in self.cells.chunks_exact_mut(row).enumerate() {
+            // Interior node (i, j) sits at (i + 1, j + 1) in the ring-padded arrays; the cells of
+            // row j read nodes i and i + 1 of rows j and j + 1.
+            let lo = (j + 1) * nx2 + 1;
+            let hi = lo + nx2;
+            let at = |f, start| span(f, start, nx);
+            let (us, un, vs, vn) = (at(u, lo), at(u, hi), at(v, lo), at(v, hi));
+            let pairs = us
+                .windows(2)
+                .zip(un.windows(2))
+                .zip(vs.windows(2).zip(vn.windows(2)));
+            for (cell, ((a, b), (c, d))) in cells.iter_mut().zip(pairs) {
+                // Each component's `f00, f10 - f00, f01 - f00, f11 - f10 - f01 + f00` from the
+                // pairs of neighbours along rows j and j + 1.
+                cell.0 = [
+                    a[0],
+                    a[1] - a[0],
+                    b[0] - a[0],
+                    b[1] - a[1] - b[0] + a[0],
+                    c[0],
+                    c[1] - c[0],
+                    d[0] - c[0],
+                    d[1] - c[1] - d[0] + c[0],
+                ];
             }
         }
     }
@@ -581,6 +639,12 @@ impl FarrellFlow {
         let (j, ty) = axis_weight(y, self.region.y_min_m, self.inv_dy, ny);
         bilinear(&self.cells[j * (nx - 1) + i], tx, ty)
     }
+}
+
+/// `len` values of `f` from `start`.
+#[inline(always)]
+fn span(f: &[f64], start: usize, len: usize) -> &[f64] {
+    &f[start..start + len]
 }
 
 /// [`axis_weight`] in floating point only: the lower node's index (as a whole `f64`, at most
@@ -728,6 +792,9 @@ impl FlowField for FarrellFlow {
     }
     fn max_stable_dt_s(&self) -> Option<f64> {
         Some(self.max_stable_dt_s)
+    }
+    fn own_step_s(&self) -> Option<f64> {
+        (self.params.step_s > 0.0).then_some(self.params.step_s)
     }
 }
 

@@ -53,6 +53,12 @@ pub trait FlowField: Send + Sync + std::fmt::Debug {
     fn max_stable_dt_s(&self) -> Option<f64> {
         None
     }
+
+    /// The step the model asks to be advanced with when the plume steps more finely, s (`None`:
+    /// with every plume step); see [`crate::environment::flow_schedule`].
+    fn own_step_s(&self) -> Option<f64> {
+        None
+    }
 }
 
 /// The flow models known to plumetrace, for static dispatch and for the model registry.
@@ -102,6 +108,9 @@ impl FlowField for FlowModel {
     }
     fn max_stable_dt_s(&self) -> Option<f64> {
         self.inner().max_stable_dt_s()
+    }
+    fn own_step_s(&self) -> Option<f64> {
+        self.inner().own_step_s()
     }
 }
 
