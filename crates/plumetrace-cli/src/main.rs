@@ -267,6 +267,15 @@ fn check(file: &std::path::Path) -> Result<()> {
                 every as f64 * dt
             );
         }
+        match plumetrace_env::flow_schedule(built.env.flow(), dt) {
+            (1, 1) => {}
+            (1, n) => {
+                let _ = write!(series, "; {n} flow sub-steps per step");
+            }
+            (every, _) => {
+                let _ = write!(series, "; the flow grid steps once per {every} steps");
+            }
+        }
         crate::outln!(
             "{}: ok (plume run, {steps} steps of {dt} s{series})",
             file.display()

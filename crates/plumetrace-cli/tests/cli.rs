@@ -417,3 +417,36 @@ fn the_readme_has_the_limits_table() {
         "the README's limits table is not the code's: paste `plumetrace limits --markdown`"
     );
 }
+
+#[test]
+fn check_says_how_the_flow_grid_steps() {
+    let dir = tempfile::tempdir().unwrap();
+    let text = std::fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../plumetrace-scenario/presets/pompy.toml"
+    ))
+    .unwrap();
+    let check = |text: &str| {
+        let p = dir.path().join("pompy.toml");
+        std::fs::write(&p, text).unwrap();
+        String::from_utf8_lossy(&run_ok(&["check", p.to_str().unwrap()]).stdout).into_owned()
+    };
+    // The preset's grid steps every 0.05 s under 0.01 s puff steps.
+    let out = check(&text);
+    assert!(
+        out.contains("the flow grid steps once per 5 steps"),
+        "{out}"
+    );
+    // With the plume's step (no block), nothing is said.
+    let along = text.replace("step_s = 0.05", "step_s = 0.0");
+    assert_ne!(along, text);
+    let out = check(&along);
+    assert!(
+        out.contains("ok (plume run") && !out.contains("flow"),
+        "{out}"
+    );
+    // A plume step beyond half the grid's stable limit takes sub-steps.
+    let coarse = along.replace("dt_s = 0.01", "dt_s = 0.5");
+    let out = check(&coarse);
+    assert!(out.contains("flow sub-steps per step"), "{out}");
+}
