@@ -8,9 +8,9 @@
 //! at every step: `--flow-step 0` for that); the field case is the `field-scale` preset. After a
 //! warm-up the environment is stepped for `--duration` simulated seconds; the CPU time of those
 //! steps over the sum of live filaments gives the cost per filament-step (flow update included,
-//! as in pompy's figure; `flow_ns_per_step` gives its share). Point queries are then timed on the final filament set, apart from the one-off index
-//! build, at points drawn around live filaments (inside the plume, the costly case) and uniformly
-//! over the domain. Cross-flow spread statistics at x = 25, 50 and 75 m are gathered every
+//! as in pompy's figure; `flow_ns_per_step` gives its share). Point queries are then timed on
+//! the final filament set, apart from the one-off index build, at points drawn around live
+//! filaments (inside the plume, the costly case) and uniformly over the domain. Cross-flow spread statistics at x = 25, 50 and 75 m are gathered every
 //! simulated second for the comparison with pompy.
 
 use anyhow::{Result, bail};
@@ -681,29 +681,26 @@ fn plume(a: &PlumeBenchArgs) -> Result<PlumeBench> {
     })
 }
 
-/// CPU ns per plume step of the environment's flow alone: a copy advanced as the environment
-/// advances it over `steps` plume steps ([`plumetrace_env::flow_schedule`]), the median over
+/// CPU ns per plume step of the environment's flow alone: a copy of the flow and of its stepper
+/// advanced over `steps` more plume steps as the environment would advance them, the median over
 /// `blocks`.
 fn time_flow(env: &Environment, steps: u64, blocks: usize) -> Result<f64> {
-    use plumetrace_env::FlowField;
     let mut flow = env.flow().clone();
+    let mut stepper = env.flow_stepper().clone();
     let mut rng = stream_rng(1, StreamId::Custom(78));
     let dt = env.dt_s();
-    let (every, n) = plumetrace_env::flow_schedule(&flow, dt);
-    let h = every as f64 * dt / n as f64;
-    let mut t = flow.time_s();
-    let advances = steps.div_ceil(every).max(1);
-    let per_block = advances.div_ceil(blocks.max(1) as u64).max(1);
+    let mut t = env.elapsed_s();
+    let per_block = steps.div_ceil(blocks.max(1) as u64).max(1);
     let mut ns = Vec::new();
     let mut done = 0;
-    while done < advances {
-        let k = per_block.min(advances - done);
+    while done < steps {
+        let k = per_block.min(steps - done);
         let c0 = ProcessTime::now();
-        for _ in 0..k * n {
-            t += h;
-            flow.advance(t, h, &mut rng)?;
+        for _ in 0..k {
+            t += dt;
+            stepper.advance(&mut flow, t, dt, &mut rng)?;
         }
-        ns.push(c0.elapsed().as_secs_f64() * 1e9 / (k * every) as f64);
+        ns.push(c0.elapsed().as_secs_f64() * 1e9 / k as f64);
         done += k;
     }
     Ok(median(&ns))

@@ -242,6 +242,14 @@ fn planners_text() -> String {
     out
 }
 
+/// How the flow steps along plume steps of `dt_s`, for `check` ([`plumetrace_env::flow_schedule`]).
+fn flow_steps(flow: &dyn plumetrace_env::FlowField, dt_s: f64) -> String {
+    match plumetrace_env::flow_schedule(flow, dt_s) {
+        (1, n) => format!("{n} flow sub-steps per step"),
+        (every, _) => format!("the flow grid steps once per {every} steps"),
+    }
+}
+
 /// `plumetrace check FILE`: everything `run` would reject, rejected here with the same message.
 fn check(file: &std::path::Path) -> Result<()> {
     let cfg = plumetrace_scenario::load_file(file)?;
@@ -267,14 +275,8 @@ fn check(file: &std::path::Path) -> Result<()> {
                 every as f64 * dt
             );
         }
-        match plumetrace_env::flow_schedule(built.env.flow(), dt) {
-            (1, 1) => {}
-            (1, n) => {
-                let _ = write!(series, "; {n} flow sub-steps per step");
-            }
-            (every, _) => {
-                let _ = write!(series, "; the flow grid steps once per {every} steps");
-            }
+        if plumetrace_env::flow_schedule(built.env.flow(), dt) != (1, 1) {
+            let _ = write!(series, "; {}", flow_steps(built.env.flow(), dt));
         }
         crate::outln!(
             "{}: ok (plume run, {steps} steps of {dt} s{series})",
@@ -297,10 +299,7 @@ fn check(file: &std::path::Path) -> Result<()> {
         .collect();
     let env = &setup.env;
     let flow = plumetrace_env::FlowField::max_stable_dt_s(env.flow());
-    let sub = |step: f64| match plumetrace_env::flow_schedule(env.flow(), step) {
-        (1, n) => format!("{n} flow sub-steps per step"),
-        (every, _) => format!("one flow step per {every} steps"),
-    };
+    let sub = |step: f64| flow_steps(env.flow(), step);
     let plume_steps = format!(
         "plume steps of {} s, {} s in the spin-up{}",
         env.dt_s(),

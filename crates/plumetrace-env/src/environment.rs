@@ -68,8 +68,7 @@ pub struct Environment {
     step: u64,
     /// Simulated time spent in spin-up before step 0, s.
     spinup_s: f64,
-    /// Plume steps left in the flow's current block (see [`flow_schedule`]); 0 starts a block.
-    flow_block_left: u64,
+    flow_stepper: FlowStepper,
     flow_rng: SimRng,
     plume_rng: SimRng,
 }
@@ -97,7 +96,7 @@ impl Environment {
             dt_s,
             step: 0,
             spinup_s: 0.0,
-            flow_block_left: 0,
+            flow_stepper: FlowStepper::default(),
             flow_rng: stream_rng(seed, StreamId::Flow),
             plume_rng: stream_rng(seed, StreamId::Plume),
         })
@@ -120,35 +119,19 @@ impl Environment {
         Ok(())
     }
 
-    /// Advances the flow (in its own sub-steps, or once per block of steps, see
-    /// [`flow_schedule`]) and then the plume (in one step) to `t_new_s`.
+    /// Advances the flow (by its [`FlowStepper`]) and then the plume (in one step) to `t_new_s`.
     fn advance(&mut self, t_new_s: f64, dt_s: f64) -> Result<(), EnvError> {
-        let (every, n) = flow_schedule(&self.flow, dt_s);
-        let t0 = t_new_s - dt_s;
-        if every > 1 {
-            // At a block's first step the flow advances to the block's middle plus half a step:
-            // each filament step of the block then meets, on average, the flow of its own end,
-            // as with the flow stepped at every plume step.
-            if self.flow_block_left == 0 {
-                let h = every as f64 * dt_s;
-                let to = t0 + 0.5 * (h + dt_s);
-                let by = to - self.flow.time_s();
-                self.flow.advance(to, by, &mut self.flow_rng)?;
-                self.flow_block_left = every;
-            }
-            self.flow_block_left -= 1;
-        } else {
-            self.flow_block_left = 0;
-            let h = dt_s / n as f64;
-            for k in 1..=n {
-                let t = if k == n { t_new_s } else { t0 + k as f64 * h };
-                self.flow.advance(t, h, &mut self.flow_rng)?;
-            }
-        }
+        self.flow_stepper
+            .advance(&mut self.flow, t_new_s, dt_s, &mut self.flow_rng)?;
         if let Plume::Filaments(p) = &mut self.plume {
             p.step(&self.flow, t_new_s, dt_s, &mut self.plume_rng);
         }
         Ok(())
+    }
+
+    /// How the flow is being stepped (where it is in its current block).
+    pub fn flow_stepper(&self) -> &FlowStepper {
+        &self.flow_stepper
     }
 
     /// Simulated time spent in spin-up, s.
@@ -172,7 +155,7 @@ impl Environment {
             dt_s: self.dt_s,
             step: self.step,
             spinup_s: self.spinup_s,
-            flow_block_left: self.flow_block_left,
+            flow_stepper: self.flow_stepper.clone(),
             flow_rng: self.flow_rng.clone(),
             plume_rng: self.plume_rng.clone(),
         })
@@ -251,6 +234,48 @@ impl Environment {
     }
 }
 
+/// Steps a flow along plume steps as [`flow_schedule`] says: in sub-steps at every plume step,
+/// or once per block of plume steps. It remembers where it is in the current block, so one
+/// stepper goes with one flow.
+#[derive(Debug, Clone, Default)]
+pub struct FlowStepper {
+    /// Plume steps left in the current block; 0 starts a block.
+    block_left: u64,
+}
+
+impl FlowStepper {
+    /// Advances `flow` for the plume step of `dt_s` that ends at `t_new_s`.
+    pub fn advance<F: FlowField>(
+        &mut self,
+        flow: &mut F,
+        t_new_s: f64,
+        dt_s: f64,
+        rng: &mut SimRng,
+    ) -> Result<(), EnvError> {
+        let (every, n) = flow_schedule(flow, dt_s);
+        let t0 = t_new_s - dt_s;
+        if every > 1 {
+            // At a block's first step the flow advances to the block's middle plus half a step:
+            // each plume step of the block then meets, on average, the flow of its own end, as
+            // with the flow stepped at every plume step.
+            if self.block_left == 0 {
+                let to = t0 + 0.5 * (every as f64 * dt_s + dt_s);
+                flow.advance(to, to - flow.time_s(), rng)?;
+                self.block_left = every;
+            }
+            self.block_left -= 1;
+        } else {
+            self.block_left = 0;
+            let h = dt_s / n as f64;
+            for k in 1..=n {
+                let t = if k == n { t_new_s } else { t0 + k as f64 * h };
+                flow.advance(t, h, rng)?;
+            }
+        }
+        Ok(())
+    }
+}
+
 /// How a flow is stepped along plume steps of `dt_s`: `(every, substeps)`, the flow advancing
 /// once every `every` plume steps by `every * dt_s` in `substeps` equal sub-steps.
 ///
@@ -258,8 +283,9 @@ impl Environment {
 /// half its stable limit) advances once per block of `every` plume steps, the most whose total
 /// is at most its own step and at most half its stable limit: at the block's first step, in one
 /// step to the block's middle plus half a plume step; the filaments of the block move in that
-/// flow (on average each plume step meets the flow of its own end, as without blocks). Otherwise it advances at every plume step, in
-/// [`flow_substeps`] sub-steps.
+/// flow (on average each plume step meets the flow of its own end, as without blocks).
+/// Otherwise it advances at every plume step, in [`flow_substeps`] sub-steps. [`FlowStepper`]
+/// carries it out.
 pub fn flow_schedule(flow: &dyn FlowField, dt_s: f64) -> (u64, u64) {
     let n = flow_substeps(flow, dt_s);
     let Some(own) = flow.own_step_s() else {
@@ -272,9 +298,9 @@ pub fn flow_schedule(flow: &dyn FlowField, dt_s: f64) -> (u64, u64) {
         Some(limit) if limit > 0.0 => own.min(0.5 * limit),
         _ => own,
     };
-    // A whole number of steps, with a margin for steps like 0.1 / 0.01 that divide in decimal.
-    let every = (cap / dt_s * (1.0 + 1e-9)).floor();
-    (if every >= 1.0 { every as u64 } else { 1 }, 1)
+    // A whole number of steps (at least one: `dt_s` is within both bounds), with a margin for
+    // steps like 0.1 / 0.01 that divide in decimal.
+    ((cap / dt_s * (1.0 + 1e-9)).floor().max(1.0) as u64, 1)
 }
 
 /// The number of equal sub-steps a flow takes for an environment step of `dt_s`: one when `dt_s`

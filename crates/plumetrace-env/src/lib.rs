@@ -25,7 +25,7 @@ mod simd;
 pub mod steady;
 
 pub use domain::Rect;
-pub use environment::{Environment, Plume, flow_schedule, flow_substeps};
+pub use environment::{Environment, FlowStepper, Plume, flow_schedule, flow_substeps};
 pub use error::EnvError;
 pub use field::{ConcentrationField, GridSpec, MeanConcentrationGrid};
 pub use flow::{FlowField, FlowModel};

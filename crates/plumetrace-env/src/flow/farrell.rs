@@ -61,8 +61,8 @@ pub struct FarrellParams {
     pub noise_scheme: NoiseScheme,
     /// The grid's own step, s, when the plume steps more finely: the grid then advances once
     /// per this many seconds (a whole number of plume steps, at most half the stable limit) and
-    /// the filaments in between move in the grid of the block's end. 0 (the default): the grid
-    /// steps with the plume.
+    /// the filaments in between move in that grid ([`crate::environment::flow_schedule`]).
+    /// 0 (the default): the grid steps with the plume.
     pub step_s: f64,
 }
 
