@@ -28,7 +28,7 @@ pub use finite::first_non_finite;
 pub use flow_gate::{FlowGate, FlowGateParams};
 pub use frame::{Vec2, Vec3, bearing_between, heading_vector, self_intersection};
 pub use message::{Link, Message, MessageBody, Outgoing, Recipient};
-pub use names::variant_name;
+pub use names::{closest, variant_name};
 pub use planner::{
     BehaviourKind, Decision, DeclarationKind, PlanStatus, Planner, PlannerEvent, RegionEvent,
     Telemetry,

@@ -169,3 +169,77 @@ mod tests {
         }
     }
 }
+
+/// The candidate nearest to `word`, when one is near enough to be what was meant: a typo of a
+/// letter or two (more for long words), two letters swapped, or a candidate that `word` is a
+/// part of. Used for "did you mean" in messages about unknown names.
+pub fn closest<'a>(word: &str, candidates: &[&'a str]) -> Option<&'a str> {
+    let w = word.to_ascii_lowercase();
+    let mut best: Option<(usize, &'a str)> = None;
+    for &c in candidates {
+        let lc = c.to_ascii_lowercase();
+        let d = edit_distance(&w, &lc);
+        let allowed = (w.chars().count().max(lc.chars().count()) / 3).max(1);
+        let near = d <= allowed || (w.len() >= 3 && (lc.contains(&w) || w.contains(&lc)));
+        if near && best.is_none_or(|(bd, _)| d < bd) {
+            best = Some((d, c));
+        }
+    }
+    best.map(|(_, c)| c)
+}
+
+/// Edits (insert, delete, replace, swap two neighbours) that turn `a` into `b`.
+fn edit_distance(a: &str, b: &str) -> usize {
+    let a: Vec<char> = a.chars().collect();
+    let b: Vec<char> = b.chars().collect();
+    let (n, m) = (a.len(), b.len());
+    let mut d = vec![vec![0usize; m + 1]; n + 1];
+    for (i, row) in d.iter_mut().enumerate() {
+        row[0] = i;
+    }
+    for (j, cell) in d[0].iter_mut().enumerate() {
+        *cell = j;
+    }
+    for i in 1..=n {
+        for j in 1..=m {
+            let cost = usize::from(a[i - 1] != b[j - 1]);
+            let mut v = (d[i - 1][j] + 1)
+                .min(d[i][j - 1] + 1)
+                .min(d[i - 1][j - 1] + cost);
+            if i > 1 && j > 1 && a[i - 1] == b[j - 2] && a[i - 2] == b[j - 1] {
+                v = v.min(d[i - 2][j - 2] + 1);
+            }
+            d[i][j] = v;
+        }
+    }
+    d[n][m]
+}
+
+#[cfg(test)]
+mod closest_tests {
+    use super::closest;
+
+    #[test]
+    fn typos_find_the_key_meant_and_strangers_find_none() {
+        let keys = [
+            "mapping_lines",
+            "mapping",
+            "beta_deg",
+            "lambda_s",
+            "speed_mps",
+        ];
+        let cases = [
+            ("maping_lines", Some("mapping_lines")),
+            ("mapping_lnies", Some("mapping_lines")),
+            ("beta", Some("beta_deg")),
+            ("BETA_DEG", Some("beta_deg")),
+            ("speed", Some("speed_mps")),
+            ("lambda", Some("lambda_s")),
+            ("colour", None),
+            ("x", None),
+        ];
+        for (word, want) in cases {
+            assert_eq!(closest(word, &keys), want, "{word}");
+        }
+    }
+}

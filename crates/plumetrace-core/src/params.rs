@@ -9,6 +9,9 @@
 use serde::Serialize;
 use std::fmt::Write as _;
 
+/// The table a parameter set is read from (TOML's).
+pub use toml::Table;
+
 /// The bounds of one parameter.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Bounds {
@@ -270,11 +273,72 @@ impl KeyDoc {
 }
 
 /// A parameter set made by [`params!`](crate::params!).
-pub trait Params {
-    /// Every key, in declaration order.
+pub trait Params: Sized {
+    /// Every key, in declaration order (the keys of included sets first), with the set's
+    /// defaults.
     fn keys() -> Vec<KeyDoc>;
+    /// Every key with this value of it as its default (what [`Params::keys`] gives for the
+    /// default set; an included set shows the defaults of the set that includes it).
+    fn docs(&self) -> Vec<KeyDoc>;
     /// Checks every value against its bounds; errors name `prefix.key`.
     fn check_bounds(&self, prefix: &str) -> Result<(), ParamError>;
+    /// Reads the set from a table, keys omitted taking this set's defaults; errors name
+    /// `prefix.key` (unknown keys, with the nearest known key; wrong types).
+    fn read(table: Table, prefix: &str) -> Result<Self, ParamError>;
+}
+
+/// Reads `table` as the serde struct `T` (own keys only: an included set's fields take their
+/// values from `T`'s default); errors name `prefix.key`. Unknown keys are refused with the nearest
+/// of `known`.
+#[doc(hidden)]
+pub fn read_own<T: serde::de::DeserializeOwned>(
+    table: Table,
+    prefix: &str,
+    known: &[KeyDoc],
+) -> Result<T, ParamError> {
+    if let Some(unknown) = table
+        .keys()
+        .find(|k| !known.iter().any(|d| d.name == k.as_str()))
+    {
+        let names: Vec<&str> = known.iter().map(|d| d.name).collect();
+        let hint = match crate::names::closest(unknown, &names) {
+            Some(near) => format!("; did you mean `{near}`?"),
+            None => String::new(),
+        };
+        return Err(ParamError::at(
+            prefix,
+            &quoted_key(unknown),
+            format!("unknown field `{unknown}`{hint} (`plumetrace planners` lists every key)"),
+        ));
+    }
+    serde_path_to_error::deserialize(toml::Value::Table(table)).map_err(|e| {
+        let path = e.path().to_string();
+        ParamError {
+            key: if path == "." {
+                prefix.to_string()
+            } else {
+                key_path(prefix, &path)
+            },
+            message: e.into_inner().to_string(),
+        }
+    })
+}
+
+/// Reads an included set: the keys of `table` that belong to it are taken out and read over
+/// `base` (the including set's defaults for it).
+#[doc(hidden)]
+pub fn read_included<T: Params + serde::Serialize>(
+    table: &mut Table,
+    base: &T,
+    prefix: &str,
+) -> Result<T, ParamError> {
+    let mut own = Table::try_from(base).map_err(|e| ParamError::at(prefix, "", e.to_string()))?;
+    for k in T::keys() {
+        if let Some(v) = table.remove(k.name) {
+            own.insert(k.name.to_string(), v);
+        }
+    }
+    T::read(own, prefix)
 }
 
 /// Checks one value (used by [`params!`](crate::params!)).
@@ -306,27 +370,44 @@ pub fn markdown_rows(keys: &[KeyDoc]) -> String {
 /// and one line of doc. The struct deserialises from a table with every key optional (defaults
 /// fill the rest) and unknown keys refused.
 ///
+/// A set may include other sets first (`include name: Type = default;`): their keys are read,
+/// written, checked and documented as keys of this set (one flat table), with the defaults this
+/// set gives them, and the code reads them as `self.name.key`. Keys shared by several planners
+/// are declared once this way.
+///
 /// ```
 /// use plumetrace_core::params::{Bounds, Params};
 /// plumetrace_core::params! {
-///     /// A planner's settings.
-///     pub struct Example {
+///     /// Keys several sets share.
+///     pub struct Shared {
 ///         /// Speed command.
 ///         speed_mps: f64 = 2.0, "m/s", Bounds::positive(10.0);
+///     }
+/// }
+/// plumetrace_core::params! {
+///     /// A planner's settings.
+///     pub struct Example {
+///         include shared: Shared = Shared { speed_mps: 1.5 };
 ///         /// Repetitions.
 ///         n: u32 = 2, "", Bounds::whole(1, 50);
 ///     }
 /// }
-/// assert_eq!(Example::default().speed_mps, 2.0);
+/// assert_eq!(Example::default().shared.speed_mps, 1.5);
+/// assert_eq!(Example::keys()[0].default, "1.5");
 /// assert_eq!(Example::keys()[1].bounds, "1..=50");
 /// let bad = Example { n: 0, ..Example::default() };
 /// assert_eq!(bad.check_bounds("p").unwrap_err().to_string(), "p.n: must be 1..=50, got 0");
+/// let read = Example::read("speed_mps = 1.0".parse().unwrap(), "p").unwrap();
+/// assert_eq!((read.shared.speed_mps, read.n), (1.0, 2));
 /// ```
 #[macro_export]
 macro_rules! params {
     (
         $(#[$meta:meta])*
         $vis:vis struct $name:ident {
+            $(
+                include $inc:ident : $ity:ty = $idefault:expr;
+            )*
             $(
                 #[doc = $doc:literal]
                 $field:ident : $ty:ty = $default:expr, $unit:literal, $bounds:expr;
@@ -338,6 +419,11 @@ macro_rules! params {
         #[serde(deny_unknown_fields, default)]
         $vis struct $name {
             $(
+                #[doc = concat!("The included [`", stringify!($ity), "`] keys.")]
+                #[serde(flatten, skip_deserializing)]
+                pub $inc: $ity,
+            )*
+            $(
                 #[doc = $doc]
                 pub $field: $ty,
             )*
@@ -345,26 +431,52 @@ macro_rules! params {
 
         impl Default for $name {
             fn default() -> Self {
-                $name { $( $field: $default, )* }
+                $name {
+                    $( $inc: $idefault, )*
+                    $( $field: $default, )*
+                }
             }
         }
 
         impl $crate::params::Params for $name {
             fn keys() -> Vec<$crate::params::KeyDoc> {
-                vec![$(
-                    $crate::params::KeyDoc::new::<$ty>(
+                <$name as Default>::default().docs()
+            }
+
+            #[allow(clippy::vec_init_then_push)]
+            fn docs(&self) -> Vec<$crate::params::KeyDoc> {
+                #[allow(unused_mut)]
+                let mut out: Vec<$crate::params::KeyDoc> = Vec::new();
+                $( out.extend($crate::params::Params::docs(&self.$inc)); )*
+                $(
+                    out.push($crate::params::KeyDoc::new::<$ty>(
                         stringify!($field),
                         $unit,
                         $doc.trim(),
-                        &$default,
+                        &self.$field,
                         $bounds,
-                    ),
-                )*]
+                    ));
+                )*
+                out
             }
 
             fn check_bounds(&self, prefix: &str) -> Result<(), $crate::params::ParamError> {
+                $( $crate::params::Params::check_bounds(&self.$inc, prefix)?; )*
                 $( $crate::params::check(prefix, stringify!($field), &self.$field, &$bounds)?; )*
                 Ok(())
+            }
+
+            #[allow(unused_mut, unused_variables)]
+            fn read(mut table: $crate::params::Table, prefix: &str) -> Result<Self, $crate::params::ParamError> {
+                let base = <$name as Default>::default();
+                $( let $inc = $crate::params::read_included(&mut table, &base.$inc, prefix)?; )*
+                let mut out: $name = $crate::params::read_own(
+                    table,
+                    prefix,
+                    &<$name as $crate::params::Params>::keys(),
+                )?;
+                $( out.$inc = $inc; )*
+                Ok(out)
             }
         }
     };
@@ -421,6 +533,64 @@ mod tests {
         );
         assert!(Bounds::positive(5.0).check_whole(3).is_err());
         assert!(Bounds::whole(1, 5).check_whole(5).is_ok());
+    }
+
+    crate::params! {
+        /// A set that includes `Set` with other defaults.
+        struct Outer {
+            include inner: Set = Set { rate_hz: 20.0, ..Set::default() };
+            /// Its own key.
+            gain: f64 = 1.0, "", Bounds::closed(0.0, 2.0);
+        }
+    }
+
+    fn table(text: &str) -> Table {
+        text.parse().unwrap_or_else(|e| panic!("{e}"))
+    }
+
+    #[test]
+    fn an_included_set_reads_writes_checks_and_documents_as_one_table() {
+        let keys: Vec<(&str, String)> = Outer::keys()
+            .into_iter()
+            .map(|k| (k.name, k.default))
+            .collect();
+        assert_eq!(
+            keys[0],
+            ("rate_hz", "20.0".to_string()),
+            "the includer's default"
+        );
+        assert_eq!(keys.len(), 5);
+        assert_eq!(keys[4].0, "gain");
+        let o = Outer::read(table("gain = 2.0\ncount = 4"), "p").unwrap_or_else(|e| panic!("{e}"));
+        assert_eq!((o.inner.rate_hz, o.inner.count, o.gain), (20.0, 4, 2.0));
+        let back = Table::try_from(&o).unwrap_or_default();
+        assert_eq!(back.len(), 5, "written flat: {back:?}");
+        assert_eq!(Outer::read(back, "p").ok(), Some(o.clone()));
+        let bad = Outer {
+            inner: Set {
+                count: 1,
+                ..o.inner
+            },
+            ..o
+        };
+        assert_eq!(
+            bad.check_bounds("q").map_err(|e| e.key),
+            Err("q.count".to_string())
+        );
+        let cases = [
+            ("rate_hz = \"x\"", "p.rate_hz", "invalid type"),
+            ("gain = \"x\"", "p.gain", "invalid type"),
+            ("cuont = 3", "p.cuont", "did you mean `count`?"),
+            ("gian = 1.0", "p.gian", "did you mean `gain`?"),
+            ("zzz = 1", "p.zzz", "unknown field `zzz` ("),
+        ];
+        for (text, key, message) in cases {
+            let e = Outer::read(table(text), "p")
+                .err()
+                .unwrap_or_else(|| panic!("{text}"));
+            assert_eq!(e.key, key, "{text}: {e}");
+            assert!(e.message.contains(message), "{text}: {e}");
+        }
     }
 
     #[test]

@@ -19,6 +19,8 @@
 //! - [`formation`]: formation tracing (seed 004): surface leaders and an underwater follower on
 //!   acoustic ranges.
 //! - [`fuzzy`]: fuzzy navigation past obstacles (seed 001): Mamdani engine, side lock, DRTs.
+//! - [`shared_keys`]: keys several planners share, declared once (the autopilot's, the source
+//!   map's) and included in each planner's table.
 
 pub mod avoid;
 pub mod behaviour;
@@ -26,6 +28,7 @@ pub mod estimate;
 pub mod flow;
 pub mod fuzzy;
 pub mod planners;
+pub mod shared_keys;
 
 pub use flow::FlowEstimate;
 pub use planners::amp::{self, Amp, AmpParams, DeclarationRule, LostPointEviction, MappingParams};
@@ -37,3 +40,4 @@ pub use planners::{
     BuildContext, CommonParams, MissionGeometry, PLANNERS, PlannerConfig, PlannerEntry,
     PlannerKind, PlannerParams, PlannerSpec, registry_defaults, registry_markdown,
 };
+pub use shared_keys::{AutopilotKeys, MapKeys};

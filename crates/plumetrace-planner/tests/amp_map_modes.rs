@@ -9,7 +9,7 @@ use plumetrace_core::{
 };
 use plumetrace_guidance::OpArea;
 use plumetrace_planner::amp::MapDeclaration;
-use plumetrace_planner::{Amp, AmpParams};
+use plumetrace_planner::{Amp, AmpParams, MapKeys};
 
 /// Flow towards North at 0.1 m/s: upflow is South.
 fn snap(t: f64, pos: Vec2, heading_deg: f64, detection: bool) -> SensorSnapshot {
@@ -40,15 +40,18 @@ fn snap(t: f64, pos: Vec2, heading_deg: f64, detection: bool) -> SensorSnapshot 
 fn amp(mode: MapDeclaration, map_can_declare: bool) -> Amp {
     let p = AmpParams {
         map_declaration: mode,
-        // A map rule that holds after a handful of detections, or one that never does.
-        map_mass: if map_can_declare { 0.01 } else { 1.0 },
-        map_min_detections: if map_can_declare { 3 } else { 1_000_000 },
-        map_check_s: 0.0,
-        // At once (the hold has its own tests with the map's tracker).
-        map_hold_s: 0.0,
-        // The most likely cell's centre is declared (the local mean has its own test with the
-        // map).
-        map_estimate_radius_m: 0.0,
+        map: MapKeys {
+            // A map rule that holds after a handful of detections, or one that never does.
+            map_mass: if map_can_declare { 0.01 } else { 1.0 },
+            map_min_detections: if map_can_declare { 3 } else { 1_000_000 },
+            map_check_s: 0.0,
+            // At once (the hold has its own tests with the map's tracker).
+            map_hold_s: 0.0,
+            // The most likely cell's centre is declared (the local mean has its own test with
+            // the map).
+            map_estimate_radius_m: 0.0,
+            ..AmpParams::default().map
+        },
         ..AmpParams::default()
     };
     let area = OpArea::rectangle(0.0, 400.0, 0.0, 1000.0).unwrap();

@@ -21,24 +21,21 @@
 
 use crate::FlowEstimate;
 use crate::estimate::infotaxis::{choose, move_outcome};
-use crate::estimate::{MapModel, MapRule, MapTracker, Objective};
+use crate::estimate::{MapTracker, Objective};
 use crate::planners::{BuildContext, PlannerParams};
+use crate::shared_keys::{AutopilotKeys, MapKeys};
 use plumetrace_core::params::{Bounds, ParamError};
 use plumetrace_core::{
     BehaviourKind, Decision, DeclarationKind, Heading, PlanStatus, Planner, PlannerEvent,
-    SensorSnapshot, Telemetry, Vec2, VerticalCommand,
+    SensorSnapshot, Telemetry, Vec2,
 };
-use plumetrace_guidance::{Autopilot, AutopilotParams, GoToPoint, ModeStatus, OpArea, Steer};
+use plumetrace_guidance::{Autopilot, GoToPoint, ModeStatus, OpArea, Steer};
 
 plumetrace_core::params! {
     /// Parameters of the infotaxis planner.
     pub struct InfotaxisParams {
-        /// Speed command.
-        speed_mps: f64 = 2.0, "m/s", Bounds::positive(10.0);
-        /// Altitude command (height above the seabed; surface craft stay at the surface).
-        altitude_m: f64 = 2.0, "m", Bounds::non_negative(1000.0);
-        /// A chemical reading above this is a detection.
-        threshold_v: f64 = 0.2, "V", Bounds::non_negative(1e6);
+        include autopilot: AutopilotKeys = AutopilotKeys::default();
+        include map: MapKeys = MapKeys::default();
         /// What a move minimises: infotaxis (the expected entropy of the map after it) or space_aware (expected log2(D + 2^(H - 1) - 1/2), distance D in map cells).
         objective: Objective = Objective::Infotaxis, "", Bounds::Any;
         /// Length of a candidate leg (about 20 s at 2 m/s, three turning radii of the field vehicle).
@@ -49,100 +46,12 @@ plumetrace_core::params! {
         edge_margin_m: f64 = 10.0, "m", Bounds::non_negative(1000.0);
         /// Arrival radius at a leg's end.
         r_m: f64 = 5.0, "m", Bounds::positive(1000.0);
-        /// Heading-rate limit of the commands.
-        max_turn_rate_deg_s: f64 = 10.0, "deg/s", Bounds::positive(360.0);
-        /// Time constant of the flow estimate.
-        flow_average_s: f64 = 60.0, "s", Bounds::non_negative(100_000.0);
-        /// Compensate courses for the measured flow (crab angle).
-        flow_compensation: bool = true, "", Bounds::Any;
-        /// Declaration: radius around the map's most likely cell.
-        map_radius_m: f64 = 10.0, "m", Bounds::closed(0.5, 10_000.0);
-        /// Declaration: posterior mass within map_radius_m that declares.
-        map_mass: f64 = 0.5, "", Bounds::closed(0.01, 1.0);
-        /// Map declaration: detections the map must have taken in first.
-        map_min_detections: u32 = 50, "", Bounds::whole(0, 1_000_000);
-        /// Declaration: how long the rule must hold with the map's most likely cell staying within map_radius_m.
-        map_hold_s: f64 = 0.0, "s", Bounds::closed(0.0, 1e5);
-        /// Map declaration: the declared position is the posterior mean within this radius of the most likely cell (0: that cell's centre, which leaves up to half a cell of error in each axis).
-        map_estimate_radius_m: f64 = 0.0, "m", Bounds::closed(0.0, 10_000.0);
-        /// Time between reads of the map for the declaration.
-        map_check_s: f64 = 5.0, "s", Bounds::closed(0.0, 3600.0);
-        /// Source map: cell size.
-        map_resolution_m: f64 = 5.0, "m", Bounds::closed(0.5, 1000.0);
-        /// Source map: probability that a sample inside the plume detects (intermittency).
-        map_p_detect: f64 = 0.1, "", Bounds::closed(0.01, 1.0);
-        /// Source map: samples closer together than this count as one look (the plume's meander keeps a vehicle in or out of it for seconds).
-        map_correlation_s: f64 = 10.0, "s", Bounds::closed(0.0, 3600.0);
-        /// Source map: growth of the back-projection spread, sigma^2 = (3 m)^2 + 2 D T.
-        map_diffusivity_m2ps: f64 = 0.1, "m^2/s", Bounds::closed(0.0, 1000.0);
-        /// Source map: vertical diffusivity that mixes a bottom source up to the vehicle's altitude, when map_mixing_length_m is 0 (0: no vertical model).
-        map_vertical_diffusivity_m2ps: f64 = 0.01, "m^2/s", Bounds::closed(0.0, 100.0);
-        /// Source map: when positive, the vertical diffusivity is this mixing length times the measured flow speed (bottom boundary-layer mixing grows with the current), replacing map_vertical_diffusivity_m2ps.
-        map_mixing_length_m: f64 = 0.0, "m", Bounds::closed(0.0, 100.0);
-        /// Source map: longest travel time a sample is back-projected over.
-        map_window_s: f64 = 3600.0, "s", Bounds::closed(1.0, 1e6);
-        /// Source map: travel time beyond which the chance of a detection falls as one over travel time (plume dilution; 0: off), when map_dilution_m is 0.
-        map_dilution_s: f64 = 60.0, "s", Bounds::closed(0.0, 1e6);
-        /// Source map: when positive, the distance downflow beyond which the chance of a detection falls as one over the distance (plume dilution measured along the flow, at the measured flow speed), replacing map_dilution_s.
-        map_dilution_m: f64 = 0.0, "m", Bounds::closed(0.0, 1e6);
     }
-}
-
-/// The source map and its declaration rule from a planner's `map_*` keys and `threshold_v`
-/// (the rest of the model at its defaults), over `$area`: `$p` is a planner's parameters with
-/// the source map's keys (`InfotaxisParams`, `AmpParams`). The error names `map_resolution_m`
-/// when the map does not fit.
-macro_rules! map_tracker {
-    ($p:expr, $area:expr) => {
-        $crate::planners::infotaxis::build_tracker(
-            $area,
-            $crate::estimate::MapModel {
-                resolution_m: $p.map_resolution_m,
-                p_detect: $p.map_p_detect,
-                diffusivity_m2ps: $p.map_diffusivity_m2ps,
-                vertical_diffusivity_m2ps: $p.map_vertical_diffusivity_m2ps,
-                vertical_mixing_length_m: $p.map_mixing_length_m,
-                window_s: $p.map_window_s,
-                correlation_s: $p.map_correlation_s,
-                dilution_s: $p.map_dilution_s,
-                dilution_m: $p.map_dilution_m,
-                ..$crate::estimate::MapModel::default()
-            },
-            $crate::estimate::MapRule {
-                radius_m: $p.map_radius_m,
-                mass: $p.map_mass,
-                check_period_s: $p.map_check_s,
-                min_detections: u64::from($p.map_min_detections),
-                hold_s: $p.map_hold_s,
-                estimate_radius_m: $p.map_estimate_radius_m,
-            },
-            $p.threshold_v,
-        )
-    };
-}
-pub(crate) use map_tracker;
-
-/// A planner's map tracker over `area`; the error names `map_resolution_m` when the map does
-/// not fit.
-pub(crate) fn build_tracker(
-    area: &OpArea,
-    model: MapModel,
-    rule: MapRule,
-    threshold_v: f64,
-) -> Result<MapTracker, ParamError> {
-    MapTracker::new(area, model, rule, threshold_v).ok_or_else(|| ParamError {
-        key: "map_resolution_m".into(),
-        message: format!(
-            "no source map fits the op-area at {} m cells (none inside, or more than {} cells)",
-            model.resolution_m,
-            crate::estimate::map::MAX_CELLS
-        ),
-    })
 }
 
 impl InfotaxisParams {
     fn tracker(&self, area: &OpArea) -> Result<MapTracker, ParamError> {
-        map_tracker!(self, area)
+        self.map.tracker(area, self.autopilot.threshold_v)
     }
 }
 
@@ -153,7 +62,7 @@ impl PlannerParams for InfotaxisParams {
     const THRESHOLD_KEY: Option<&'static str> = Some("threshold_v");
 
     fn detection_threshold_v(&self) -> Option<f64> {
-        Some(self.threshold_v)
+        Some(self.autopilot.threshold_v)
     }
 
     fn build(&self, ctx: &BuildContext) -> Result<Box<dyn Planner>, ParamError> {
@@ -196,19 +105,12 @@ impl Infotaxis {
     /// A planner over `area` with its map; `prior_flow` is the flow direction assumed until the
     /// first flow measurement.
     pub fn new(p: InfotaxisParams, area: OpArea, prior_flow: Heading, tracker: MapTracker) -> Self {
-        let autopilot = Autopilot::new(AutopilotParams {
-            op_area: area.clone(),
-            flow_compensation: p.flow_compensation,
-            max_turn_rate_deg_s: p.max_turn_rate_deg_s,
-            vertical: VerticalCommand::Altitude(p.altitude_m),
-            nav_drift_mps: 0.0,
-            max_inset_m: 0.0,
-        });
+        let autopilot = Autopilot::new(p.autopilot.autopilot(area.clone()));
         Infotaxis {
-            flow: FlowEstimate::new(p.flow_average_s, prior_flow),
+            flow: p.autopilot.flow_estimate(prior_flow),
             last_steer: Steer {
                 heading: Heading::NORTH,
-                speed_mps: p.speed_mps,
+                speed_mps: p.autopilot.speed_mps,
             },
             p,
             area,
@@ -243,7 +145,7 @@ impl Infotaxis {
     /// Chooses the next leg's end from `pos` at `t_s`: the candidate of smallest objective
     /// value, or the op-area's centre when no candidate fits.
     fn choose_leg(&mut self, pos: Vec2, t_s: f64, altitude_m: Option<f64>) -> Vec2 {
-        let leg_s = self.p.step_m / self.p.speed_mps;
+        let leg_s = self.p.step_m / self.p.autopilot.speed_mps;
         let samples = (leg_s / self.tracker.map().model().correlation_s.max(1e-3)).max(1.0);
         let ends = self.candidates(pos);
         let objective = self.p.objective;
@@ -301,7 +203,10 @@ impl Planner for Infotaxis {
         if !self.declared {
             self.tracker.feed(s, pos, ground, flow);
         }
-        let detected = s.chem.iter().any(|c| c.reading > self.p.threshold_v);
+        let detected = s
+            .chem
+            .iter()
+            .any(|c| c.reading > self.p.autopilot.threshold_v);
         let new_contact = detected && self.last_detection_s.is_none_or(|l| t - l > 5.0);
         if new_contact {
             events.push(PlannerEvent::Detection { pos_m: pos });
@@ -336,7 +241,7 @@ impl Planner for Infotaxis {
                 status: PlanStatus::Finished,
             };
         }
-        let leg_s = self.p.step_m / self.p.speed_mps;
+        let leg_s = self.p.step_m / self.p.autopilot.speed_mps;
         let leg_over = match self.leg {
             None => true,
             Some(l) => {
@@ -350,7 +255,7 @@ impl Planner for Infotaxis {
             self.leg = Some(Leg {
                 goal: GoToPoint {
                     target_m,
-                    speed_mps: self.p.speed_mps,
+                    speed_mps: self.p.autopilot.speed_mps,
                     radius_m: self.p.r_m,
                 },
                 started_s: t,
@@ -433,9 +338,12 @@ mod tests {
     fn fly(objective: Objective) -> (Vec<PlannerEvent>, Vec<Telemetry>) {
         let params = InfotaxisParams {
             objective,
-            map_vertical_diffusivity_m2ps: 0.0,
-            map_dilution_s: 0.0,
-            map_p_detect: 0.5,
+            map: MapKeys {
+                map_vertical_diffusivity_m2ps: 0.0,
+                map_dilution_s: 0.0,
+                map_p_detect: 0.5,
+                ..MapKeys::default()
+            },
             ..InfotaxisParams::default()
         };
         let mut planner = params.build(&ctx()).unwrap_or_else(|e| panic!("{e}"));
@@ -506,7 +414,10 @@ mod tests {
     #[test]
     fn a_map_that_does_not_fit_is_an_error_naming_the_key() {
         let p = InfotaxisParams {
-            map_resolution_m: 0.5,
+            map: MapKeys {
+                map_resolution_m: 0.5,
+                ..MapKeys::default()
+            },
             ..InfotaxisParams::default()
         };
         let mut g = ctx();

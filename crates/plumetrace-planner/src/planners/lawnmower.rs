@@ -16,22 +16,18 @@
 use crate::FlowEstimate;
 use crate::behaviour::{Arbiter, Behaviour, GoTo, Legs, LineParams, Percept, Reached, Sequence};
 use crate::planners::{BuildContext, PlannerParams};
+use crate::shared_keys::AutopilotKeys;
 use plumetrace_core::params::{Bounds, ParamError};
 use plumetrace_core::{
     BehaviourKind, Decision, DeclarationKind, Heading, PlanStatus, Planner, PlannerEvent,
-    SensorSnapshot, Telemetry, Vec2, VerticalCommand,
+    SensorSnapshot, Telemetry, Vec2,
 };
-use plumetrace_guidance::{Autopilot, AutopilotParams, GoToPoint, OpArea, Steer};
+use plumetrace_guidance::{Autopilot, GoToPoint, OpArea, Steer};
 
 plumetrace_core::params! {
     /// Parameters of the lawnmower survey.
     pub struct LawnmowerParams {
-        /// Speed command.
-        speed_mps: f64 = 2.0, "m/s", Bounds::positive(10.0);
-        /// Altitude command (height above the seabed; surface craft stay at the surface).
-        altitude_m: f64 = 2.0, "m", Bounds::non_negative(1000.0);
-        /// A chemical reading above this is a detection.
-        threshold_v: f64 = 0.2, "V", Bounds::non_negative(1e6);
+        include autopilot: AutopilotKeys = AutopilotKeys::default();
         /// Distance between lanes, along the flow.
         lane_spacing_m: f64 = 40.0, "m", Bounds::closed(1.0, 10_000.0);
         /// How far inside the op-area's edges the lanes run.
@@ -42,12 +38,6 @@ plumetrace_core::params! {
         k_deg_per_m: f64 = 5.0, "deg/m", Bounds::positive(180.0);
         /// Turning radius of the approach to each lane.
         min_turn_radius_m: f64 = 12.0, "m", Bounds::positive(1000.0);
-        /// Heading-rate limit of the commands.
-        max_turn_rate_deg_s: f64 = 10.0, "deg/s", Bounds::positive(360.0);
-        /// Time constant of the flow estimate.
-        flow_average_s: f64 = 60.0, "s", Bounds::non_negative(100_000.0);
-        /// Compensate courses for the measured flow (crab angle).
-        flow_compensation: bool = true, "", Bounds::Any;
     }
 }
 
@@ -58,7 +48,7 @@ impl PlannerParams for LawnmowerParams {
     const THRESHOLD_KEY: Option<&'static str> = Some("threshold_v");
 
     fn detection_threshold_v(&self) -> Option<f64> {
-        Some(self.threshold_v)
+        Some(self.autopilot.threshold_v)
     }
 
     fn build(&self, ctx: &BuildContext) -> Result<Box<dyn Planner>, ParamError> {
@@ -191,19 +181,12 @@ impl Lawnmower {
     /// A survey of `area`; `prior_flow` is the flow direction assumed until the first flow
     /// measurement.
     pub fn new(p: LawnmowerParams, area: OpArea, prior_flow: Heading) -> Self {
-        let autopilot = Autopilot::new(AutopilotParams {
-            op_area: area.clone(),
-            flow_compensation: p.flow_compensation,
-            max_turn_rate_deg_s: p.max_turn_rate_deg_s,
-            vertical: VerticalCommand::Altitude(p.altitude_m),
-            nav_drift_mps: 0.0,
-            max_inset_m: 0.0,
-        });
+        let autopilot = Autopilot::new(p.autopilot.autopilot(area.clone()));
         Lawnmower {
-            flow: FlowEstimate::new(p.flow_average_s, prior_flow),
+            flow: p.autopilot.flow_estimate(prior_flow),
             last_steer: Steer {
                 heading: Heading::NORTH,
-                speed_mps: p.speed_mps,
+                speed_mps: p.autopilot.speed_mps,
             },
             p,
             area,
@@ -231,7 +214,7 @@ impl Lawnmower {
             pos,
         );
         let line = LineParams {
-            speed_mps: self.p.speed_mps,
+            speed_mps: self.p.autopilot.speed_mps,
             radius_m: self.p.r_m,
             gain_deg_per_m: self.p.k_deg_per_m,
             min_turn_radius_m: self.p.min_turn_radius_m,
@@ -242,7 +225,7 @@ impl Lawnmower {
             plan.push(Box::new(GoTo {
                 goal: GoToPoint {
                     target_m: *start,
-                    speed_mps: self.p.speed_mps,
+                    speed_mps: self.p.autopilot.speed_mps,
                     radius_m: self.p.r_m,
                 },
                 kind: BehaviourKind::GoTo,
@@ -279,7 +262,7 @@ impl Planner for Lawnmower {
         if let Some(best) = s
             .chem
             .iter()
-            .filter(|c| c.reading > self.p.threshold_v)
+            .filter(|c| c.reading > self.p.autopilot.threshold_v)
             .max_by(|a, b| a.reading.total_cmp(&b.reading))
         {
             let at = pos - velocity * (t - best.time_s).max(0.0);
@@ -533,7 +516,10 @@ mod tests {
     #[test]
     fn no_reading_above_the_threshold_no_declaration() {
         let p = LawnmowerParams {
-            threshold_v: 10.0,
+            autopilot: AutopilotKeys {
+                threshold_v: 10.0,
+                ..AutopilotKeys::default()
+            },
             lane_spacing_m: 100.0,
             ..LawnmowerParams::default()
         };

@@ -122,24 +122,13 @@ pub struct PlannerEntry {
 /// Reads a parameter set from a table; errors name `prefix.key` (unknown keys, wrong types,
 /// values out of bounds).
 fn parse_params<T: PlannerParamsLike>(table: toml::Table, prefix: &str) -> Result<T, ParamError> {
-    let value = toml::Value::Table(table);
-    let parsed: T = serde_path_to_error::deserialize(value).map_err(|e| {
-        let path = e.path().to_string();
-        ParamError {
-            key: if path == "." {
-                prefix.to_string()
-            } else {
-                key_path(prefix, &path)
-            },
-            message: e.into_inner().to_string(),
-        }
-    })?;
+    let parsed = T::read(table, prefix)?;
     parsed.validate_like(prefix)?;
     Ok(parsed)
 }
 
 /// What [`parse_params`] needs: the common keys and every planner's parameters.
-trait PlannerParamsLike: DeserializeOwned {
+trait PlannerParamsLike: Params {
     fn validate_like(&self, prefix: &str) -> Result<(), ParamError>;
 }
 
@@ -186,6 +175,8 @@ macro_rules! registry {
         }
 
         /// The parameters of one planner, by kind.
+        // Configuration, built once per vehicle: the size of the largest planner's table is fine.
+        #[allow(clippy::large_enum_variant)]
         #[derive(Debug, Clone, PartialEq)]
         pub enum PlannerSpec {
             $(

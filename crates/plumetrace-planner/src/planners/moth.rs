@@ -36,16 +36,21 @@
 //! gives back 12 m), `track_out_s` = 8.5 s (as long as `lambda_s`).
 //!
 //! Every course passes the shared [`Autopilot`]; a reading above `threshold_v` is a detection.
+//!
+//! Of the keys shared with other planners ([`AutopilotKeys`]), the moth flies at 1.5 m/s (the top
+//! of the paper's 1.0-1.5 m/s: its current is 1 m/s, so speed is what gains ground up-flow), turns
+//! at up to 20 deg/s and averages the flow over 10 s.
 
 use crate::FlowEstimate;
 use crate::behaviour::{Arbiter, Behaviour, EventLog, Percept, Proposal, Subsumption};
 use crate::planners::{BuildContext, PlannerParams};
+use crate::shared_keys::AutopilotKeys;
 use plumetrace_core::params::{Bounds, Choice, ParamError, Params};
 use plumetrace_core::{
     BehaviourKind, Decision, DeclarationKind, Heading, PlanStatus, Planner, PlannerEvent,
-    SensorSnapshot, Telemetry, Vec2, VerticalCommand, bearing_between,
+    SensorSnapshot, Telemetry, Vec2, bearing_between,
 };
-use plumetrace_guidance::{Autopilot, AutopilotParams, OpArea, Steer};
+use plumetrace_guidance::{Autopilot, OpArea, Steer};
 use serde::{Deserialize, Serialize};
 
 /// Which of Li, Farrell and Cardé's strategies Maintain-Plume flies.
@@ -67,12 +72,7 @@ plumetrace_core::params! {
     /// Parameters of the moth-inspired planner. Defaults: Table II of the paper where it gives
     /// them (lambda, threshold, leaf, N_re, M, epsilon, offsets), otherwise documented choices.
     pub struct MothParams {
-        /// Speed command: the top of the paper's 1.0-1.5 m/s (its current is 1 m/s, so speed is what gains ground up-flow).
-        speed_mps: f64 = 1.5, "m/s", Bounds::positive(10.0);
-        /// Altitude command (height above the seabed).
-        altitude_m: f64 = 2.0, "m", Bounds::non_negative(1000.0);
-        /// A chemical reading above this is a detection.
-        threshold_v: f64 = 0.2, "V", Bounds::non_negative(1e6);
+        include autopilot: AutopilotKeys = AutopilotKeys { speed_mps: 1.5, max_turn_rate_deg_s: 20.0, flow_average_s: 10.0, ..AutopilotKeys::default() };
         /// lambda: time after the last detection that ends Track-In.
         lambda_s: f64 = 8.5, "s", Bounds::positive(3600.0);
         /// Maintain-Plume strategy of Li, Farrell and Carde: passive (Track-In straight up-flow, Track-Out casts to either side in turn) or active (Track-In counter-turns across the plume, Track-Out turns back to the side the plume was lost on). Not `strategy`, which older `[planner]` tables use for the planner's kind.
@@ -111,12 +111,6 @@ plumetrace_core::params! {
         find_swing_m: f64 = 20.0, "m", Bounds::non_negative(10_000.0);
         /// Distance from the op-area's edges that Find-Plume and Move-To-Field keep.
         find_margin_m: f64 = 8.0, "m", Bounds::non_negative(1000.0);
-        /// Heading-rate limit of the commands.
-        max_turn_rate_deg_s: f64 = 20.0, "deg/s", Bounds::positive(360.0);
-        /// Time constant of the flow estimate.
-        flow_average_s: f64 = 10.0, "s", Bounds::non_negative(100_000.0);
-        /// Compensate courses for the measured flow (crab angle).
-        flow_compensation: bool = true, "", Bounds::Any;
     }
 }
 
@@ -141,7 +135,7 @@ impl PlannerParams for MothParams {
     }
 
     fn detection_threshold_v(&self) -> Option<f64> {
-        Some(self.threshold_v)
+        Some(self.autopilot.threshold_v)
     }
 
     fn build(&self, ctx: &BuildContext) -> Result<Box<dyn Planner>, ParamError> {
@@ -208,7 +202,7 @@ impl Memory {
     fn steer(&self, heading: Heading) -> Proposal<MothDone> {
         Proposal::Steer(Steer {
             heading,
-            speed_mps: self.p.speed_mps,
+            speed_mps: self.p.autopilot.speed_mps,
         })
     }
 
@@ -556,14 +550,7 @@ impl Moth {
     /// A planner searching `area`; `prior_flow` is the flow direction assumed until the first
     /// flow measurement.
     pub fn new(p: MothParams, area: OpArea, prior_flow: Heading) -> Self {
-        let autopilot = Autopilot::new(AutopilotParams {
-            op_area: area.clone(),
-            flow_compensation: p.flow_compensation,
-            max_turn_rate_deg_s: p.max_turn_rate_deg_s,
-            vertical: VerticalCommand::Altitude(p.altitude_m),
-            nav_drift_mps: 0.0,
-            max_inset_m: 0.0,
-        });
+        let autopilot = Autopilot::new(p.autopilot.autopilot(area.clone()));
         let centroid =
             area.vertices().iter().fold(Vec2::zeros(), |a, v| a + v) / area.vertices().len() as f64;
         let layers: Vec<Box<dyn Behaviour<Memory, MothDone>>> = vec![
@@ -581,10 +568,10 @@ impl Moth {
         Moth {
             last_steer: Steer {
                 heading: prior_flow.reversed(),
-                speed_mps: p.speed_mps,
+                speed_mps: p.autopilot.speed_mps,
             },
             m: Memory {
-                flow: FlowEstimate::new(p.flow_average_s, prior_flow),
+                flow: p.autopilot.flow_estimate(prior_flow),
                 flow_sum: Vec2::zeros(),
                 flow_count: 0,
                 prior_flow,
@@ -710,7 +697,7 @@ impl Planner for Moth {
                 .unwrap_or_else(|a| a.command);
             return Decision::new(command, PlanStatus::Running);
         };
-        let threshold = self.m.p.threshold_v;
+        let threshold = self.m.p.autopilot.threshold_v;
         let detected = s.chem.iter().any(|c| c.reading > threshold);
         self.sense(t, pos, detected);
         let percept = Percept {

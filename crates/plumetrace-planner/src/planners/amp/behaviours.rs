@@ -138,7 +138,7 @@ impl Find {
         }
         Proposal::Steer(Steer {
             heading: self.heading,
-            speed_mps: m.p.speed_mps,
+            speed_mps: m.p.autopilot.speed_mps,
         })
     }
 }
@@ -199,7 +199,7 @@ impl Behaviour<Memory, AmpDone> for TrackIn {
         let steer = |heading| {
             Proposal::Steer(Steer {
                 heading,
-                speed_mps: m.p.speed_mps,
+                speed_mps: m.p.autopilot.speed_mps,
             })
         };
         if p.detected {
@@ -324,7 +324,7 @@ impl Behaviour<Memory, AmpDone> for Reacquire {
                                     FollowLine::tracking(
                                         first_end,
                                         second_start,
-                                        m.p.speed_mps,
+                                        m.p.autopilot.speed_mps,
                                         m.p.r_m,
                                         m.p.k_deg_per_m,
                                     )

@@ -23,6 +23,12 @@
 //! the AMP's [`Arbiter`](crate::behaviour::Arbiter). Every course passes the shared
 //! [`Autopilot`] (op-area cage, flow compensation, heading-rate filter); a cage abort ends the
 //! mission. A chemical sample counts as a detection when its reading exceeds `threshold_v`.
+//!
+//! Keys shared with other planners come from [`AutopilotKeys`] and [`MapKeys`], at their
+//! defaults but for the map's, chosen on Duck-like and coastal sites: `map_mass` 0.7 (among
+//! 0.5-0.9: higher waits longer and, on coastal sites, drifts upflow), `map_hold_s` 300 s (0 and
+//! 600 s did worse on Duck-like sites), `map_estimate_radius_m` 10 m (it lowered the p90 error),
+//! `map_mixing_length_m` 0.12 m and `map_dilution_m` 30 m.
 
 mod behaviours;
 mod bowtie;
@@ -40,6 +46,7 @@ use crate::behaviour::{Proposal, Reached};
 use crate::estimate::MapTracker;
 use crate::flow::FlowEstimate;
 use crate::planners::{BuildContext, PlannerParams};
+use crate::shared_keys::{AutopilotKeys, MapKeys};
 use behaviours::{Find, Reacquire, TrackIn, TrackOut};
 use plumetrace_core::params::{Bounds, Choice, ParamError};
 use plumetrace_core::{
@@ -52,14 +59,10 @@ use serde::{Deserialize, Serialize};
 plumetrace_core::params! {
     /// Parameters of the AMP. Defaults: Table 4 of the field tests and the field vehicle.
     pub struct AmpParams {
-        /// Speed command.
-        speed_mps: f64 = 2.0, "m/s", Bounds::positive(10.0);
-        /// Altitude command (height above the seabed).
-        altitude_m: f64 = 2.0, "m", Bounds::non_negative(1000.0);
+        include autopilot: AutopilotKeys = AutopilotKeys::default();
+        include map: MapKeys = MapKeys { map_mass: 0.7, map_hold_s: 300.0, map_estimate_radius_m: 10.0, map_mixing_length_m: 0.12, map_dilution_m: 30.0, ..MapKeys::default() };
         /// Altitude flown while tracing the plume (Track-In, Track-Out, Reacquire; 0: altitude_m). A bottom source's chemical reaches a vehicle at altitude z only some way downflow, a distance that grows as z^2 with how weakly the water mixes vertically: lower, the contacts begin nearer the source whatever the mixing.
         track_altitude_m: f64 = 0.0, "m", Bounds::non_negative(1000.0);
-        /// A chemical reading above this is a detection (4 % of the field sensor's 5 V).
-        threshold_v: f64 = 0.2, "V", Bounds::non_negative(1e6);
         /// lambda: time without detection that ends Track-In.
         lambda_s: f64 = 5.0, "s", Bounds::positive(3600.0);
         /// beta: Track-In offset from upflow.
@@ -78,8 +81,6 @@ plumetrace_core::params! {
         min_turn_radius_m: f64 = 12.0, "m", Bounds::positive(1000.0);
         /// Re-plans of the Dubins approach to a line's start before it gives up and the line is joined from where the vehicle is at up to 45 deg (0: never, as in the field: near an edge the cage or the current can keep the vehicle off the turn onto the line for good).
         approach_replans: u32 = 4, "", Bounds::whole(0, 1000);
-        /// Heading-rate limit of the commands.
-        max_turn_rate_deg_s: f64 = 10.0, "deg/s", Bounds::positive(360.0);
         /// Most lost points kept (the field planner kept six).
         max_lost_points: u32 = 6, "", Bounds::whole(3, 1000);
         /// Which lost point a full list drops.
@@ -108,10 +109,6 @@ plumetrace_core::params! {
         mapping_length_m: f64 = 80.0, "m", Bounds::positive(10_000.0);
         /// Mapping line spacing.
         mapping_spacing_m: f64 = 20.0, "m", Bounds::positive(1000.0);
-        /// Time constant of the flow estimate.
-        flow_average_s: f64 = 60.0, "s", Bounds::non_negative(100_000.0);
-        /// Compensate courses for the measured flow (crab angle).
-        flow_compensation: bool = true, "", Bounds::Any;
         /// Search time per subregion of a multi-source mission before it is declared source-free.
         region_timeout_s: f64 = 1800.0, "s", Bounds::positive(1e6);
         /// When Track-In updates LHS from the heading: heading_upflow (only while the heading is within 90 deg of upflow, so a turn from downflow completes) or every_detection (Table 1 as printed: a Track-In that starts heading downflow can lock onto it).
@@ -142,36 +139,6 @@ plumetrace_core::params! {
         max_cage_inset_m: f64 = 20.0, "m", Bounds::non_negative(1000.0);
         /// Declaring from the source-likelihood map: off (the lost-point rule alone), instead (the map's rule alone: its most likely cell once the mass within map_radius_m reaches map_mass), also (whichever rule declares first) or refine (the lost-point rule says when, the map where: its most likely cell if the map's rule holds then, else the lost point).
         map_declaration: MapDeclaration = MapDeclaration::Off, "", Bounds::Any;
-        /// Map declaration: radius around the map's most likely cell.
-        map_radius_m: f64 = 10.0, "m", Bounds::closed(0.5, 10_000.0);
-        /// Map declaration: posterior mass within map_radius_m that declares (0.7 chosen among 0.5-0.9 on Duck-like and coastal sites: higher waits longer and, on coastal sites, drifts upflow).
-        map_mass: f64 = 0.7, "", Bounds::closed(0.01, 1.0);
-        /// Map declaration: detections the map must have taken in first.
-        map_min_detections: u32 = 50, "", Bounds::whole(0, 1_000_000);
-        /// Map declaration: how long the rule must hold with the map's most likely cell staying within map_radius_m (the plume traced to its head, not a map read mid-plume; 0 and 600 s did worse on Duck-like sites).
-        map_hold_s: f64 = 300.0, "s", Bounds::closed(0.0, 1e5);
-        /// Map declaration: the declared position is the posterior mean within this radius of the most likely cell (0: that cell's centre, which leaves up to half a cell of error in each axis; 10 m lowered the p90 error on Duck-like and coastal sites).
-        map_estimate_radius_m: f64 = 10.0, "m", Bounds::closed(0.0, 10_000.0);
-        /// Time between reads of the map for the declaration.
-        map_check_s: f64 = 5.0, "s", Bounds::closed(0.0, 3600.0);
-        /// Source map: cell size.
-        map_resolution_m: f64 = 5.0, "m", Bounds::closed(0.5, 1000.0);
-        /// Source map: probability that a sample inside the plume detects (intermittency).
-        map_p_detect: f64 = 0.1, "", Bounds::closed(0.01, 1.0);
-        /// Source map: samples closer together than this count as one look (the plume's meander keeps a vehicle in or out of it for seconds).
-        map_correlation_s: f64 = 10.0, "s", Bounds::closed(0.0, 3600.0);
-        /// Source map: growth of the back-projection spread, sigma^2 = (3 m)^2 + 2 D T.
-        map_diffusivity_m2ps: f64 = 0.1, "m^2/s", Bounds::closed(0.0, 1000.0);
-        /// Source map: vertical diffusivity that mixes a bottom source up to the vehicle's altitude, when map_mixing_length_m is 0 (0: no vertical model).
-        map_vertical_diffusivity_m2ps: f64 = 0.01, "m^2/s", Bounds::closed(0.0, 100.0);
-        /// Source map: when positive, the vertical diffusivity is this mixing length times the measured flow speed (bottom boundary-layer mixing grows with the current), replacing map_vertical_diffusivity_m2ps.
-        map_mixing_length_m: f64 = 0.12, "m", Bounds::closed(0.0, 100.0);
-        /// Source map: longest travel time a sample is back-projected over.
-        map_window_s: f64 = 3600.0, "s", Bounds::closed(1.0, 1e6);
-        /// Source map: travel time beyond which the chance of a detection falls as one over travel time (plume dilution; 0: off), when map_dilution_m is 0.
-        map_dilution_s: f64 = 60.0, "s", Bounds::closed(0.0, 1e6);
-        /// Source map: when positive, the distance downflow beyond which the chance of a detection falls as one over the distance (plume dilution measured along the flow, at the measured flow speed), replacing map_dilution_s.
-        map_dilution_m: f64 = 30.0, "m", Bounds::closed(0.0, 1e6);
     }
 }
 
@@ -233,7 +200,7 @@ impl AmpParams {
         if self.map_declaration == MapDeclaration::Off {
             return Ok(None);
         }
-        crate::planners::infotaxis::map_tracker!(self, area).map(Some)
+        self.map.tracker(area, self.autopilot.threshold_v).map(Some)
     }
 
     /// The declaration rule the keys describe.
@@ -260,7 +227,7 @@ impl AmpParams {
 
     fn line_params(&self) -> LineParams {
         LineParams {
-            speed_mps: self.speed_mps,
+            speed_mps: self.autopilot.speed_mps,
             radius_m: self.r_m,
             gain_deg_per_m: self.k_deg_per_m,
             min_turn_radius_m: self.min_turn_radius_m,
@@ -280,7 +247,7 @@ impl AmpParams {
     fn go_to(&self, target_m: Vec2) -> GoToPoint {
         GoToPoint {
             target_m,
-            speed_mps: self.speed_mps,
+            speed_mps: self.autopilot.speed_mps,
             radius_m: self.r_m,
         }
     }
@@ -293,7 +260,7 @@ impl PlannerParams for AmpParams {
     const THRESHOLD_KEY: Option<&'static str> = Some("threshold_v");
 
     fn detection_threshold_v(&self) -> Option<f64> {
-        Some(self.threshold_v)
+        Some(self.autopilot.threshold_v)
     }
 
     fn build(&self, ctx: &BuildContext) -> Result<Box<dyn Planner>, ParamError> {
@@ -796,21 +763,18 @@ impl Amp {
             regions
         };
         let autopilot = Autopilot::new(AutopilotParams {
-            op_area: area.clone(),
-            flow_compensation: p.flow_compensation,
-            max_turn_rate_deg_s: p.max_turn_rate_deg_s,
-            vertical: VerticalCommand::Altitude(p.altitude_m),
             nav_drift_mps: p.nav_drift_mps,
             max_inset_m: p.max_cage_inset_m,
+            ..p.autopilot.autopilot(area.clone())
         });
         Amp {
             last_steer: Steer {
                 heading: Heading::NORTH,
-                speed_mps: p.speed_mps,
+                speed_mps: p.autopilot.speed_mps,
             },
             m: Memory {
                 flow: {
-                    let f = FlowEstimate::new(p.flow_average_s, prior_flow);
+                    let f = p.autopilot.flow_estimate(prior_flow);
                     if p.flow_gate_deg < 180.0 {
                         f.with_gate(plumetrace_core::FlowGateParams {
                             max_turn_deg: p.flow_gate_deg,
@@ -971,7 +935,7 @@ impl Planner for Amp {
             self.switching.start_region(&mut self.m, 0, t);
         }
         let transit = self.switching.active() == BehaviourKind::Transit;
-        let threshold = self.m.p.threshold_v;
+        let threshold = self.m.p.autopilot.threshold_v;
         let detected = !transit && s.chem.iter().any(|c| c.reading > threshold);
         if detected && !self.in_contact {
             self.m.log(PlannerEvent::Detection { pos_m: pos });
@@ -1010,7 +974,7 @@ impl Planner for Amp {
         );
         let altitude_m = match self.m.p.track_altitude_m {
             a if tracing && a > 0.0 => a,
-            _ => self.m.p.altitude_m,
+            _ => self.m.p.autopilot.altitude_m,
         };
         self.autopilot
             .set_vertical(VerticalCommand::Altitude(altitude_m));
