@@ -86,9 +86,9 @@ impl Bounds {
         }
     }
 
-    fn check_real(&self, v: f64) -> Result<(), String> {
+    fn check_real(&self, v: f64) -> Result<(), BoundsError> {
         if !v.is_finite() {
-            return Err(format!("must be a finite number, got {v}"));
+            return Err(BoundsError::NotFinite(v));
         }
         match *self {
             Bounds::Real {
@@ -102,23 +102,46 @@ impl Bounds {
                 if low && high {
                     Ok(())
                 } else {
-                    Err(format!("must be {}, got {v}", self.describe()))
+                    Err(BoundsError::Outside {
+                        bounds: self.describe(),
+                        value: v.to_string(),
+                    })
                 }
             }
             Bounds::Any => Ok(()),
-            Bounds::Whole { .. } => Err("whole-number bounds on a real-valued key".into()),
+            Bounds::Whole { .. } => Err(BoundsError::WrongKind("whole-number", "real-valued")),
         }
     }
 
-    fn check_whole(&self, v: u64) -> Result<(), String> {
+    fn check_whole(&self, v: u64) -> Result<(), BoundsError> {
         match *self {
-            Bounds::Whole { min, max } if !(min..=max).contains(&v) => {
-                Err(format!("must be {}, got {v}", self.describe()))
-            }
+            Bounds::Whole { min, max } if !(min..=max).contains(&v) => Err(BoundsError::Outside {
+                bounds: self.describe(),
+                value: v.to_string(),
+            }),
             Bounds::Whole { .. } | Bounds::Any => Ok(()),
-            Bounds::Real { .. } => Err("real-valued bounds on a whole-number key".into()),
+            Bounds::Real { .. } => Err(BoundsError::WrongKind("real-valued", "whole-number")),
         }
     }
+}
+
+/// A value outside its key's bounds.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum BoundsError {
+    /// Not a finite number.
+    #[error("must be a finite number, got {0}")]
+    NotFinite(f64),
+    /// Outside the bounds.
+    #[error("must be {bounds}, got {value}")]
+    Outside {
+        /// The bounds as text.
+        bounds: String,
+        /// The value as written.
+        value: String,
+    },
+    /// Bounds of one kind on a key of another (a mistake in a parameter table).
+    #[error("{0} bounds on a {1} key")]
+    WrongKind(&'static str, &'static str),
 }
 
 /// A value a parameter can hold: it knows its type name for docs and how to check bounds.
@@ -128,7 +151,7 @@ pub trait ParamValue {
     /// The value as it is written in a file.
     fn show(&self) -> String;
     /// Checks the value against its bounds; the message says what is wrong.
-    fn check(&self, bounds: &Bounds) -> Result<(), String>;
+    fn check(&self, bounds: &Bounds) -> Result<(), BoundsError>;
 }
 
 impl ParamValue for f64 {
@@ -139,7 +162,7 @@ impl ParamValue for f64 {
         // Debug keeps the decimal point (`2.0`), as the value is written in TOML.
         format!("{self:?}")
     }
-    fn check(&self, bounds: &Bounds) -> Result<(), String> {
+    fn check(&self, bounds: &Bounds) -> Result<(), BoundsError> {
         bounds.check_real(*self)
     }
 }
@@ -153,7 +176,7 @@ macro_rules! whole_param {
             fn show(&self) -> String {
                 format!("{self}")
             }
-            fn check(&self, bounds: &Bounds) -> Result<(), String> {
+            fn check(&self, bounds: &Bounds) -> Result<(), BoundsError> {
                 bounds.check_whole(u64::try_from(*self).unwrap_or(u64::MAX))
             }
         }
@@ -168,7 +191,7 @@ impl ParamValue for bool {
     fn show(&self) -> String {
         format!("{self}")
     }
-    fn check(&self, _: &Bounds) -> Result<(), String> {
+    fn check(&self, _: &Bounds) -> Result<(), BoundsError> {
         Ok(())
     }
 }
@@ -187,7 +210,7 @@ impl<T: Choice> ParamValue for T {
     fn show(&self) -> String {
         crate::names::variant_name(self).unwrap_or("?").to_string()
     }
-    fn check(&self, _: &Bounds) -> Result<(), String> {
+    fn check(&self, _: &Bounds) -> Result<(), BoundsError> {
         Ok(())
     }
 }
@@ -350,7 +373,7 @@ pub fn check<T: ParamValue>(
 ) -> Result<(), ParamError> {
     value
         .check(bounds)
-        .map_err(|message| ParamError::at(prefix, name, message))
+        .map_err(|e| ParamError::at(prefix, name, e.to_string()))
 }
 
 /// The keys as Markdown table rows (`| key | type | default | unit | bounds | doc |`).

@@ -223,9 +223,9 @@ macro_rules! registry {
                 }
             }
 
-            fn to_table(&self) -> Result<toml::Table, String> {
+            fn to_table(&self) -> Result<toml::Table, toml::ser::Error> {
                 match self {
-                    $(PlannerSpec::$variant(p) => toml::Table::try_from(p).map_err(|e| e.to_string()),)*
+                    $(PlannerSpec::$variant(p) => toml::Table::try_from(p),)*
                 }
             }
         }
@@ -328,13 +328,13 @@ impl PlannerConfig {
 
     /// The configuration as a table (every key, defaults included): what
     /// [`PlannerConfig::from_table`] reads back to an equal configuration.
-    pub fn to_table(&self) -> Result<toml::Table, String> {
+    pub fn to_table(&self) -> Result<toml::Table, toml::ser::Error> {
         let mut t = toml::Table::new();
         t.insert(
             "kind".into(),
             toml::Value::String(self.kind().name().into()),
         );
-        t.extend(toml::Table::try_from(&self.common).map_err(|e| e.to_string())?);
+        t.extend(toml::Table::try_from(&self.common)?);
         t.extend(self.spec.to_table()?);
         Ok(t)
     }
@@ -413,7 +413,7 @@ pub fn registry_defaults() -> toml::Table {
         t.insert("kind".into(), toml::Value::String(kind.name().into()));
         let resolved = PlannerConfig::from_table(&t, "planner")
             .map_err(|e| e.to_string())
-            .and_then(|c| c.to_table());
+            .and_then(|c| c.to_table().map_err(|e| e.to_string()));
         let value = match resolved {
             Ok(t) => toml::Value::Table(t),
             Err(e) => toml::Value::String(e),
