@@ -31,7 +31,7 @@ pub use message::{Link, Message, MessageBody, Outgoing, Recipient};
 pub use names::{closest, variant_name};
 pub use planner::{
     BehaviourKind, Decision, DeclarationKind, PlanStatus, Planner, PlannerEvent, RegionEvent,
-    Telemetry,
+    RuleDoc, Telemetry,
 };
 pub use vehicle::{
     ChemSample, Command, FlowSample, NavEstimate, RangeReturn, SensorSnapshot, VehicleId,

@@ -147,16 +147,12 @@ impl Serializer for NameOnly {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::{BehaviourKind, DeclarationKind, PlanStatus};
+    use crate::{BehaviourKind, PlanStatus};
 
     #[test]
     fn names_are_serdes() {
         assert_eq!(variant_name(&BehaviourKind::TrackIn), Some("track_in"));
         assert_eq!(variant_name(&BehaviourKind::GoTo), Some("go_to"));
-        assert_eq!(
-            variant_name(&DeclarationKind::AlongAndCrossFlow),
-            Some("along_and_cross_flow")
-        );
         assert_eq!(variant_name(&PlanStatus::Finished), Some("finished"));
         assert_eq!(variant_name(&3.0), None);
         assert_eq!(variant_name("text"), None);

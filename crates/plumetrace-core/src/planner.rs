@@ -5,10 +5,12 @@
 //! goes on. The same planner code runs against the simulator, a replayed log or a vehicle link.
 //!
 //! Everything a planner reports is typed: behaviours are [`BehaviourKind`]s, declaration rules
-//! [`DeclarationKind`]s. Their names in files come from serde (`snake_case`), in one place.
+//! [`DeclarationKind`]s (rules named by the planners that use them). Names in files come from
+//! serde (`snake_case`), in one place.
 
 use crate::{Command, Outgoing, SensorSnapshot, Vec2};
 use serde::{Deserialize, Serialize};
+use std::borrow::Cow;
 
 /// The behaviours of plume-tracing planners: one vocabulary shared by every planner, so that
 /// figures colour them alike and campaigns can compare time spent in each.
@@ -57,26 +59,53 @@ impl BehaviourKind {
     ];
 }
 
-/// What made a planner declare a source.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum DeclarationKind {
-    /// The three most up-flow lost points lie close together along the flow (the field rule).
-    AlongFlow,
-    /// The same, and close together across the flow too.
-    AlongAndCrossFlow,
-    /// A multi-source search traced the plume to its subregion's up-flow edge.
-    UpflowEdge,
-    /// The position of the strongest reading of a survey.
-    StrongestReading,
-    /// A formation moved up-flow past its strongest readings and every member's reading faded:
-    /// declared at the most up-flow strong reading, on the formation's centre line.
-    FormationPassedPeak,
-    /// A rule of a planner outside the registry (a Python planner, say), which names none.
-    Custom,
-    /// The most likely cell of the source-likelihood map, once the map's mass within a radius of
-    /// it passed a threshold.
-    SourceMap,
+/// What made a planner declare a source: the name of a declaration rule. Each planner declares
+/// the rules it uses (with a line of doc each) in its own module, as constants made with
+/// [`DeclarationKind::new`]; files carry the name (`"along_flow"`), and a rule read back from a
+/// file keeps whatever name it had.
+#[derive(Debug, Clone, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub struct DeclarationKind(Cow<'static, str>);
+
+impl DeclarationKind {
+    /// The rule called `name` (snake_case, as in files).
+    pub const fn new(name: &'static str) -> Self {
+        DeclarationKind(Cow::Borrowed(name))
+    }
+
+    /// The rule of a planner outside the registry (a Python planner, say), which names none.
+    pub const CUSTOM: DeclarationKind = DeclarationKind::new("custom");
+
+    /// Its name in files.
+    pub fn name(&self) -> &str {
+        &self.0
+    }
+}
+
+impl std::fmt::Display for DeclarationKind {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&self.0)
+    }
+}
+
+impl Serialize for DeclarationKind {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        s.serialize_str(&self.0)
+    }
+}
+
+impl<'de> Deserialize<'de> for DeclarationKind {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        String::deserialize(d).map(|name| DeclarationKind(Cow::Owned(name)))
+    }
+}
+
+/// A declaration rule with what it means, as a planner documents the rules it uses.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RuleDoc {
+    /// The rule.
+    pub rule: DeclarationKind,
+    /// One line saying when it declares, and where.
+    pub doc: &'static str,
 }
 
 /// Something a planner reports for the event stream (written to logs, never read back by the
@@ -301,7 +330,7 @@ mod tests {
                 },
                 PlannerEvent::Declared {
                     pos_m: Vec2::new(0.1, -7.0e-9),
-                    rule: DeclarationKind::UpflowEdge,
+                    rule: DeclarationKind::new("upflow_edge"),
                 },
             ],
             telemetry: vec![Telemetry::SourceEstimate {

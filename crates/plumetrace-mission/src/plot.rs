@@ -2777,7 +2777,7 @@ mod tests {
             error_m: 20.0,
             error_along_m: 20.0,
             error_cross_m: 0.0,
-            rule: DeclarationKind::AlongFlow,
+            rule: DeclarationKind::new("along_flow"),
         });
         let l = labels(&layout(&run));
         assert_eq!(l.iter().filter(|s| *s == "declared source").count(), 1);
@@ -2826,7 +2826,7 @@ mod tests {
             vehicle: 0,
             event: EventKind::Planner(PlannerEvent::Declared {
                 pos_m: Vec2::new(17.5, -27.5),
-                rule: DeclarationKind::SourceMap,
+                rule: DeclarationKind::new("source_map"),
             }),
         });
         run.events.push(raster_event(200.0, 10, 12));

@@ -310,7 +310,7 @@ impl Observer for TrackStats {
                         track.first_detection = Some((t, *pos_m));
                     }
                     PlannerEvent::Declared { pos_m, rule } => {
-                        track.declarations.push((t, *pos_m, *rule));
+                        track.declarations.push((t, *pos_m, rule.clone()));
                     }
                     _ => {}
                 }
@@ -559,7 +559,7 @@ mod tests {
             PlannerEvent::LostPoint { pos_m: p },
             PlannerEvent::Declared {
                 pos_m: p,
-                rule: DeclarationKind::AlongFlow,
+                rule: DeclarationKind::new("along_flow"),
             },
             PlannerEvent::Region {
                 index: 0,

@@ -150,7 +150,7 @@ impl Summary {
             .flat_map(|(v, t)| {
                 t.declarations
                     .iter()
-                    .map(move |(at, p, rule)| (*at, v, *p, *rule))
+                    .map(move |(at, p, rule)| (*at, v, *p, rule.clone()))
             })
             .map(|(t, v, p, rule)| {
                 declaration_record(t, v as u32, p, rule, i.sources, i.mean_flow_mps)
@@ -315,12 +315,24 @@ mod tests {
         let sources = [Vec3::new(300.0, 860.0, 0.0), Vec3::new(700.0, 820.0, 0.0)];
         let flow = Vec2::new(0.05, -0.25);
         let decl: Vec<DeclarationRecord> = [
-            (100.0, Vec2::new(340.0, 550.0), DeclarationKind::UpflowEdge),
-            (900.0, Vec2::new(298.0, 852.0), DeclarationKind::AlongFlow),
-            (1500.0, Vec2::new(305.0, 845.0), DeclarationKind::AlongFlow),
+            (
+                100.0,
+                Vec2::new(340.0, 550.0),
+                DeclarationKind::new("upflow_edge"),
+            ),
+            (
+                900.0,
+                Vec2::new(298.0, 852.0),
+                DeclarationKind::new("along_flow"),
+            ),
+            (
+                1500.0,
+                Vec2::new(305.0, 845.0),
+                DeclarationKind::new("along_flow"),
+            ),
         ]
         .iter()
-        .map(|(t, p, rule)| declaration_record(*t, 0, *p, *rule, &sources, flow))
+        .map(|(t, p, rule)| declaration_record(*t, 0, *p, rule.clone(), &sources, flow))
         .collect();
         let recs = source_records(&sources, &decl);
         assert_eq!(recs[0].declarations, 3, "the edge declaration counts too");
@@ -338,7 +350,7 @@ mod tests {
                 .is_some_and(|e| e > LOCATED_RADIUS_M)
                 && !recs[0].located
         );
-        assert_eq!(decl[0].rule, DeclarationKind::UpflowEdge);
+        assert_eq!(decl[0].rule, DeclarationKind::new("upflow_edge"));
     }
 
     #[test]
@@ -348,7 +360,7 @@ mod tests {
             1.0,
             0,
             Vec2::new(10.0, -3.0),
-            DeclarationKind::AlongFlow,
+            DeclarationKind::new("along_flow"),
             &[Vec3::zeros()],
             Vec2::new(0.2, 0.0),
         );

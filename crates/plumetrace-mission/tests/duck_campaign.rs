@@ -59,7 +59,7 @@ fn duck_st_map_declaration_declares_every_seed_within_a_few_metres() {
     let mut errors: Vec<f64> = results
         .iter()
         .filter_map(|r| r.1.first_declaration.as_ref())
-        .filter(|d| d.rule == DeclarationKind::SourceMap)
+        .filter(|d| d.rule == DeclarationKind::new("source_map"))
         .map(|d| d.error_m)
         .collect();
     errors.sort_by(f64::total_cmp);
@@ -131,7 +131,9 @@ fn duck_mt_locates_the_sources_and_declares_the_southern_edges() {
         .map(|r| {
             r.1.declarations
                 .iter()
-                .filter(|d| d.rule == DeclarationKind::UpflowEdge && (d.y_m - 550.0).abs() < 1.0)
+                .filter(|d| {
+                    d.rule == DeclarationKind::new("upflow_edge") && (d.y_m - 550.0).abs() < 1.0
+                })
                 .count()
         })
         .collect();

@@ -31,6 +31,59 @@ fn shorten(cfg: &mut ScenarioConfig, spinup_s: f64, limit_s: f64) {
     }
 }
 
+/// Every behaviour and declaration rule in the run's events is one its vehicle's planner declares
+/// in the registry (`avoid` too, for planners flying with obstacle avoidance).
+fn reports_only_what_its_planner_declares(
+    run: &plumetrace_mission::MissionRun,
+    label: &str,
+) -> usize {
+    let mut rules = 0;
+    for e in &run.events {
+        let EventKind::Planner(event) = &e.event else {
+            continue;
+        };
+        let kind = run.vehicles[e.vehicle as usize]
+            .planner
+            .unwrap_or_else(|| panic!("{label}: an event of a vehicle without a planner"));
+        let entry = plumetrace_planner::planners::entry(kind);
+        match event {
+            PlannerEvent::Behaviour { behaviour } => assert!(
+                entry.behaviours.contains(behaviour) || *behaviour == BehaviourKind::Avoid,
+                "{label}: {kind} reported {behaviour:?}, which it does not declare"
+            ),
+            PlannerEvent::Declared { rule, .. } => {
+                rules += 1;
+                assert!(
+                    entry.rules.iter().any(|r| r.rule == *rule),
+                    "{label}: {kind} declared with '{rule}', which it does not declare"
+                );
+            }
+            _ => {}
+        }
+    }
+    rules
+}
+
+#[test]
+fn planners_report_the_behaviours_and_rules_they_declare() {
+    for name in [
+        "demo-survey",
+        "demo-infotaxis",
+        "li-zhang-open",
+        "soares-freshwater",
+    ] {
+        let mut cfg = load_preset(name).unwrap();
+        shorten(&mut cfg, 1500.0, 3000.0);
+        let sc = build(&cfg, &Origin::Preset(name.into()), Some(2)).unwrap();
+        let run = run_mission(sc, &mut |_, _| {}).unwrap();
+        assert!(
+            reports_only_what_its_planner_declares(&run, name) > 0,
+            "{name}: no declaration to check ({:?})",
+            run.outcome
+        );
+    }
+}
+
 #[test]
 fn every_mission_preset_runs_without_panicking() {
     for p in PRESETS {
@@ -39,6 +92,7 @@ fn every_mission_preset_runs_without_panicking() {
             continue;
         }
         let run = run_mission(shortened(p.name, 1500.0, 120.0, 3), &mut |_, _| {}).unwrap();
+        reports_only_what_its_planner_declares(&run, p.name);
         let s = &run.summary;
         assert!(
             s.sim_time_s > 0.0 && s.sim_time_s <= 120.0 + 1e-9,

@@ -128,12 +128,7 @@ impl<W: Write> AlogWriter<W> {
                 PlannerEvent::Declared { pos_m, rule } => self.post(
                     t,
                     "CPT_DECLARATION",
-                    &format!(
-                        "x={:.2},y={:.2},rule={}",
-                        pos_m.x,
-                        pos_m.y,
-                        variant_name(rule).unwrap_or("?")
-                    ),
+                    &format!("x={:.2},y={:.2},rule={}", pos_m.x, pos_m.y, rule.name()),
                 )?,
                 _ => {}
             }
@@ -195,7 +190,7 @@ mod tests {
         assert!(w.decision(&snap(0.1), &d).is_ok());
         d.events = vec![PlannerEvent::Declared {
             pos_m: Vec2::new(100.0, 0.5),
-            rule: DeclarationKind::AlongFlow,
+            rule: DeclarationKind::new("along_flow"),
         }];
         d.status = PlanStatus::Finished;
         assert!(w.decision(&snap(0.2), &d).is_ok());

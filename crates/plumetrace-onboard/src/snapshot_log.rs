@@ -83,7 +83,10 @@ impl Header {
         let mut vehicles = Vec::new();
         for (k, p) in planners.iter().enumerate() {
             let Some(p) = p else { continue };
-            let table = p.config().to_table().map_err(|e| format!("{}: {e}", p.key()))?;
+            let table = p
+                .config()
+                .to_table()
+                .map_err(|e| format!("{}: {e}", p.key()))?;
             vehicles.push(LoggedPlanner {
                 id: k as u32,
                 name: names.get(k).cloned().unwrap_or_default(),

@@ -3,8 +3,8 @@
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
 use plumetrace_core::{
-    BehaviourKind, ChemSample, DeclarationKind, FlowSample, Heading, NavEstimate, PlanStatus,
-    Planner, PlannerEvent, SensorSnapshot, Vec2, VehicleId, bearing_between,
+    BehaviourKind, ChemSample, FlowSample, Heading, NavEstimate, PlanStatus, Planner, PlannerEvent,
+    SensorSnapshot, Vec2, VehicleId, bearing_between,
 };
 use plumetrace_guidance::OpArea;
 use plumetrace_planner::amp::{FindPattern, LhsUpdate};
@@ -382,7 +382,7 @@ fn multi_source_tracing_to_the_upflow_edge_declares_there() {
         .iter()
         .filter_map(|e| {
             if let PlannerEvent::Declared { pos_m, rule } = e {
-                Some((*pos_m, *rule))
+                Some((*pos_m, rule.clone()))
             } else {
                 None
             }
@@ -391,7 +391,7 @@ fn multi_source_tracing_to_the_upflow_edge_declares_there() {
     assert_eq!(declared.len(), 1, "{:?}", d.events);
     assert!(
         (declared[0].0 - Vec2::new(150.0, 500.0)).norm() < 1e-9
-            && declared[0].1 == DeclarationKind::UpflowEdge
+            && declared[0].1 == plumetrace_planner::amp::UPFLOW_EDGE
     );
     assert_eq!(a.behaviour(), BehaviourKind::Transit);
 }

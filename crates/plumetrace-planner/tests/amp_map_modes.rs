@@ -74,7 +74,7 @@ impl Log {
         let d = a.decide(s);
         for e in &d.events {
             if let PlannerEvent::Declared { pos_m, rule } = e {
-                self.declared.push((t, *pos_m, *rule));
+                self.declared.push((t, *pos_m, rule.clone()));
             }
         }
         for x in &d.telemetry {
@@ -131,8 +131,11 @@ fn off_keeps_no_map_and_declares_by_lost_points() {
     let mut log = Log::default();
     lose_at(&mut a, &mut log, &CLOSE);
     assert_eq!(
-        log.declared.iter().map(|d| (d.1, d.2)).collect::<Vec<_>>(),
-        vec![(Vec2::new(195.0, 296.5), DeclarationKind::AlongFlow)]
+        log.declared
+            .iter()
+            .map(|d| (d.1, d.2.clone()))
+            .collect::<Vec<_>>(),
+        vec![(Vec2::new(195.0, 296.5), plumetrace_planner::amp::ALONG_FLOW)]
     );
     assert!(log.peaks.is_empty() && log.rasters.is_empty());
 }
@@ -157,8 +160,8 @@ fn instead_declares_the_maps_peak_as_soon_as_its_rule_holds() {
     let mut log = Log::default();
     let arrivals = lose_at(&mut a, &mut log, &CLOSE);
     assert_eq!(log.declared.len(), 1, "{:?}", log.declared);
-    let (t, at, rule) = log.declared[0];
-    assert_eq!(rule, DeclarationKind::SourceMap);
+    let (t, at, rule) = log.declared[0].clone();
+    assert_eq!(rule, plumetrace_planner::estimate::tracker::SOURCE_MAP);
     // During a burst of detections, before the lost points agree (the lost-point rule alone
     // declares at the third Track-Out arrival).
     assert!(t < lost_point_declaration_s(), "{t}");
@@ -178,7 +181,10 @@ fn also_declares_by_whichever_rule_holds_first() {
     let mut log = Log::default();
     lose_at(&mut a, &mut log, &CLOSE);
     assert_eq!(log.declared.len(), 1, "{:?}", log.declared);
-    assert_eq!(log.declared[0].2, DeclarationKind::SourceMap);
+    assert_eq!(
+        log.declared[0].2,
+        plumetrace_planner::estimate::tracker::SOURCE_MAP
+    );
     assert!(log.declared[0].0 < lost_point_declaration_s());
     // The map's rule never holds: the lost-point rule declares at the most upflow point.
     let mut a = amp(MapDeclaration::Also, false);
@@ -189,7 +195,7 @@ fn also_declares_by_whichever_rule_holds_first() {
         vec![(
             arrivals[2],
             Vec2::new(195.0, 296.5),
-            DeclarationKind::AlongFlow
+            plumetrace_planner::amp::ALONG_FLOW
         )]
     );
 }
@@ -203,8 +209,14 @@ fn refine_declares_when_the_lost_points_agree_at_the_maps_peak_if_its_rule_holds
     // arrival, where the lost-point rule holds.
     assert_eq!(arrivals.len(), 3);
     assert_eq!(log.declared.len(), 1, "{:?}", log.declared);
-    let (t, at, rule) = log.declared[0];
-    assert_eq!((t, rule), (arrivals[2], DeclarationKind::SourceMap));
+    let (t, at, rule) = log.declared[0].clone();
+    assert_eq!(
+        (t, rule),
+        (
+            arrivals[2],
+            plumetrace_planner::estimate::tracker::SOURCE_MAP
+        )
+    );
     let peak = log.peaks.iter().rev().find(|p| p.0 == t).unwrap().1;
     assert_eq!(at, peak);
     assert_ne!(at, Vec2::new(195.0, 296.5));
@@ -219,7 +231,7 @@ fn refine_declares_when_the_lost_points_agree_at_the_maps_peak_if_its_rule_holds
         vec![(
             arrivals[2],
             Vec2::new(195.0, 296.5),
-            DeclarationKind::AlongFlow
+            plumetrace_planner::amp::ALONG_FLOW
         )]
     );
 }

@@ -8,8 +8,8 @@
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
 use plumetrace_core::{
-    BehaviourKind, ChemSample, DeclarationKind, FlowSample, Heading, NavEstimate, PlanStatus,
-    Planner, PlannerEvent, SensorSnapshot, Vec2, VehicleId, bearing_between,
+    BehaviourKind, ChemSample, FlowSample, Heading, NavEstimate, PlanStatus, Planner, PlannerEvent,
+    SensorSnapshot, Vec2, VehicleId, bearing_between,
 };
 use plumetrace_guidance::OpArea;
 use plumetrace_planner::{Moth, MothParams, MothStrategy};
@@ -294,7 +294,7 @@ fn declaration_fires_at_4_9_m_and_not_at_5_1_m() {
     let want = Vec2::new(60.0 - 4.9, 50.0 + 0.3);
     assert!(events.contains(&PlannerEvent::Declared {
         pos_m: want,
-        rule: DeclarationKind::AlongFlow
+        rule: plumetrace_planner::amp::ALONG_FLOW
     }));
     assert_eq!(m.declared(), Some(want));
     assert_eq!(m.contact_points().len(), 6);

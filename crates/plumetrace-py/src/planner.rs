@@ -186,7 +186,7 @@ impl PyPlanner {
         if let Some(p) = point("declare")? {
             decision.events.push(PlannerEvent::Declared {
                 pos_m: p,
-                rule: DeclarationKind::Custom,
+                rule: DeclarationKind::CUSTOM,
             });
         }
         if let Some(p) = point("source_estimate")? {

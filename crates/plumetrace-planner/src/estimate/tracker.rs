@@ -17,8 +17,12 @@
 //! brings non-detections upflow and detections at the head, and the peak stays.
 
 use crate::estimate::{MapModel, SourceMap};
-use plumetrace_core::{SensorSnapshot, Telemetry, Vec2};
+use plumetrace_core::{DeclarationKind, SensorSnapshot, Telemetry, Vec2};
 use plumetrace_guidance::OpArea;
+
+/// The map's rule in events: the most likely cell (or the posterior mean around it), once the
+/// map's mass within a radius of that cell has passed a threshold.
+pub const SOURCE_MAP: DeclarationKind = DeclarationKind::new("source_map");
 
 /// When a map read is reported as a whole raster besides its summary.
 const RASTER_EVERY_S: f64 = 600.0;

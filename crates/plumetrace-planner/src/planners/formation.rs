@@ -71,8 +71,9 @@
 use crate::planners::{BuildContext, PlannerParams};
 use plumetrace_core::params::{Bounds, Choice, ParamError, Params};
 use plumetrace_core::{
-    Decision, DeclarationKind, Heading, Link, MessageBody, Outgoing, PlanStatus, Planner,
-    PlannerEvent, Recipient, SensorSnapshot, Telemetry, Vec2, VehicleId, VerticalCommand,
+    BehaviourKind, Decision, DeclarationKind, Heading, Link, MessageBody, Outgoing, PlanStatus,
+    Planner, PlannerEvent, Recipient, RuleDoc, SensorSnapshot, Telemetry, Vec2, VehicleId,
+    VerticalCommand,
 };
 use plumetrace_guidance::{Autopilot, AutopilotParams, OpArea, Steer};
 use serde::{Deserialize, Serialize};
@@ -108,6 +109,11 @@ pub enum ReadingModel {
 impl Choice for ReadingModel {
     const ALL: &'static [Self] = &[ReadingModel::Freshness, ReadingModel::Concentration];
 }
+
+/// The formation's rule in events: the team moved up-flow past its strongest readings and every
+/// member's reading faded; declared at the most up-flow strong reading, on the formation's centre
+/// line.
+pub const PASSED_PEAK: DeclarationKind = DeclarationKind::new("formation_passed_peak");
 
 plumetrace_core::params! {
     /// Parameters of a formation leader (surface craft with GPS).
@@ -224,6 +230,11 @@ plumetrace_core::params! {
 impl PlannerParams for FormationLeaderParams {
     const KIND: &'static str = "formation_leader";
     const SUMMARY: &'static str = "Formation leader (seed 004): Laplacian formation feedback on GPS positions by radio, up-flow urge, plume centring and cross-flow scaling; answers the follower's ranging requests; declares when the team has passed its strongest readings";
+    const BEHAVIOURS: &'static [BehaviourKind] = &[];
+    const RULES: &'static [RuleDoc] = &[RuleDoc {
+        rule: PASSED_PEAK,
+        doc: "the team moved past_m up-flow of its strongest readings and every member's reading stayed below quiet_fraction of its peak for quiet_s: the most up-flow strong reading, on the formation's centre line",
+    }];
 
     fn validate(&self, prefix: &str) -> Result<(), ParamError> {
         self.check_bounds(prefix)?;
@@ -267,6 +278,8 @@ impl PlannerParams for FormationLeaderParams {
 impl PlannerParams for FormationFollowerParams {
     const KIND: &'static str = "formation_follower";
     const SUMMARY: &'static str = "Formation follower (seed 004): no position; PI speed on the common-mode range error and heading from a Kalman estimate of the formation heading plus the differential-mode term, on ranges measured alternately to the two leaders";
+    const BEHAVIOURS: &'static [BehaviourKind] = &[];
+    const RULES: &'static [RuleDoc] = &[];
     const NEEDS_POSITION: bool = false;
 
     fn validate(&self, prefix: &str) -> Result<(), ParamError> {
@@ -672,7 +685,7 @@ impl Planner for FormationLeader {
             self.declared = true;
             events.push(PlannerEvent::Declared {
                 pos_m,
-                rule: DeclarationKind::FormationPassedPeak,
+                rule: PASSED_PEAK,
             });
             status = PlanStatus::Finished;
         }

@@ -26,8 +26,8 @@ use crate::planners::{BuildContext, PlannerParams};
 use crate::shared_keys::{AutopilotKeys, MapKeys};
 use plumetrace_core::params::{Bounds, ParamError};
 use plumetrace_core::{
-    BehaviourKind, Decision, DeclarationKind, Heading, PlanStatus, Planner, PlannerEvent,
-    SensorSnapshot, Telemetry, Vec2,
+    BehaviourKind, Decision, Heading, PlanStatus, Planner, PlannerEvent, RuleDoc, SensorSnapshot,
+    Telemetry, Vec2,
 };
 use plumetrace_guidance::{Autopilot, GoToPoint, ModeStatus, OpArea, Steer};
 
@@ -60,6 +60,11 @@ impl PlannerParams for InfotaxisParams {
     const SUMMARY: &'static str = "Infotaxis on a source-likelihood map: legs chosen to minimise the expected entropy of the map (or space-aware), declaration once the map concentrates";
 
     const THRESHOLD_KEY: Option<&'static str> = Some("threshold_v");
+    const BEHAVIOURS: &'static [BehaviourKind] = &[BehaviourKind::Infotaxis, BehaviourKind::Done];
+    const RULES: &'static [RuleDoc] = &[RuleDoc {
+        rule: crate::estimate::tracker::SOURCE_MAP,
+        doc: "the source map's most likely cell (the posterior mean within map_estimate_radius_m of it) once map_mass lies within map_radius_m of it for map_hold_s",
+    }];
 
     fn detection_threshold_v(&self) -> Option<f64> {
         Some(self.autopilot.threshold_v)
@@ -225,7 +230,7 @@ impl Planner for Infotaxis {
             });
             events.push(PlannerEvent::Declared {
                 pos_m: r.estimate_m,
-                rule: DeclarationKind::SourceMap,
+                rule: crate::estimate::tracker::SOURCE_MAP,
             });
             events.push(PlannerEvent::Behaviour {
                 behaviour: BehaviourKind::Done,
@@ -370,13 +375,13 @@ mod tests {
         for objective in [Objective::Infotaxis, Objective::SpaceAware] {
             let (events, telemetry) = fly(objective);
             let declared = events.iter().find_map(|e| match e {
-                PlannerEvent::Declared { pos_m, rule } => Some((*pos_m, *rule)),
+                PlannerEvent::Declared { pos_m, rule } => Some((*pos_m, rule.clone())),
                 _ => None,
             });
             let Some((at, rule)) = declared else {
                 panic!("{objective:?}: no declaration; {} events", events.len());
             };
-            assert_eq!(rule, DeclarationKind::SourceMap);
+            assert_eq!(rule, crate::estimate::tracker::SOURCE_MAP);
             assert!(
                 (at - Vec2::new(80.0, 100.0)).norm() < 25.0,
                 "{objective:?}: declared at {at:?}"

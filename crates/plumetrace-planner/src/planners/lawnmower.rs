@@ -19,10 +19,13 @@ use crate::planners::{BuildContext, PlannerParams};
 use crate::shared_keys::AutopilotKeys;
 use plumetrace_core::params::{Bounds, ParamError};
 use plumetrace_core::{
-    BehaviourKind, Decision, DeclarationKind, Heading, PlanStatus, Planner, PlannerEvent,
+    BehaviourKind, Decision, DeclarationKind, Heading, PlanStatus, Planner, PlannerEvent, RuleDoc,
     SensorSnapshot, Telemetry, Vec2,
 };
 use plumetrace_guidance::{Autopilot, GoToPoint, OpArea, Steer};
+
+/// The lawnmower's rule in events: the position of the strongest reading of the survey.
+pub const STRONGEST_READING: DeclarationKind = DeclarationKind::new("strongest_reading");
 
 plumetrace_core::params! {
     /// Parameters of the lawnmower survey.
@@ -46,6 +49,15 @@ impl PlannerParams for LawnmowerParams {
     const SUMMARY: &'static str = "Lawnmower survey: lanes across the mean flow over the op-area, then a declaration at the strongest reading (the exhaustive baseline)";
 
     const THRESHOLD_KEY: Option<&'static str> = Some("threshold_v");
+    const BEHAVIOURS: &'static [BehaviourKind] = &[
+        BehaviourKind::GoTo,
+        BehaviourKind::Survey,
+        BehaviourKind::Done,
+    ];
+    const RULES: &'static [RuleDoc] = &[RuleDoc {
+        rule: STRONGEST_READING,
+        doc: "when the last lane is flown: the position of the strongest reading",
+    }];
 
     fn detection_threshold_v(&self) -> Option<f64> {
         Some(self.autopilot.threshold_v)
@@ -293,7 +305,7 @@ impl Planner for Lawnmower {
             if let Some((_, at)) = self.strongest {
                 self.events.push(PlannerEvent::Declared {
                     pos_m: at,
-                    rule: DeclarationKind::StrongestReading,
+                    rule: STRONGEST_READING,
                 });
             }
         }
@@ -499,7 +511,7 @@ mod tests {
             .iter()
             .filter_map(|e| match e {
                 PlannerEvent::Declared { pos_m, rule } => {
-                    assert_eq!(*rule, DeclarationKind::StrongestReading);
+                    assert_eq!(*rule, STRONGEST_READING);
                     Some(*pos_m)
                 }
                 _ => None,

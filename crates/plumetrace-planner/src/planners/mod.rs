@@ -22,7 +22,10 @@ pub mod lawnmower;
 pub mod moth;
 
 use plumetrace_core::params::{Bounds, KeyDoc, ParamError, Params, key_path, markdown_rows};
-use plumetrace_core::{Decision, Heading, Planner, SensorSnapshot, Vec2, VehicleId, VehicleKind};
+use plumetrace_core::{
+    BehaviourKind, Decision, Heading, Planner, RuleDoc, SensorSnapshot, Vec2, VehicleId,
+    VehicleKind,
+};
 use plumetrace_guidance::OpArea;
 use serde::de::DeserializeOwned;
 use serde::{Deserialize, Serialize};
@@ -79,6 +82,10 @@ pub trait PlannerParams:
     /// The key of its detection threshold, if it thresholds chemical readings (an older
     /// scenario's `[vehicles.chem_sensor] threshold_v` is passed to it).
     const THRESHOLD_KEY: Option<&'static str> = None;
+    /// The behaviours it reports (of the shared vocabulary), in the order it flies them.
+    const BEHAVIOURS: &'static [BehaviourKind];
+    /// The declaration rules it reports, with what each means.
+    const RULES: &'static [RuleDoc];
 
     /// Checks every value (bounds, and rules across keys); errors name `prefix.key`.
     fn validate(&self, prefix: &str) -> Result<(), ParamError> {
@@ -117,6 +124,10 @@ pub struct PlannerEntry {
     pub needs_position: bool,
     /// The key of its detection threshold, if it has one.
     pub threshold_key: Option<&'static str>,
+    /// The behaviours it reports.
+    pub behaviours: &'static [BehaviourKind],
+    /// The declaration rules it reports.
+    pub rules: &'static [RuleDoc],
 }
 
 /// Reads a parameter set from a table; errors name `prefix.key` (unknown keys, wrong types,
@@ -193,6 +204,8 @@ macro_rules! registry {
                 keys: <$ty as Params>::keys,
                 needs_position: <$ty as PlannerParams>::NEEDS_POSITION,
                 threshold_key: <$ty as PlannerParams>::THRESHOLD_KEY,
+                behaviours: <$ty as PlannerParams>::BEHAVIOURS,
+                rules: <$ty as PlannerParams>::RULES,
             },
         )*];
 
@@ -423,6 +436,26 @@ pub fn registry_defaults() -> toml::Table {
     out
 }
 
+/// A planner's behaviours and declaration rules as Markdown lines (after its key table).
+fn behaviours_and_rules(p: &PlannerEntry) -> String {
+    let names: Vec<String> = p
+        .behaviours
+        .iter()
+        .map(|b| format!("`{}`", plumetrace_core::variant_name(b).unwrap_or("?")))
+        .collect();
+    let mut out = String::new();
+    if !names.is_empty() {
+        let _ = write!(out, "\nBehaviours: {}.\n", names.join(", "));
+    }
+    if !p.rules.is_empty() {
+        out.push_str("\nDeclaration rules:\n");
+        for r in p.rules {
+            let _ = writeln!(out, "- `{}`: {}", r.rule, r.doc);
+        }
+    }
+    out
+}
+
 /// Every planner with its keys as Markdown (the README's planner section is this text).
 pub fn registry_markdown() -> String {
     let mut out = String::new();
@@ -439,6 +472,7 @@ pub fn registry_markdown() -> String {
             p.summary
         );
         out.push_str(&markdown_rows(&(p.keys)()));
+        out.push_str(&behaviours_and_rules(p));
     }
     out
 }

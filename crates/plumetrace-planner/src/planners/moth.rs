@@ -47,7 +47,7 @@ use crate::planners::{BuildContext, PlannerParams};
 use crate::shared_keys::AutopilotKeys;
 use plumetrace_core::params::{Bounds, Choice, ParamError, Params};
 use plumetrace_core::{
-    BehaviourKind, Decision, DeclarationKind, Heading, PlanStatus, Planner, PlannerEvent,
+    BehaviourKind, Decision, DeclarationKind, Heading, PlanStatus, Planner, PlannerEvent, RuleDoc,
     SensorSnapshot, Telemetry, Vec2, bearing_between,
 };
 use plumetrace_guidance::{Autopilot, OpArea, Steer};
@@ -118,6 +118,18 @@ impl PlannerParams for MothParams {
     const KIND: &'static str = "moth";
     const SUMMARY: &'static str = "Moth-inspired planner (Li and Zhang): Find-Plume, Track-In, Track-Out, cloverleaf Reacquire, declaration from recent contacts, in a subsumption architecture";
     const THRESHOLD_KEY: Option<&'static str> = Some("threshold_v");
+    const BEHAVIOURS: &'static [BehaviourKind] = &[
+        BehaviourKind::GoTo,
+        BehaviourKind::Find,
+        BehaviourKind::TrackIn,
+        BehaviourKind::TrackOut,
+        BehaviourKind::Reacquire,
+        BehaviourKind::Done,
+    ];
+    const RULES: &'static [RuleDoc] = &[RuleDoc {
+        rule: ALONG_FLOW,
+        doc: "the declare_points most up-flow of the recent contacts lie within declare_spread_m along the flow and declare_across_m across it: the most up-flow one",
+    }];
 
     fn validate(&self, prefix: &str) -> Result<(), ParamError> {
         self.check_bounds(prefix)?;
@@ -146,6 +158,11 @@ impl PlannerParams for MothParams {
         )))
     }
 }
+
+/// The moth's rule in events: the M most up-flow recent contacts lie within epsilon of each other
+/// along the flow (and within `declare_across_m` across it); written as the AMP's field rule,
+/// the test it shares.
+pub const ALONG_FLOW: DeclarationKind = DeclarationKind::new("along_flow");
 
 /// Contacts kept for Declare-Source (one per `lambda_s` at most: 10,000 is over a day at the
 /// default `lambda_s`).
@@ -295,7 +312,7 @@ fn on_done(m: &mut Memory, d: MothDone) {
             m.declared = Some(at);
             m.events.push(PlannerEvent::Declared {
                 pos_m: at,
-                rule: DeclarationKind::AlongFlow,
+                rule: ALONG_FLOW,
             });
         }
     }

@@ -41,12 +41,19 @@ pub enum DeclarationRule {
     },
 }
 
+/// The field rule's name in events.
+pub const ALONG_FLOW: DeclarationKind = DeclarationKind::new("along_flow");
+/// The field rule with a crossflow bound, in events.
+pub const ALONG_AND_CROSS_FLOW: DeclarationKind = DeclarationKind::new("along_and_cross_flow");
+/// A multi-source search traced the plume to its subregion's up-flow edge, in events.
+pub const UPFLOW_EDGE: DeclarationKind = DeclarationKind::new("upflow_edge");
+
 impl DeclarationRule {
     /// The rule as reported in events.
     pub fn kind(&self) -> DeclarationKind {
         match self {
-            DeclarationRule::AlongFlow { .. } => DeclarationKind::AlongFlow,
-            DeclarationRule::AlongAndCrossFlow { .. } => DeclarationKind::AlongAndCrossFlow,
+            DeclarationRule::AlongFlow { .. } => ALONG_FLOW,
+            DeclarationRule::AlongAndCrossFlow { .. } => ALONG_AND_CROSS_FLOW,
         }
     }
 

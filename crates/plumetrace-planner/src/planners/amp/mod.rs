@@ -37,7 +37,9 @@ mod find;
 mod mapping;
 
 pub use bowtie::{Bowtie, centres as bowtie_centres};
-pub use declaration::{DeclarationChoice, DeclarationRule};
+pub use declaration::{
+    ALONG_AND_CROSS_FLOW, ALONG_FLOW, DeclarationChoice, DeclarationRule, UPFLOW_EDGE,
+};
 pub use find::{candidates as find_candidates, reflect as find_reflect};
 pub use mapping::MappingParams;
 
@@ -51,7 +53,7 @@ use behaviours::{Find, Reacquire, TrackIn, TrackOut};
 use plumetrace_core::params::{Bounds, Choice, ParamError};
 use plumetrace_core::{
     BehaviourKind, Decision, DeclarationKind, Heading, PlanStatus, Planner, PlannerEvent,
-    RegionEvent, SensorSnapshot, Telemetry, Vec2, VerticalCommand, wrap_deg_360,
+    RegionEvent, RuleDoc, SensorSnapshot, Telemetry, Vec2, VerticalCommand, wrap_deg_360,
 };
 use plumetrace_guidance::{Autopilot, AutopilotParams, FollowLine, GoToPoint, OpArea, Steer};
 use serde::{Deserialize, Serialize};
@@ -258,6 +260,34 @@ impl PlannerParams for AmpParams {
     const SUMMARY: &'static str = "REMUS Adaptive Mission Planner: Find, Track-In, Track-Out, Reacquire (Bowtie), lost-point declaration, mapping, subregions";
 
     const THRESHOLD_KEY: Option<&'static str> = Some("threshold_v");
+    const BEHAVIOURS: &'static [BehaviourKind] = &[
+        BehaviourKind::GoTo,
+        BehaviourKind::Transit,
+        BehaviourKind::Find,
+        BehaviourKind::TrackIn,
+        BehaviourKind::TrackOut,
+        BehaviourKind::Reacquire,
+        BehaviourKind::Mapping,
+        BehaviourKind::Done,
+    ];
+    const RULES: &'static [RuleDoc] = &[
+        RuleDoc {
+            rule: declaration::ALONG_FLOW,
+            doc: "the three most upflow lost points lie within declaration_along_m of each other along the flow: the most upflow one (the field rule)",
+        },
+        RuleDoc {
+            rule: declaration::ALONG_AND_CROSS_FLOW,
+            doc: "the same, and within declaration_cross_m across the flow too",
+        },
+        RuleDoc {
+            rule: declaration::UPFLOW_EDGE,
+            doc: "a multi-source search traced the plume to its subregion's up-flow edge: the point there",
+        },
+        RuleDoc {
+            rule: crate::estimate::tracker::SOURCE_MAP,
+            doc: "with map_declaration: the source map's most likely cell (the posterior mean within map_estimate_radius_m of it) once map_mass lies within map_radius_m of it for map_hold_s",
+        },
+    ];
 
     fn detection_threshold_v(&self) -> Option<f64> {
         Some(self.autopilot.threshold_v)
@@ -621,7 +651,7 @@ impl Switching {
                     Some(peak) => self.declare(
                         m,
                         peak,
-                        DeclarationKind::SourceMap,
+                        crate::estimate::tracker::SOURCE_MAP,
                         RegionEvent::Declared,
                         t,
                     ),
@@ -640,7 +670,7 @@ impl Switching {
                 self.declare(
                     m,
                     at,
-                    DeclarationKind::UpflowEdge,
+                    declaration::UPFLOW_EDGE,
                     RegionEvent::DeclaredAtEdge,
                     p.t_s,
                 );
@@ -893,7 +923,7 @@ impl Amp {
         self.switching.declare(
             &mut self.m,
             read.estimate_m,
-            DeclarationKind::SourceMap,
+            crate::estimate::tracker::SOURCE_MAP,
             RegionEvent::Declared,
             t,
         );
