@@ -292,7 +292,10 @@ pub fn error_chart(
         rows.iter()
             .map(|(_, r)| r)
             .filter(|r| {
-                r.declared && r.scenario == g.scenario && r.config == g.config && r.point == g.point
+                r.metrics.declared
+                    && r.scenario == g.scenario
+                    && r.config == g.config
+                    && r.point == g.point
             })
             .flat_map(|r| f(r).into_iter().map(|v| (r.seed_index, v)))
             .collect()
@@ -302,7 +305,8 @@ pub fn error_chart(
         vec![(
             "distance from each source to its nearest declaration (m; located: within the success radius, 50 m by default)",
             &|r: &RunRow| {
-                r.source_errors_m
+                r.metrics
+                    .source_errors_m
                     .split(';')
                     .filter_map(|v| v.parse::<f64>().ok())
                     .collect()
@@ -311,13 +315,13 @@ pub fn error_chart(
     } else {
         vec![
             ("declaration error (m)", &|r: &RunRow| {
-                r.error_m.into_iter().collect()
+                r.metrics.error_m.into_iter().collect()
             }),
             ("along-flow error (m, + downflow)", &|r: &RunRow| {
-                r.error_along_m.into_iter().collect()
+                r.metrics.error_along_m.into_iter().collect()
             }),
             ("crossflow error (m, + right of flow)", &|r: &RunRow| {
-                r.error_cross_m.into_iter().collect()
+                r.metrics.error_cross_m.into_iter().collect()
             }),
         ]
     };

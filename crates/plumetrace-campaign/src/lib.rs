@@ -16,7 +16,7 @@
 //!
 //! | file | what |
 //! | --- | --- |
-//! | `runs.csv` | one row per run: keys, outcome, every metric of the mission summary |
+//! | `runs.csv` | one row per run ([`runs::columns`]): keys, outcome, the mission's metrics ([`plumetrace_mission::RunMetrics`]), the drawn site, the failure message |
 //! | `summary.csv`, `summary.md` | per group: success rate with Wilson 95 % interval, error quantiles, times, path |
 //! | `success.svg`, `errors.svg`, `trajectories.svg` | charts |
 //! | `examples/*.json` | the example run (seed index 0) of each group, for the trajectory chart |

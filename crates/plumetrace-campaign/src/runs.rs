@@ -6,7 +6,9 @@
 
 use crate::error::CampaignError;
 use crate::spec::{Campaign, RunKey};
-use plumetrace_mission::{Outcome, Summary};
+use plumetrace_mission::metrics::columns_of;
+use plumetrace_mission::{Column, Outcome, RunMetrics, Summary};
+use plumetrace_scenario::Site;
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 use std::io::{Read, Seek, Write};
@@ -59,189 +61,94 @@ impl Default for RunOutcome {
     }
 }
 
-/// One run's keys and results. Missing numbers (no declaration, no detection) are empty fields.
-#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
-pub struct RunRow {
-    /// Scenario label.
-    pub scenario: String,
-    /// Configuration name.
-    pub config: String,
-    /// Sweep point (`key=value;...`, empty without a sweep).
-    pub point: String,
-    /// Seed index within the group.
-    pub seed_index: u64,
-    /// Run seed (the same for every group at this seed index).
-    pub seed: u64,
-    /// Outcome (`declared`, `no_declaration`, `timed_out`, ..., or `error`).
-    pub outcome: RunOutcome,
-    /// Single source: declared (within the success radius, if the campaign sets one). Several
-    /// sources: every source located (`sources_located == sources`).
-    pub success: bool,
-    /// Declared at all.
-    pub declared: bool,
-    /// Number of declarations (several on multi-source missions).
-    pub declarations: u32,
-    /// Number of true sources.
-    pub sources: u32,
-    /// Sources with a declaration within the success radius (the mission's 50 m without one).
-    pub sources_located: u32,
-    /// First declared position, m.
-    pub declared_x: Option<f64>,
-    /// First declared position, m.
-    pub declared_y: Option<f64>,
-    /// Nearest true source, m.
-    pub source_x: Option<f64>,
-    /// Nearest true source, m.
-    pub source_y: Option<f64>,
-    /// Declaration error, m.
-    pub error_m: Option<f64>,
-    /// Along-flow error (positive downflow), m.
-    pub error_along_m: Option<f64>,
-    /// Crossflow error (positive to the right looking downflow), m.
-    pub error_cross_m: Option<f64>,
-    /// Time of the first detection, s.
-    pub first_detection_s: Option<f64>,
-    /// Time of the first declaration, s.
-    pub declaration_s: Option<f64>,
-    /// Distance over ground, m.
-    pub path_length_m: Option<f64>,
-    /// Distance over ground from the first detection to the first declaration, m.
-    pub trace_length_m: Option<f64>,
-    /// Straight line from the first detection to the source, m.
-    pub detection_to_source_m: Option<f64>,
-    /// `trace_length_m / detection_to_source_m`.
-    pub path_ratio: Option<f64>,
-    /// Mission time, s.
-    pub sim_time_s: Option<f64>,
-    /// Distance from each true source to its nearest declaration, m, `;`-separated in the
-    /// scenario's source order (empty entries for sources without one).
-    pub source_errors_m: String,
-    /// The longest any vehicle spent in one behaviour without a detection, s.
-    pub longest_quiet_s: Option<f64>,
-    /// The farthest any vehicle went outside the op-area (true position), m.
-    pub max_outside_m: Option<f64>,
-    /// Team (two or more planners): when the formation first held its ranges within 20 %, s.
-    pub team_converged_s: Option<f64>,
-    /// Team: median absolute range error after convergence, m.
-    pub team_range_error_median_m: Option<f64>,
-    /// Team: 90th percentile of the absolute range error after convergence, m.
-    pub team_range_error_p90_m: Option<f64>,
-    /// Team: the range set-point, m.
-    pub team_range_setpoint_m: Option<f64>,
-    /// Team: median cross-flow distance of the centroid from the plume's centre line, m.
-    pub team_centroid_cross_median_m: Option<f64>,
-    /// Team: path to the first declaration over the straight line from start to source.
-    pub team_distance_overhead: Option<f64>,
-    /// Team: largest cross-flow scale reported.
-    pub team_scale_max: Option<f64>,
-    /// Team: last cross-flow scale reported.
-    pub team_scale_final: Option<f64>,
-    /// Team: acoustic messages lost (per recipient).
-    pub team_acoustic_lost: Option<u64>,
-    /// Team: acoustic messages delivered.
-    pub team_acoustic_delivered: Option<u64>,
-    /// Team: commands refused for a non-finite number.
-    pub team_non_finite_commands: Option<u64>,
-    /// Drawn site (family scenarios; empty otherwise): flow direction, deg.
-    pub site_flow_toward_deg: Option<f64>,
-    /// Drawn site: flow speed, m/s.
-    pub site_flow_speed_mps: Option<f64>,
-    /// Drawn site: tidal swing of the flow direction, deg.
-    pub site_tidal_swing_deg: Option<f64>,
-    /// Drawn site: op-area shape.
-    pub site_shape: String,
-    /// Drawn site: flow direction from the op-area's main axis, 0-90 deg.
-    pub site_flow_to_axis_deg: Option<f64>,
-    /// Drawn site: op-area extent along its axis, m.
-    pub site_length_m: Option<f64>,
-    /// Drawn site: op-area extent across its axis, m.
-    pub site_width_m: Option<f64>,
-    /// Drawn site: the source's distance from the nearest op-area edge, m.
-    pub site_source_edge_m: Option<f64>,
-    /// Drawn site: source release rate.
-    pub site_mass_rate_per_s: Option<f64>,
-    /// Drawn site: where the vehicle started.
-    pub site_start: String,
-    /// Drawn site: navigation fix interval, s.
-    pub site_fix_interval_s: Option<f64>,
-    /// Drawn site: navigation fix error, m.
-    pub site_fix_sigma_m: Option<f64>,
-    /// Drawn site: the flow sensor had a fault window.
-    pub site_flow_fault: Option<bool>,
-    /// Why a run failed (outcome `error`), else empty.
-    pub message: String,
+impl plumetrace_mission::Leaf for RunOutcome {
+    const KIND: plumetrace_mission::ColumnKind = plumetrace_mission::ColumnKind::Text;
+    fn value(&self) -> plumetrace_mission::Value<'_> {
+        plumetrace_mission::Value::Text(self.name())
+    }
+}
+
+plumetrace_mission::columns! {
+    /// One run's keys and results: the columns of `runs.csv` and `runs.parquet`, in order (the
+    /// mission's metrics and the drawn site take the place of their fields). Missing numbers
+    /// (no declaration, no detection) are empty fields.
+    pub struct RunRow {
+        /// Scenario label.
+        scenario: String;
+        /// Configuration name.
+        config: String;
+        /// Sweep point (`key=value;...`, empty without a sweep).
+        point: String;
+        /// Seed index within the group.
+        seed_index: u64;
+        /// Run seed (the same for every group at this seed index).
+        seed: u64;
+        /// Outcome (`declared`, `no_declaration`, `timed_out`, ..., or `error`).
+        outcome: RunOutcome;
+        /// The mission's metrics (empty for a run that could not run).
+        metrics: RunMetrics;
+        /// The drawn site (family scenarios; empty otherwise).
+        site: SiteColumns;
+        /// Why a run failed (outcome `error`), else empty.
+        message: String;
+    }
+}
+
+plumetrace_mission::columns! {
+    /// The site a run of a family flew, rounded as the site file writes it.
+    pub struct SiteColumns from (s: &Site) {
+        /// Drawn site (family scenarios; empty otherwise): flow direction, deg.
+        site_flow_toward_deg: Option<f64> ["deg"] = round(s.flow_toward_deg, 2);
+        /// Drawn site: flow speed, m/s.
+        site_flow_speed_mps: Option<f64> ["m/s"] = round(s.flow_speed_mps, 4);
+        /// Drawn site: tidal swing of the flow direction, deg.
+        site_tidal_swing_deg: Option<f64> ["deg"] = round(s.tidal_swing_deg, 2);
+        /// Drawn site: op-area shape.
+        site_shape: String = name(&s.shape);
+        /// Drawn site: flow direction from the op-area's main axis, 0-90 deg.
+        site_flow_to_axis_deg: Option<f64> ["deg"] = round(s.flow_to_axis_deg, 2);
+        /// Drawn site: op-area extent along its axis, m.
+        site_length_m: Option<f64> ["m"] = round(s.length_m, 1);
+        /// Drawn site: op-area extent across its axis, m.
+        site_width_m: Option<f64> ["m"] = round(s.width_m, 1);
+        /// Drawn site: the source's distance from the nearest op-area edge, m.
+        site_source_edge_m: Option<f64> ["m"] = round(s.source_edge_m, 1);
+        /// Drawn site: source release rate.
+        site_mass_rate_per_s: Option<f64> = s.mass_rate_per_s.and_then(|q| round(q, 4));
+        /// Drawn site: where the vehicle started.
+        site_start: String = name(&s.start);
+        /// Drawn site: navigation fix interval, s.
+        site_fix_interval_s: Option<f64> ["s"] = s.fix_interval_s.and_then(|q| round(q, 2));
+        /// Drawn site: navigation fix error, m.
+        site_fix_sigma_m: Option<f64> ["m"] = s.fix_sigma_m.and_then(|q| round(q, 3));
+        /// Drawn site: the flow sensor had a fault window.
+        site_flow_fault: Option<bool> = Some(s.flow_fault_s.is_some());
+    }
+}
+
+/// `v` rounded to `digits` decimals.
+fn round(v: f64, digits: i32) -> Option<f64> {
+    let k = 10f64.powi(digits);
+    Some((v * k).round() / k)
+}
+
+/// A value's name in files (serde's).
+fn name<T: Serialize>(v: &T) -> String {
+    plumetrace_core::variant_name(v).unwrap_or("?").into()
+}
+
+/// Every column of `runs.csv`, in order: the keys, the outcome, the mission's metrics
+/// ([`RunMetrics`]), the drawn site and the failure message.
+pub fn columns() -> Vec<Column> {
+    columns_of::<RunRow>()
 }
 
 impl RunRow {
     /// The row of a finished mission.
     pub fn from_summary(c: &Campaign, key: &RunKey, s: &Summary) -> Self {
-        let declared = s.declared;
-        let radius = c.located_radius_m();
-        let located = s
-            .sources
-            .iter()
-            .filter(|src| src.nearest_error_m.is_some_and(|e| e <= radius))
-            .count();
-        let first = s.first_declaration.as_ref();
-        let success = if s.sources.len() > 1 {
-            located == s.sources.len()
-        } else {
-            declared
-                && c.success_radius_m()
-                    .is_none_or(|r| first.is_some_and(|d| d.error_m <= r))
-        };
-        let ratio = s
-            .trace_length_m
-            .zip(s.detection_to_source_m)
-            .filter(|(_, d)| *d > 0.0)
-            .map(|(t, d)| t / d);
         RunRow {
             outcome: RunOutcome::Mission(s.outcome),
-            success,
-            declared,
-            declarations: u32::try_from(s.declarations.len()).unwrap_or(u32::MAX),
-            sources: u32::try_from(s.sources.len()).unwrap_or(u32::MAX),
-            sources_located: u32::try_from(located).unwrap_or(u32::MAX),
-            declared_x: first.map(|d| d.x_m),
-            declared_y: first.map(|d| d.y_m),
-            source_x: first
-                .map(|d| d.source_x_m)
-                .or_else(|| s.sources.first().map(|src| src.x_m)),
-            source_y: first
-                .map(|d| d.source_y_m)
-                .or_else(|| s.sources.first().map(|src| src.y_m)),
-            error_m: first.map(|d| d.error_m),
-            error_along_m: first.map(|d| d.error_along_m),
-            error_cross_m: first.map(|d| d.error_cross_m),
-            first_detection_s: s.first_detection_s,
-            declaration_s: first.map(|d| d.t_s),
-            path_length_m: Some(s.path_length_m).filter(|v| v.is_finite()),
-            trace_length_m: s.trace_length_m,
-            detection_to_source_m: s.detection_to_source_m,
-            path_ratio: ratio,
-            sim_time_s: Some(s.sim_time_s),
-            longest_quiet_s: s.longest_quiet_s,
-            max_outside_m: Some(s.max_outside_m),
-            source_errors_m: s
-                .sources
-                .iter()
-                .map(|src| {
-                    src.nearest_error_m
-                        .map_or(String::new(), |e| format!("{e:.3}"))
-                })
-                .collect::<Vec<_>>()
-                .join(";"),
-            team_converged_s: s.team.as_ref().and_then(|t| t.converged_s),
-            team_range_error_median_m: s.team.as_ref().and_then(|t| t.range_error_median_m),
-            team_range_error_p90_m: s.team.as_ref().and_then(|t| t.range_error_p90_m),
-            team_range_setpoint_m: s.team.as_ref().and_then(|t| t.range_setpoint_m),
-            team_centroid_cross_median_m: s.team.as_ref().and_then(|t| t.centroid_cross_median_m),
-            team_distance_overhead: s.team.as_ref().and_then(|t| t.distance_overhead),
-            team_scale_max: s.team.as_ref().and_then(|t| t.scale_max),
-            team_scale_final: s.team.as_ref().and_then(|t| t.scale_final),
-            team_acoustic_lost: s.team.as_ref().map(|t| t.acoustic_lost),
-            team_acoustic_delivered: s.team.as_ref().map(|t| t.acoustic_delivered),
-            team_non_finite_commands: s.team.as_ref().map(|t| t.non_finite_commands),
+            metrics: RunMetrics::new(s, &c.metric_context()),
             ..RunRow::empty(c, key)
         }
     }
@@ -256,69 +163,36 @@ impl RunRow {
     }
 
     fn empty(c: &Campaign, key: &RunKey) -> Self {
-        let row = RunRow {
+        RunRow {
             scenario: c.scenarios[key.scenario].label.clone(),
             config: c.configs[key.config].name.clone(),
             point: c.points[key.point].label(),
             seed_index: key.seed_index,
             seed: c.run_seed(key),
+            site: c
+                .site(key)
+                .map_or_else(SiteColumns::default, |s| SiteColumns::new(&s)),
             ..RunRow::default()
-        };
-        match c.site(key) {
-            Some(site) => row.with_site(&site),
-            None => row,
-        }
-    }
-
-    /// The row with a drawn site's columns filled in (rounded as the site file writes them).
-    fn with_site(self, s: &plumetrace_scenario::Site) -> Self {
-        let r = |v: f64, d: i32| {
-            let k = 10f64.powi(d);
-            Some((v * k).round() / k)
-        };
-        RunRow {
-            site_flow_toward_deg: r(s.flow_toward_deg, 2),
-            site_flow_speed_mps: r(s.flow_speed_mps, 4),
-            site_tidal_swing_deg: r(s.tidal_swing_deg, 2),
-            site_shape: plumetrace_core::variant_name(&s.shape)
-                .unwrap_or("?")
-                .into(),
-            site_flow_to_axis_deg: r(s.flow_to_axis_deg, 2),
-            site_length_m: r(s.length_m, 1),
-            site_width_m: r(s.width_m, 1),
-            site_source_edge_m: r(s.source_edge_m, 1),
-            site_mass_rate_per_s: s.mass_rate_per_s.and_then(|q| r(q, 4)),
-            site_start: plumetrace_core::variant_name(&s.start)
-                .unwrap_or("?")
-                .into(),
-            site_fix_interval_s: s.fix_interval_s.and_then(|q| r(q, 2)),
-            site_fix_sigma_m: s.fix_sigma_m.and_then(|q| r(q, 3)),
-            site_flow_fault: Some(s.flow_fault_s.is_some()),
-            ..self
         }
     }
 
     /// The row as one CSV line (with its newline).
-    pub fn to_line(&self) -> Result<Vec<u8>, String> {
+    pub fn to_line(&self) -> Result<Vec<u8>, csv::Error> {
         let mut w = csv::WriterBuilder::new()
             .has_headers(false)
             .from_writer(Vec::new());
-        w.serialize(self).map_err(|e| e.to_string())?;
-        w.into_inner().map_err(|e| e.to_string())
+        w.serialize(self)?;
+        w.into_inner().map_err(|e| e.into_error().into())
     }
 }
 
-/// The header line of `runs.csv` (without its newline).
+/// The header line of `runs.csv` (without its newline): the column names.
 pub fn header() -> String {
-    let mut w = csv::Writer::from_writer(Vec::new());
-    let probe = RunRow::default();
-    let _ = w.serialize(&probe);
-    let bytes = w.into_inner().unwrap_or_default();
-    String::from_utf8_lossy(&bytes)
-        .lines()
-        .next()
-        .unwrap_or_default()
-        .to_string()
+    columns()
+        .iter()
+        .map(|c| c.name)
+        .collect::<Vec<_>>()
+        .join(",")
 }
 
 /// What was found in an existing results file.
@@ -526,9 +400,60 @@ pub fn rows_text(rows: &[(RunKey, RunRow)]) -> Result<String, CampaignError> {
         let line = r.to_line().map_err(|e| CampaignError::Results {
             path: RUNS_FILE.into(),
             line: None,
-            message: e,
+            message: e.to_string(),
         })?;
         out.push_str(&String::from_utf8_lossy(&line));
     }
     Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    #![allow(clippy::unwrap_used)]
+    use super::*;
+
+    #[test]
+    fn a_row_is_its_columns_in_order_and_reads_back() {
+        let row = RunRow {
+            scenario: "demo".into(),
+            config: "a,b".into(),
+            seed_index: 3,
+            seed: u64::MAX,
+            outcome: RunOutcome::Mission(Outcome::Declared),
+            metrics: RunMetrics {
+                success: true,
+                declarations: 2,
+                error_m: Some(0.1 + 0.2),
+                sim_time_s: Some(1e16),
+                source_errors_m: "1.000;".into(),
+                team_acoustic_lost: Some(7),
+                ..RunMetrics::default()
+            },
+            site: SiteColumns {
+                site_shape: "convex".into(),
+                site_flow_fault: Some(false),
+                ..SiteColumns::default()
+            },
+            ..RunRow::default()
+        };
+        let line = String::from_utf8(row.to_line().unwrap()).unwrap();
+        let fields: Vec<&str> = line.trim_end().split(',').collect();
+        let at = |name: &str| {
+            let i = columns().iter().position(|c| c.name == name).unwrap();
+            // The quoted config `"a,b"` is two pieces after a naive split.
+            fields[if i > 1 { i + 1 } else { i }]
+        };
+        assert_eq!(fields.len(), columns().len() + 1);
+        assert_eq!(at("outcome"), "declared");
+        assert_eq!(at("success"), "true");
+        assert_eq!(at("error_m"), "0.30000000000000004");
+        assert_eq!(at("sim_time_s"), "1e16");
+        assert_eq!(at("team_acoustic_lost"), "7");
+        assert_eq!(at("team_scale_max"), "");
+        assert_eq!(at("site_flow_fault"), "false");
+        assert_eq!(at("message"), "");
+        let text = format!("{}\n{line}", header());
+        let back = parse_rows(Path::new(RUNS_FILE), &text).unwrap();
+        assert_eq!(back, vec![row]);
+    }
 }

@@ -433,9 +433,14 @@ impl Campaign {
     /// Within this distance of a declaration a source counts as located: the success radius, or
     /// the mission's 50 m without one.
     pub fn located_radius_m(&self) -> f64 {
-        self.file
-            .success_radius_m
-            .unwrap_or(plumetrace_mission::LOCATED_RADIUS_M)
+        self.metric_context().located_radius_m()
+    }
+
+    /// What runs are judged against besides their summaries (the success radius).
+    pub fn metric_context(&self) -> plumetrace_mission::MetricContext {
+        plumetrace_mission::MetricContext {
+            success_radius_m: self.file.success_radius_m,
+        }
     }
 
     /// Every run, in the canonical order: scenario, configuration, sweep point, seed index.

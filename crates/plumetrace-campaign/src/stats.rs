@@ -124,21 +124,27 @@ pub fn summarise(c: &Campaign, rows: &[(RunKey, RunRow)]) -> Vec<GroupSummary> {
 
 fn summarise_group(c: &Campaign, key: &RunKey, rows: &[&RunRow]) -> GroupSummary {
     let n = rows.len() as u64;
-    let k = rows.iter().filter(|r| r.success).count() as u64;
+    let k = rows.iter().filter(|r| r.metrics.success).count() as u64;
     let (lo, hi) = wilson(k, n, Z95);
-    let dec: Vec<&&RunRow> = rows.iter().filter(|r| r.declared).collect();
-    let err = sorted(dec.iter().filter_map(|r| r.error_m));
-    let along = sorted(dec.iter().filter_map(|r| r.error_along_m.map(f64::abs)));
-    let along_signed = sorted(dec.iter().filter_map(|r| r.error_along_m));
-    let cross = sorted(dec.iter().filter_map(|r| r.error_cross_m.map(f64::abs)));
-    let det = sorted(rows.iter().filter_map(|r| r.first_detection_s));
-    let decl = sorted(dec.iter().filter_map(|r| r.declaration_s));
-    let path = sorted(rows.iter().filter_map(|r| r.path_length_m));
-    let ratio = sorted(dec.iter().filter_map(|r| r.path_ratio));
+    let dec: Vec<&&RunRow> = rows.iter().filter(|r| r.metrics.declared).collect();
+    let err = sorted(dec.iter().filter_map(|r| r.metrics.error_m));
+    let along = sorted(
+        dec.iter()
+            .filter_map(|r| r.metrics.error_along_m.map(f64::abs)),
+    );
+    let along_signed = sorted(dec.iter().filter_map(|r| r.metrics.error_along_m));
+    let cross = sorted(
+        dec.iter()
+            .filter_map(|r| r.metrics.error_cross_m.map(f64::abs)),
+    );
+    let det = sorted(rows.iter().filter_map(|r| r.metrics.first_detection_s));
+    let decl = sorted(dec.iter().filter_map(|r| r.metrics.declaration_s));
+    let path = sorted(rows.iter().filter_map(|r| r.metrics.path_length_m));
+    let ratio = sorted(dec.iter().filter_map(|r| r.metrics.path_ratio));
     let radius = c.located_radius_m();
     let located = sorted(
         rows.iter()
-            .flat_map(|r| r.source_errors_m.split(';'))
+            .flat_map(|r| r.metrics.source_errors_m.split(';'))
             .filter_map(|e| e.parse::<f64>().ok())
             .filter(|e| *e <= radius),
     );
@@ -151,8 +157,11 @@ fn summarise_group(c: &Campaign, key: &RunKey, rows: &[&RunRow]) -> GroupSummary
         success_rate: if n > 0 { k as f64 / n as f64 } else { f64::NAN },
         success_ci_low: lo,
         success_ci_high: hi,
-        sources: rows.iter().map(|r| u64::from(r.sources)).sum(),
-        sources_located: rows.iter().map(|r| u64::from(r.sources_located)).sum(),
+        sources: rows.iter().map(|r| u64::from(r.metrics.sources)).sum(),
+        sources_located: rows
+            .iter()
+            .map(|r| u64::from(r.metrics.sources_located))
+            .sum(),
         located_error_median_m: quantile(&located, 0.5),
         located_error_p90_m: quantile(&located, 0.9),
         error_median_m: quantile(&err, 0.5),
@@ -433,25 +442,28 @@ pub fn sites_md(c: &Campaign, rows: &[(RunKey, RunRow)]) -> String {
         let mut splits = vec![SiteSplit {
             title: "flow direction from the op-area's long axis",
             bins: number_bins(
-                |r| r.site_flow_to_axis_deg,
+                |r| r.site.site_flow_to_axis_deg,
                 &[0.0, 30.0, 60.0, 90.0],
                 0,
                 "deg",
             ),
         }];
-        if let Some(e) = terciles(values(|r| r.site_flow_speed_mps)) {
+        if let Some(e) = terciles(values(|r| r.site.site_flow_speed_mps)) {
             splits.push(SiteSplit {
                 title: "flow speed (terciles)",
-                bins: number_bins(|r| r.site_flow_speed_mps, &e, 2, "m/s"),
+                bins: number_bins(|r| r.site.site_flow_speed_mps, &e, 2, "m/s"),
             });
         }
-        if let Some(e) = terciles(values(|r| r.site_source_edge_m)) {
+        if let Some(e) = terciles(values(|r| r.site.site_source_edge_m)) {
             splits.push(SiteSplit {
                 title: "source's distance from the op-area's edge (terciles)",
-                bins: number_bins(|r| r.site_source_edge_m, &e, 0, "m"),
+                bins: number_bins(|r| r.site.site_source_edge_m, &e, 0, "m"),
             });
         }
-        let mut starts: Vec<String> = runs.iter().map(|(_, r)| r.site_start.clone()).collect();
+        let mut starts: Vec<String> = runs
+            .iter()
+            .map(|(_, r)| r.site.site_start.clone())
+            .collect();
         starts.sort();
         starts.dedup();
         splits.push(SiteSplit {
@@ -462,23 +474,26 @@ pub fn sites_md(c: &Campaign, rows: &[(RunKey, RunRow)]) -> String {
                     let key = k.clone();
                     (
                         k,
-                        Box::new(move |r: &RunRow| r.site_start == key)
+                        Box::new(move |r: &RunRow| r.site.site_start == key)
                             as Box<dyn Fn(&RunRow) -> bool>,
                     )
                 })
                 .collect(),
         });
-        if runs.iter().any(|(_, r)| r.site_flow_fault == Some(true)) {
+        if runs
+            .iter()
+            .any(|(_, r)| r.site.site_flow_fault == Some(true))
+        {
             splits.push(SiteSplit {
                 title: "flow-sensor fault",
                 bins: vec![
                     (
                         "no fault".into(),
-                        Box::new(|r: &RunRow| r.site_flow_fault == Some(false)),
+                        Box::new(|r: &RunRow| r.site.site_flow_fault == Some(false)),
                     ),
                     (
                         "fault".into(),
-                        Box::new(|r: &RunRow| r.site_flow_fault == Some(true)),
+                        Box::new(|r: &RunRow| r.site.site_flow_fault == Some(true)),
                     ),
                 ],
             });
@@ -517,7 +532,10 @@ pub fn sites_md(c: &Campaign, rows: &[(RunKey, RunRow)]) -> String {
                     }
                     for (_, test) in &split.bins {
                         let n = group.iter().filter(|r| test(r)).count();
-                        let k = group.iter().filter(|r| test(r) && r.success).count();
+                        let k = group
+                            .iter()
+                            .filter(|r| test(r) && r.metrics.success)
+                            .count();
                         row.push(if n == 0 {
                             "-".into()
                         } else {
@@ -554,12 +572,15 @@ pub(crate) mod tests {
             };
             let r = RunRow {
                 outcome: RunOutcome::Mission(plumetrace_mission::Outcome::Declared),
-                declared: true,
-                success: located == 2,
-                sources: 2,
-                sources_located: located,
-                source_errors_m: errors.into(),
-                error_m: Some(313.0),
+                metrics: plumetrace_mission::RunMetrics {
+                    declared: true,
+                    success: located == 2,
+                    sources: 2,
+                    sources_located: located,
+                    source_errors_m: errors.into(),
+                    error_m: Some(313.0),
+                    ..Default::default()
+                },
                 ..RunRow::default()
             };
             (key, r)

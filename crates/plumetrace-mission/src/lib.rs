@@ -15,6 +15,8 @@
 //! - [`record`]: the observer trait and the mission's own recorders;
 //! - [`summary`]: the key numbers written as `summary.json`; [`team`]: what a team of vehicles
 //!   did together (formation error, centroid against the centre line, overhead, losses);
+//! - [`metrics`]: the run metrics, declared once ([`RunMetrics`]: name, type, unit, meaning and
+//!   how each is read from the summary), which campaigns and the Python bindings read;
 //! - [`snapshot_log`]: the replayable log of snapshots and decisions;
 //! - [`alog`]: MOOS `.alog` files, one per planned vehicle;
 //! - [`plot`]: the mission figure; [`team_plot`]: the team figure (readings, speeds, headings,
@@ -22,6 +24,7 @@
 //!   [`output`]: atomic file writing.
 
 pub mod alog;
+pub mod metrics;
 pub mod mission;
 pub mod outcome;
 pub mod output;
@@ -35,6 +38,7 @@ pub mod summary;
 pub mod team;
 pub mod team_plot;
 
+pub use metrics::{Column, ColumnKind, Columns, Leaf, MetricContext, RunMetrics, Value};
 pub use mission::{
     FaultWindow, Mission, MissionOptions, MissionRun, PLUME_FRAME_EVERY_S, VehicleInfo,
     run_mission, run_mission_with,
@@ -48,3 +52,7 @@ pub use setup::{MissionError, MissionSetup, PlannedVehicle};
 pub use shared::fly_shared;
 pub use summary::{DeclarationRecord, LOCATED_RADIUS_M, SourceRecord, Summary, VehicleSummary};
 pub use team::{TeamStats, TeamSummary};
+
+/// serde, for the code [`columns!`] makes in other crates.
+#[doc(hidden)]
+pub use serde as __serde;

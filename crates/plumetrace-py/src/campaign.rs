@@ -88,6 +88,17 @@ pub fn campaign<'py>(
     Ok(d)
 }
 
+/// The columns of a campaign's `runs.csv` (and `runs.parquet`), in order, as `(name, kind, unit,
+/// description)`: the run's keys and outcome, the mission's metrics, the drawn site and the
+/// failure message. `read_runs` reads each column by its kind.
+#[pyfunction]
+pub fn run_columns() -> Vec<(&'static str, &'static str, &'static str, String)> {
+    plumetrace_campaign::runs::columns()
+        .iter()
+        .map(|c| (c.name, c.kind.name(), c.unit, c.description()))
+        .collect()
+}
+
 /// Merges shard directories of one campaign into `out`.
 #[pyfunction]
 pub fn merge<'py>(

@@ -28,6 +28,7 @@ fn _plumetrace(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(run::planners, m)?)?;
     m.add_function(wrap_pyfunction!(campaign::campaign, m)?)?;
     m.add_function(wrap_pyfunction!(campaign::merge, m)?)?;
+    m.add_function(wrap_pyfunction!(campaign::run_columns, m)?)?;
     m.add_class::<plume::Plume>()?;
     m.add_class::<gym::EnvCore>()?;
     m.add_class::<gym::VecEnvCore>()?;

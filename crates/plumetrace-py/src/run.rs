@@ -9,7 +9,7 @@ use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 use std::sync::{Arc, Mutex};
 
-/// Flies a mission; returns a dict with `summary` (JSON text), `events` (JSON lines),
+/// Flies a mission; returns a dict with `summary` and `metrics` (JSON text), `events` (JSON lines),
 /// `trajectory` (a dict of numpy arrays) and `vehicles` (names). The Python wrapper
 /// `plumetrace.run` turns it into a `RunResult`.
 #[pyfunction]
@@ -83,6 +83,13 @@ fn result<'py>(
     out.set_item("name", name)?;
     let summary = serde_json::to_string(&run.summary).map_err(|e| msg(e.to_string()))?;
     out.set_item("summary", summary)?;
+    // The run's metrics as a campaign records them (no success radius).
+    let metrics = plumetrace_mission::RunMetrics::new(
+        &run.summary,
+        &plumetrace_mission::MetricContext::default(),
+    );
+    let metrics = serde_json::to_string(&metrics).map_err(|e| msg(e.to_string()))?;
+    out.set_item("metrics", metrics)?;
     let events = PyList::empty(py);
     for e in &run.events {
         events.append(serde_json::to_string(e).map_err(|e| msg(e.to_string()))?)?;

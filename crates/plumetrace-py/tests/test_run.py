@@ -83,3 +83,23 @@ def test_frames_when_pandas_is_installed():
     assert isinstance(f, pd.DataFrame)
     assert len(f) == len(r.trajectory["t_s"])
     assert set(r.events_frame().columns) >= {"t_s", "event"}
+
+
+def test_a_runs_metrics_are_the_campaign_columns_of_its_summary():
+    r = plumetrace.run("demo", seed=7, trajectory=False)
+    names = [c["name"] for c in plumetrace.run_columns()]
+    assert set(r.metrics) < set(names)
+    assert list(r.metrics) == [n for n in names if n in r.metrics]
+    assert r.metrics["declared"] == r.summary["declared"]
+    assert r.metrics["sim_time_s"] == r.summary["sim_time_s"]
+    assert r.metrics["team_converged_s"] is None
+
+
+def test_read_runs_reads_each_column_by_its_kind(tmp_path):
+    f = tmp_path / "c.toml"
+    f.write_text('name = "k"\nseed = 5\nseeds = 1\nscenarios = ["demo"]\n')
+    plumetrace.campaign(f, tmp_path / "o", progress=False)
+    rows = plumetrace.read_runs(tmp_path / "o", frame=False)
+    assert list(rows) == [c["name"] for c in plumetrace.run_columns()]
+    assert isinstance(rows["seed"][0], int) and isinstance(rows["success"][0], bool)
+    assert rows["scenario"] == ["demo"] and rows["message"] == [None]

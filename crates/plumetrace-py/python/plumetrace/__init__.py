@@ -35,6 +35,7 @@ __all__ = [
     "presets",
     "read_runs",
     "run",
+    "run_columns",
     "__version__",
 ]
 
@@ -66,6 +67,9 @@ class RunResult:
             ``reading_v``, ``detection``.
         vehicles: vehicle names, by index.
         warnings: what ``plumetrace check`` would warn about.
+        metrics: the run's metrics as a campaign's ``runs.csv`` records them (its metric
+            columns, see :func:`run_columns`; ``success`` without a success radius), missing
+            numbers as None.
     """
 
     name: str
@@ -74,6 +78,7 @@ class RunResult:
     trajectory: Dict[str, np.ndarray]
     vehicles: List[str]
     warnings: List[str] = field(default_factory=list)
+    metrics: Dict[str, Any] = field(default_factory=dict)
 
     @property
     def outcome(self) -> str:
@@ -143,6 +148,7 @@ def run(
         trajectory=traj,
         vehicles=list(raw["vehicles"]),
         warnings=list(raw["warnings"]),
+        metrics=json.loads(raw["metrics"]),
     )
 
 
@@ -214,6 +220,35 @@ def merge(dirs: Sequence[PathLike], out: PathLike) -> Dict[str, Any]:
     return dict(_plumetrace.merge([os.fspath(d) for d in dirs], os.fspath(out)))
 
 
+def run_columns() -> List[Dict[str, str]]:
+    """The columns of a campaign's ``runs.csv`` (and ``runs.parquet``), in order.
+
+    Each is a dict with ``name``, ``kind`` (``text``, ``u64``, ``u32``, ``bool``, ``opt_bool``,
+    ``opt_f64`` or ``opt_u64``), ``unit`` (empty for counts, flags, text and ratios) and
+    ``description``: the run's keys and outcome, the mission's metrics, the drawn site of a
+    family and the failure message.
+    """
+    return [
+        {"name": n, "kind": k, "unit": u, "description": d}
+        for n, k, u, d in _plumetrace.run_columns()
+    ]
+
+
+def _value(kind: Optional[str], text: str) -> Any:
+    """A field of ``runs.csv`` read by its column's kind (empty fields as None)."""
+    if text == "":
+        return None
+    if kind in ("u64", "u32", "opt_u64"):
+        return int(text)
+    if kind == "opt_f64":
+        return float(text)
+    if kind in ("bool", "opt_bool"):
+        return text == "true"
+    if kind == "text":
+        return text
+    return _number(text)
+
+
 def _number(text: str) -> Any:
     if text == "":
         return None
@@ -231,9 +266,11 @@ def read_runs(path: PathLike, *, frame: Optional[bool] = None) -> Any:
     """Reads a campaign's ``runs.csv`` (or ``runs.parquet``), or the one in a directory.
 
     Returns a pandas DataFrame when pandas is installed (or ``frame=True``), else a dict of
-    column name to list (numbers parsed, empty fields as None). Parquet needs pandas and
-    pyarrow.
+    column name to list (each field read by its column's kind, see :func:`run_columns`: whole
+    numbers as int, numbers as float, flags as bool, empty fields as None). Parquet needs pandas
+    and pyarrow.
     """
+    kinds = {c["name"]: c["kind"] for c in run_columns()}
     p = os.fspath(path)
     if os.path.isdir(p):
         p = os.path.join(p, "runs.csv")
@@ -251,9 +288,9 @@ def read_runs(path: PathLike, *, frame: Optional[bool] = None) -> Any:
     if frame:
         import pandas as pd
 
-        return pd.read_csv(p)
+        return pd.read_csv(p, dtype={n: str for n, k in kinds.items() if k == "text"})
     with open(p, newline="") as f:
         rows = list(csv.DictReader(f))
     if not rows:
         return {}
-    return {k: [_number(r[k]) for r in rows] for k in rows[0]}
+    return {k: [_value(kinds.get(k), r[k]) for r in rows] for k in rows[0]}
