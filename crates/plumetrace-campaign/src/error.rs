@@ -51,6 +51,29 @@ pub enum CampaignError {
     },
 }
 
+/// Why one run could not run: the `message` of its row (outcome `error`).
+#[derive(Debug, thiserror::Error)]
+pub enum RunError {
+    /// Its scenario did not build.
+    #[error(transparent)]
+    Campaign(#[from] CampaignError),
+    /// Its mission could not be set up or flown.
+    #[error(transparent)]
+    Mission(#[from] plumetrace_mission::MissionError),
+    /// Its summary has a number that is not finite.
+    #[error("the summary has a number that is not finite ({at})")]
+    NonFinite {
+        /// Where in the summary.
+        at: String,
+    },
+    /// The example run's track could not be written.
+    #[error(transparent)]
+    Example(std::io::Error),
+    /// The example run's replay page could not be made or written.
+    #[error(transparent)]
+    Page(#[from] crate::example::PageError),
+}
+
 impl CampaignError {
     pub(crate) fn io(path: &std::path::Path, e: impl std::fmt::Display) -> Self {
         CampaignError::Io {

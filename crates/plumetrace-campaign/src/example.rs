@@ -143,8 +143,29 @@ pub fn page_file(dir: &Path, scenario: &str, config: &str, point: &str) -> PathB
     example_file(dir, scenario, config, point).with_extension("html")
 }
 
+/// Why the replay page of an example run was not written.
+#[derive(Debug, thiserror::Error)]
+pub enum PageError {
+    /// The page could not be made.
+    #[error("{0}")]
+    Draw(String),
+    /// The page could not be written.
+    #[error("writing {path}: {error}")]
+    Write {
+        /// The page's file.
+        path: String,
+        /// What failed.
+        error: std::io::Error,
+    },
+}
+
 /// Writes the replay page of a group's example run (atomically).
-pub fn write_page(c: &Campaign, key: &RunKey, run: &MissionRun, dir: &Path) -> Result<(), String> {
+pub fn write_page(
+    c: &Campaign,
+    key: &RunKey,
+    run: &MissionRun,
+    dir: &Path,
+) -> Result<(), PageError> {
     let (scenario, config, point) = (
         &c.scenarios[key.scenario].label,
         &c.configs[key.config].name,
@@ -159,10 +180,15 @@ pub fn write_page(c: &Campaign, key: &RunKey, run: &MissionRun, dir: &Path) -> R
         "{}: {group}, example run (seed {})",
         c.file.name, run.summary.seed
     );
-    let page = plumetrace_mission::replay_page::replay_page(run, &title)?;
+    let page =
+        plumetrace_mission::replay_page::replay_page(run, &title).map_err(PageError::Draw)?;
     let path = page_file(dir, scenario, config, &point);
-    plumetrace_mission::output::write_atomic(&path, page.as_bytes())
-        .map_err(|e| format!("writing {}: {e}", path.display()))
+    plumetrace_mission::output::write_atomic(&path, page.as_bytes()).map_err(|error| {
+        PageError::Write {
+            path: path.display().to_string(),
+            error,
+        }
+    })
 }
 
 /// A file name from labels, short, safe and unique: each label's letters, digits, `-`, `.` and

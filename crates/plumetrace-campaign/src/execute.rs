@@ -1,7 +1,7 @@
 //! Running a campaign: parallel over runs, appending each result as it finishes, resuming from
 //! what a directory already holds, and writing the summary, charts and example tracks at the end.
 
-use crate::error::CampaignError;
+use crate::error::{CampaignError, RunError};
 use crate::example::{EXAMPLES_DIR, ExampleRun};
 use crate::runs::{Appender, RUNS_FILE, RunRow, row_key};
 use crate::spec::{Campaign, RunKey, Shard};
@@ -315,43 +315,41 @@ fn run_one(
         match shared.as_ref().and_then(Environment::try_clone) {
             Some(env) => setup.use_spun_up(env),
             None => {
-                setup.spin_up().map_err(|e| e.to_string())?;
+                setup.spin_up()?;
                 if more {
                     *shared = setup.env.try_clone();
                 }
             }
         }
-        let mut mission = Mission::new(setup, options).map_err(|e| e.to_string())?;
-        mission.run(&mut |_, _| {}).map_err(|e| e.to_string())?;
-        let run = mission.finish().map_err(|e| e.to_string())?;
+        let mut mission = Mission::new(setup, options)?;
+        mission.run(&mut |_, _| {})?;
+        let run = mission.finish()?;
         row_of(c, key, out, run)
     }));
     row_or_failure(c, key, attempt)
 }
 
 /// A run's setup and what it records (everything for the example run at seed index 0).
-fn prepare(c: &Campaign, key: &RunKey) -> Result<(MissionSetup, MissionOptions), String> {
-    let sc = c.build(key).map_err(|e| e.to_string())?;
+fn prepare(c: &Campaign, key: &RunKey) -> Result<(MissionSetup, MissionOptions), RunError> {
+    let sc = c.build(key)?;
     let example = key.seed_index == 0;
     let options = MissionOptions {
         mean_plume: false,
         trajectory: example,
         plume_frames_every_s: example.then_some(plumetrace_mission::PLUME_FRAME_EVERY_S),
     };
-    let setup = MissionSetup::new(sc).map_err(|e| e.to_string())?;
+    let setup = MissionSetup::new(sc)?;
     Ok((setup, options))
 }
 
 /// A finished run's row; the example run's files are written on the way.
-fn row_of(c: &Campaign, key: &RunKey, out: &Path, run: MissionRun) -> Result<RunRow, String> {
+fn row_of(c: &Campaign, key: &RunKey, out: &Path, run: MissionRun) -> Result<RunRow, RunError> {
     if let Some(at) = plumetrace_mission::output::first_non_finite(&run.summary) {
-        return Err(format!(
-            "the summary has a number that is not finite ({at})"
-        ));
+        return Err(RunError::NonFinite { at });
     }
     if key.seed_index == 0 {
         let ex = ExampleRun::from_run(c, key, &run);
-        ex.write(out).map_err(|e| e.to_string())?;
+        ex.write(out).map_err(RunError::Example)?;
         crate::example::write_page(c, key, &run, out)?;
     }
     Ok(RunRow::from_summary(c, key, &run.summary))
@@ -371,9 +369,9 @@ fn run_shared(c: &Campaign, group: &[RunKey], out: &Path, emit: &mut dyn FnMut(R
                     missions.push(m);
                     keys.push(i);
                 }
-                Err(message) => {
+                Err(e) => {
                     written[i] = true;
-                    emit(RunRow::failed(c, key, message));
+                    emit(RunRow::failed(c, key, e.to_string()));
                 }
             }
         }
@@ -381,7 +379,7 @@ fn run_shared(c: &Campaign, group: &[RunKey], out: &Path, emit: &mut dyn FnMut(R
             let Some(&i) = keys.get(k) else { return };
             let key = &group[i];
             let row = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-                row_of(c, key, out, result.map_err(|e| e.to_string())?)
+                row_of(c, key, out, result?)
             }));
             written[i] = true;
             emit(row_or_failure(c, key, row));
@@ -398,11 +396,11 @@ fn run_shared(c: &Campaign, group: &[RunKey], out: &Path, emit: &mut dyn FnMut(R
 fn row_or_failure(
     c: &Campaign,
     key: &RunKey,
-    attempt: std::thread::Result<Result<RunRow, String>>,
+    attempt: std::thread::Result<Result<RunRow, RunError>>,
 ) -> RunRow {
     match attempt {
         Ok(Ok(row)) => row,
-        Ok(Err(message)) => RunRow::failed(c, key, message),
+        Ok(Err(e)) => RunRow::failed(c, key, e.to_string()),
         Err(panic) => {
             let what = panic
                 .downcast_ref::<String>()

@@ -144,22 +144,39 @@ pub struct Shard {
     pub count: u64,
 }
 
+/// Why a shard (`K/N`) was not understood.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub enum ShardError {
+    /// Not `K/N`.
+    #[error("shard '{0}' is not K/N (e.g. 2/4)")]
+    NotKOfN(String),
+    /// K is not a whole number.
+    #[error("shard '{0}': K is not a whole number")]
+    BadIndex(String),
+    /// N is not a whole number.
+    #[error("shard '{0}': N is not a whole number")]
+    BadCount(String),
+    /// K is 0 or more than N.
+    #[error("shard '{0}': need 1 <= K <= N")]
+    OutOfRange(String),
+}
+
 impl std::str::FromStr for Shard {
-    type Err = String;
-    fn from_str(s: &str) -> Result<Self, String> {
+    type Err = ShardError;
+    fn from_str(s: &str) -> Result<Self, ShardError> {
         let (k, n) = s
             .split_once('/')
-            .ok_or_else(|| format!("shard '{s}' is not K/N (e.g. 2/4)"))?;
+            .ok_or_else(|| ShardError::NotKOfN(s.into()))?;
         let k: u64 = k
             .trim()
             .parse()
-            .map_err(|_| format!("shard '{s}': K is not a whole number"))?;
+            .map_err(|_| ShardError::BadIndex(s.into()))?;
         let n: u64 = n
             .trim()
             .parse()
-            .map_err(|_| format!("shard '{s}': N is not a whole number"))?;
+            .map_err(|_| ShardError::BadCount(s.into()))?;
         if n == 0 || k == 0 || k > n {
-            return Err(format!("shard '{s}': need 1 <= K <= N"));
+            return Err(ShardError::OutOfRange(s.into()));
         }
         Ok(Shard { index: k, count: n })
     }

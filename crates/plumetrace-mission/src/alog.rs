@@ -2,7 +2,7 @@
 //! by the onboard crate's [`AlogWriter`] (navigation estimate, the planner's set-points and the
 //! plume-tracing variables).
 
-use crate::record::{Observer, StepView};
+use crate::record::{Observer, RecordError, StepView};
 use plumetrace_onboard::alog::AlogWriter;
 use std::fs::File;
 use std::io::BufWriter;
@@ -11,7 +11,7 @@ use std::path::{Path, PathBuf};
 /// Writes `NAME.alog` for every named vehicle.
 pub struct AlogObserver {
     writers: Vec<Option<(PathBuf, AlogWriter<BufWriter<File>>)>>,
-    error: Option<String>,
+    error: Option<RecordError>,
 }
 
 impl AlogObserver {
@@ -49,7 +49,7 @@ impl Observer for AlogObserver {
                 continue;
             };
             if let Err(e) = w.decision(s, d) {
-                self.error = Some(format!("{}: {e}", path.display()));
+                self.error = Some(RecordError::file(path, e));
                 return;
             }
         }
@@ -59,12 +59,12 @@ impl Observer for AlogObserver {
         true
     }
 
-    fn finish(&mut self) -> Result<(), String> {
+    fn finish(&mut self) -> Result<(), RecordError> {
         if let Some(e) = self.error.take() {
             return Err(e);
         }
         for (path, w) in self.writers.drain(..).flatten() {
-            w.finish().map_err(|e| format!("{}: {e}", path.display()))?;
+            w.finish().map_err(|e| RecordError::file(&path, e))?;
         }
         Ok(())
     }

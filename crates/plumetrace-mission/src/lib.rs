@@ -46,7 +46,7 @@ pub use mission::{
 pub use outcome::{EndReason, MissionEnd, MissionEvent, Outcome, VehicleStatus};
 pub use plumetrace_planner::registry_defaults as planner_defaults;
 pub use record::{
-    EventKind, EventRecord, Observer, PlumeFrame, PlumeFrames, StepView, TrajectoryRow,
+    EventKind, EventRecord, Observer, PlumeFrame, PlumeFrames, RecordError, StepView, TrajectoryRow,
 };
 pub use setup::{MissionError, MissionSetup, PlannedVehicle};
 pub use shared::fly_shared;

@@ -512,9 +512,9 @@ impl Flight {
     /// What was recorded; the observers are finished (their buffered output flushed).
     pub(crate) fn finish(mut self, env: &Environment) -> Result<MissionRun, MissionError> {
         for o in &mut self.observers {
-            o.finish().map_err(|message| MissionError::Output {
+            o.finish().map_err(|e| MissionError::Output {
                 what: "an observer's output".into(),
-                message,
+                message: e.to_string(),
             })?;
         }
         let end = self.end.unwrap_or(MissionEnd {

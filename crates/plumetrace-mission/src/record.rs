@@ -58,8 +58,34 @@ pub trait Observer: Send {
     }
 
     /// The mission is over: flush what is buffered; errors name what could not be written.
-    fn finish(&mut self) -> Result<(), String> {
+    fn finish(&mut self) -> Result<(), RecordError> {
         Ok(())
+    }
+}
+
+/// Why an observer could not write its output.
+#[derive(Debug, thiserror::Error)]
+pub enum RecordError {
+    /// A file could not be written.
+    #[error("{path}: {message}")]
+    File {
+        /// The file.
+        path: String,
+        /// What failed.
+        message: String,
+    },
+    /// A writer failed; its message names the file.
+    #[error("{0}")]
+    Writer(String),
+}
+
+impl RecordError {
+    /// A file that could not be written.
+    pub fn file(path: &std::path::Path, e: impl std::fmt::Display) -> Self {
+        RecordError::File {
+            path: path.display().to_string(),
+            message: e.to_string(),
+        }
     }
 }
 

@@ -4,7 +4,7 @@
 
 pub use plumetrace_onboard::snapshot_log::*;
 
-use crate::record::{Observer, StepView};
+use crate::record::{Observer, RecordError, StepView};
 use crate::setup::PlannedVehicle;
 use plumetrace_planner::{BuildContext, PlannerConfig};
 use std::path::Path;
@@ -55,10 +55,10 @@ impl Observer for SnapshotLogWriter {
         true
     }
 
-    fn finish(&mut self) -> Result<(), String> {
+    fn finish(&mut self) -> Result<(), RecordError> {
         if let Some(e) = self.error.take() {
-            return Err(format!("{}: {e}", self.file.path().display()));
+            return Err(RecordError::file(self.file.path(), e));
         }
-        self.file.finish()
+        self.file.finish().map_err(RecordError::Writer)
     }
 }
