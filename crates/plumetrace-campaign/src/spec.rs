@@ -247,191 +247,20 @@ impl Campaign {
             key,
             message,
         };
-        if !(1..=MAX_SEEDS).contains(&file.seeds) {
-            return Err(invalid(
-                "seeds".into(),
-                format!("must be 1 to {MAX_SEEDS}, got {}", file.seeds),
-            ));
-        }
-        for (key, n, max) in [
-            ("scenarios", file.scenarios.len(), MAX_LIST),
-            ("configs", file.configs.len(), MAX_LIST),
-            ("sweep", file.sweep.len(), 16),
-        ] {
-            if n > max {
-                return Err(invalid(key.into(), format!("{n} entries; at most {max}")));
-            }
-        }
-        if file.scenarios.is_empty() {
-            return Err(invalid(
-                "scenarios".into(),
-                "name at least one scenario".into(),
-            ));
-        }
-        if let Some(r) = file.success_radius_m
-            && !(r.is_finite() && r > 0.0)
-        {
-            return Err(invalid(
-                "success_radius_m".into(),
-                format!("must be a finite number > 0, got {r}"),
-            ));
-        }
+        check_sizes(&file, &invalid)?;
         let base = path.parent().map(Path::to_path_buf).unwrap_or_default();
-        let mut scenarios = Vec::new();
+        let mut scenarios: Vec<ScenarioEntry> = Vec::new();
         for (i, s) in file.scenarios.iter().enumerate() {
-            if scenarios.iter().any(|e: &ScenarioEntry| &e.label == s) {
+            if scenarios.iter().any(|e| &e.label == s) {
                 return Err(invalid(
                     format!("scenarios[{i}]"),
                     format!("'{s}' is listed twice"),
                 ));
             }
-            if is_family_path(s) {
-                let p = base.join(s);
-                let family = if read_scenarios {
-                    Some(
-                        Family::load(&p)
-                            .map_err(|e| invalid(format!("scenarios[{i}]"), e.to_string()))?,
-                    )
-                } else {
-                    None
-                };
-                scenarios.push(ScenarioEntry {
-                    label: s.clone(),
-                    origin: family
-                        .as_ref()
-                        .map_or(Origin::File(p), |f| f.base_origin.clone()),
-                    table: family.as_ref().map(|f| f.base.clone()).unwrap_or_default(),
-                    family,
-                });
-                continue;
-            }
-            let (origin, text) = if s.ends_with(".toml") {
-                let p = base.join(s);
-                let text = if read_scenarios {
-                    plumetrace_env::input::read_text(&p, plumetrace_env::input::MAX_TEXT_BYTES)
-                        .map_err(|e| {
-                            invalid(format!("scenarios[{i}]"), format!("{}: {e}", p.display()))
-                        })?
-                } else {
-                    String::new()
-                };
-                (Origin::File(p), text)
-            } else if let Some(p) = find_preset(s) {
-                (Origin::Preset(s.clone()), p.toml.to_string())
-            } else {
-                let known: Vec<&str> = PRESETS.iter().map(|p| p.name).collect();
-                return Err(invalid(
-                    format!("scenarios[{i}]"),
-                    format!(
-                        "'{s}' is neither a preset ({}) nor a path ending in .toml",
-                        known.join(", ")
-                    ),
-                ));
-            };
-            let table: toml::Table = text.parse().map_err(|e: toml::de::Error| {
-                invalid(format!("scenarios[{i}]"), format!("{origin}: {e}"))
-            })?;
-            scenarios.push(ScenarioEntry {
-                label: s.clone(),
-                origin,
-                table,
-                family: None,
-            });
+            scenarios.push(scenario_entry(i, s, &base, read_scenarios, &invalid)?);
         }
-        let configs = if file.configs.is_empty() {
-            vec![ConfigFile {
-                name: "default".into(),
-                planner: None,
-                set: toml::Table::new(),
-            }]
-        } else {
-            file.configs.clone()
-        };
-        for (i, c) in configs.iter().enumerate() {
-            if c.name.trim().is_empty() {
-                return Err(invalid(
-                    format!("configs[{i}].name"),
-                    "must not be empty".into(),
-                ));
-            }
-            if c.name.chars().any(char::is_control) || c.name.chars().count() > 200 {
-                return Err(invalid(
-                    format!("configs[{i}].name"),
-                    "must be one line of at most 200 characters (it names the group in tables \
-                     and charts)"
-                        .into(),
-                ));
-            }
-            if configs[..i].iter().any(|d| d.name == c.name) {
-                return Err(invalid(
-                    format!("configs[{i}].name"),
-                    format!("'{}' is used twice", c.name),
-                ));
-            }
-        }
-        // The sweep's size is checked before its points are made.
-        let mut n_points: usize = 1;
-        for (key, values) in &file.sweep {
-            let toml::Value::Array(values) = values else {
-                continue;
-            };
-            for (i, v) in values.iter().enumerate() {
-                if values[..i].iter().any(|w| value_text(w) == value_text(v)) {
-                    return Err(invalid(
-                        format!("sweep.{}[{i}]", quoted(key)),
-                        format!("{} is listed twice", value_text(v)),
-                    ));
-                }
-            }
-            n_points = n_points.saturating_mul(values.len().max(1));
-        }
-        let groups = n_points
-            .saturating_mul(configs.len())
-            .saturating_mul(scenarios.len());
-        if n_points > MAX_POINTS || groups > MAX_GROUPS {
-            return Err(invalid(
-                "sweep".into(),
-                format!(
-                    "{n_points} sweep points, {groups} groups (scenarios x configs x points); at \
-                     most {MAX_POINTS} points and {MAX_GROUPS} groups"
-                ),
-            ));
-        }
-        let runs = (groups as u64).saturating_mul(file.seeds);
-        if runs > MAX_RUNS {
-            return Err(invalid(
-                "seeds".into(),
-                format!(
-                    "{groups} groups x {} seeds = {runs} runs; at most {MAX_RUNS} in one campaign \
-                     (split it into several)",
-                    file.seeds
-                ),
-            ));
-        }
-        let mut points = vec![SweepPoint { values: Vec::new() }];
-        for (key, values) in &file.sweep {
-            let toml::Value::Array(values) = values else {
-                return Err(invalid(
-                    format!("sweep.{}", quoted(key)),
-                    "must be an array of values".into(),
-                ));
-            };
-            if values.is_empty() {
-                return Err(invalid(
-                    format!("sweep.{}", quoted(key)),
-                    "must not be empty".into(),
-                ));
-            }
-            let mut next = Vec::new();
-            for p in &points {
-                for v in values {
-                    let mut q = p.clone();
-                    q.values.push((key.clone(), v.clone()));
-                    next.push(q);
-                }
-            }
-            points = next;
-        }
+        let configs = resolve_configs(&file.configs, &invalid)?;
+        let points = sweep_points(&file, configs.len() * scenarios.len(), &invalid)?;
         Ok(Campaign {
             file,
             path: path.to_path_buf(),
@@ -674,6 +503,209 @@ impl Campaign {
         let text = serde_json::to_string(&canon).unwrap_or_default();
         format!("{:016x}", fnv1a(text.as_bytes()))
     }
+}
+
+/// Makes a [`CampaignError::Invalid`] from a key path and a message.
+type Invalid<'a> = dyn Fn(String, String) -> CampaignError + 'a;
+
+/// Checks the seeds, the lengths of the lists and the success radius.
+fn check_sizes(file: &CampaignFile, invalid: &Invalid<'_>) -> Result<(), CampaignError> {
+    if !(1..=MAX_SEEDS).contains(&file.seeds) {
+        return Err(invalid(
+            "seeds".into(),
+            format!("must be 1 to {MAX_SEEDS}, got {}", file.seeds),
+        ));
+    }
+    for (key, n, max) in [
+        ("scenarios", file.scenarios.len(), MAX_LIST),
+        ("configs", file.configs.len(), MAX_LIST),
+        ("sweep", file.sweep.len(), 16),
+    ] {
+        if n > max {
+            return Err(invalid(key.into(), format!("{n} entries; at most {max}")));
+        }
+    }
+    if file.scenarios.is_empty() {
+        return Err(invalid(
+            "scenarios".into(),
+            "name at least one scenario".into(),
+        ));
+    }
+    if let Some(r) = file.success_radius_m
+        && !(r.is_finite() && r > 0.0)
+    {
+        return Err(invalid(
+            "success_radius_m".into(),
+            format!("must be a finite number > 0, got {r}"),
+        ));
+    }
+    Ok(())
+}
+
+/// The scenario `s` (entry `i` of the list): a family, a file next to the campaign file, or a
+/// preset. `read` false leaves files and families unread.
+fn scenario_entry(
+    i: usize,
+    s: &str,
+    base: &Path,
+    read: bool,
+    invalid: &Invalid<'_>,
+) -> Result<ScenarioEntry, CampaignError> {
+    if is_family_path(s) {
+        let p = base.join(s);
+        let family = if read {
+            Some(Family::load(&p).map_err(|e| invalid(format!("scenarios[{i}]"), e.to_string()))?)
+        } else {
+            None
+        };
+        return Ok(ScenarioEntry {
+            label: s.to_string(),
+            origin: family
+                .as_ref()
+                .map_or(Origin::File(p), |f| f.base_origin.clone()),
+            table: family.as_ref().map(|f| f.base.clone()).unwrap_or_default(),
+            family,
+        });
+    }
+    let (origin, text) = if s.ends_with(".toml") {
+        let p = base.join(s);
+        let text = if read {
+            plumetrace_env::input::read_text(&p, plumetrace_env::input::MAX_TEXT_BYTES)
+                .map_err(|e| invalid(format!("scenarios[{i}]"), format!("{}: {e}", p.display())))?
+        } else {
+            String::new()
+        };
+        (Origin::File(p), text)
+    } else if let Some(p) = find_preset(s) {
+        (Origin::Preset(s.to_string()), p.toml.to_string())
+    } else {
+        let known: Vec<&str> = PRESETS.iter().map(|p| p.name).collect();
+        return Err(invalid(
+            format!("scenarios[{i}]"),
+            format!(
+                "'{s}' is neither a preset ({}) nor a path ending in .toml",
+                known.join(", ")
+            ),
+        ));
+    };
+    let table: toml::Table = text.parse().map_err(|e: toml::de::Error| {
+        invalid(format!("scenarios[{i}]"), format!("{origin}: {e}"))
+    })?;
+    Ok(ScenarioEntry {
+        label: s.to_string(),
+        origin,
+        table,
+        family: None,
+    })
+}
+
+/// The configurations (one, "default", when none is given), their names checked.
+fn resolve_configs(
+    given: &[ConfigFile],
+    invalid: &Invalid<'_>,
+) -> Result<Vec<ConfigFile>, CampaignError> {
+    let configs = if given.is_empty() {
+        vec![ConfigFile {
+            name: "default".into(),
+            planner: None,
+            set: toml::Table::new(),
+        }]
+    } else {
+        given.to_vec()
+    };
+    for (i, c) in configs.iter().enumerate() {
+        if c.name.trim().is_empty() {
+            return Err(invalid(
+                format!("configs[{i}].name"),
+                "must not be empty".into(),
+            ));
+        }
+        if c.name.chars().any(char::is_control) || c.name.chars().count() > 200 {
+            return Err(invalid(
+                format!("configs[{i}].name"),
+                "must be one line of at most 200 characters (it names the group in tables \
+                 and charts)"
+                    .into(),
+            ));
+        }
+        if configs[..i].iter().any(|d| d.name == c.name) {
+            return Err(invalid(
+                format!("configs[{i}].name"),
+                format!("'{}' is used twice", c.name),
+            ));
+        }
+    }
+    Ok(configs)
+}
+
+/// The sweep's points (every combination of its values; one empty point without a sweep), its
+/// size, and the number of runs of `groups_per_point` groups per point, checked first.
+fn sweep_points(
+    file: &CampaignFile,
+    groups_per_point: usize,
+    invalid: &Invalid<'_>,
+) -> Result<Vec<SweepPoint>, CampaignError> {
+    let mut n_points: usize = 1;
+    for (key, values) in &file.sweep {
+        let toml::Value::Array(values) = values else {
+            continue;
+        };
+        for (i, v) in values.iter().enumerate() {
+            if values[..i].iter().any(|w| value_text(w) == value_text(v)) {
+                return Err(invalid(
+                    format!("sweep.{}[{i}]", quoted(key)),
+                    format!("{} is listed twice", value_text(v)),
+                ));
+            }
+        }
+        n_points = n_points.saturating_mul(values.len().max(1));
+    }
+    let groups = n_points.saturating_mul(groups_per_point);
+    if n_points > MAX_POINTS || groups > MAX_GROUPS {
+        return Err(invalid(
+            "sweep".into(),
+            format!(
+                "{n_points} sweep points, {groups} groups (scenarios x configs x points); at \
+                 most {MAX_POINTS} points and {MAX_GROUPS} groups"
+            ),
+        ));
+    }
+    let runs = (groups as u64).saturating_mul(file.seeds);
+    if runs > MAX_RUNS {
+        return Err(invalid(
+            "seeds".into(),
+            format!(
+                "{groups} groups x {} seeds = {runs} runs; at most {MAX_RUNS} in one campaign \
+                 (split it into several)",
+                file.seeds
+            ),
+        ));
+    }
+    let mut points = vec![SweepPoint { values: Vec::new() }];
+    for (key, values) in &file.sweep {
+        let toml::Value::Array(values) = values else {
+            return Err(invalid(
+                format!("sweep.{}", quoted(key)),
+                "must be an array of values".into(),
+            ));
+        };
+        if values.is_empty() {
+            return Err(invalid(
+                format!("sweep.{}", quoted(key)),
+                "must not be empty".into(),
+            ));
+        }
+        let mut next = Vec::new();
+        for p in &points {
+            for v in values {
+                let mut q = p.clone();
+                q.values.push((key.clone(), v.clone()));
+                next.push(q);
+            }
+        }
+        points = next;
+    }
+    Ok(points)
 }
 
 /// A key as written in a key path.
