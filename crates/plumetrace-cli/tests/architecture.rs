@@ -30,12 +30,18 @@ const RULES: &[(&str, Side, &[&str])] = &[
         &["plumetrace-core", "plumetrace-guidance"],
     ),
     (
+        "plumetrace-log",
+        Side::Shared,
+        &["plumetrace-core", "plumetrace-planner"],
+    ),
+    (
         "plumetrace-onboard",
         Side::Onboard,
         &[
             "plumetrace-core",
             "plumetrace-guidance",
             "plumetrace-planner",
+            "plumetrace-log",
         ],
     ),
     (
@@ -58,7 +64,7 @@ const RULES: &[(&str, Side, &[&str])] = &[
             "plumetrace-scenario",
             "plumetrace-guidance",
             "plumetrace-planner",
-            "plumetrace-onboard",
+            "plumetrace-log",
         ],
     ),
     (
@@ -80,6 +86,7 @@ const RULES: &[(&str, Side, &[&str])] = &[
             "plumetrace-sim",
             "plumetrace-scenario",
             "plumetrace-planner",
+            "plumetrace-log",
             "plumetrace-onboard",
             "plumetrace-mission",
             "plumetrace-campaign",

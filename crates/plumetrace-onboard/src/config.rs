@@ -576,7 +576,7 @@ fn check_moos(file: &OnboardFile) -> Result<(), ParamError> {
     }
 }
 
-impl crate::snapshot_log::LoggablePlanner for Onboard {
+impl plumetrace_log::snapshot::LoggablePlanner for Onboard {
     fn key(&self) -> &str {
         "planner"
     }

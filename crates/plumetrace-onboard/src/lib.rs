@@ -7,7 +7,6 @@
 //! sends the planner's commands back, checked at one chokepoint. It depends on no simulator
 //! crate, so what flies a vehicle is exactly what flew the simulations.
 //!
-//! - [`alog`]: a MOOS `.alog` writer for onboard runs and missions;
 //! - [`sentence`]: the line rule (framing and checksum) and field readers shared by the codecs;
 //! - [`bluefin`]: the Bluefin standard payload interface sentences;
 //! - [`iver`]: the Iver remote-helm sentences and their unit setting;
@@ -20,10 +19,10 @@
 //! - `moos` (the `moos` feature): a MOOS community client, its wire format and the MOOS link;
 //! - [`runner`]: the onboard runner (snapshots in, checked commands out, pauses for safety);
 //! - [`serial`]: raw serial lines and pseudo-terminals (no system library);
-//! - [`geo`]: latitude and longitude to the local frame and back (GeographicLib geodesics);
-//! - [`snapshot_log`]: the snapshot log (every snapshot and decision) and its replay.
+//! - [`geo`]: latitude and longitude to the local frame and back (GeographicLib geodesics).
+//!
+//! The snapshot log and the `.alog` files a run writes are `plumetrace_log`'s formats.
 
-pub mod alog;
 pub mod bluefin;
 pub mod chem;
 pub mod command;
@@ -37,6 +36,5 @@ pub mod moos;
 pub mod runner;
 pub mod sentence;
 pub mod serial;
-pub mod snapshot_log;
 
 pub use sentence::{SentenceError, UtcTime};

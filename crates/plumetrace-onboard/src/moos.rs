@@ -80,7 +80,8 @@
 //! Published: `DESIRED_HEADING` (deg), `DESIRED_SPEED` (m/s), `DESIRED_DEPTH` (m; an altitude
 //! hold goes out as the depth that leaves that altitude over the last `NAV_DEPTH` plus
 //! `NAV_ALTITUDE`, and without both no depth goes out), `CPT_BEHAVIOUR`, `CPT_DETECTION`,
-//! `CPT_DECLARATION`, `CPT_STATUS` (the names and values of the `.alog` writer, [`crate::alog`]),
+//! `CPT_DECLARATION`, `CPT_STATUS` (the names and values of the `.alog` writer,
+//! [`plumetrace_log::alog`]),
 //! and `CPT_PAUSED` (`true` when the planner pauses, `false` when it steers again). The safe
 //! command (`link.safe_command = "stop"`) is `DESIRED_SPEED = 0`; at the end of a run the safe
 //! command goes out and `CPT_STATUS = ended`. No flow (current) variable is read: the runner
