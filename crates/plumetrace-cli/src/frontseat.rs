@@ -15,14 +15,16 @@ use plumetrace_core::{
     Command, Decision, Heading, PlanStatus, Planner, SensorSnapshot, VerticalCommand,
 };
 use plumetrace_mission::{Mission, MissionOptions, MissionSetup};
-use plumetrace_onboard::bluefin::{self, AckStatus, HorizontalMode, SpeedMode, VerticalMode};
-use plumetrace_onboard::chem::ChemFormat;
 use plumetrace_onboard::command::VehicleLimits;
-use plumetrace_onboard::current::Cur;
 use plumetrace_onboard::geo::{LocalFrame, Origin};
-use plumetrace_onboard::iver::{self, M_PER_FT, MPS_PER_KN, Units};
-use plumetrace_onboard::sentence::UtcTime;
-use plumetrace_onboard::serial::Pty;
+use plumetrace_onboard::protocol::bluefin::{
+    self, AckStatus, HorizontalMode, SpeedMode, VerticalMode,
+};
+use plumetrace_onboard::protocol::chem::ChemFormat;
+use plumetrace_onboard::protocol::current::Cur;
+use plumetrace_onboard::protocol::iver::{self, M_PER_FT, MPS_PER_KN, Units};
+use plumetrace_onboard::protocol::sentence::UtcTime;
+use plumetrace_onboard::transport::serial::Pty;
 use serde::Serialize;
 use std::io::{Read, Write};
 use std::net::{SocketAddr, TcpListener, TcpStream};
@@ -258,7 +260,7 @@ impl FrontSeat {
         let mut chunk = [0u8; 4096];
         let n = match &mut self.wire {
             Wire::Tcp { conn: Some(c), .. } => {
-                plumetrace_onboard::link::read_tcp(c, &mut chunk, wait).map_err(|_| ())
+                plumetrace_onboard::transport::conn::read_tcp(c, &mut chunk, wait).map_err(|_| ())
             }
             Wire::Tcp { conn: None, .. } => {
                 std::thread::sleep(wait.min(Duration::from_millis(10)));

@@ -90,7 +90,6 @@ pub fn run(args: &OnboardArgs) -> Result<()> {
     let traffic = std::fs::File::create(&traffic_path)
         .with_context(|| format!("creating {}", traffic_path.display()))?;
     let mut link = runner::link_for(&onboard, Some(Box::new(std::io::BufWriter::new(traffic))))
-        .map_err(anyhow::Error::msg)
         .with_context(|| format!("{}", args.file.display()))?;
     let chem_traffic = match &onboard.file.chemical {
         c if c.address.is_some() || c.device.is_some() => {
@@ -138,8 +137,7 @@ pub fn run(args: &OnboardArgs) -> Result<()> {
                 log_error = Some(e);
             }
         }
-    })
-    .map_err(anyhow::Error::msg)?;
+    })?;
     drop(link);
     if let Some(e) = log_error {
         anyhow::bail!("writing {}: {e}", log_path.display());
