@@ -30,7 +30,10 @@ fn the_onboard_file_names_this_front_seat_and_reads_back() {
     let r = Rehearsal::prepare(demo(), &lock_step(60.0)).unwrap();
     let address = r.link_table()["address"].as_str().unwrap().to_string();
     assert_eq!(r.location(), format!("listening on {address}"));
-    assert!(!address.ends_with(":0"), "a free port was picked: {address}");
+    assert!(
+        !address.ends_with(":0"),
+        "a free port was picked: {address}"
+    );
     let text = r.onboard_file().unwrap();
     assert!(text.starts_with("# Written by `plumetrace frontseat` for scenario 'demo'"));
     let o = Onboard::from_toml(&text).unwrap_or_else(|e| panic!("{e}\n{text}"));
@@ -40,7 +43,10 @@ fn the_onboard_file_names_this_front_seat_and_reads_back() {
     assert_eq!(o.file.run.mode, RunMode::LockStep);
     assert_eq!(o.file.run.time_limit_s, 60.0);
     assert_eq!(o.file.run.lock_step_period_s, 0.1);
-    assert!(o.file.flow.is_some(), "the current readings travel on the link");
+    assert!(
+        o.file.flow.is_some(),
+        "the current readings travel on the link"
+    );
     assert_eq!(format!("{:?}", o.planner.kind()), "Amp");
 
     let no_flow = FrontSeatOptions {
