@@ -2,7 +2,8 @@
 
 use crate::output::write_atomic;
 use anyhow::{Context, Result};
-use plumetrace_mission::snapshot_log::{Header, SnapshotLogWriter};
+use plumetrace_log::snapshot::Header;
+use plumetrace_mission::snapshot_log::SnapshotLogWriter;
 use plumetrace_mission::{Mission, MissionOptions, MissionRun, MissionSetup};
 use plumetrace_scenario::BuiltScenario;
 use serde::Serialize;
@@ -49,7 +50,6 @@ pub fn run(
             &mission.vehicle_names(),
             mission.planned(),
         )
-        .map_err(anyhow::Error::msg)
         .context("writing the snapshot log's header")?;
         let path = out.join(SNAPSHOT_LOG);
         let writer = SnapshotLogWriter::create(&path, &header)

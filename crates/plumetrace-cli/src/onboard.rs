@@ -5,9 +5,10 @@
 
 use crate::output::write_atomic;
 use anyhow::{Context, Result};
+use plumetrace_log::alog::AlogWriter;
+use plumetrace_log::snapshot::{Header, SnapshotLogFile};
 use plumetrace_onboard::config::Onboard;
 use plumetrace_onboard::runner::{self, RunReport};
-use plumetrace_onboard::snapshot_log::{Header, SnapshotLogFile};
 use serde::Serialize;
 use std::path::PathBuf;
 
@@ -81,8 +82,7 @@ pub fn run(args: &OnboardArgs) -> Result<()> {
         0,
         std::slice::from_ref(&onboard.file.name),
         &[Some(onboard.clone())],
-    )
-    .map_err(anyhow::Error::msg)?;
+    )?;
     let log_path = args.out.join(crate::mission::SNAPSHOT_LOG);
     let mut log = SnapshotLogFile::create(&log_path, &header)
         .with_context(|| format!("creating {}", log_path.display()))?;
@@ -90,7 +90,6 @@ pub fn run(args: &OnboardArgs) -> Result<()> {
     let traffic = std::fs::File::create(&traffic_path)
         .with_context(|| format!("creating {}", traffic_path.display()))?;
     let mut link = runner::link_for(&onboard, Some(Box::new(std::io::BufWriter::new(traffic))))
-        .map_err(anyhow::Error::msg)
         .with_context(|| format!("{}", args.file.display()))?;
     let chem_traffic = match &onboard.file.chemical {
         c if c.address.is_some() || c.device.is_some() => {
@@ -118,7 +117,7 @@ pub fn run(args: &OnboardArgs) -> Result<()> {
     let start_unix = std::time::SystemTime::now()
         .duration_since(std::time::UNIX_EPOCH)
         .map_or(0.0, |d| d.as_secs_f64());
-    let mut alog = plumetrace_onboard::alog::AlogWriter::new(
+    let mut alog = AlogWriter::new(
         std::io::BufWriter::new(alog_file),
         &alog_path.display().to_string(),
         start_unix,
@@ -132,18 +131,18 @@ pub fn run(args: &OnboardArgs) -> Result<()> {
         if log_error.is_none() {
             let written = log
                 .write(0, s, d)
+                .map_err(|e| e.to_string())
                 .and_then(|()| alog.decision(s, d).map_err(|e| format!("run.alog: {e}")));
             if let Err(e) = written {
                 log_error = Some(e);
             }
         }
-    })
-    .map_err(anyhow::Error::msg)?;
+    })?;
     drop(link);
     if let Some(e) = log_error {
         anyhow::bail!("writing {}: {e}", log_path.display());
     }
-    log.finish().map_err(anyhow::Error::msg)?;
+    log.finish()?;
     alog.finish()
         .with_context(|| format!("writing {}", alog_path.display()))?;
     let file = ReportFile::from(&report);

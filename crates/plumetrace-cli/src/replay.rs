@@ -44,14 +44,14 @@ pub fn run(args: &ReplayArgs) -> Result<bool> {
         }
         None => None,
     };
-    let log = plumetrace_mission::snapshot_log::open(&args.log)
+    let log = plumetrace_log::snapshot::open(&args.log)
         .with_context(|| format!("opening {}", args.log.display()))?;
     let only = args.vehicle;
     let mut page = args
         .page
         .as_ref()
         .map(|_| plumetrace_mission::replay_page::LogPageBuilder::default());
-    let report = plumetrace_mission::snapshot_log::replay_with(
+    let report = plumetrace_log::snapshot::replay_with(
         log,
         &|v| other.clone().filter(|_| only.is_none_or(|o| o == v)),
         &mut |r| {

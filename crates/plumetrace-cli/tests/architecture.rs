@@ -30,12 +30,18 @@ const RULES: &[(&str, Side, &[&str])] = &[
         &["plumetrace-core", "plumetrace-guidance"],
     ),
     (
+        "plumetrace-log",
+        Side::Shared,
+        &["plumetrace-core", "plumetrace-planner"],
+    ),
+    (
         "plumetrace-onboard",
         Side::Onboard,
         &[
             "plumetrace-core",
             "plumetrace-guidance",
             "plumetrace-planner",
+            "plumetrace-log",
         ],
     ),
     (
@@ -58,6 +64,18 @@ const RULES: &[(&str, Side, &[&str])] = &[
             "plumetrace-scenario",
             "plumetrace-guidance",
             "plumetrace-planner",
+            "plumetrace-log",
+        ],
+    ),
+    (
+        "plumetrace-frontseat",
+        Side::App,
+        &[
+            "plumetrace-core",
+            "plumetrace-env",
+            "plumetrace-sim",
+            "plumetrace-scenario",
+            "plumetrace-mission",
             "plumetrace-onboard",
         ],
     ),
@@ -80,8 +98,10 @@ const RULES: &[(&str, Side, &[&str])] = &[
             "plumetrace-sim",
             "plumetrace-scenario",
             "plumetrace-planner",
+            "plumetrace-log",
             "plumetrace-onboard",
             "plumetrace-mission",
+            "plumetrace-frontseat",
             "plumetrace-campaign",
         ],
     ),
@@ -112,6 +132,56 @@ const RULES: &[(&str, Side, &[&str])] = &[
         ],
     ),
 ];
+
+/// Dependencies no row may ever allow, whatever else changes, with the reason.
+const NEVER: &[(&str, &str, &str)] = &[
+    (
+        "plumetrace-onboard",
+        "plumetrace-env",
+        "what flies a vehicle never sees the simulated world",
+    ),
+    (
+        "plumetrace-onboard",
+        "plumetrace-sim",
+        "what flies a vehicle never sees the simulated world",
+    ),
+    (
+        "plumetrace-onboard",
+        "plumetrace-scenario",
+        "what flies a vehicle never sees the simulated world",
+    ),
+    (
+        "plumetrace-onboard",
+        "plumetrace-mission",
+        "what flies a vehicle never sees the simulated world",
+    ),
+    (
+        "plumetrace-mission",
+        "plumetrace-onboard",
+        "missions write their logs through plumetrace-log, not the vehicle link",
+    ),
+    (
+        "plumetrace-log",
+        "plumetrace-onboard",
+        "both sides write the log formats, so they depend on neither side's links",
+    ),
+    (
+        "plumetrace-log",
+        "plumetrace-mission",
+        "both sides write the log formats, so they depend on neither side's links",
+    ),
+];
+
+#[test]
+fn the_vehicle_link_and_the_simulated_world_stay_apart() {
+    for (from, to, why) in NEVER {
+        let allowed = RULES.iter().find(|r| r.0 == *from).map(|r| r.2);
+        assert!(
+            allowed.is_some_and(|a| !a.contains(to)),
+            "{from} may not depend on {to}: {why}"
+        );
+    }
+}
 
 fn manifest_deps(path: &Path, table: &str) -> BTreeSet<String> {
     let text = std::fs::read_to_string(path).unwrap();

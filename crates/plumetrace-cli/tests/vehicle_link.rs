@@ -216,10 +216,7 @@ fn read_alog(path: &Path) -> Vec<(String, String)> {
         let t: f64 = f[0].parse().unwrap();
         assert!(t >= last, "time order: {line}");
         last = t;
-        assert!(
-            plumetrace_onboard::alog::VARIABLES.contains(&f[1]),
-            "{line}"
-        );
+        assert!(plumetrace_log::alog::VARIABLES.contains(&f[1]), "{line}");
         postings.push((f[1].to_string(), f[3].to_string()));
     }
     assert!(text.contains("%% LOGSTART"));
@@ -266,7 +263,7 @@ fn a_mission_writes_an_alog_per_planned_vehicle_that_reads_back() {
 
 /// The lines of a snapshot log.
 fn plumetrace_onboard_log(p: &Path) -> Vec<String> {
-    plumetrace_onboard::snapshot_log::open(p)
+    plumetrace_log::snapshot::open(p)
         .unwrap()
         .lines()
         .map(Result::unwrap)

@@ -1,9 +1,9 @@
 //! MOOS `.alog` files of a mission: one per vehicle with a planner, written as the mission runs
-//! by the onboard crate's [`AlogWriter`] (navigation estimate, the planner's set-points and the
+//! by the log crate's [`AlogWriter`] (navigation estimate, the planner's set-points and the
 //! plume-tracing variables).
 
 use crate::record::{Observer, RecordError, StepView};
-use plumetrace_onboard::alog::AlogWriter;
+use plumetrace_log::alog::AlogWriter;
 use std::fs::File;
 use std::io::BufWriter;
 use std::path::{Path, PathBuf};

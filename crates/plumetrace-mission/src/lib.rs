@@ -17,8 +17,9 @@
 //!   did together (formation error, centroid against the centre line, overhead, losses);
 //! - [`metrics`]: the run metrics, declared once ([`RunMetrics`]: name, type, unit, meaning and
 //!   how each is read from the summary), which campaigns and the Python bindings read;
-//! - [`snapshot_log`]: the replayable log of snapshots and decisions;
-//! - [`alog`]: MOOS `.alog` files, one per planned vehicle;
+//! - [`snapshot_log`]: the observer writing the replayable log of snapshots and decisions (its
+//!   format and replay are `plumetrace_log`'s);
+//! - [`alog`]: MOOS `.alog` files, one per planned vehicle (the log crate's writer);
 //! - [`plot`]: the mission figure; [`team_plot`]: the team figure (readings, speeds, headings,
 //!   scale and centroid against time); [`replay_page`]: the self-contained replay page;
 //!   [`output`]: atomic file writing.

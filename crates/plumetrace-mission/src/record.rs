@@ -74,9 +74,9 @@ pub enum RecordError {
         /// What failed.
         message: String,
     },
-    /// A writer failed; its message names the file.
-    #[error("{0}")]
-    Writer(String),
+    /// A log writer failed; its message names the file.
+    #[error(transparent)]
+    Log(#[from] plumetrace_log::LogError),
 }
 
 impl RecordError {

@@ -431,7 +431,7 @@ impl PageData {
     }
 }
 
-/// Collects a replayed log ([`crate::snapshot_log::replay_with`]) into a page: each vehicle's
+/// Collects a replayed log ([`plumetrace_log::snapshot::replay_with`]) into a page: each vehicle's
 /// estimated track as logged, its readings, and the *replayed* planner's behaviours and events
 /// (so a page of a log replayed with another configuration shows what that one would have
 /// decided along the logged track). A log holds no truth and no plume.
@@ -446,7 +446,7 @@ pub struct LogPageBuilder {
 
 impl LogPageBuilder {
     /// Takes one replayed decision.
-    pub fn add(&mut self, r: crate::snapshot_log::Replayed<'_>) {
+    pub fn add(&mut self, r: plumetrace_log::snapshot::Replayed<'_>) {
         if self.geometry.is_none() {
             for v in &r.header.vehicles {
                 let kind = v

@@ -1,11 +1,10 @@
 //! The snapshot log of a simulated mission: an observer that writes every snapshot a planner
-//! received and every decision it returned (the format and the replay are the onboard crate's,
-//! [`plumetrace_onboard::snapshot_log`], re-exported here).
-
-pub use plumetrace_onboard::snapshot_log::*;
+//! received and every decision it returned (the format, the file and the replay are the log
+//! crate's, [`plumetrace_log::snapshot`]).
 
 use crate::record::{Observer, RecordError, StepView};
 use crate::setup::PlannedVehicle;
+use plumetrace_log::snapshot::{Header, LoggablePlanner, SnapshotLogFile};
 use plumetrace_planner::{BuildContext, PlannerConfig};
 use std::path::Path;
 
@@ -45,7 +44,7 @@ impl Observer for SnapshotLogWriter {
         }
         for (k, snapshot, decision) in step.decided() {
             if let Err(e) = self.file.write(k as u32, snapshot, decision) {
-                self.error = Some(e);
+                self.error = Some(e.to_string());
                 return;
             }
         }
@@ -59,6 +58,6 @@ impl Observer for SnapshotLogWriter {
         if let Some(e) = self.error.take() {
             return Err(RecordError::file(self.file.path(), e));
         }
-        self.file.finish().map_err(RecordError::Writer)
+        self.file.finish().map_err(RecordError::Log)
     }
 }

@@ -4,7 +4,8 @@
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
 use plumetrace_core::{BehaviourKind, PlannerEvent, VehicleKind};
-use plumetrace_mission::snapshot_log::{Header, SnapshotLogWriter, open, replay};
+use plumetrace_log::snapshot::{Header, open, replay};
+use plumetrace_mission::snapshot_log::SnapshotLogWriter;
 use plumetrace_mission::{
     EndReason, EventKind, Mission, MissionOptions, MissionSetup, Outcome, VehicleStatus,
     run_mission,
@@ -632,11 +633,10 @@ fn a_replayed_log_makes_a_page_of_the_logged_track_and_the_replayed_behaviours()
     mission.run(&mut |_, _| {}).unwrap();
     let run = mission.finish().unwrap();
     let mut builder = plumetrace_mission::replay_page::LogPageBuilder::default();
-    let report =
-        plumetrace_mission::snapshot_log::replay_with(open(&path).unwrap(), &|_| None, &mut |r| {
-            builder.add(r)
-        })
-        .unwrap();
+    let report = plumetrace_log::snapshot::replay_with(open(&path).unwrap(), &|_| None, &mut |r| {
+        builder.add(r)
+    })
+    .unwrap();
     assert_eq!(report.differing, 0);
     let page = builder.page("replay", "same planner");
     assert_eq!(page.vehicles.len(), 1);

@@ -32,7 +32,7 @@ impl Default for VehicleLimits {
 
 impl VehicleLimits {
     /// The limits' own bounds, with the key that breaks them.
-    pub fn validate(&self) -> Result<(), (String, String)> {
+    pub fn validate(&self) -> Result<(), LimitError> {
         let checks = [
             ("max_speed_mps", self.max_speed_mps, 0.0, 10.0, false),
             ("max_depth_m", self.max_depth_m, 0.0, 6000.0, false),
@@ -45,20 +45,41 @@ impl VehicleLimits {
                 true,
             ),
         ];
-        for (key, v, lo, hi, lo_incl) in checks {
-            let above = if lo_incl { v >= lo } else { v > lo };
-            if !(v.is_finite() && above && v <= hi) {
-                return Err((
-                    key.into(),
-                    format!(
-                        "{v} is outside {}{lo}, {hi}]",
-                        if lo_incl { "[" } else { "(" }
-                    ),
-                ));
+        for (key, value, lo, hi, lo_inclusive) in checks {
+            let above = if lo_inclusive {
+                value >= lo
+            } else {
+                value > lo
+            };
+            if !(value.is_finite() && above && value <= hi) {
+                return Err(LimitError {
+                    key,
+                    value,
+                    lo,
+                    hi,
+                    lo_inclusive,
+                });
             }
         }
         Ok(())
     }
+}
+
+/// A vehicle limit outside its own bounds; the message leaves the key out ([`LimitError::key`]
+/// gives it).
+#[derive(Debug, Clone, Copy, PartialEq, thiserror::Error)]
+#[error("{value} is outside {}{lo}, {hi}]", if *lo_inclusive { "[" } else { "(" })]
+pub struct LimitError {
+    /// The limit's key (`max_speed_mps`, ...).
+    pub key: &'static str,
+    /// Its value.
+    pub value: f64,
+    /// The lower bound.
+    pub lo: f64,
+    /// The upper bound (inclusive).
+    pub hi: f64,
+    /// Whether the lower bound is allowed.
+    pub lo_inclusive: bool,
 }
 
 /// How the vertical set-point is held.
@@ -197,9 +218,11 @@ mod tests {
             min_altitude_m: 60.0,
             ..VehicleLimits::default()
         };
+        let e = bad.validate().err();
+        assert_eq!(e.map(|e| e.key), Some("min_altitude_m"));
         assert_eq!(
-            bad.validate().map_err(|e| e.0),
-            Err("min_altitude_m".to_string())
+            e.map(|e| e.to_string()).as_deref(),
+            Some("60 is outside [0, 50]")
         );
     }
 }

@@ -22,9 +22,9 @@
 //! mode = "lock_step"            # or "real_time"
 //! ```
 
-use crate::chem::ChemFormat;
 use crate::command::VehicleLimits;
 use crate::geo::Origin;
+use crate::protocol::chem::ChemFormat;
 use plumetrace_core::params::ParamError;
 use plumetrace_core::{Vec2, VehicleKind};
 use plumetrace_guidance::OpArea;
@@ -305,7 +305,7 @@ impl ChemicalFile {
 }
 
 /// `[flow]`: a current meter (ADCP or DVL) writing NMEA 0183 `$--CUR` sentences (see
-/// [`crate::current`]), and where its lines come from.
+/// [`crate::protocol::current`]), and where its lines come from.
 #[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct FlowFile {
@@ -320,8 +320,8 @@ pub struct FlowFile {
 
 impl FlowFile {
     /// The line format.
-    pub fn line_format(&self) -> crate::current::FlowFormat {
-        crate::current::FlowFormat { layer: self.layer }
+    pub fn line_format(&self) -> crate::protocol::current::FlowFormat {
+        crate::protocol::current::FlowFormat { layer: self.layer }
     }
 }
 
@@ -457,7 +457,7 @@ impl Onboard {
         if let Some(v) = l.remote_helm_major {
             in_range("link.remote_helm_major", f64::from(v), 1.0, 99.0, false)?;
         }
-        crate::geo::LocalFrame::new(l.origin).map_err(|e| err("link.origin", e))?;
+        crate::geo::LocalFrame::new(l.origin).map_err(|e| err("link.origin", e.to_string()))?;
         in_range("link.baud", f64::from(l.baud), 1200.0, 921_600.0, false)?;
         for (key, v, hi) in [
             ("link.stale_nav_s", l.stale_nav_s, 600.0),
@@ -489,7 +489,7 @@ impl Onboard {
         )?;
         l.limits
             .validate()
-            .map_err(|(k, m)| err(&format!("link.limits.{k}"), m))?;
+            .map_err(|e| err(&format!("link.limits.{}", e.key), e.to_string()))?;
         let c = &file.chemical;
         if c.address.is_some() && c.device.is_some() {
             return Err(err("chemical", "give address or device, not both"));
@@ -576,7 +576,7 @@ fn check_moos(file: &OnboardFile) -> Result<(), ParamError> {
     }
 }
 
-impl crate::snapshot_log::LoggablePlanner for Onboard {
+impl plumetrace_log::snapshot::LoggablePlanner for Onboard {
     fn key(&self) -> &str {
         "planner"
     }

@@ -20,6 +20,17 @@ pub struct Origin {
     pub lon_deg: f64,
 }
 
+/// Why an origin cannot have a local frame.
+#[derive(Debug, Clone, Copy, PartialEq, thiserror::Error)]
+pub enum OriginError {
+    /// The latitude is not a finite number in `[-89, 89]` (the poles have no east).
+    #[error("origin latitude {0} is not in [-89, 89] deg")]
+    Latitude(f64),
+    /// The longitude is not a finite number in `[-180, 180]`.
+    #[error("origin longitude {0} is not in [-180, 180] deg")]
+    Longitude(f64),
+}
+
 /// Converts between latitude/longitude and the local frame around an [`Origin`].
 #[derive(Debug, Clone)]
 pub struct LocalFrame {
@@ -30,18 +41,12 @@ pub struct LocalFrame {
 impl LocalFrame {
     /// The frame around `origin`; an error if the origin is not a finite latitude in
     /// `[-89, 89]` and longitude in `[-180, 180]` (the poles have no east).
-    pub fn new(origin: Origin) -> Result<Self, String> {
+    pub fn new(origin: Origin) -> Result<Self, OriginError> {
         if !(origin.lat_deg.is_finite() && origin.lat_deg.abs() <= 89.0) {
-            return Err(format!(
-                "origin latitude {} is not in [-89, 89] deg",
-                origin.lat_deg
-            ));
+            return Err(OriginError::Latitude(origin.lat_deg));
         }
         if !(origin.lon_deg.is_finite() && origin.lon_deg.abs() <= 180.0) {
-            return Err(format!(
-                "origin longitude {} is not in [-180, 180] deg",
-                origin.lon_deg
-            ));
+            return Err(OriginError::Longitude(origin.lon_deg));
         }
         Ok(LocalFrame {
             origin,
@@ -126,5 +131,14 @@ mod tests {
                 .is_err()
             );
         }
+        let e = LocalFrame::new(Origin {
+            lat_deg: 95.0,
+            lon_deg: 0.0,
+        })
+        .err();
+        assert_eq!(
+            e.map(|e| e.to_string()).as_deref(),
+            Some("origin latitude 95 is not in [-89, 89] deg")
+        );
     }
 }

@@ -7,36 +7,32 @@
 //! sends the planner's commands back, checked at one chokepoint. It depends on no simulator
 //! crate, so what flies a vehicle is exactly what flew the simulations.
 //!
-//! - [`alog`]: a MOOS `.alog` writer for onboard runs and missions;
-//! - [`sentence`]: the line rule (framing and checksum) and field readers shared by the codecs;
-//! - [`bluefin`]: the Bluefin standard payload interface sentences;
-//! - [`iver`]: the Iver remote-helm sentences and their unit setting;
-//! - [`chem`]: the chemical sensor's line input;
-//! - [`current`]: the current meter's `$--CUR` sentences (measured flow);
-//! - [`config`]: the onboard file (planner, mission geometry, chemical input, link, time);
-//! - [`command`]: the chokepoint every command passes (finite, within the vehicle's limits);
-//! - [`link`]: the link trait, the Bluefin and Iver protocols on TCP or a serial line,
-//!   reconnection, keep-alives, acknowledgements and the raw traffic log;
-//! - `moos` (the `moos` feature): a MOOS community client, its wire format and the MOOS link;
-//! - [`runner`]: the onboard runner (snapshots in, checked commands out, pauses for safety);
-//! - [`serial`]: raw serial lines and pseudo-terminals (no system library);
-//! - [`geo`]: latitude and longitude to the local frame and back (GeographicLib geodesics);
-//! - [`snapshot_log`]: the snapshot log (every snapshot and decision) and its replay.
+//! Its layers, from the bytes up:
+//!
+//! - [`protocol`]: what the lines mean: the sentence rule and the Bluefin, Iver, chemical and
+//!   current-meter codecs, and the back seat's session of each protocol (acknowledgements,
+//!   polls, keep-alives);
+//! - [`transport`]: how the lines travel: TCP and serial connections, line framing, raw serial
+//!   lines and pseudo-terminals, and the line link that carries a session over them
+//!   (reconnection, counts, the raw traffic log);
+//! - `moos` (the `moos` feature): a MOOS community client: its wire format, navigation from its
+//!   postings, and the MOOS link;
+//! - [`link`]: the link trait the runner drives and what links report;
+//! - [`runner`]: the onboard runner (snapshots in, checked commands out, pauses for safety) and
+//!   the links an onboard file describes;
+//!
+//! and beside them [`config`] (the onboard file: planner, mission geometry, chemical input, link,
+//! time), [`command`] (the chokepoint every command passes: finite, within the vehicle's limits)
+//! and [`geo`] (latitude and longitude to the local frame and back, GeographicLib geodesics).
+//!
+//! The snapshot log and the `.alog` files a run writes are `plumetrace_log`'s formats.
 
-pub mod alog;
-pub mod bluefin;
-pub mod chem;
 pub mod command;
 pub mod config;
-pub mod current;
 pub mod geo;
-pub mod iver;
 pub mod link;
 #[cfg(feature = "moos")]
 pub mod moos;
+pub mod protocol;
 pub mod runner;
-pub mod sentence;
-pub mod serial;
-pub mod snapshot_log;
-
-pub use sentence::{SentenceError, UtcTime};
+pub mod transport;

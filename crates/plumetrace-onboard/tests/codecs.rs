@@ -3,13 +3,13 @@
 
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
-use plumetrace_onboard::bluefin::{
+use plumetrace_onboard::protocol::bluefin::{
     self, Ack, AckStatus, HorizontalMode, Nvg, Nvr, Rmb, SpeedMode, VerticalMode,
 };
-use plumetrace_onboard::chem::ChemFormat;
-use plumetrace_onboard::current::{Cur, DirectionRef, FlowFormat};
-use plumetrace_onboard::iver::{self, Mode, Oms, Osi, Units};
-use plumetrace_onboard::sentence::{LineCounts, SentenceError, UtcTime, checksum};
+use plumetrace_onboard::protocol::chem::ChemFormat;
+use plumetrace_onboard::protocol::current::{Cur, DirectionRef, FlowFormat};
+use plumetrace_onboard::protocol::iver::{self, Mode, Oms, Osi, Units};
+use plumetrace_onboard::protocol::sentence::{LineCounts, SentenceError, UtcTime, checksum};
 
 fn t(text: &str) -> UtcTime {
     UtcTime::parse(text).unwrap()
@@ -292,7 +292,7 @@ fn the_current_meter_sentence_reads_and_writes_its_golden_lines() {
 
 #[test]
 fn current_readings_out_of_range_or_not_over_the_ground_are_refused() {
-    use plumetrace_onboard::sentence::frame;
+    use plumetrace_onboard::protocol::sentence::frame;
     let cases: &[(&str, &str)] = &[
         ("VDCUR,V,0,1,6.0,78.1,T,0.300,,,,B", "bad_field"),
         ("VDCUR,A,0,1,6.0,78.1,T,0.300,,,,W", "bad_field"),
@@ -339,7 +339,7 @@ fn iver_depth_units_follow_the_remote_helm_version() {
 
 #[test]
 fn out_of_range_and_malformed_fields_are_typed_errors() {
-    use plumetrace_onboard::sentence::frame;
+    use plumetrace_onboard::protocol::sentence::frame;
     let cases: &[(&str, &str)] = &[
         ("BPRMB,120000.000,400.0,10.0,0,1.5,1,0", "out_of_range"),
         ("BPRMB,120000.000,270.0,10.0,3,1.5,1,0", "out_of_range"),

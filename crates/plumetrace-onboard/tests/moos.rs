@@ -1,14 +1,14 @@
 //! The MOOS link against an in-process fake MOOSDB (a TCP listener thread speaking the wire
-//! format of `plumetrace_onboard::moos`): the handshake, registrations, navigation in, set-points
-//! out, a registered planner flying a simple simulated vehicle in the loop, pauses on stale
-//! navigation, lock-step time from the postings, reconnection after the server drops the
-//! connection or sends an unreadable stream, a refused name, the manual override, and bad
-//! packets counted and never acted on.
+//! format of `plumetrace_onboard::moos::wire`): the handshake, registrations, navigation in,
+//! set-points out, a registered planner flying a simple simulated vehicle in the loop, pauses on
+//! stale navigation, lock-step time from the postings, reconnection after the server drops the
+//! connection or sends an unreadable stream, a refused name, the manual override, and bad packets
+//! counted and never acted on.
 
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
 use plumetrace_onboard::config::Onboard;
-use plumetrace_onboard::moos::{
+use plumetrace_onboard::moos::wire::{
     Framer, Message, PROTOCOL_LEN, data, decode_packet, encode_packet, kind, protocol_bytes,
     unix_now,
 };

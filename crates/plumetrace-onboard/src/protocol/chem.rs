@@ -2,7 +2,7 @@
 //! the reading in a configured field, checksum required) or the instrument's plain ASCII reading
 //! (one number per line). Readings are timestamped on arrival by the caller.
 
-use crate::sentence::{ANY, Fields, SentenceError};
+use crate::protocol::sentence::{ANY, Fields, SentenceError};
 use serde::{Deserialize, Serialize};
 
 /// How chemical readings arrive.
@@ -77,16 +77,16 @@ impl ChemFormat {
 
     /// A line carrying `reading` (what a simulated front seat sends); sentence formats put the
     /// time of day in every field before the reading's.
-    pub fn encode(&self, time: crate::sentence::UtcTime, reading: f64) -> String {
+    pub fn encode(&self, time: crate::protocol::sentence::UtcTime, reading: f64) -> String {
         match self {
             ChemFormat::Plain => format!("{reading:.6}\r\n"),
             ChemFormat::Sentence { id, field } => {
-                let mut body = crate::sentence::clean_text(id);
+                let mut body = crate::protocol::sentence::clean_text(id);
                 for _ in 1..*field {
                     body.push_str(&format!(",{time}"));
                 }
                 body.push_str(&format!(",{reading:.6}"));
-                crate::sentence::frame(&body)
+                crate::protocol::sentence::frame(&body)
             }
         }
     }

@@ -6,7 +6,7 @@
 //! depth of `$OMS` is in feet below remote-helm major version 5 and in metres from 5: the version
 //! is an explicit setting ([`Units`]). `$OSI` reports altitude and depth in feet, speed in knots.
 
-use crate::sentence::{Fields, HEADING, Range, SPEED, SentenceError, clean_text, frame};
+use crate::protocol::sentence::{Fields, HEADING, Range, SPEED, SentenceError, clean_text, frame};
 
 /// Metres per foot.
 pub const M_PER_FT: f64 = 0.3048;

@@ -8,7 +8,7 @@
 //! `$BPABT` (abort). Numbers are written with the decimals the interface uses (one for angles,
 //! depths and speeds, two for velocities).
 
-use crate::sentence::{
+use crate::protocol::sentence::{
     ANGLE, DEPTH, Fields, HEADING, RATE, Range, SPEED, SentenceError, UtcTime, clean_text, frame,
     write_deg_min,
 };
@@ -210,6 +210,63 @@ fn bit(b: bool) -> u8 {
     u8::from(b)
 }
 
+/// The fields of a `$BFACK`.
+fn read_ack(f: &Fields<'_>) -> Result<Ack, SentenceError> {
+    const ID: &str = "BFACK";
+    f.expect_len(ID, 7)?;
+    let status = match f.int(ID, 5, "status", 3)? {
+        0 => AckStatus::Invalid,
+        1 => AckStatus::Failed,
+        2 => AckStatus::Ok,
+        _ => AckStatus::Pending,
+    };
+    Ok(Ack {
+        time: f.time(ID, 1, "time")?,
+        acked: f.text(2).to_string(),
+        command_time: f.time(ID, 3, "command time")?,
+        behaviour: f.text(4).to_string(),
+        status,
+        reserved: f.text(6).to_string(),
+        description: f.text(7).to_string(),
+    })
+}
+
+/// The fields of a `$BPRMB` (the ranges of its set-points depend on its modes).
+fn read_rmb(f: &Fields<'_>) -> Result<Rmb, SentenceError> {
+    const ID: &str = "BPRMB";
+    f.expect_len(ID, 7)?;
+    let vertical_mode = match f.int(ID, 4, "vertical mode", 2)? {
+        0 => VerticalMode::Depth,
+        1 => VerticalMode::Altitude,
+        _ => VerticalMode::Pitch,
+    };
+    let speed_mode = match f.int(ID, 6, "speed mode", 1)? {
+        0 => SpeedMode::Rpm,
+        _ => SpeedMode::Mps,
+    };
+    let horizontal_mode = match f.int(ID, 7, "horizontal mode", 1)? {
+        0 => HorizontalMode::Heading,
+        _ => HorizontalMode::Rudder,
+    };
+    let vertical_range = match vertical_mode {
+        VerticalMode::Pitch => ANGLE,
+        _ => DEPTH,
+    };
+    let speed_range = match speed_mode {
+        SpeedMode::Mps => SPEED,
+        SpeedMode::Rpm => Range::new(-10_000.0, 10_000.0, "[-10000, 10000] rpm"),
+    };
+    Ok(Rmb {
+        time: f.time(ID, 1, "time")?,
+        heading_deg: f.f64(ID, 2, "heading", ANGLE)?,
+        vertical: f.f64(ID, 3, "depth, altitude or pitch", vertical_range)?,
+        vertical_mode,
+        speed: f.f64(ID, 5, "speed", speed_range)?,
+        speed_mode,
+        horizontal_mode,
+    })
+}
+
 impl Sentence {
     /// Reads one line (framing, checksum, fields and their ranges).
     pub fn parse(line: &str) -> Result<Self, SentenceError> {
@@ -244,25 +301,7 @@ impl Sentence {
                     yaw_rate_dps: f.f64(ID, 7, "yaw rate", RATE)?,
                 })
             }
-            "BFACK" => {
-                const ID: &str = "BFACK";
-                f.expect_len(ID, 7)?;
-                let status = match f.int(ID, 5, "status", 3)? {
-                    0 => AckStatus::Invalid,
-                    1 => AckStatus::Failed,
-                    2 => AckStatus::Ok,
-                    _ => AckStatus::Pending,
-                };
-                Sentence::Ack(Ack {
-                    time: f.time(ID, 1, "time")?,
-                    acked: f.text(2).to_string(),
-                    command_time: f.time(ID, 3, "command time")?,
-                    behaviour: f.text(4).to_string(),
-                    status,
-                    reserved: f.text(6).to_string(),
-                    description: f.text(7).to_string(),
-                })
-            }
+            "BFACK" => Sentence::Ack(read_ack(&f)?),
             "BFCTL" => {
                 const ID: &str = "BFCTL";
                 f.expect_len(ID, 2)?;
@@ -271,40 +310,7 @@ impl Sentence {
                     accepting: flag(&f, ID, 2, "accepting commands")?,
                 }
             }
-            "BPRMB" => {
-                const ID: &str = "BPRMB";
-                f.expect_len(ID, 7)?;
-                let vertical_mode = match f.int(ID, 4, "vertical mode", 2)? {
-                    0 => VerticalMode::Depth,
-                    1 => VerticalMode::Altitude,
-                    _ => VerticalMode::Pitch,
-                };
-                let speed_mode = match f.int(ID, 6, "speed mode", 1)? {
-                    0 => SpeedMode::Rpm,
-                    _ => SpeedMode::Mps,
-                };
-                let horizontal_mode = match f.int(ID, 7, "horizontal mode", 1)? {
-                    0 => HorizontalMode::Heading,
-                    _ => HorizontalMode::Rudder,
-                };
-                let vertical_range = match vertical_mode {
-                    VerticalMode::Pitch => ANGLE,
-                    _ => DEPTH,
-                };
-                let speed_range = match speed_mode {
-                    SpeedMode::Mps => SPEED,
-                    SpeedMode::Rpm => Range::new(-10_000.0, 10_000.0, "[-10000, 10000] rpm"),
-                };
-                Sentence::Rmb(Rmb {
-                    time: f.time(ID, 1, "time")?,
-                    heading_deg: f.f64(ID, 2, "heading", ANGLE)?,
-                    vertical: f.f64(ID, 3, "depth, altitude or pitch", vertical_range)?,
-                    vertical_mode,
-                    speed: f.f64(ID, 5, "speed", speed_range)?,
-                    speed_mode,
-                    horizontal_mode,
-                })
-            }
+            "BPRMB" => Sentence::Rmb(read_rmb(&f)?),
             "BPLOG" => {
                 const ID: &str = "BPLOG";
                 f.expect_len(ID, 2)?;

@@ -22,7 +22,7 @@
 //!
 //! The talker (the two letters before `CUR`) is any.
 
-use crate::sentence::{Fields, HEADING, Range, SentenceError, frame};
+use crate::protocol::sentence::{Fields, HEADING, Range, SentenceError, frame};
 use plumetrace_core::{Heading, Vec2};
 
 /// Metres per second per knot.

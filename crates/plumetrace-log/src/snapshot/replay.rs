@@ -1,0 +1,244 @@
+//! Replaying a snapshot log: each logged planner rebuilt and fed the logged snapshots, and the
+//! decisions that come out differently.
+
+use super::{FORMAT, Header, Line, VERSION};
+use plumetrace_core::{Decision, Planner};
+use plumetrace_planner::PlannerConfig;
+use std::collections::BTreeMap;
+use std::io::BufRead;
+
+/// Why a log could not be read or replayed.
+#[derive(Debug, thiserror::Error)]
+pub enum ReplayError {
+    /// A line could not be read or parsed.
+    #[error("line {line}: {message}")]
+    Line {
+        /// 1-based line number.
+        line: u64,
+        /// What is wrong.
+        message: String,
+    },
+    /// A logged planner could not be rebuilt.
+    #[error("vehicle {vehicle}: {message}")]
+    Planner {
+        /// Vehicle index.
+        vehicle: u32,
+        /// What is wrong.
+        message: String,
+    },
+}
+
+/// A decision that came out differently.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Difference {
+    /// 1-based line number in the log.
+    pub line: u64,
+    /// Vehicle index.
+    pub vehicle: u32,
+    /// Snapshot time, s.
+    pub t_s: f64,
+    /// What the log says.
+    pub logged: Decision,
+    /// What the replayed planner decided.
+    pub replayed: Decision,
+}
+
+/// What a replay found.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct ReplayReport {
+    /// Decisions replayed.
+    pub decisions: u64,
+    /// How many differ.
+    pub differing: u64,
+    /// The first differences (at most [`ReplayReport::KEEP`]).
+    pub first: Vec<Difference>,
+}
+
+impl ReplayReport {
+    /// Differences kept in full.
+    pub const KEEP: usize = 10;
+}
+
+/// Whether two decisions are the same to the bit, non-finite numbers included (their text in the
+/// log is exact: numbers round-trip, non-finite ones are written as words).
+fn same(a: &Decision, b: &Decision) -> bool {
+    match (serde_json::to_string(a), serde_json::to_string(b)) {
+        (Ok(x), Ok(y)) => x == y,
+        _ => false,
+    }
+}
+
+/// Reads the header of a log.
+pub fn read_header(line: &str) -> Result<Header, ReplayError> {
+    let header: Header = serde_json::from_str(line).map_err(|e| ReplayError::Line {
+        line: 1,
+        message: format!("not a snapshot log header: {e}"),
+    })?;
+    if header.format != FORMAT || header.version != VERSION {
+        return Err(ReplayError::Line {
+            line: 1,
+            message: format!(
+                "format '{}' version {}; this reads '{FORMAT}' version {VERSION}",
+                header.format, header.version
+            ),
+        });
+    }
+    Ok(header)
+}
+
+/// One replayed decision, as [`replay_with`] shows it.
+pub struct Replayed<'a> {
+    /// The log's header.
+    pub header: &'a Header,
+    /// The logged line (snapshot and logged decision).
+    pub line: &'a Line,
+    /// The replayed planner's decision.
+    pub replayed: &'a Decision,
+    /// The replayed planner's detection threshold, if it has one.
+    pub threshold_v: Option<f64>,
+}
+
+/// Replays a log: each vehicle's planner is rebuilt from the header, or from `tables` where it
+/// gives one for the vehicle (another configuration), and fed the logged snapshots in order.
+pub fn replay(
+    log: impl BufRead,
+    tables: &dyn Fn(u32) -> Option<toml::Table>,
+) -> Result<ReplayReport, ReplayError> {
+    replay_with(log, tables, &mut |_| {})
+}
+
+/// [`replay`], showing every replayed decision to `on` (e.g. to draw the replay page).
+pub fn replay_with(
+    log: impl BufRead,
+    tables: &dyn Fn(u32) -> Option<toml::Table>,
+    on: &mut dyn FnMut(Replayed<'_>),
+) -> Result<ReplayReport, ReplayError> {
+    let mut lines = log.lines();
+    let first = lines
+        .next()
+        .ok_or(ReplayError::Line {
+            line: 1,
+            message: "the log is empty".into(),
+        })?
+        .map_err(|e| ReplayError::Line {
+            line: 1,
+            message: e.to_string(),
+        })?;
+    let header = read_header(&first)?;
+    let (mut planners, thresholds) = build_planners(&header, tables)?;
+    let mut report = ReplayReport::default();
+    for (n, line) in lines.enumerate() {
+        let number = n as u64 + 2;
+        let text = line.map_err(|e| ReplayError::Line {
+            line: number,
+            message: e.to_string(),
+        })?;
+        if text.trim().is_empty() {
+            continue;
+        }
+        let l: Line = serde_json::from_str(&text).map_err(|e| ReplayError::Line {
+            line: number,
+            message: e.to_string(),
+        })?;
+        let planner = planners.get_mut(&l.vehicle).ok_or(ReplayError::Line {
+            line: number,
+            message: format!("vehicle {} has no planner in the header", l.vehicle),
+        })?;
+        let replayed = planner.decide(&l.snapshot);
+        on(Replayed {
+            header: &header,
+            line: &l,
+            replayed: &replayed,
+            threshold_v: thresholds.get(&l.vehicle).copied().flatten(),
+        });
+        report.decisions += 1;
+        if !same(&replayed, &l.decision) {
+            report.differing += 1;
+            if report.first.len() < ReplayReport::KEEP {
+                report.first.push(Difference {
+                    line: number,
+                    vehicle: l.vehicle,
+                    t_s: l.snapshot.time_s,
+                    logged: l.decision,
+                    replayed,
+                });
+            }
+        }
+    }
+    Ok(report)
+}
+
+/// The rebuilt planners by vehicle, and their detection thresholds.
+type Rebuilt = (BTreeMap<u32, Box<dyn Planner>>, BTreeMap<u32, Option<f64>>);
+
+/// Each logged vehicle's planner, rebuilt from the header (or from `tables`), and its detection
+/// threshold.
+fn build_planners(
+    header: &Header,
+    tables: &dyn Fn(u32) -> Option<toml::Table>,
+) -> Result<Rebuilt, ReplayError> {
+    let mut planners: BTreeMap<u32, Box<dyn Planner>> = BTreeMap::new();
+    let mut thresholds: BTreeMap<u32, Option<f64>> = BTreeMap::new();
+    for v in &header.vehicles {
+        if planners.contains_key(&v.id) {
+            return Err(ReplayError::Line {
+                line: 1,
+                message: format!("vehicle {} is listed twice in the header", v.id),
+            });
+        }
+        if !v.context.geometry.prior_flow_toward_deg.is_finite() {
+            return Err(ReplayError::Planner {
+                vehicle: v.id,
+                message: "its prior flow direction is not a finite number".into(),
+            });
+        }
+        let table = match tables(v.id) {
+            Some(t) => t,
+            None => v.planner.parse().map_err(|e| ReplayError::Planner {
+                vehicle: v.id,
+                message: format!("its planner table: {e}"),
+            })?,
+        };
+        let planner = PlannerConfig::from_table(&table, &v.planner_key)
+            .and_then(|c| {
+                thresholds.insert(v.id, c.detection_threshold_v());
+                c.build(&v.context, &v.planner_key)
+            })
+            .map_err(|e| ReplayError::Planner {
+                vehicle: v.id,
+                message: e.to_string(),
+            })?;
+        planners.insert(v.id, planner);
+    }
+    Ok((planners, thresholds))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use plumetrace_core::{Command, Heading, PlanStatus, VerticalCommand};
+
+    #[test]
+    fn decisions_with_non_finite_numbers_read_back_the_same() {
+        let d = Decision::new(
+            Command {
+                heading: Heading::from_rad(f64::NAN),
+                speed_mps: f64::INFINITY,
+                vertical: VerticalCommand::Altitude(2.0),
+            },
+            PlanStatus::Running,
+        );
+        let text = serde_json::to_string(&d).unwrap_or_default();
+        let back: Decision = serde_json::from_str(&text).unwrap_or_else(|e| panic!("{e}: {text}"));
+        assert_ne!(back, d, "NaN is not equal to itself");
+        assert!(same(&back, &d), "but the replay compares them as the same");
+        let other = Decision::new(
+            Command {
+                speed_mps: 1.0,
+                ..d.command
+            },
+            PlanStatus::Running,
+        );
+        assert!(!same(&other, &d));
+    }
+}
