@@ -32,6 +32,11 @@ pub const PRESETS: &[Preset] = &[
         toml: include_str!("../presets/demo-infotaxis.toml"),
     },
     Preset {
+        name: "demo-surge-cast",
+        summary: "the demo site searched by spiral-out then surge-cast: up-flow surges, widening casts, declaration at the most up-flow contact",
+        toml: include_str!("../presets/demo-surge-cast.toml"),
+    },
+    Preset {
         name: "duck-2003-st",
         summary: "Duck 2003 single-source mission: 1094 m x 367 m op-area, 0.10-0.15 m/s, about 1 km of plume",
         toml: include_str!("../presets/duck-2003-st.toml"),

@@ -20,6 +20,7 @@ pub mod formation;
 pub mod infotaxis;
 pub mod lawnmower;
 pub mod moth;
+pub mod surge_cast;
 
 use plumetrace_core::params::{Bounds, KeyDoc, ParamError, Params, key_path, markdown_rows};
 use plumetrace_core::{
@@ -252,6 +253,7 @@ registry! {
     Moth(moth::MothParams),
     FormationLeader(formation::FormationLeaderParams),
     FormationFollower(formation::FormationFollowerParams),
+    SurgeCast(surge_cast::SurgeCastParams),
 }
 
 impl std::fmt::Display for PlannerKind {
