@@ -463,11 +463,45 @@ impl Campaign {
     }
 
     /// A digest of everything that decides the runs' results except the number of seeds: seed,
-    /// scenarios' TOML, configurations, sweep, success radius, and every planner's defaults (a
-    /// build whose defaults differ does not resume or merge results recorded by another).
-    /// Resuming or merging requires equal fingerprints.
+    /// scenarios' TOML, configurations, sweep, success radius, and the defaults of the planners
+    /// the campaign flies (a build whose defaults differ does not resume or merge results
+    /// recorded by another; a build that only adds a planner does). Resuming or merging requires
+    /// equal fingerprints.
     pub fn fingerprint(&self) -> String {
-        self.fingerprint_with(plumetrace_mission::planner_defaults())
+        let flown = self.planner_kinds();
+        let mut defaults = plumetrace_mission::planner_defaults();
+        defaults.retain(|kind, _| flown.contains(kind));
+        self.fingerprint_with(defaults)
+    }
+
+    /// The planner kinds the groups name: every `kind` in a group's table (at its first seed)
+    /// that is a registered planner's.
+    fn planner_kinds(&self) -> std::collections::BTreeSet<String> {
+        fn collect(v: &toml::Value, out: &mut std::collections::BTreeSet<String>) {
+            match v {
+                toml::Value::Table(t) => {
+                    if let Some(toml::Value::String(k)) = t.get("kind")
+                        && plumetrace_mission::PlannerKind::from_name(k).is_some()
+                    {
+                        out.insert(k.clone());
+                    }
+                    t.values().for_each(|v| collect(v, out));
+                }
+                toml::Value::Array(a) => a.iter().for_each(|v| collect(v, out)),
+                _ => {}
+            }
+        }
+        let mut out = std::collections::BTreeSet::new();
+        for s in 0..self.scenarios.len() {
+            for c in 0..self.configs.len() {
+                for p in 0..self.points.len() {
+                    if let Ok(t) = self.group_table(s, c, p, 0) {
+                        collect(&toml::Value::Table(t), &mut out);
+                    }
+                }
+            }
+        }
+        out
     }
 
     /// [`Campaign::fingerprint`] with the planners' defaults given.
@@ -897,13 +931,16 @@ mod tests {
         let path = Path::new("c.toml");
         let file = parse_campaign(text, path).unwrap();
         let c = Campaign::resolve(file, path, text.to_string(), true).unwrap();
-        let defaults = plumetrace_mission::planner_defaults();
+        let mut defaults = plumetrace_mission::planner_defaults();
+        defaults.retain(|kind, _| kind == "amp");
         assert_eq!(c.fingerprint(), c.fingerprint_with(defaults.clone()));
         let mut other = defaults;
         if let Some(toml::Value::Table(amp)) = other.get_mut("amp") {
             amp.insert("map_mass".into(), toml::Value::Float(0.123));
         }
         assert_ne!(c.fingerprint(), c.fingerprint_with(other));
+        // Only the planners the campaign flies count: one added to the registry changes nothing.
+        assert_eq!(c.planner_kinds().into_iter().collect::<Vec<_>>(), ["amp"]);
     }
 
     #[test]
