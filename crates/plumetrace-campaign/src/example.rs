@@ -159,7 +159,7 @@ pub fn write_page(c: &Campaign, key: &RunKey, run: &MissionRun, dir: &Path) -> R
         "{}: {group}, example run (seed {})",
         c.file.name, run.summary.seed
     );
-    let page = plumetrace_mission::replay_page::replay_page(run, &title)?;
+    let page = plumetrace_report::replay_page(run, &title).map_err(|e| e.to_string())?;
     let path = page_file(dir, scenario, config, &point);
     plumetrace_mission::output::write_atomic(&path, page.as_bytes())
         .map_err(|e| format!("writing {}: {e}", path.display()))

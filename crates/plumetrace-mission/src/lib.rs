@@ -4,8 +4,8 @@
 //! a built scenario through the planner registry (so `check` catches every bad key), [`Mission`]
 //! develops the plume first (spin-up) and steps the world until every planner has finished or
 //! stopped or the time limit comes, and observers record what happened: the events, every
-//! vehicle's trajectory, a summary with the declaration errors, a snapshot log that a planner can
-//! replay, and the figure.
+//! vehicle's trajectory, a summary with the declaration errors, and a snapshot log that a planner
+//! can replay. Figures and pages are drawn from the finished run by the report crate.
 //!
 //! - [`setup`]: scenario to mission, planners checked;
 //! - [`mission`]: the stepper ([`Mission::new`], [`Mission::step`], [`Mission::finish`]);
@@ -17,23 +17,18 @@
 //!   did together (formation error, centroid against the centre line, overhead, losses);
 //! - [`snapshot_log`]: the replayable log of snapshots and decisions;
 //! - [`alog`]: MOOS `.alog` files, one per planned vehicle;
-//! - [`plot`]: the mission figure; [`team_plot`]: the team figure (readings, speeds, headings,
-//!   scale and centroid against time); [`replay_page`]: the self-contained replay page;
-//!   [`output`]: atomic file writing.
+//! - [`output`]: atomic file writing.
 
 pub mod alog;
 pub mod mission;
 pub mod outcome;
 pub mod output;
-pub mod plot;
 pub mod record;
-pub mod replay_page;
 pub mod setup;
 pub mod shared;
 pub mod snapshot_log;
 pub mod summary;
 pub mod team;
-pub mod team_plot;
 
 pub use mission::{
     FaultWindow, Mission, MissionOptions, MissionRun, PLUME_FRAME_EVERY_S, VehicleInfo,
