@@ -10,6 +10,7 @@ use plotters::coord::types::RangedCoordf64;
 use plotters::prelude::*;
 use plotters::style::text_anchor;
 use plumetrace_core::Vec2;
+use plumetrace_report::{dashed, map_chart};
 use std::path::Path;
 
 fn err<E: std::fmt::Debug>(what: &str) -> impl Fn(E) -> CampaignError + '_ {
@@ -524,33 +525,22 @@ pub fn trajectory_chart(c: &Campaign, examples: &[ExampleRun]) -> Result<String,
                 Some(d) => format!("{}, {d:.1} m", ex.outcome.name()),
                 None => ex.outcome.name().to_string(),
             };
-            let mut chart = plumetrace_mission::plot::map_chart(
-                area,
-                &format!("{name}: {result}"),
-                x0..x1,
-                y0..y1,
-            )
-            .map_err(|m| CampaignError::Chart {
-                what: "trajectories.svg".into(),
-                message: m,
-            })?;
+            let mut chart =
+                map_chart(area, &format!("{name}: {result}"), x0..x1, y0..y1).map_err(|m| {
+                    CampaignError::Chart {
+                        what: "trajectories.svg".into(),
+                        message: m.to_string(),
+                    }
+                })?;
             let poly = |pts: &[[f64; 2]]| -> Vec<Vec2> {
                 pts.iter().map(|p| Vec2::new(p[0], p[1])).collect()
             };
             chart
-                .draw_series(plumetrace_mission::plot::dashed(
-                    &poly(&ex.op_area),
-                    BLACK,
-                    1,
-                ))
+                .draw_series(dashed(&poly(&ex.op_area), BLACK, 1))
                 .map_err(&e)?;
             for r in &ex.subregions {
                 chart
-                    .draw_series(plumetrace_mission::plot::dashed(
-                        &poly(r),
-                        RGBColor(150, 150, 150),
-                        1,
-                    ))
+                    .draw_series(dashed(&poly(r), RGBColor(150, 150, 150), 1))
                     .map_err(&e)?;
             }
             for other in &ex.others {

@@ -148,7 +148,7 @@ pub fn page_file(dir: &Path, scenario: &str, config: &str, point: &str) -> PathB
 pub enum PageError {
     /// The page could not be made.
     #[error("{0}")]
-    Draw(String),
+    Draw(plumetrace_report::ReportError),
     /// The page could not be written.
     #[error("writing {path}: {error}")]
     Write {
@@ -180,8 +180,7 @@ pub fn write_page(
         "{}: {group}, example run (seed {})",
         c.file.name, run.summary.seed
     );
-    let page =
-        plumetrace_mission::replay_page::replay_page(run, &title).map_err(PageError::Draw)?;
+    let page = plumetrace_report::replay_page(run, &title).map_err(PageError::Draw)?;
     let path = page_file(dir, scenario, config, &point);
     plumetrace_mission::output::write_atomic(&path, page.as_bytes()).map_err(|error| {
         PageError::Write {

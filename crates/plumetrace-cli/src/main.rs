@@ -36,7 +36,6 @@ mod mission;
 mod netcdf;
 mod onboard;
 mod output;
-mod plot;
 mod progress;
 mod replay;
 mod run;

@@ -210,14 +210,12 @@ fn write_outputs(run: &MissionRun, out: &Path, name: &str, wall: f64) -> Result<
     } else {
         format!("{name}: {} (seed {})", s.outcome.name(), s.seed)
     };
-    let svg = plumetrace_mission::plot::mission_figure(run, &title).map_err(anyhow::Error::msg)?;
+    let svg = plumetrace_report::mission_figure(run, &title)?;
     write_atomic(&out.join("plot.svg"), svg.as_bytes())?;
-    if let Some(team) = plumetrace_mission::team_plot::team_figure(run, &title) {
-        let svg = team.map_err(anyhow::Error::msg)?;
-        write_atomic(&out.join("team.svg"), svg.as_bytes())?;
+    if let Some(team) = plumetrace_report::team_figure(run, &title) {
+        write_atomic(&out.join("team.svg"), team?.as_bytes())?;
     }
-    let page =
-        plumetrace_mission::replay_page::replay_page(run, &title).map_err(anyhow::Error::msg)?;
+    let page = plumetrace_report::replay_page(run, &title)?;
     write_atomic(&out.join(REPLAY_PAGE), page.as_bytes())?;
     Ok(())
 }

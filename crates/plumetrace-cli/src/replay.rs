@@ -50,7 +50,7 @@ pub fn run(args: &ReplayArgs) -> Result<bool> {
     let mut page = args
         .page
         .as_ref()
-        .map(|_| plumetrace_mission::replay_page::LogPageBuilder::default());
+        .map(|_| plumetrace_report::LogPageBuilder::default());
     let report = plumetrace_log::snapshot::replay_with(
         log,
         &|v| other.clone().filter(|_| only.is_none_or(|o| o == v)),
@@ -72,8 +72,7 @@ pub fn run(args: &ReplayArgs) -> Result<bool> {
         );
         let html = builder
             .page(&format!("replay of {}", args.log.display()), &subtitle)
-            .html()
-            .map_err(anyhow::Error::msg)?;
+            .html()?;
         crate::output::write_atomic(path, html.as_bytes())
             .with_context(|| format!("writing {}", path.display()))?;
     }

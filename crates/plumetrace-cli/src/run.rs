@@ -7,7 +7,6 @@
 //! `plume.nc`, [`crate::netcdf`]).
 
 use crate::output::write_atomic;
-use crate::plot;
 use crate::series::{FilamentSeries, ProbeSeries, time_decimals};
 use anyhow::{Context, Result, bail};
 use plumetrace_env::{ConcentrationField, FlowField, MeanConcentrationGrid, Plume};
@@ -239,7 +238,7 @@ fn run_plume(mut sc: BuiltScenario, args: &RunArgs) -> Result<()> {
             );
         }
     }
-    let svg = plot::plume_figure(&sc, &snapshot, &mean_c, mean.samples())?;
+    let svg = plumetrace_report::plume_figure(&sc, &snapshot, &mean_c, mean.samples())?;
     write_atomic(&args.out.join("plume.svg"), svg.as_bytes())?;
     times.record_s += t_rec.elapsed().as_secs_f64();
 

@@ -80,6 +80,20 @@ const RULES: &[(&str, Side, &[&str])] = &[
         ],
     ),
     (
+        "plumetrace-report",
+        Side::App,
+        &[
+            "plumetrace-core",
+            "plumetrace-env",
+            "plumetrace-sim",
+            "plumetrace-scenario",
+            "plumetrace-guidance",
+            "plumetrace-planner",
+            "plumetrace-log",
+            "plumetrace-mission",
+        ],
+    ),
+    (
         "plumetrace-campaign",
         Side::App,
         &[
@@ -87,6 +101,7 @@ const RULES: &[(&str, Side, &[&str])] = &[
             "plumetrace-env",
             "plumetrace-scenario",
             "plumetrace-mission",
+            "plumetrace-report",
         ],
     ),
     (
@@ -102,6 +117,7 @@ const RULES: &[(&str, Side, &[&str])] = &[
             "plumetrace-onboard",
             "plumetrace-mission",
             "plumetrace-frontseat",
+            "plumetrace-report",
             "plumetrace-campaign",
         ],
     ),
@@ -128,6 +144,7 @@ const RULES: &[(&str, Side, &[&str])] = &[
             "plumetrace-scenario",
             "plumetrace-planner",
             "plumetrace-mission",
+            "plumetrace-report",
             "plumetrace-campaign",
         ],
     ),
@@ -182,6 +199,10 @@ fn the_vehicle_link_and_the_simulated_world_stay_apart() {
         );
     }
 }
+/// The crates that may draw (depend on `plotters`): the report crate, and the campaign's charts
+/// (which draw their maps with the report crate's map panel). The mission runner records and
+/// never draws.
+const DRAWING: &[&str] = &["plumetrace-report", "plumetrace-campaign"];
 
 fn manifest_deps(path: &Path, table: &str) -> BTreeSet<String> {
     let text = std::fs::read_to_string(path).unwrap();
@@ -224,6 +245,10 @@ fn crates_depend_only_on_what_their_side_allows() {
                 );
             }
         }
+        assert!(
+            !deps.contains("plotters") || DRAWING.contains(&name.as_str()),
+            "{name} may not draw (depend on plotters): drawing belongs in plumetrace-report"
+        );
         if side == Side::Shared || side == Side::Onboard {
             for banned in ["rand", "rand_pcg", "rand_distr"] {
                 assert!(

@@ -292,12 +292,12 @@ fn scenario(input: &Input, path: &Path, deadline: Instant) -> Result<String, Sto
     check_summary(&run)?;
     check_trajectory(&run)?;
     let t0 = Instant::now();
-    let svg = plumetrace_mission::plot::mission_figure(&run, "fuzz")
+    let svg = plumetrace_report::mission_figure(&run, "fuzz")
         .map_err(|e| Stop::Rejected(format!("short run: drawing the figure: {e}")))?;
     check_deadline(deadline, || "drawing the figure".into())?;
     // The replay page refuses data that is not finite: a flown mission must always have one.
     let page =
-        plumetrace_mission::replay_page::replay_page(&run, "fuzz").map_err(Stop::Nonfinite)?;
+        plumetrace_report::replay_page(&run, "fuzz").map_err(|e| Stop::Nonfinite(e.to_string()))?;
     check_deadline(deadline, || "writing the replay page".into())?;
     Ok(format!(
         "mission: {} at t = {} s, {} trajectory rows, figure of {} bytes and replay page of {} bytes in {:.2} s",

@@ -4,8 +4,8 @@
 //! a built scenario through the planner registry (so `check` catches every bad key), [`Mission`]
 //! develops the plume first (spin-up) and steps the world until every planner has finished or
 //! stopped or the time limit comes, and observers record what happened: the events, every
-//! vehicle's trajectory, a summary with the declaration errors, a snapshot log that a planner can
-//! replay, and the figure.
+//! vehicle's trajectory, a summary with the declaration errors, and a snapshot log that a planner
+//! can replay. Figures and pages are drawn from the finished run by the report crate.
 //!
 //! - [`setup`]: scenario to mission, planners checked;
 //! - [`mission`]: the stepper ([`Mission::new`], [`Mission::step`], [`Mission::finish`]);
@@ -20,24 +20,19 @@
 //! - [`snapshot_log`]: the observer writing the replayable log of snapshots and decisions (its
 //!   format and replay are `plumetrace_log`'s);
 //! - [`alog`]: MOOS `.alog` files, one per planned vehicle (the log crate's writer);
-//! - [`plot`]: the mission figure; [`team_plot`]: the team figure (readings, speeds, headings,
-//!   scale and centroid against time); [`replay_page`]: the self-contained replay page;
-//!   [`output`]: atomic file writing.
+//! - [`output`]: atomic file writing.
 
 pub mod alog;
 pub mod metrics;
 pub mod mission;
 pub mod outcome;
 pub mod output;
-pub mod plot;
 pub mod record;
-pub mod replay_page;
 pub mod setup;
 pub mod shared;
 pub mod snapshot_log;
 pub mod summary;
 pub mod team;
-pub mod team_plot;
 
 pub use metrics::{Column, ColumnKind, Columns, Leaf, MetricContext, RunMetrics, Value};
 pub use mission::{
@@ -45,8 +40,8 @@ pub use mission::{
     run_mission, run_mission_with,
 };
 pub use outcome::{EndReason, MissionEnd, MissionEvent, Outcome, VehicleStatus};
-pub use plumetrace_planner::registry_defaults as planner_defaults;
 pub use plumetrace_planner::PlannerKind;
+pub use plumetrace_planner::registry_defaults as planner_defaults;
 pub use record::{
     EventKind, EventRecord, Observer, PlumeFrame, PlumeFrames, RecordError, StepView, TrajectoryRow,
 };

@@ -1,9 +1,15 @@
-//! Figures drawn from recorded data (never inside the step loop).
+//! The plume figure of a plume-only run: the instantaneous and the time-averaged concentration
+//! as two stacked heat maps, with the sources, obstacles and mean flow.
 
-use anyhow::{Result, anyhow};
+use crate::chart::map_chart;
+use crate::error::ReportError;
 use plotters::prelude::*;
 use plumetrace_env::{FlowField, GridSpec, Plume};
 use plumetrace_scenario::BuiltScenario;
+
+fn plume_err<E: std::fmt::Debug>(e: E) -> ReportError {
+    ReportError::PlumeFigure(format!("{e:?}"))
+}
 
 /// Colour stops of the light heat map, from the lowest shown value to the highest.
 const STOPS: [(f64, (u8, u8, u8)); 5] = [
@@ -47,7 +53,7 @@ pub fn plume_figure(
     snapshot: &[f64],
     mean: &[f64],
     samples: u32,
-) -> Result<String> {
+) -> Result<String, ReportError> {
     let g = sc.output.grid;
     let d = sc.env.domain();
     let width = 1000u32;
@@ -57,7 +63,7 @@ pub fn plume_figure(
     let mut svg = String::new();
     {
         let root = SVGBackend::with_string(&mut svg, (width, height)).into_drawing_area();
-        root.fill(&WHITE).map_err(|e| anyhow!("{e:?}"))?;
+        root.fill(&WHITE).map_err(plume_err)?;
         let (top, bottom) = root.split_vertically(height / 2);
         let t = sc.env.time_s();
         let steady = matches!(sc.env.plume(), Plume::Steady(_));
@@ -72,7 +78,7 @@ pub fn plume_figure(
         let bottom_title = format!("time-averaged concentration ({samples} samples)");
         panel(&top, sc, &g, snapshot, &top_title)?;
         panel(&bottom, sc, &g, mean, &bottom_title)?;
-        root.present().map_err(|e| anyhow!("{e:?}"))?;
+        root.present().map_err(plume_err)?;
     }
     Ok(svg)
 }
@@ -83,19 +89,13 @@ fn panel<DB: DrawingBackend>(
     g: &GridSpec,
     values: &[f64],
     title: &str,
-) -> Result<()>
+) -> Result<(), ReportError>
 where
     DB::ErrorType: 'static,
 {
-    let err = |e: DrawingAreaErrorKind<DB::ErrorType>| anyhow!("drawing: {e:?}");
+    let err = plume_err::<DrawingAreaErrorKind<DB::ErrorType>>;
     let d = sc.env.domain();
-    let mut chart = plumetrace_mission::plot::map_chart(
-        area,
-        title,
-        d.x_min_m..d.x_max_m,
-        d.y_min_m..d.y_max_m,
-    )
-    .map_err(anyhow::Error::msg)?;
+    let mut chart = map_chart(area, title, d.x_min_m..d.x_max_m, d.y_min_m..d.y_max_m)?;
     let max = values.iter().copied().fold(0.0, f64::max);
     // At most ~250 x 250 cells are drawn: coarser grids are subsampled.
     let stride_x = g.nx.div_ceil(250).max(1);

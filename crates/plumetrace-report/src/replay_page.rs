@@ -19,9 +19,11 @@
 //! [`PageData`] is what the page shows; it is made from a flown mission
 //! ([`PageData::from_run`]) or built by hand (a replayed log, which has no truth and no plume).
 
-use crate::mission::MissionRun;
-use crate::record::{EventRecord, PlumeFrames};
+use crate::error::ReportError;
+use crate::figure::style::{behaviour_colour, behaviour_label};
 use plumetrace_core::{BehaviourKind, Vec2};
+use plumetrace_log::snapshot::Replayed;
+use plumetrace_mission::{EventKind, EventRecord, MissionRun, PlumeFrames};
 use serde::Serialize;
 use serde_json::{Value, json};
 
@@ -136,17 +138,17 @@ fn behaviours() -> Vec<(String, String, String)> {
     BehaviourKind::ALL
         .iter()
         .map(|&b| {
-            let c = crate::plot::behaviour_colour(b);
+            let c = behaviour_colour(b);
             (
                 plumetrace_core::variant_name(&b).unwrap_or("?").to_string(),
-                crate::plot::behaviour_label(b).to_string(),
+                behaviour_label(b).to_string(),
                 format!("#{:02x}{:02x}{:02x}", c.0, c.1, c.2),
             )
         })
         .collect()
 }
 
-/// The index of `b` in [`behaviours`], -1 for none.
+/// The index of `b` in every page's behaviour list ([`PageData::behaviours`]), -1 for none.
 pub fn behaviour_index(b: Option<BehaviourKind>) -> i8 {
     b.and_then(|b| BehaviourKind::ALL.iter().position(|&k| k == b))
         .map_or(-1, |i| i as i8)
@@ -414,13 +416,11 @@ impl PageData {
     }
 
     /// The page as one HTML file.
-    pub fn html(&self) -> Result<String, String> {
+    pub fn html(&self) -> Result<String, ReportError> {
         if let Some(at) = plumetrace_core::first_non_finite(self) {
-            return Err(format!(
-                "the replay page's data has a number that is not finite ({at})"
-            ));
+            return Err(ReportError::NonFinite(at));
         }
-        let data = serde_json::to_string(self).map_err(|e| format!("encoding the page: {e}"))?;
+        let data = serde_json::to_string(self).map_err(ReportError::Encode)?;
         // Inside <script>, "</script" would end the element and "<!--" change how it is read:
         // '<' only occurs inside JSON strings, where "\u003c" stands for it.
         let data = data.replace('<', "\\u003c");
@@ -446,7 +446,7 @@ pub struct LogPageBuilder {
 
 impl LogPageBuilder {
     /// Takes one replayed decision.
-    pub fn add(&mut self, r: plumetrace_log::snapshot::Replayed<'_>) {
+    pub fn add(&mut self, r: Replayed<'_>) {
         if self.geometry.is_none() {
             for v in &r.header.vehicles {
                 let kind = v
@@ -504,12 +504,12 @@ impl LogPageBuilder {
         self.events.extend(d.events.iter().map(|e| EventRecord {
             t_s: t,
             vehicle: v,
-            event: crate::record::EventKind::Planner(e.clone()),
+            event: EventKind::Planner(e.clone()),
         }));
         self.events.extend(d.telemetry.iter().map(|e| EventRecord {
             t_s: t,
             vehicle: v,
-            event: crate::record::EventKind::Telemetry(e.clone()),
+            event: EventKind::Telemetry(e.clone()),
         }));
     }
 
@@ -561,9 +561,7 @@ fn events_json(events: &[EventRecord]) -> Vec<Value> {
         .filter(|e| {
             !matches!(
                 e.event,
-                crate::record::EventKind::Telemetry(
-                    plumetrace_core::Telemetry::SourceMapRaster { .. }
-                )
+                EventKind::Telemetry(plumetrace_core::Telemetry::SourceMapRaster { .. })
             )
         })
         .filter_map(|e| serde_json::to_value(e).ok())
@@ -585,7 +583,7 @@ fn html_escape(s: &str) -> String {
 }
 
 /// The replay page of a flown mission.
-pub fn replay_page(run: &MissionRun, title: &str) -> Result<String, String> {
+pub fn replay_page(run: &MissionRun, title: &str) -> Result<String, ReportError> {
     PageData::from_run(run, title).html()
 }
 

@@ -4,17 +4,17 @@
 //! cross-flow scale each member reported with the team centroid's cross-flow distance from the
 //! plume's centre line.
 
-use crate::mission::MissionRun;
-use crate::record::EventKind;
+use crate::error::ReportError;
 use plotters::prelude::*;
 use plumetrace_core::Telemetry;
+use plumetrace_mission::{EventKind, MissionRun};
 use std::collections::BTreeMap;
 
 const WIDTH_PX: u32 = 900;
 const PANEL_PX: u32 = 210;
 
-fn err<E: std::fmt::Debug>(e: E) -> String {
-    format!("drawing the team figure: {e:?}")
+fn err<E: std::fmt::Debug>(e: E) -> ReportError {
+    ReportError::TeamFigure(format!("{e:?}"))
 }
 
 type Series = BTreeMap<u32, Vec<(f64, f64)>>;
@@ -27,7 +27,7 @@ fn panel<DB: DrawingBackend>(
     t_max: f64,
     series: &Series,
     names: &[String],
-) -> Result<(), String>
+) -> Result<(), ReportError>
 where
     DB::ErrorType: 'static,
 {
@@ -78,7 +78,7 @@ where
 }
 
 /// The team figure, for runs whose summary has a team (two or more planners); `None` otherwise.
-pub fn team_figure(run: &MissionRun, title: &str) -> Option<Result<String, String>> {
+pub fn team_figure(run: &MissionRun, title: &str) -> Option<Result<String, ReportError>> {
     let team = run.summary.team.as_ref()?;
     let names: Vec<String> = run
         .summary

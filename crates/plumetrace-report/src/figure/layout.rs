@@ -1,0 +1,781 @@
+//! Where everything goes on the map: its extent at one scale in x and y, the layers drawn of
+//! each vehicle, the legend's corner (or the band below), the key's corner, the markers' labels,
+//! and the polygons clipped to the map.
+
+use super::DETECTION_GAP_S;
+use super::legend::{LegendEntry, legend_px, map_legend};
+use super::model::{
+    BehaviourRun, EventMark, Overlays, Segment, TimeMark, detection_ticks, est_track, fault_pieces,
+    flow_words, outside_pieces, thin, time_marks, time_step_min,
+};
+use super::raster::{hot_points, plume_cells, posterior_cells};
+use super::style::{Icon, MAP_MAX_PX, MAP_MIN_PX, TIME_FONT_PX, TRACK_COLOURS, WIDTH_PX, text_px};
+use crate::chart::map_chart;
+use crate::error::ReportError;
+use plotters::prelude::*;
+use plumetrace_core::{Heading, PlannerEvent, Vec2};
+use plumetrace_guidance::OpArea;
+use plumetrace_mission::{EventKind, MissionRun, TrajectoryRow};
+use std::collections::BTreeMap;
+use std::ops::Range;
+
+/// The corner of the map panel where a box of `px` pixels hides the fewest of `points` (data
+/// coordinates over `x` x `y` drawn on a panel of `panel_px`), lower right on ties; corners in
+/// `taken` are not considered (all four taken: lower right).
+pub(super) fn emptiest_corner(
+    points: &[(f64, f64)],
+    x: Range<f64>,
+    y: Range<f64>,
+    panel_px: (f64, f64),
+    px: (f64, f64),
+    taken: &[Corner],
+) -> Corner {
+    let fx = (px.0 / panel_px.0).min(1.0) * (x.end - x.start);
+    let fy = (px.1 / panel_px.1).min(1.0) * (y.end - y.start);
+    let mut best = (Corner::LowerRight, usize::MAX);
+    for corner in Corner::ALL.into_iter().filter(|c| !taken.contains(c)) {
+        let (cx, cy) = corner.box_in(&x, &y, fx, fy);
+        let n = points
+            .iter()
+            .filter(|(px, py)| cx.contains(px) && cy.contains(py))
+            .count();
+        if n < best.1 {
+            best = (corner, n);
+        }
+    }
+    best.0
+}
+
+/// A corner of the map's plotting area.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(super) enum Corner {
+    LowerRight,
+    UpperRight,
+    LowerLeft,
+    UpperLeft,
+}
+
+impl Corner {
+    /// In the order ties are broken.
+    pub(super) const ALL: [Corner; 4] = [
+        Corner::LowerRight,
+        Corner::UpperRight,
+        Corner::LowerLeft,
+        Corner::UpperLeft,
+    ];
+
+    pub(super) fn right(self) -> bool {
+        matches!(self, Corner::LowerRight | Corner::UpperRight)
+    }
+
+    pub(super) fn upper(self) -> bool {
+        matches!(self, Corner::UpperRight | Corner::UpperLeft)
+    }
+
+    /// The box `fx` x `fy` (data units) in this corner of `x` x `y`.
+    pub(super) fn box_in(
+        self,
+        x: &Range<f64>,
+        y: &Range<f64>,
+        fx: f64,
+        fy: f64,
+    ) -> (Range<f64>, Range<f64>) {
+        let cx = if self.right() {
+            x.end - fx..x.end
+        } else {
+            x.start..x.start + fx
+        };
+        let cy = if self.upper() {
+            y.end - fy..y.end
+        } else {
+            y.start..y.start + fy
+        };
+        (cx, cy)
+    }
+
+    pub(super) fn position(self) -> SeriesLabelPosition {
+        match self {
+            Corner::LowerRight => SeriesLabelPosition::LowerRight,
+            Corner::UpperRight => SeriesLabelPosition::UpperRight,
+            Corner::LowerLeft => SeriesLabelPosition::LowerLeft,
+            Corner::UpperLeft => SeriesLabelPosition::UpperLeft,
+        }
+    }
+}
+
+/// What is drawn of one vehicle.
+#[derive(Debug, Clone, PartialEq)]
+pub(super) struct VehicleLayer {
+    pub(super) vehicle: u32,
+    /// The vehicle's own colour (its track with several vehicles, its reading line).
+    pub(super) colour: RGBColor,
+    pub(super) truth: Vec<(f64, f64)>,
+    /// The estimated track in runs under one behaviour.
+    pub(super) runs: Vec<BehaviourRun>,
+    /// The track flown during each fault window, estimated and true (index into the vehicle's
+    /// faults).
+    pub(super) faults: Vec<(usize, Vec<(f64, f64)>)>,
+    /// The true track outside the op-area, in pieces.
+    pub(super) outside: Vec<Vec<(f64, f64)>>,
+    /// Where a position fix moved the estimate (from, to) and when, s.
+    pub(super) jumps: Vec<(Segment, f64)>,
+    pub(super) detections: Vec<Segment>,
+    pub(super) times: Vec<TimeMark>,
+}
+
+/// Everything the map shows, in data coordinates, and where it goes.
+#[derive(Debug, Clone, PartialEq)]
+pub(super) struct MapLayout {
+    pub(super) x: Range<f64>,
+    pub(super) y: Range<f64>,
+    /// Plotting area, px.
+    pub(super) plot_px: (u32, u32),
+    /// The map panel's height, px.
+    pub(super) map_h_px: u32,
+    /// Metres per pixel, the same along x and y.
+    pub(super) m_per_px: f64,
+    /// Multi-vehicle: tracks in the vehicles' colours.
+    pub(super) multi: bool,
+    pub(super) plume: Vec<([(f64, f64); 2], RGBColor)>,
+    pub(super) obstacles: Vec<Vec<(f64, f64)>>,
+    pub(super) layers: Vec<VehicleLayer>,
+    pub(super) time_step_min: f64,
+    /// Obstacle avoidance: each virtual path from where the obstacle was sensed, its course
+    /// and its last reference target.
+    pub(super) virtual_paths: Vec<(Vec2, Heading, Vec2)>,
+    pub(super) targets: Vec<(f64, f64)>,
+    pub(super) lost: Vec<(f64, f64)>,
+    pub(super) declared: Vec<(f64, f64)>,
+    pub(super) marks: Vec<EventMark>,
+    pub(super) legend: Vec<LegendEntry>,
+    /// The legend's corner of the map (`None`: below the map).
+    pub(super) legend_corner: Option<Corner>,
+    /// The flow arrow and scale bar: corner, size in px, scale bar length in m.
+    pub(super) key_corner: Corner,
+    pub(super) key_px: (u32, u32),
+    pub(super) scale_m: f64,
+}
+
+/// A growing bounding box of finite points.
+#[derive(Debug, Clone, Copy)]
+struct Bounds {
+    x0: f64,
+    x1: f64,
+    y0: f64,
+    y1: f64,
+}
+
+impl Bounds {
+    fn new() -> Self {
+        Bounds {
+            x0: f64::INFINITY,
+            x1: f64::NEG_INFINITY,
+            y0: f64::INFINITY,
+            y1: f64::NEG_INFINITY,
+        }
+    }
+
+    fn add(&mut self, x: f64, y: f64) {
+        if x.is_finite() && y.is_finite() {
+            (self.x0, self.x1) = (self.x0.min(x), self.x1.max(x));
+            (self.y0, self.y1) = (self.y0.min(y), self.y1.max(y));
+        }
+    }
+}
+
+/// The extent of everything the map shows (every vehicle's true and estimated track, the
+/// op-area and subregions, true and declared sources, lost points and reference targets) with
+/// a margin of 5 % of its larger side, at least 5 m.
+fn map_bounds(run: &MissionRun) -> (Range<f64>, Range<f64>) {
+    let mut b = Bounds::new();
+    for r in &run.trajectory {
+        b.add(r.true_x_m, r.true_y_m);
+        if let Some((x, y)) = r.est_x_m.zip(r.est_y_m) {
+            b.add(x, y);
+        }
+    }
+    for p in run.op_area.iter().chain(run.subregions.iter().flatten()) {
+        b.add(p.x, p.y);
+    }
+    for s in &run.sources {
+        b.add(s.x, s.y);
+    }
+    for d in &run.summary.declarations {
+        b.add(d.x_m, d.y_m);
+    }
+    for e in &run.events {
+        if let EventKind::Planner(
+            PlannerEvent::LostPoint { pos_m }
+            | PlannerEvent::ReferenceTarget { pos_m }
+            | PlannerEvent::Declared { pos_m, .. },
+        ) = &e.event
+        {
+            b.add(pos_m.x, pos_m.y);
+        }
+    }
+    if b.x0 > b.x1 {
+        return (-50.0..50.0, -50.0..50.0);
+    }
+    let pad = (0.05 * (b.x1 - b.x0).max(b.y1 - b.y0)).max(5.0);
+    (b.x0 - pad..b.x1 + pad, b.y0 - pad..b.y1 + pad)
+}
+
+/// Grows `x` or `y` about its centre so that a plotting area `plot_w_px` wide and between
+/// `min_h_px` and `max_h_px` high shows both at one scale; the ranges and the height, px.
+pub(super) fn fit_aspect(
+    x: Range<f64>,
+    y: Range<f64>,
+    plot_w_px: f64,
+    min_h_px: f64,
+    max_h_px: f64,
+) -> (Range<f64>, Range<f64>, u32) {
+    let (dx, dy) = (x.end - x.start, y.end - y.start);
+    let h = (plot_w_px * dy / dx)
+        .clamp(min_h_px, max_h_px.max(min_h_px))
+        .round();
+    let m = (dx / plot_w_px).max(dy / h);
+    let grow = |r: Range<f64>, len: f64| {
+        let c = 0.5 * (r.start + r.end);
+        c - 0.5 * len..c + 0.5 * len
+    };
+    (grow(x, m * plot_w_px), grow(y, m * h), h as u32)
+}
+
+/// The pixels `map_chart` puts around its plotting area (width, height) on a panel
+/// `width_px` wide with `title`.
+pub(super) fn map_overhead_px(width_px: u32, title: &str) -> Result<(u32, u32), ReportError> {
+    let mut scratch = String::new();
+    let (w, h) = {
+        let area = SVGBackend::with_string(&mut scratch, (width_px, 1000)).into_drawing_area();
+        let chart = map_chart(&area, title, 0.0..1.0, 0.0..1.0)?;
+        chart.plotting_area().dim_in_pixel()
+    };
+    Ok((width_px.saturating_sub(w), 1000u32.saturating_sub(h)))
+}
+
+/// A round scale-bar length, m: 1, 2 or 5 times a power of ten, at most a fifth of `width_m`.
+pub(super) fn scale_bar_m(width_m: f64) -> f64 {
+    let target = (width_m / 5.0).max(1e-3);
+    let p = 10f64.powf(target.log10().floor());
+    [5.0, 2.0, 1.0]
+        .into_iter()
+        .map(|k| k * p)
+        .find(|&l| l <= target)
+        .unwrap_or(p)
+}
+
+/// The part of `poly` inside the rectangle `x` x `y` (Sutherland-Hodgman).
+pub(super) fn clip_polygon(poly: &[(f64, f64)], x: &Range<f64>, y: &Range<f64>) -> Vec<(f64, f64)> {
+    type Side = (fn((f64, f64), f64) -> f64, f64, bool);
+    // Signed distance inside each edge, the edge's value, and whether it cuts along x.
+    let sides: [Side; 4] = [
+        (|p, v| p.0 - v, x.start, true),
+        (|p, v| v - p.0, x.end, true),
+        (|p, v| p.1 - v, y.start, false),
+        (|p, v| v - p.1, y.end, false),
+    ];
+    let mut out = poly.to_vec();
+    for (inside, v, along_x) in sides {
+        let input = std::mem::take(&mut out);
+        for (k, &p) in input.iter().enumerate() {
+            let q = input[(k + 1) % input.len()];
+            let (dp, dq) = (inside(p, v), inside(q, v));
+            if dp >= 0.0 {
+                out.push(p);
+            }
+            if (dp >= 0.0) != (dq >= 0.0) {
+                let s = dp / (dp - dq);
+                let c = (p.0 + s * (q.0 - p.0), p.1 + s * (q.1 - p.1));
+                out.push(if along_x { (v, c.1) } else { (c.0, v) });
+            }
+        }
+        if out.is_empty() {
+            break;
+        }
+    }
+    out
+}
+
+/// Where a label of `size_px` next to a marker at `at` hides the fewest of `points` and stays
+/// on the map: right of it, left of it, above or below it (centred, then starting or ending
+/// at it), in that order on ties; its upper left corner, px from the marker (right, down).
+fn label_place(
+    at: (f64, f64),
+    size_px: (i32, i32),
+    points: &[(f64, f64)],
+    (x, y): (&Range<f64>, &Range<f64>),
+    m: f64,
+) -> (i32, i32) {
+    let (w, h) = size_px;
+    let candidates = [
+        (10, -h / 2),
+        (-10 - w, -h / 2),
+        (-w / 2, -h - 10),
+        (-w / 2, 10),
+        (-4, -h - 10),
+        (-4, 10),
+        (4 - w, -h - 10),
+        (4 - w, 10),
+    ];
+    let mut best = (candidates[0], usize::MAX);
+    for (ox, oy) in candidates {
+        let (xa, xb) = (at.0 + f64::from(ox) * m, at.0 + f64::from(ox + w) * m);
+        let (ya, yb) = (at.1 - f64::from(oy + h) * m, at.1 - f64::from(oy) * m);
+        let on_map = xa >= x.start && xb <= x.end && ya >= y.start && yb <= y.end;
+        let hidden = points
+            .iter()
+            .filter(|p| (xa..xb).contains(&p.0) && (ya..yb).contains(&p.1))
+            .count();
+        let cost = if on_map { hidden } else { usize::MAX - 1 };
+        if cost < best.1 {
+            best = ((ox, oy), cost);
+        }
+    }
+    best.0
+}
+
+/// Everything the map shows and where.
+pub(super) fn map_layout(
+    run: &MissionRun,
+    rows: &BTreeMap<u32, Vec<&TrajectoryRow>>,
+    title: &str,
+) -> Result<MapLayout, ReportError> {
+    let (bx, by) = map_bounds(run);
+    let multi = rows.len() > 1;
+    let duration_s = rows
+        .values()
+        .filter_map(|r| r.last())
+        .map(|r| r.t_s)
+        .fold(0.0, f64::max);
+    let step_min = time_step_min(duration_s);
+    let over = Overlays::of(run, rows);
+    let area = OpArea::new(run.op_area.clone()).ok();
+    let outside: BTreeMap<u32, Vec<Vec<(f64, f64)>>> = rows
+        .iter()
+        .map(|(&v, rs)| {
+            (
+                v,
+                area.as_ref().map_or(Vec::new(), |a| outside_pieces(rs, a)),
+            )
+        })
+        .collect();
+    let any_outside = outside.values().any(|p| !p.is_empty());
+    let mut legend = map_legend(run, rows, (&bx, &by), any_outside, step_min, &over);
+
+    // The scale: one in x and y. The legend goes into a corner of the map (made tall enough
+    // for it) where it hides nothing; with no such corner, below the map.
+    let (over_w, over_h) = map_overhead_px(WIDTH_PX, title)?;
+    let plot_w = f64::from(WIDTH_PX - over_w);
+    let (_, lh) = legend_px(&legend);
+    let (x, y, plot_h, legend_corner) = fit_map(run, rows, &over, &legend, (bx, by), plot_w);
+    let m = (x.end - x.start) / plot_w;
+    let mut layers = vehicle_layers(run, rows, &outside, m, step_min);
+    // Jumps too short to see are not drawn, so not listed (the legend only shrinks).
+    if layers.iter().all(|l| l.jumps.is_empty()) {
+        legend.retain(|e| e.icon != Icon::Dotted(BLACK));
+    }
+    hide_crowded_times(&mut layers, m);
+    let mut plume = plume_cells(run, &x, &y);
+    plume.extend(posterior_cells(run, &x, &y));
+    let obstacles = run
+        .obstacles
+        .iter()
+        .map(|o| clip_polygon(&o.iter().map(|v| (v.x, v.y)).collect::<Vec<_>>(), &x, &y))
+        .filter(|o| o.len() > 2)
+        .collect();
+
+    // What the legend and the key could hide.
+    let points = drawn_points(run, &layers, &over);
+    let Overlays {
+        virtual_paths,
+        targets,
+        lost,
+        declared,
+        mut marks,
+    } = over;
+    for k in &mut marks {
+        let w = text_px(&k.kind.text(k.t_s), 12.0).round() as i32 + 4;
+        k.label_px = label_place(k.pos, (w, 16), &points, (&x, &y), m);
+    }
+    let panel_px = (plot_w, f64::from(plot_h));
+    let scale_m = scale_bar_m(x.end - x.start);
+    let key_w = (44.0 + text_px(&flow_words(run.mean_flow_mps).0, 12.0) + 10.0)
+        .max(12.0 + scale_m / m + 6.0 + text_px(&format!("{scale_m:.0} m"), 12.0) + 10.0);
+    let key_px = (key_w.round() as u32, 62);
+    // The key shares a side with the legend only where both fit one above the other.
+    let fits = lh + f64::from(key_px.1) + 20.0 <= f64::from(plot_h);
+    let taken: Vec<Corner> = match legend_corner {
+        Some(l) => Corner::ALL
+            .into_iter()
+            .filter(|&c| c == l || (!fits && c.right() == l.right()))
+            .collect(),
+        None => Vec::new(),
+    };
+    let key_corner = emptiest_corner(
+        &points,
+        x.clone(),
+        y.clone(),
+        panel_px,
+        (f64::from(key_px.0), f64::from(key_px.1)),
+        &taken,
+    );
+    Ok(MapLayout {
+        map_h_px: plot_h + over_h,
+        plot_px: (WIDTH_PX - over_w, plot_h),
+        x,
+        y,
+        m_per_px: m,
+        multi,
+        plume,
+        obstacles,
+        layers,
+        time_step_min: step_min,
+        virtual_paths,
+        targets,
+        lost,
+        declared,
+        marks,
+        legend,
+        legend_corner,
+        key_corner,
+        key_px,
+        scale_m,
+    })
+}
+
+/// The map's extent over the bounds `(bx, by)` at one scale in x and y on a plotting area
+/// `plot_w` px wide, its plotting height, px, and the legend's corner: a corner of the map (made
+/// tall enough for the legend) where the legend hides nothing marked; with no such corner,
+/// `None` (the legend goes below the map, and the map is not made taller for it).
+fn fit_map(
+    run: &MissionRun,
+    rows: &BTreeMap<u32, Vec<&TrajectoryRow>>,
+    over: &Overlays,
+    legend: &[LegendEntry],
+    (bx, by): (Range<f64>, Range<f64>),
+    plot_w: f64,
+) -> (Range<f64>, Range<f64>, u32, Option<Corner>) {
+    let (lw, lh) = legend_px(legend);
+    let mut marked: Vec<(f64, f64)> = rows
+        .values()
+        .flat_map(|rs| rs.iter().step_by(5))
+        .flat_map(|r| [Some((r.true_x_m, r.true_y_m)), r.est_x_m.zip(r.est_y_m)])
+        .flatten()
+        .collect();
+    marked.extend(&over.lost);
+    marked.extend(&over.declared);
+    marked.extend(run.sources.iter().map(|s| (s.x, s.y)));
+    marked.extend(over.marks.iter().map(|k| k.pos));
+    // Nor the plume's core or the source map's likely cells.
+    marked.extend(hot_points(run));
+    let (x, y, plot_h) = fit_aspect(
+        bx.clone(),
+        by.clone(),
+        plot_w,
+        MAP_MIN_PX.max(lh + 20.0),
+        MAP_MAX_PX,
+    );
+    let (fx, fy) = (
+        lw / plot_w * (x.end - x.start),
+        lh / f64::from(plot_h) * (y.end - y.start),
+    );
+    let inside = Corner::ALL.into_iter().find(|c| {
+        let (cx, cy) = c.box_in(&x, &y, fx, fy);
+        !legend.is_empty()
+            && !marked
+                .iter()
+                .any(|(px, py)| cx.contains(px) && cy.contains(py))
+    });
+    match inside {
+        Some(_) => (x, y, plot_h, inside),
+        None => {
+            let (x, y, plot_h) = fit_aspect(bx, by, plot_w, MAP_MIN_PX, MAP_MAX_PX);
+            (x, y, plot_h, inside)
+        }
+    }
+}
+
+/// What is drawn of each vehicle at `m` metres a pixel (`outside`: each vehicle's true track
+/// outside the op-area; `step_min`: minutes between time marks).
+fn vehicle_layers(
+    run: &MissionRun,
+    rows: &BTreeMap<u32, Vec<&TrajectoryRow>>,
+    outside: &BTreeMap<u32, Vec<Vec<(f64, f64)>>>,
+    m: f64,
+    step_min: f64,
+) -> Vec<VehicleLayer> {
+    let mut layers: Vec<VehicleLayer> = Vec::new();
+    for (n, (&vid, rs)) in rows.iter().enumerate() {
+        let truth: Vec<(f64, f64)> = rs.iter().map(|r| (r.true_x_m, r.true_y_m)).collect();
+        // Jumps of 10 px or more break the track and are drawn.
+        let (runs, jumps) = est_track(rs, (10.0 * m).max(5.0));
+        let runs = runs
+            .into_iter()
+            .map(|(b, pts)| (b, thin(&pts, m)))
+            .collect();
+        layers.push(VehicleLayer {
+            vehicle: vid,
+            colour: TRACK_COLOURS[n % TRACK_COLOURS.len()],
+            truth: thin(&truth, m),
+            runs,
+            faults: fault_pieces(run, vid, rs, (10.0 * m).max(5.0))
+                .into_iter()
+                .map(|(k, pts)| (k, thin(&pts, m)))
+                .collect(),
+            outside: outside
+                .get(&vid)
+                .map_or(Vec::new(), |p| p.iter().map(|p| thin(p, m)).collect()),
+            jumps,
+            detections: detection_ticks(rs, DETECTION_GAP_S, 4.0 * m, 1.5 * m),
+            times: time_marks(rs, step_min, 5.0 * m, 15.0 * m, 4.0 * m),
+        });
+    }
+    layers
+}
+
+/// Leaves out the time labels that would overlap an earlier one (their ticks stay).
+fn hide_crowded_times(layers: &mut [VehicleLayer], m: f64) {
+    let mut boxes: Vec<(f64, f64, f64)> = Vec::new();
+    for l in layers {
+        for t in &mut l.times {
+            let half_w = (text_px(&t.label, TIME_FONT_PX) / 2.0 + 2.0) * m;
+            let half_h = 7.0 * m;
+            let (cx, cy) = t.label_at;
+            if boxes
+                .iter()
+                .any(|&(x, y, w)| (cx - x).abs() < half_w + w && (cy - y).abs() < 2.0 * half_h)
+            {
+                t.label.clear();
+            } else {
+                boxes.push((cx, cy, half_w));
+            }
+        }
+    }
+}
+
+/// Every point drawn on the map that the legend, the key or a marker's label could hide.
+fn drawn_points(run: &MissionRun, layers: &[VehicleLayer], over: &Overlays) -> Vec<(f64, f64)> {
+    let mut points: Vec<(f64, f64)> = Vec::new();
+    for l in layers {
+        points.extend(&l.truth);
+        points.extend(l.runs.iter().flat_map(|(_, p)| p.iter().copied()));
+        points.extend(l.outside.iter().flatten());
+        points.extend(l.times.iter().map(|t| t.label_at));
+    }
+    points.extend(&over.lost);
+    points.extend(&over.declared);
+    points.extend(run.sources.iter().map(|s| (s.x, s.y)));
+    points.extend(over.marks.iter().map(|k| k.pos));
+    points
+}
+
+#[cfg(test)]
+mod tests {
+    #![allow(clippy::unwrap_used, clippy::expect_used)]
+
+    use super::super::test_support::{demo, labels, layout, row};
+    use super::super::{DETECTION_GAP_S, mission_figure};
+    use super::*;
+    use plumetrace_mission::{EventRecord, FaultWindow, MissionEvent};
+
+    #[test]
+    fn boxes_go_to_the_emptiest_free_corner() {
+        let panel = (800.0, 800.0);
+        let legend = (200.0, 200.0);
+        let pick = |pts: &[(f64, f64)], taken: &[Corner]| {
+            emptiest_corner(pts, 0.0..100.0, 0.0..100.0, panel, legend, taken)
+        };
+        assert_eq!(pick(&[], &[]), Corner::LowerRight);
+        // A track through the lower right and upper right corners.
+        let track: Vec<(f64, f64)> = (0..100).map(|k| (90.0, f64::from(k))).collect();
+        assert_eq!(pick(&track, &[]), Corner::LowerLeft);
+        let mut more = track.clone();
+        more.push((10.0, 10.0));
+        assert_eq!(pick(&more, &[]), Corner::UpperLeft);
+        assert_eq!(pick(&more, &[Corner::UpperLeft]), Corner::LowerLeft);
+        assert_eq!(pick(&[], &[Corner::LowerRight]), Corner::UpperRight);
+    }
+
+    #[test]
+    fn scale_bars_are_round_and_at_most_a_fifth_of_the_map() {
+        let cases = [
+            (420.0, 50.0),
+            (1100.0, 200.0),
+            (250.0, 50.0),
+            (1000.0, 200.0),
+            (90.0, 10.0),
+            (3000.0, 500.0),
+        ];
+        for (width_m, bar_m) in cases {
+            assert_eq!(scale_bar_m(width_m), bar_m, "{width_m} m");
+        }
+    }
+
+    #[test]
+    fn fitting_keeps_one_scale_in_x_and_y() {
+        // (x extent, y extent, plot width px) -> the same metres per pixel along both
+        let cases = [
+            (400.0, 200.0, 800.0),
+            (400.0, 10.0, 800.0),
+            (100.0, 2000.0, 800.0),
+            (1100.0, 950.0, 803.0),
+        ];
+        for (dx, dy, w) in cases {
+            let (x, y, h) = fit_aspect(0.0..dx, 0.0..dy, w, 300.0, 1200.0);
+            assert!((300..=1200).contains(&h), "{dx} x {dy}: {h} px");
+            let (mx, my) = ((x.end - x.start) / w, (y.end - y.start) / f64::from(h));
+            assert!((mx - my).abs() < 1e-9 * mx, "{dx} x {dy}: {mx} vs {my}");
+            assert!(x.start <= 0.0 && x.end >= dx && y.start <= 0.0 && y.end >= dy);
+        }
+    }
+
+    #[test]
+    fn polygons_are_clipped_to_the_map() {
+        let square = [(-10.0, -10.0), (10.0, -10.0), (10.0, 10.0), (-10.0, 10.0)];
+        let inside = clip_polygon(&square, &(-20.0..20.0), &(-20.0..20.0));
+        assert_eq!(inside.len(), 4);
+        let half = clip_polygon(&square, &(0.0..20.0), &(-20.0..20.0));
+        assert!(half.iter().all(|p| p.0 >= 0.0 && p.0 <= 10.0), "{half:?}");
+        assert!(clip_polygon(&square, &(30.0..40.0), &(0.0..1.0)).is_empty());
+    }
+
+    #[test]
+    fn the_map_covers_an_excursion_and_marks_the_cage_abort() {
+        let mut run = demo(240.0);
+        let op_x_max = run.op_area.iter().map(|p| p.x).fold(f64::MIN, f64::max);
+        let last = run.trajectory.iter().map(|r| r.t_s).fold(0.0, f64::max);
+        // The vehicle truly flies on 600 m east of the op-area while its estimate stays where
+        // it was; a position fix then moves the estimate out there, and the cage aborts.
+        let (ex, ey) = run
+            .trajectory
+            .iter()
+            .rev()
+            .find(|r| r.vehicle == 0)
+            .and_then(|r| r.est_x_m.zip(r.est_y_m))
+            .unwrap();
+        for k in 1..=600 {
+            let t = last + f64::from(k);
+            let mut r = row(t, op_x_max + f64::from(k), -20.0, false);
+            if k < 600 {
+                (r.est_x_m, r.est_y_m) = (Some(ex), Some(ey));
+            }
+            run.trajectory.push(r);
+        }
+        let t_abort = last + 600.0;
+        run.events.push(EventRecord {
+            t_s: t_abort,
+            vehicle: 0,
+            event: EventKind::Planner(PlannerEvent::CageAbort {
+                distance_outside_m: 600.0,
+            }),
+        });
+        run.events.push(EventRecord {
+            t_s: t_abort,
+            vehicle: 0,
+            event: EventKind::Mission(MissionEvent::PlannerAborted),
+        });
+        let lay = layout(&run);
+        let far = op_x_max + 600.0;
+        assert!(lay.x.end > far + 10.0, "{:?} misses {far}", lay.x);
+        let (mx, my) = (
+            (lay.x.end - lay.x.start) / f64::from(lay.plot_px.0),
+            (lay.y.end - lay.y.start) / f64::from(lay.plot_px.1),
+        );
+        assert!((mx - my).abs() < 1e-9 * mx, "one scale: {mx} vs {my}");
+        // One marker (the planner's abort in the same step is the cage abort), where the
+        // vehicle truly was.
+        assert_eq!(lay.marks.len(), 1, "{:?}", lay.marks);
+        assert_eq!(lay.marks[0].pos, (far, -20.0));
+        let l = labels(&lay);
+        for entry in [
+            "cage abort (true position)",
+            "true track outside the op-area",
+            "navigation fix (the estimate jumps)",
+        ] {
+            assert!(l.contains(&entry.to_string()), "{entry}: {l:?}");
+        }
+        let out: usize = lay.layers[0].outside.iter().map(Vec::len).sum();
+        assert!(out > 10, "the excursion is drawn: {out} points");
+        assert_eq!(lay.layers[0].jumps.len(), 1, "{:?}", lay.layers[0].jumps);
+        let ([_, to], t) = lay.layers[0].jumps[0];
+        assert_eq!((to, t), ((far, -20.0), t_abort));
+        let svg = mission_figure(&run, "excursion").unwrap();
+        assert!(svg.contains("fix at "), "the jump's label");
+        assert!(
+            svg.contains("cage abort, 600 m outside"),
+            "the marker's label"
+        );
+        assert!(svg.contains("cage abort (true position)"), "the legend");
+    }
+
+    #[test]
+    fn a_fault_window_is_highlighted_and_named() {
+        let mut run = demo(240.0);
+        run.vehicles[0].faults = vec![FaultWindow {
+            start_s: 60.0,
+            end_s: 150.0,
+            what: "flow sensor reads the wrong layer",
+        }];
+        let lay = layout(&run);
+        let label = "fault 1.0-2.5 min: flow sensor reads the wrong layer";
+        assert!(
+            labels(&lay).contains(&label.to_string()),
+            "{:?}",
+            labels(&lay)
+        );
+        let (k, pts) = &lay.layers[0].faults[0];
+        assert_eq!(*k, 0);
+        assert!(
+            pts.len() > 10,
+            "the track flown in the window: {} points",
+            pts.len()
+        );
+        let svg = mission_figure(&run, "fault").unwrap();
+        assert!(svg.contains(label));
+        // A window after the mission is not drawn, so not listed.
+        run.vehicles[0].faults[0].start_s = 1000.0;
+        run.vehicles[0].faults[0].end_s = 1200.0;
+        let lay = layout(&run);
+        assert!(lay.layers[0].faults.is_empty());
+        assert!(labels(&lay).iter().all(|s| !s.starts_with("fault")));
+    }
+
+    #[test]
+    fn tracks_carry_time_marks_and_thinned_detections() {
+        let run = demo(240.0);
+        let lay = layout(&run);
+        assert_eq!(lay.time_step_min, 1.0);
+        let times: Vec<&str> = lay.layers[0]
+            .times
+            .iter()
+            .map(|t| t.label.as_str())
+            .collect();
+        // A mark every minute; a label that would overlap an earlier one is left out.
+        assert_eq!(times.len(), 4, "{times:?}");
+        for (k, t) in times.iter().enumerate() {
+            assert!(t.is_empty() || *t == format!("{} min", k + 1), "{times:?}");
+        }
+        assert!(times[0] == "1 min" && times.iter().filter(|t| !t.is_empty()).count() >= 2);
+        let duration_s = run.trajectory.iter().map(|r| r.t_s).fold(0.0, f64::max);
+        let ticks = lay.layers[0].detections.len();
+        assert!(
+            ticks as f64 <= duration_s / DETECTION_GAP_S + 1.0,
+            "{ticks} ticks in {duration_s} s"
+        );
+        let rows = run.trajectory.iter().filter(|r| r.vehicle == 0).count();
+        assert!(lay.layers[0].truth.len() < rows, "the track is thinned");
+        let svg = mission_figure(&run, "times").unwrap();
+        for s in [
+            "\n1 min\n",
+            "time along the track, every 1 min",
+            "reading (V)",
+            "mean flow ",
+        ] {
+            assert!(svg.contains(s), "{s}");
+        }
+        assert!(
+            svg.contains(&format!("\n{:.0} m\n", lay.scale_m)),
+            "the scale bar"
+        );
+    }
+}

@@ -1,0 +1,29 @@
+//! Reports of plumetrace: everything drawn from what a run recorded, never inside the step loop.
+//!
+//! The mission runner records; this crate draws. Each figure reads a finished run (a
+//! [`plumetrace_mission::MissionRun`], a built scenario's plume, a replayed log) and returns the
+//! file's text; the caller writes it.
+//!
+//! - [`figure`]: the mission figure (`plot.svg`): the map of every track over the plume, the
+//!   source maps, and the reading panel;
+//! - [`mod@team_figure`]: the team figure (`team.svg`): readings, speeds, headings, scale and
+//!   centroid against time;
+//! - [`mod@plume_figure`]: the plume figure of a plume-only run (`plume.svg`);
+//! - [`mod@replay_page`]: the self-contained replay page (`replay.html`), of a flown mission or a
+//!   replayed log;
+//! - [`chart`]: the map panel and dashed outlines every figure and chart shares;
+//! - [`error`]: what can go wrong ([`ReportError`]).
+
+pub mod chart;
+pub mod error;
+pub mod figure;
+pub mod plume_figure;
+pub mod replay_page;
+pub mod team_figure;
+
+pub use chart::{dashed, map_chart};
+pub use error::ReportError;
+pub use figure::{DETECTION_GAP_S, mission_figure};
+pub use plume_figure::plume_figure;
+pub use replay_page::{LogPageBuilder, PageData, replay_page};
+pub use team_figure::team_figure;
