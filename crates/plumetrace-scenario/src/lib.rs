@@ -10,12 +10,14 @@ pub mod config;
 pub mod error;
 pub mod family;
 pub mod limits;
+pub mod overrides;
 pub mod presets;
 
 pub use build::{BuiltScenario, MissionSpec, OutputSpec, PlannerRef, VehicleSetup, build};
 pub use config::ScenarioConfig;
 pub use error::ScenarioError;
 pub use family::{Family, Site, is_family_path};
+pub use overrides::{OverrideError, set_key};
 pub use presets::{PRESETS, Preset, find_preset};
 
 use std::path::Path;
@@ -83,9 +85,9 @@ fn deserialize<'de, D: serde::Deserializer<'de>>(
 pub fn load_file(path: &Path) -> Result<ScenarioConfig, ScenarioError> {
     let origin = Origin::File(path.to_path_buf());
     let text = plumetrace_env::input::read_text(path, plumetrace_env::input::MAX_TEXT_BYTES)
-        .map_err(|message| ScenarioError::Io {
+        .map_err(|e| ScenarioError::Io {
             origin: origin.to_string(),
-            message,
+            message: e.to_string(),
         })?;
     parse(&text, &origin)
 }
