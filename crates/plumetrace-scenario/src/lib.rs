@@ -1,9 +1,10 @@
 //! Scenario files and built-in presets.
 //!
 //! Configuration is read in two phases. [`config`] mirrors the TOML file with serde
-//! (`deny_unknown_fields`, units in key names) and only checks types; [`build`] turns it into
-//! models and checks values, naming the key path of anything wrong. Built-in scenarios live in
-//! one registry, [`presets::PRESETS`], from which `plumetrace presets` and the docs are made.
+//! (`deny_unknown_fields`, units in key names) and only checks types; [`build`](mod@build)
+//! turns it into models and checks values, naming the key path of anything wrong. Built-in
+//! scenarios live in one registry, [`presets::PRESETS`], from which `plumetrace presets` and the
+//! docs are made.
 
 pub mod build;
 pub mod config;
