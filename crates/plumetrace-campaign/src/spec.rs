@@ -6,6 +6,7 @@
 //! campaign seed and the seed index, so every configuration meets the same plume realisations.
 
 use crate::error::CampaignError;
+use plumetrace_scenario::overrides::{planner_path, set_key, set_path};
 use plumetrace_scenario::{Family, Origin, PRESETS, Site, find_preset, is_family_path};
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
@@ -220,9 +221,9 @@ impl Campaign {
     /// Reads a campaign file, loads its scenarios and checks every group builds.
     pub fn load(path: &Path, seeds: Option<u64>) -> Result<Self, CampaignError> {
         let text = plumetrace_env::input::read_text(path, plumetrace_env::input::MAX_TEXT_BYTES)
-            .map_err(|message| CampaignError::Io {
+            .map_err(|e| CampaignError::Io {
                 path: path.display().to_string(),
-                message,
+                message: e.to_string(),
             })?;
         let mut file = parse_campaign(&text, path)?;
         if let Some(n) = seeds {
@@ -352,32 +353,32 @@ impl Campaign {
         };
         let c = &self.configs[config];
         if let Some(p) = &c.planner {
-            let path = planner_path(&t).map_err(|m| CampaignError::Invalid {
+            let path = planner_path(&t).map_err(|e| CampaignError::Invalid {
                 file: self.path.display().to_string(),
                 key: format!("configs[{config}].planner"),
-                message: m,
+                message: e.to_string(),
             })?;
             let segments: Vec<&str> = path.split('.').collect();
-            set_path(&mut t, &segments, toml::Value::Table(p.clone())).map_err(|m| {
+            set_path(&mut t, &segments, toml::Value::Table(p.clone())).map_err(|e| {
                 CampaignError::Invalid {
                     file: self.path.display().to_string(),
                     key: format!("configs[{config}].planner"),
-                    message: m,
+                    message: e.to_string(),
                 }
             })?;
         }
         for (k, v) in &c.set {
-            set_key(&mut t, k, v.clone()).map_err(|m| CampaignError::Invalid {
+            set_key(&mut t, k, v.clone()).map_err(|e| CampaignError::Invalid {
                 file: self.path.display().to_string(),
                 key: format!("configs[{config}].set.{}", quoted(k)),
-                message: m,
+                message: e.to_string(),
             })?;
         }
         for (k, v) in &self.points[point].values {
-            set_key(&mut t, k, v.clone()).map_err(|m| CampaignError::Invalid {
+            set_key(&mut t, k, v.clone()).map_err(|e| CampaignError::Invalid {
                 file: self.path.display().to_string(),
                 key: format!("sweep.{}", quoted(k)),
-                message: m,
+                message: e.to_string(),
             })?;
         }
         Ok(t)
@@ -757,144 +758,9 @@ pub(crate) fn fnv1a(bytes: &[u8]) -> u64 {
     h
 }
 
-/// The key path of a scenario's single planner table: `planner`, or `planners.NAME` when it has
-/// exactly one named planner.
-pub fn planner_path(table: &toml::Table) -> Result<String, String> {
-    let named: Vec<&String> = table
-        .get("planners")
-        .and_then(toml::Value::as_table)
-        .map(|t| t.keys().collect())
-        .unwrap_or_default();
-    match (table.contains_key("planner"), named.as_slice()) {
-        (true, []) => Ok("planner".into()),
-        (false, [one]) => Ok(format!("planners.{}", quoted(one))),
-        (false, []) => Err("the scenario has no planner table".into()),
-        _ => Err(format!(
-            "the scenario has several planners ({}): name one with a dotted key \
-             (planners.NAME.KEY)",
-            table
-                .contains_key("planner")
-                .then_some("planner".to_string())
-                .into_iter()
-                .chain(named.iter().map(|n| format!("planners.{}", quoted(n))))
-                .collect::<Vec<_>>()
-                .join(", ")
-        )),
-    }
-}
-
-/// Sets `key` in a scenario table: a bare name is a key of the scenario's planner (see
-/// [`planner_path`]); a dotted path walks tables, and whole-number segments index arrays
-/// (`sources.0.mass_rate_per_s`).
-pub fn set_key(table: &mut toml::Table, key: &str, value: toml::Value) -> Result<(), String> {
-    let planner;
-    let path: Vec<&str> = if key.contains('.') {
-        key.split('.').collect()
-    } else {
-        planner = planner_path(table)?;
-        planner.split('.').chain([key]).collect()
-    };
-    set_path(table, &path, value)
-}
-
-/// Sets the value at `path` (table keys, or whole numbers indexing arrays), making tables on
-/// the way.
-fn set_path(table: &mut toml::Table, path: &[&str], value: toml::Value) -> Result<(), String> {
-    let key = path.join(".");
-    if path.iter().any(|s| s.is_empty()) {
-        return Err(format!("'{key}' is not a key path"));
-    }
-    let (last, walk) = path.split_last().ok_or_else(|| "empty key".to_string())?;
-    let mut here = TableOrArray::Table(table);
-    let mut walked = String::new();
-    for seg in walk {
-        if !walked.is_empty() {
-            walked.push('.');
-        }
-        walked.push_str(seg);
-        here = match here {
-            TableOrArray::Table(t) => {
-                let next = t
-                    .entry(seg.to_string())
-                    .or_insert_with(|| toml::Value::Table(toml::Table::new()));
-                TableOrArray::from_value(next, &walked)?
-            }
-            TableOrArray::Array(a) => {
-                let len = a.len();
-                let i: usize = seg
-                    .parse()
-                    .map_err(|_| format!("'{walked}': '{seg}' is not an index of an array"))?;
-                let next = a
-                    .get_mut(i)
-                    .ok_or_else(|| format!("'{walked}': index {i} past the {len} entries"))?;
-                TableOrArray::from_value(next, &walked)?
-            }
-        };
-    }
-    match here {
-        TableOrArray::Table(t) => {
-            t.insert(last.to_string(), value);
-        }
-        TableOrArray::Array(a) => {
-            let len = a.len();
-            let i: usize = last
-                .parse()
-                .map_err(|_| format!("'{key}': '{last}' is not an index of an array"))?;
-            *a.get_mut(i)
-                .ok_or_else(|| format!("'{key}': index {i} past the {len} entries"))? = value;
-        }
-    }
-    Ok(())
-}
-
-enum TableOrArray<'a> {
-    Table(&'a mut toml::Table),
-    Array(&'a mut Vec<toml::Value>),
-}
-
-impl<'a> TableOrArray<'a> {
-    fn from_value(v: &'a mut toml::Value, at: &str) -> Result<Self, String> {
-        match v {
-            toml::Value::Table(t) => Ok(TableOrArray::Table(t)),
-            toml::Value::Array(a) => Ok(TableOrArray::Array(a)),
-            other => Err(format!("'{at}' is a {}, not a table", other.type_str())),
-        }
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    fn table(s: &str) -> toml::Table {
-        s.parse().unwrap_or_default()
-    }
-
-    #[test]
-    fn bare_keys_go_to_the_planner_and_paths_walk_tables_and_arrays() {
-        let mut t = table("[planner]\nstrategy = \"amp\"\n[[sources]]\nx_m = 1.0\n");
-        assert!(set_key(&mut t, "beta_deg", toml::Value::Float(30.0)).is_ok());
-        assert!(set_key(&mut t, "sources.0.x_m", toml::Value::Float(5.0)).is_ok());
-        assert!(set_key(&mut t, "plume.growth_rate_m2ps", toml::Value::Float(0.01)).is_ok());
-        assert_eq!(t["planner"]["beta_deg"].as_float(), Some(30.0));
-        assert_eq!(t["sources"][0]["x_m"].as_float(), Some(5.0));
-        assert_eq!(t["plume"]["growth_rate_m2ps"].as_float(), Some(0.01));
-        let e = set_key(&mut t, "sources.3.x_m", toml::Value::Float(5.0));
-        assert!(e.is_err_and(|m| m.contains("index 3")));
-        let e = set_key(&mut t, "planner.strategy.x", toml::Value::Float(5.0));
-        assert!(e.is_err_and(|m| m.contains("not a table")));
-        // A scenario with one named planner: bare keys go there; with two they are ambiguous.
-        let mut named = table("[planners.tracer]\nkind = \"amp\"\n");
-        assert!(set_key(&mut named, "beta_deg", toml::Value::Float(25.0)).is_ok());
-        assert_eq!(
-            named["planners"]["tracer"]["beta_deg"].as_float(),
-            Some(25.0)
-        );
-        let mut two = table("[planners.a]\nkind = \"amp\"\n[planners.b]\nkind = \"amp\"\n");
-        let e = set_key(&mut two, "beta_deg", toml::Value::Float(25.0));
-        assert!(e.is_err_and(|m| m.contains("planners.a, planners.b")));
-        assert!(set_key(&mut two, "planners.b.beta_deg", toml::Value::Float(25.0)).is_ok());
-    }
 
     #[test]
     fn a_config_can_replace_the_scenarios_planner_and_the_registry_checks_it() {

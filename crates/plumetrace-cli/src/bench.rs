@@ -253,7 +253,7 @@ fn preset_with_sets(
             .map_err(|e| anyhow::anyhow!("--set {s:?}: the value is not TOML: {e}"))?
             .remove("v")
             .ok_or_else(|| anyhow::anyhow!("--set {s:?}: no value"))?;
-        plumetrace_campaign::spec::set_key(&mut table, key.trim(), value)
+        plumetrace_scenario::set_key(&mut table, key.trim(), value)
             .map_err(|e| anyhow::anyhow!("--set {s:?}: {e}"))?;
     }
     Ok(plumetrace_scenario::from_table(

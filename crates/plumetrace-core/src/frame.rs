@@ -48,6 +48,58 @@ pub fn self_intersection(poly: &[Vec2]) -> Option<(usize, usize)> {
     None
 }
 
+/// Why a list of vertices is not a simple polygon.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
+pub enum PolygonError {
+    /// Fewer than three vertices.
+    #[error("needs at least 3 vertices, got {0}")]
+    TooFewVertices(usize),
+    /// Vertex `k` is not finite.
+    #[error("vertex {0} is not finite")]
+    NonFinite(usize),
+    /// The vertices enclose no area.
+    #[error("has zero area")]
+    ZeroArea,
+    /// Edges `i` and `j` touch or cross ([`self_intersection`]).
+    #[error(
+        "the polygon crosses itself: edges {0} and {1} meet (edge k runs from vertex k to the next)"
+    )]
+    SelfIntersecting(usize, usize),
+}
+
+/// Twice the signed area of a closed polygon: positive for anticlockwise vertices.
+pub fn signed_area2(poly: &[Vec2]) -> f64 {
+    (0..poly.len())
+        .map(|i| {
+            let (a, b) = (poly[i], poly[(i + 1) % poly.len()]);
+            a.x * b.y - b.x * a.y
+        })
+        .sum()
+}
+
+/// Checks that `poly` is a simple polygon, in this order: at least 3 vertices, every one finite,
+/// an area (when `need_area`: twice the area at least 1e-9 m^2), no two edges that touch or
+/// cross. Returns twice its signed area ([`signed_area2`]).
+pub fn check_polygon(poly: &[Vec2], need_area: bool) -> Result<f64, PolygonError> {
+    if poly.len() < 3 {
+        return Err(PolygonError::TooFewVertices(poly.len()));
+    }
+    if let Some(k) = poly
+        .iter()
+        .position(|v| !(v.x.is_finite() && v.y.is_finite()))
+    {
+        return Err(PolygonError::NonFinite(k));
+    }
+    let area2 = signed_area2(poly);
+    if need_area && area2.abs() < 1e-9 {
+        return Err(PolygonError::ZeroArea);
+    }
+    if let Some((a, b)) = self_intersection(poly) {
+        return Err(PolygonError::SelfIntersecting(a, b));
+    }
+    Ok(area2)
+}
+
 /// Whether segments `ab` and `cd` share at least one point.
 fn segments_touch(a: Vec2, b: Vec2, c: Vec2, d: Vec2) -> bool {
     let cross = |o: Vec2, p: Vec2, q: Vec2| (p.x - o.x) * (q.y - o.y) - (p.y - o.y) * (q.x - o.x);
@@ -91,6 +143,39 @@ mod tests {
             );
         }
         assert!(bearing_between(o, o).is_none());
+    }
+
+    #[test]
+    fn polygon_checks_table() {
+        let p = |v: &[(f64, f64)]| v.iter().map(|(x, y)| Vec2::new(*x, *y)).collect::<Vec<_>>();
+        let square = p(&[(0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0)]);
+        assert_eq!(check_polygon(&square, true), Ok(2.0));
+        let line = p(&[(0.0, 0.0), (1.0, 0.0), (2.0, 0.0)]);
+        let cases = [
+            (
+                p(&[(0.0, 0.0), (1.0, 0.0)]),
+                true,
+                PolygonError::TooFewVertices(2),
+            ),
+            (
+                p(&[(0.0, 0.0), (f64::NAN, 0.0), (1.0, 1.0)]),
+                true,
+                PolygonError::NonFinite(1),
+            ),
+            (line, true, PolygonError::ZeroArea),
+            (
+                p(&[(0.0, 0.0), (1.0, 1.0), (1.0, 0.0), (0.0, 1.0)]),
+                false,
+                PolygonError::SelfIntersecting(0, 2),
+            ),
+        ];
+        for (poly, need_area, want) in cases {
+            assert_eq!(check_polygon(&poly, need_area), Err(want), "{poly:?}");
+        }
+        // A tiny triangle is simple: only `need_area` refuses it.
+        let tiny = p(&[(0.0, 0.0), (1e-5, 0.0), (0.0, 1e-5)]);
+        assert!(check_polygon(&tiny, false).is_ok());
+        assert_eq!(check_polygon(&tiny, true), Err(PolygonError::ZeroArea));
     }
 
     #[test]

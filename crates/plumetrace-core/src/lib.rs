@@ -26,7 +26,10 @@ pub mod vehicle;
 pub use angle::{Heading, wrap_deg_180, wrap_deg_360, wrap_rad_pi};
 pub use finite::first_non_finite;
 pub use flow_gate::{FlowGate, FlowGateParams};
-pub use frame::{Vec2, Vec3, bearing_between, heading_vector, self_intersection};
+pub use frame::{
+    PolygonError, Vec2, Vec3, bearing_between, check_polygon, heading_vector, self_intersection,
+    signed_area2,
+};
 pub use message::{Link, Message, MessageBody, Outgoing, Recipient};
 pub use names::{closest, variant_name};
 pub use planner::{

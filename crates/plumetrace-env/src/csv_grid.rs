@@ -16,7 +16,8 @@ pub(crate) fn read_columns(
         path: path.to_path_buf(),
         message,
     };
-    crate::input::check_file(path, crate::input::MAX_DATA_BYTES).map_err(file_err)?;
+    crate::input::check_file(path, crate::input::MAX_DATA_BYTES)
+        .map_err(|e| file_err(e.to_string()))?;
     let mut reader = csv::ReaderBuilder::new()
         .trim(csv::Trim::All)
         .from_path(path)

@@ -83,7 +83,7 @@ impl Environment {
         dt_s: f64,
         seed: u64,
     ) -> Result<Self, EnvError> {
-        crate::error::require_positive("sim.dt_s", dt_s)?;
+        crate::error::require_positive("dt_s", dt_s)?;
         let mut plume = plume;
         if let Plume::Filaments(p) = &mut plume {
             p.set_key_seed(stream_rng(seed, StreamId::PlumeKeys).next_u64());
@@ -105,10 +105,11 @@ impl Environment {
     /// Develops the plume before the run starts: `duration_s` of simulated time in steps of
     /// `dt_s` (coarser than the run's step: the physics does not depend on the step, and a
     /// kilometre of plume in a 0.1 m/s current needs hours to form). The run's clock then starts
-    /// at 0; [`Environment::elapsed_s`] includes the spin-up.
+    /// at 0; [`Environment::elapsed_s`] includes the spin-up. Errors name the arguments as the
+    /// mission's keys do (`spinup_s`, `spinup_dt_s`).
     pub fn spin_up(&mut self, duration_s: f64, dt_s: f64) -> Result<(), EnvError> {
-        crate::error::require_non_negative("mission.spinup_s", duration_s)?;
-        crate::error::require_positive("mission.spinup_dt_s", dt_s)?;
+        crate::error::require_non_negative("spinup_s", duration_s)?;
+        crate::error::require_positive("spinup_dt_s", dt_s)?;
         let n = (duration_s / dt_s).round() as u64;
         let start = self.elapsed_s();
         for k in 1..=n {

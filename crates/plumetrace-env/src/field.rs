@@ -47,8 +47,8 @@ pub struct GridSpec {
 }
 
 impl GridSpec {
-    /// Checks the grid; `key` prefixes the names in errors.
-    pub fn validate(&self, key: &str) -> Result<(), EnvError> {
+    /// Checks the grid; errors name its fields (`nx`; [`EnvError::under`] places them).
+    pub fn validate(&self) -> Result<(), EnvError> {
         for (k, v) in [
             ("x_min_m", self.x_min_m),
             ("x_max_m", self.x_max_m),
@@ -56,19 +56,13 @@ impl GridSpec {
             ("y_max_m", self.y_max_m),
             ("z_m", self.z_m),
         ] {
-            require_finite(&format!("{key}.{k}"), v)?;
+            require_finite(k, v)?;
         }
-        require_positive(
-            &format!("{key}.x_max_m - x_min_m"),
-            self.x_max_m - self.x_min_m,
-        )?;
-        require_positive(
-            &format!("{key}.y_max_m - y_min_m"),
-            self.y_max_m - self.y_min_m,
-        )?;
+        require_positive("x_max_m - x_min_m", self.x_max_m - self.x_min_m)?;
+        require_positive("y_max_m - y_min_m", self.y_max_m - self.y_min_m)?;
         if self.nx < 2 || self.ny < 2 || self.nx * self.ny > 16_000_000 {
             return Err(EnvError::invalid(
-                format!("{key}.nx"),
+                "nx",
                 "nx and ny must be >= 2 with nx * ny <= 16,000,000",
             ));
         }

@@ -39,21 +39,62 @@ pub struct KelpFieldParams {
     pub roughness: f64,
 }
 
-/// Draws a kelp field; `keep_clear` holds circles `(centre, radius)` no patch may reach. Patch
-/// `j` is named `{name}.patch[j]`; errors name `key`.
+impl KelpFieldParams {
+    /// The most ragged outline: vertex radii stay above 1 % of the radius.
+    pub const MAX_ROUGHNESS: f64 = 0.99;
+    /// The fewest vertices of a patch outline.
+    pub const MIN_VERTICES: usize = 3;
+    /// The most vertices of a patch outline: 64 is round enough.
+    pub const MAX_VERTICES: usize = 64;
+
+    /// Checks the parameters; errors name the field (`radius_m`).
+    pub fn validate(&self) -> Result<(), EnvError> {
+        let [r_lo, r_hi] = self.radius_m;
+        if !(r_lo > 0.0 && r_hi >= r_lo) {
+            return Err(EnvError::invalid(
+                "radius_m",
+                format!("needs 0 < smallest <= largest, got [{r_lo}, {r_hi}]"),
+            ));
+        }
+        if !(0.0..=Self::MAX_ROUGHNESS).contains(&self.roughness) {
+            return Err(EnvError::invalid(
+                "roughness",
+                format!(
+                    "must be in [0, {}], got {}",
+                    Self::MAX_ROUGHNESS,
+                    self.roughness
+                ),
+            ));
+        }
+        if !(Self::MIN_VERTICES..=Self::MAX_VERTICES).contains(&self.vertices) {
+            return Err(EnvError::invalid(
+                "vertices",
+                format!(
+                    "must be {} to {}, got {}",
+                    Self::MIN_VERTICES,
+                    Self::MAX_VERTICES,
+                    self.vertices
+                ),
+            ));
+        }
+        if self.region.len() < 3 {
+            let e = plumetrace_core::PolygonError::TooFewVertices(self.region.len());
+            return Err(EnvError::from(e).under("region"));
+        }
+        Ok(())
+    }
+}
+
+/// Draws a kelp field ([`KelpFieldParams::validate`] first); `keep_clear` holds circles
+/// `(centre, radius)` no patch may reach. Patch `j` is named `{name}.patch[j]`. Errors name the
+/// parameter's field, a patch as `patch[j]`, and a field that does not fit with an empty key.
 pub fn kelp_field(
     p: &KelpFieldParams,
     keep_clear: &[(Vec2, f64)],
     name: &str,
-    key: &str,
     rng: &mut SimRng,
 ) -> Result<Vec<SoftObstacle>, EnvError> {
-    if p.region.len() < 3 {
-        return Err(EnvError::invalid(
-            format!("{key}.region"),
-            format!("needs at least 3 vertices, got {}", p.region.len()),
-        ));
-    }
+    p.validate()?;
     let ring: Vec<Coord<f64>> = p
         .region
         .iter()
@@ -92,7 +133,7 @@ pub fn kelp_field(
             if !clear {
                 continue;
             }
-            let n = p.vertices.max(3);
+            let n = p.vertices;
             let step = std::f64::consts::TAU / n as f64;
             let outline: Vec<[f64; 2]> = (0..n)
                 .map(|k| {
@@ -103,11 +144,10 @@ pub fn kelp_field(
                 })
                 .collect();
             let j = placed.len();
-            out.push(SoftObstacle::new(
-                format!("{name}.patch[{j}]"),
-                &outline,
-                &format!("{key}.patch[{j}]"),
-            )?);
+            out.push(
+                SoftObstacle::new(format!("{name}.patch[{j}]"), &outline)
+                    .map_err(|e| e.under(&format!("patch[{j}]")))?,
+            );
             placed.push((c, r));
         }
         if placed.len() == p.patches {
@@ -116,7 +156,7 @@ pub fn kelp_field(
         best = best.max(placed.len());
     }
     Err(EnvError::invalid(
-        key.to_string(),
+        "",
         format!(
             "at most {best} of {} patches fit in {RESTARTS} draws of {budget} tries: lower \
              patches, radius_m or gap_m, or enlarge the region",
@@ -147,7 +187,7 @@ mod tests {
         let source = (Vec2::new(30.0, 50.0), 10.0);
         for seed in 1..=20 {
             let mut rng = stream_rng(seed, StreamId::Custom(9));
-            let field = kelp_field(&params(), &[source], "kelp[0]", "kelp[0]", &mut rng).unwrap();
+            let field = kelp_field(&params(), &[source], "kelp[0]", &mut rng).unwrap();
             assert_eq!(field.len(), 8);
             let set = ObstacleSet::new(field.clone());
             // Nothing within the clear circle: its centre is at least 10 m from every patch.
@@ -169,7 +209,7 @@ mod tests {
         // The same seed draws the same field; another seed another one.
         let draw = |seed| {
             let mut rng = stream_rng(seed, StreamId::Custom(9));
-            kelp_field(&params(), &[], "k", "k", &mut rng).unwrap()
+            kelp_field(&params(), &[], "k", &mut rng).unwrap()
         };
         assert_eq!(draw(3), draw(3));
         assert_ne!(draw(3), draw(4));
@@ -189,7 +229,7 @@ mod tests {
         };
         for seed in 0..2000 {
             let mut rng = stream_rng(seed, StreamId::Custom(9));
-            let field = kelp_field(&p, &[], "kelp", "kelp[0]", &mut rng);
+            let field = kelp_field(&p, &[], "kelp", &mut rng);
             assert!(field.is_ok_and(|f| f.len() == 8), "seed {seed}");
         }
     }
@@ -201,8 +241,9 @@ mod tests {
             ..params()
         };
         let mut rng = stream_rng(1, StreamId::Custom(9));
-        let err = kelp_field(&p, &[], "kelp[2]", "kelp[2]", &mut rng)
+        let err = kelp_field(&p, &[], "kelp[2]", &mut rng)
             .unwrap_err()
+            .under("kelp[2]")
             .to_string();
         assert!(
             err.starts_with("kelp[2]") && err.contains("of 200 patches fit in 10 draws"),

@@ -16,39 +16,12 @@ pub struct SoftObstacle {
 }
 
 impl SoftObstacle {
-    /// An obstacle from its vertices `(east, north)` in order (closed automatically).
-    pub fn new(
-        name: impl Into<String>,
-        vertices: &[[f64; 2]],
-        key: &str,
-    ) -> Result<Self, EnvError> {
-        if vertices.len() < 3 {
-            return Err(EnvError::invalid(
-                format!("{key}.vertices"),
-                format!("needs at least 3 vertices, got {}", vertices.len()),
-            ));
-        }
-        if let Some(k) = vertices
-            .iter()
-            .position(|v| !(v[0].is_finite() && v[1].is_finite()))
-        {
-            return Err(EnvError::invalid(
-                format!("{key}.vertices[{k}]"),
-                "is not finite",
-            ));
-        }
-        let points: Vec<plumetrace_core::Vec2> = vertices
-            .iter()
-            .map(|v| plumetrace_core::Vec2::new(v[0], v[1]))
-            .collect();
-        if let Some((a, b)) = plumetrace_core::self_intersection(&points) {
-            return Err(EnvError::invalid(
-                format!("{key}.vertices"),
-                format!(
-                    "the polygon crosses itself: edges {a} and {b} meet (edge k runs from vertex k to the next)"
-                ),
-            ));
-        }
+    /// An obstacle from its vertices `(east, north)` in order (closed automatically): a simple
+    /// polygon ([`plumetrace_core::check_polygon`]); errors name `vertices`.
+    pub fn new(name: impl Into<String>, vertices: &[[f64; 2]]) -> Result<Self, EnvError> {
+        let points: Vec<Vec2> = vertices.iter().map(|v| Vec2::new(v[0], v[1])).collect();
+        plumetrace_core::check_polygon(&points, false)
+            .map_err(|e| EnvError::from(e).under("vertices"))?;
         let ring: Vec<Coord<f64>> = vertices
             .iter()
             .map(|v| Coord { x: v[0], y: v[1] })
@@ -162,7 +135,6 @@ mod tests {
             SoftObstacle::new(
                 "kelp",
                 &[[10.0, -5.0], [20.0, -5.0], [20.0, 5.0], [10.0, 5.0]],
-                "obstacles[0]",
             )
             .unwrap(),
         ])
@@ -199,9 +171,27 @@ mod tests {
 
     #[test]
     fn rejects_degenerate_polygons() {
-        let e = SoftObstacle::new("x", &[[0.0, 0.0], [1.0, 1.0]], "obstacles[2]")
-            .unwrap_err()
-            .to_string();
-        assert!(e.starts_with("obstacles[2].vertices"), "{e}");
+        let cases = [
+            (
+                vec![[0.0, 0.0], [1.0, 1.0]],
+                "vertices: needs at least 3 vertices, got 2",
+            ),
+            (
+                vec![[0.0, 0.0], [1.0, f64::NAN], [1.0, 1.0]],
+                "vertices[1]: is not finite",
+            ),
+            (
+                vec![[0.0, 0.0], [1.0, 1.0], [1.0, 0.0], [0.0, 1.0]],
+                "vertices: the polygon crosses itself: edges 0 and 2 meet (edge k runs from \
+                 vertex k to the next)",
+            ),
+        ];
+        for (vertices, want) in cases {
+            let e = SoftObstacle::new("x", &vertices)
+                .unwrap_err()
+                .under("obstacles[2]")
+                .to_string();
+            assert_eq!(e, format!("obstacles[2].{want}"));
+        }
     }
 }

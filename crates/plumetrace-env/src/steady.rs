@@ -40,7 +40,12 @@ pub struct GaussianPlume {
 const IMAGE_PAIRS: i32 = 4;
 
 impl GaussianPlume {
-    /// A steady plume; `flow_toward_deg` is the direction the current moves towards.
+    /// The least diffusivity of a steady plume, m^2/s: its width goes as the square root of it.
+    pub const MIN_DIFFUSIVITY_M2PS: f64 = 1e-6;
+
+    /// A steady plume; `flow_toward_deg` is the direction the current moves towards. Errors name
+    /// `source.*`, the current's `speed_mps` and `toward_deg`, the diffusivities as the
+    /// scenario's `[plume]` keys and the water depth as `depth_m`.
     pub fn new(
         source_m: Vec3,
         mass_rate_per_s: f64,
@@ -54,12 +59,25 @@ impl GaussianPlume {
         require_finite("source.y_m", source_m.y)?;
         require_non_negative("source.z_m", source_m.z)?;
         require_non_negative("source.mass_rate_per_s", mass_rate_per_s)?;
-        require_positive("flow.speed_mps", speed_mps)?;
-        require_finite("flow.toward_deg", flow_toward_deg)?;
-        require_positive("plume.horizontal_diffusivity_m2ps", k_cross_m2ps)?;
-        require_positive("plume.vertical_diffusivity_m2ps", k_vert_m2ps)?;
+        require_positive("speed_mps", speed_mps)?;
+        require_finite("toward_deg", flow_toward_deg)?;
+        for (key, k) in [
+            ("horizontal_diffusivity_m2ps", k_cross_m2ps),
+            ("vertical_diffusivity_m2ps", k_vert_m2ps),
+        ] {
+            if !(k.is_finite() && k >= Self::MIN_DIFFUSIVITY_M2PS) {
+                return Err(EnvError::invalid(
+                    key,
+                    format!(
+                        "the steady plume needs at least {:e} m^2/s (its width goes as the \
+                         square root of it), got {k:?}",
+                        Self::MIN_DIFFUSIVITY_M2PS
+                    ),
+                ));
+            }
+        }
         if let Some(d) = depth_m {
-            require_positive("domain.depth_m", d)?;
+            require_positive("depth_m", d)?;
             if source_m.z > d {
                 return Err(EnvError::invalid(
                     "source.z_m",

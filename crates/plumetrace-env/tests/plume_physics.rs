@@ -633,7 +633,6 @@ fn filaments_pass_through_soft_obstacles() {
     let kelp = SoftObstacle::new(
         "kelp",
         &[[30.0, -10.0], [40.0, -10.0], [40.0, 10.0], [30.0, 10.0]],
-        "obstacles[0]",
     )
     .unwrap();
     let build = |obstacles: ObstacleSet| {

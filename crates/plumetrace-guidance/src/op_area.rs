@@ -20,6 +20,18 @@ pub enum OpAreaError {
     SelfIntersecting(usize, usize),
 }
 
+impl From<plumetrace_core::PolygonError> for OpAreaError {
+    fn from(e: plumetrace_core::PolygonError) -> Self {
+        use plumetrace_core::PolygonError as P;
+        match e {
+            P::TooFewVertices(n) => OpAreaError::TooFewVertices(n),
+            P::NonFinite(k) => OpAreaError::NonFinite(k),
+            P::ZeroArea => OpAreaError::ZeroArea,
+            P::SelfIntersecting(a, b) => OpAreaError::SelfIntersecting(a, b),
+        }
+    }
+}
+
 /// Where a point is relative to the nearest edge.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct EdgeInfo {
@@ -58,27 +70,7 @@ impl From<OpArea> for Vec<Vec2> {
 impl OpArea {
     /// An op-area from its vertices (the closing edge is implied).
     pub fn new(vertices: Vec<Vec2>) -> Result<Self, OpAreaError> {
-        if vertices.len() < 3 {
-            return Err(OpAreaError::TooFewVertices(vertices.len()));
-        }
-        if let Some(k) = vertices
-            .iter()
-            .position(|v| !(v.x.is_finite() && v.y.is_finite()))
-        {
-            return Err(OpAreaError::NonFinite(k));
-        }
-        let area2: f64 = (0..vertices.len())
-            .map(|i| {
-                let (a, b) = (vertices[i], vertices[(i + 1) % vertices.len()]);
-                a.x * b.y - b.x * a.y
-            })
-            .sum();
-        if area2.abs() < 1e-9 {
-            return Err(OpAreaError::ZeroArea);
-        }
-        if let Some((a, b)) = plumetrace_core::self_intersection(&vertices) {
-            return Err(OpAreaError::SelfIntersecting(a, b));
-        }
+        let area2 = plumetrace_core::check_polygon(&vertices, true)?;
         Ok(OpArea {
             vertices,
             orientation: area2.signum(),

@@ -158,7 +158,9 @@ impl Plume {
     fn spin_up(&mut self, py: Python<'_>, duration_s: f64, dt_s: Option<f64>) -> PyResult<()> {
         let dt = dt_s.unwrap_or(self.env.dt_s());
         let env = &mut self.env;
-        py.detach(|| env.spin_up(duration_s, dt)).map_err(to_py)
+        // Errors name the arguments as a scenario's [mission] keys, as they always have.
+        py.detach(|| env.spin_up(duration_s, dt))
+            .map_err(|e| to_py(e.under("mission")))
     }
 
     /// Concentrations at `points` (an `(N, 3)` array of x, y, z in metres), evaluated in
@@ -281,7 +283,7 @@ impl Plume {
             ny: ys.len(),
             z_m: z,
         };
-        spec.validate("grid").map_err(to_py)?;
+        spec.validate().map_err(|e| to_py(e.under("grid")))?;
         let threshold = threshold.unwrap_or(self.threshold);
         let steps = (duration_s / dt).round() as u64;
         let every = (every_s / dt).round().max(1.0) as u64;

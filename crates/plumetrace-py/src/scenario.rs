@@ -68,7 +68,7 @@ impl Source {
     ) -> PyResult<BuiltScenario> {
         let (mut table, origin) = self.table(seed.unwrap_or(0));
         for (k, v) in overrides {
-            plumetrace_campaign::spec::set_key(&mut table, k, v.clone())
+            plumetrace_scenario::set_key(&mut table, k, v.clone())
                 .map_err(|m| msg(format!("{origin}: override '{k}': {m}")))?;
         }
         let cfg = plumetrace_scenario::from_table(table, &origin).map_err(to_py)?;

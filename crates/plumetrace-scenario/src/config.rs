@@ -1,5 +1,6 @@
 //! The serde layer: a mirror of the scenario TOML. Types only; values are checked in
-//! [`crate::build`]. Every key carries its unit (`_m`, `_s`, `_mps`, `_deg`, `_m2ps`, `_hz`).
+//! [`crate::build`](mod@crate::build). Every key carries its unit (`_m`, `_s`, `_mps`, `_deg`,
+//! `_m2ps`, `_hz`).
 
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;

@@ -363,7 +363,7 @@ impl Family {
     /// Reads a family file and its base scenario.
     pub fn load(path: &Path) -> Result<Self, ScenarioError> {
         let text = plumetrace_env::input::read_text(path, plumetrace_env::input::MAX_TEXT_BYTES)
-            .map_err(|m| invalid(path, "", m))?;
+            .map_err(|e| invalid(path, "", e.to_string()))?;
         Family::parse(&text, path)
     }
 

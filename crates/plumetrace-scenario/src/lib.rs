@@ -1,21 +1,24 @@
 //! Scenario files and built-in presets.
 //!
 //! Configuration is read in two phases. [`config`] mirrors the TOML file with serde
-//! (`deny_unknown_fields`, units in key names) and only checks types; [`build`] turns it into
-//! models and checks values, naming the key path of anything wrong. Built-in scenarios live in
-//! one registry, [`presets::PRESETS`], from which `plumetrace presets` and the docs are made.
+//! (`deny_unknown_fields`, units in key names) and only checks types; [`build`](mod@build)
+//! turns it into models and checks values, naming the key path of anything wrong. Built-in
+//! scenarios live in one registry, [`presets::PRESETS`], from which `plumetrace presets` and the
+//! docs are made.
 
 pub mod build;
 pub mod config;
 pub mod error;
 pub mod family;
 pub mod limits;
+pub mod overrides;
 pub mod presets;
 
 pub use build::{BuiltScenario, MissionSpec, OutputSpec, PlannerRef, VehicleSetup, build};
 pub use config::ScenarioConfig;
 pub use error::ScenarioError;
 pub use family::{Family, Site, is_family_path};
+pub use overrides::{OverrideError, set_key};
 pub use presets::{PRESETS, Preset, find_preset};
 
 use std::path::Path;
@@ -83,9 +86,9 @@ fn deserialize<'de, D: serde::Deserializer<'de>>(
 pub fn load_file(path: &Path) -> Result<ScenarioConfig, ScenarioError> {
     let origin = Origin::File(path.to_path_buf());
     let text = plumetrace_env::input::read_text(path, plumetrace_env::input::MAX_TEXT_BYTES)
-        .map_err(|message| ScenarioError::Io {
+        .map_err(|e| ScenarioError::Io {
             origin: origin.to_string(),
-            message,
+            message: e.to_string(),
         })?;
     parse(&text, &origin)
 }

@@ -7,7 +7,16 @@
 //! format without a bound fails the tests). Planner keys are the planner registry's to check.
 //! Bounds that involve several keys (steps per run, positions inside the domain, stable steps)
 //! are checked when the models are built.
+//!
+//! Each key's bound lives here alone: the build checks no number against a bound of its own.
+//! A model checks what it needs to be valid (finite, positive, in order); where a model has a
+//! capacity of its own (grid nodes of the Farrell flow, sources of a filament plume, vertices
+//! and roughness of a kelp outline, rays of a range sensor), it is a constant of the model and
+//! the row here takes its numbers from it.
 
+use plumetrace_env::flow::FarrellParams;
+use plumetrace_env::{FilamentPlume, KelpFieldParams};
+use plumetrace_sim::RangeSensorParams;
 use std::fmt::Write as _;
 
 /// What a limit bounds.
@@ -128,14 +137,14 @@ pub const LIMITS: &[Limit] = &[
     num("flow.mean.phase_deg", -TURNS, TURNS, ANGLE_WHY),
     num(
         "flow.farrell.nx",
-        3.0,
-        1000.0,
+        FarrellParams::MIN_NODES as f64,
+        FarrellParams::MAX_NODES as f64,
         "a million grid nodes at most (memory and step time)",
     ),
     num(
         "flow.farrell.ny",
-        3.0,
-        1000.0,
+        FarrellParams::MIN_NODES as f64,
+        FarrellParams::MAX_NODES as f64,
         "a million grid nodes at most (memory and step time)",
     ),
     pos(
@@ -220,7 +229,7 @@ pub const LIMITS: &[Limit] = &[
     ),
     count(
         "sources",
-        1000,
+        FilamentPlume::MAX_SOURCES,
         "the step and the query time grow with the sources",
     ),
     num("sources[].x_m", -COORD, COORD, COORD_WHY),
@@ -280,14 +289,14 @@ pub const LIMITS: &[Limit] = &[
     ),
     num(
         "kelp[].vertices",
-        3.0,
-        64.0,
+        KelpFieldParams::MIN_VERTICES as f64,
+        KelpFieldParams::MAX_VERTICES as f64,
         "an outline of 64 vertices is round enough",
     ),
     num(
         "kelp[].roughness",
         0.0,
-        0.99,
+        KelpFieldParams::MAX_ROUGHNESS,
         "vertex radii stay above 1 % of the radius",
     ),
     num(
@@ -495,7 +504,7 @@ pub const LIMITS: &[Limit] = &[
     num(
         "vehicles[].range_sensor.rays_per_group",
         1.0,
-        1000.0,
+        RangeSensorParams::MAX_RAYS_PER_GROUP as f64,
         "rays are cast at every step",
     ),
     pos(
@@ -614,9 +623,69 @@ impl Bound {
     }
 }
 
-/// Checks every number and list of a scenario's table against [`LIMITS`]; on error returns
-/// `(key path, message)`. Tables of planners are left to the planner registry.
-pub fn check(table: &toml::Table) -> Result<(), (String, String)> {
+/// A number or list of a scenario out of its bound, by key path.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("{path}: {kind}")]
+pub struct LimitError {
+    /// Key path, e.g. `vehicles[0].nav.fix_interval_s`.
+    pub path: String,
+    /// What is wrong.
+    pub kind: LimitErrorKind,
+}
+
+/// What is wrong with a number or list ([`LimitError`]).
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum LimitErrorKind {
+    /// A list longer than its row allows.
+    #[error("{count} entries; {bound} ({why})")]
+    TooManyEntries {
+        /// Its length.
+        count: usize,
+        /// The bound in words ([`Bound::describe`]).
+        bound: String,
+        /// Why.
+        why: &'static str,
+    },
+    /// More `[planners.NAME]` tables than the `planners` row allows.
+    #[error("{count} tables; {bound} ({why})")]
+    TooManyTables {
+        /// How many.
+        count: usize,
+        /// The bound in words.
+        bound: String,
+        /// Why.
+        why: &'static str,
+    },
+    /// A number whose key has no row.
+    #[error("this number has no documented bound (a key of the format without one)")]
+    NoBound,
+    /// A number outside its row's bound (or not finite).
+    #[error("must be {bound} ({why}), got {got}")]
+    OutOfBound {
+        /// The bound in words.
+        bound: String,
+        /// Why.
+        why: &'static str,
+        /// The value, as [`show`] writes it.
+        got: String,
+    },
+    /// A number where the row bounds a list.
+    #[error("expected a list, got a number")]
+    NotAList,
+}
+
+impl LimitError {
+    fn new(path: impl Into<String>, kind: LimitErrorKind) -> Self {
+        LimitError {
+            path: path.into(),
+            kind,
+        }
+    }
+}
+
+/// Checks every number and list of a scenario's table against [`LIMITS`]; errors name the key
+/// path. Tables of planners are left to the planner registry.
+pub fn check(table: &toml::Table) -> Result<(), LimitError> {
     walk(&toml::Value::Table(table.clone()), "", "")
 }
 
@@ -628,7 +697,7 @@ fn join(a: &str, b: &str) -> String {
     }
 }
 
-fn walk(v: &toml::Value, path: &str, pattern: &str) -> Result<(), (String, String)> {
+fn walk(v: &toml::Value, path: &str, pattern: &str) -> Result<(), LimitError> {
     match v {
         toml::Value::Table(t) => {
             for (k, x) in t {
@@ -638,9 +707,13 @@ fn walk(v: &toml::Value, path: &str, pattern: &str) -> Result<(), (String, Strin
                         && let Bound::Count(max) = n.bound
                         && p.len() > max
                     {
-                        return Err((
-                            "planners".into(),
-                            format!("{} tables; {} ({})", p.len(), n.bound.describe(), n.why),
+                        return Err(LimitError::new(
+                            "planners",
+                            LimitErrorKind::TooManyTables {
+                                count: p.len(),
+                                bound: n.bound.describe(),
+                                why: n.why,
+                            },
                         ));
                     }
                     continue;
@@ -654,9 +727,13 @@ fn walk(v: &toml::Value, path: &str, pattern: &str) -> Result<(), (String, Strin
                 && let Bound::Count(max) = l.bound
                 && a.len() > max
             {
-                return Err((
-                    path.to_string(),
-                    format!("{} entries; {} ({})", a.len(), l.bound.describe(), l.why),
+                return Err(LimitError::new(
+                    path,
+                    LimitErrorKind::TooManyEntries {
+                        count: a.len(),
+                        bound: l.bound.describe(),
+                        why: l.why,
+                    },
                 ));
             }
             for (i, x) in a.iter().enumerate() {
@@ -670,12 +747,9 @@ fn walk(v: &toml::Value, path: &str, pattern: &str) -> Result<(), (String, Strin
     }
 }
 
-fn number(v: f64, path: &str, pattern: &str) -> Result<(), (String, String)> {
+fn number(v: f64, path: &str, pattern: &str) -> Result<(), LimitError> {
     let Some(l) = limit(pattern) else {
-        return Err((
-            path.to_string(),
-            "this number has no documented bound (a key of the format without one)".into(),
-        ));
+        return Err(LimitError::new(path, LimitErrorKind::NoBound));
     };
     match l.bound {
         Bound::Number { min, min_open, max } => {
@@ -683,18 +757,17 @@ fn number(v: f64, path: &str, pattern: &str) -> Result<(), (String, String)> {
             if v.is_finite() && low && v <= max {
                 Ok(())
             } else {
-                Err((
-                    path.to_string(),
-                    format!(
-                        "must be {} ({}), got {}",
-                        l.bound.describe(),
-                        l.why,
-                        show(v)
-                    ),
+                Err(LimitError::new(
+                    path,
+                    LimitErrorKind::OutOfBound {
+                        bound: l.bound.describe(),
+                        why: l.why,
+                        got: show(v),
+                    },
                 ))
             }
         }
-        Bound::Count(_) => Err((path.to_string(), "expected a list, got a number".into())),
+        Bound::Count(_) => Err(LimitError::new(path, LimitErrorKind::NotAList)),
         Bound::Any => Ok(()),
     }
 }
@@ -761,14 +834,19 @@ mod tests {
                 "no documented bound",
             ),
         ];
+        let error = |text: &str| {
+            check(&table(text))
+                .err()
+                .map(|e| (e.path, e.kind.to_string()))
+                .unwrap_or_default()
+        };
         for (text, key, message) in cases {
-            let e = check(&table(text)).err().unwrap_or_default();
+            let e = error(text);
             assert_eq!(e.0, key, "{text}");
             assert!(e.1.contains(message), "{text}: {}", e.1);
         }
         let many = format!("vehicles = [{}]", vec!["{ x_m = 1.0 }"; 101].join(", "));
-        let e = check(&table(&many)).err().unwrap_or_default();
-        assert_eq!(e.0, "vehicles");
+        assert_eq!(error(&many).0, "vehicles");
         // Planner tables are the registry's.
         assert!(
             check(&table(

@@ -499,3 +499,89 @@ fn bad_salinity_modem_and_ranging_keys_name_themselves() {
         assert!(e.contains(key), "{key}: {e}");
     }
 }
+
+/// The models name only their own fields; the scenario places their errors under the section's
+/// key path, with the models' messages as they are.
+#[test]
+fn model_errors_are_placed_under_their_section() {
+    let plume = find_preset("plume-demo").unwrap().toml;
+    let demo = find_preset("demo").unwrap().toml;
+    let vehicle = |table: &str| {
+        format!("{plume}\n[[vehicles]]\nkind = \"auv\"\nx_m = 20.0\ny_m = 0.0\n{table}")
+    };
+    let cases: Vec<(String, &str)> = vec![
+        (
+            plume
+                .replace("model = \"filaments\"", "model = \"gaussian\"")
+                .replace(
+                    "vertical_diffusivity_m2ps = 0.005",
+                    "vertical_diffusivity_m2ps = 0.0",
+                ),
+            "plume.vertical_diffusivity_m2ps: the steady plume needs at least 1e-6 m^2/s (its \
+             width goes as the square root of it), got 0.0",
+        ),
+        (
+            plume
+                .replace("model = \"filaments\"", "model = \"gaussian\"")
+                .replace("z_m = 0.0 ", "z_m = 5000.0"),
+            "sources[0].z_m: 5000 m is above the surface (10 m)",
+        ),
+        (
+            format!(
+                "{plume}\n[[obstacles]]\nvertices = [[0.0, 0.0], [9.0, 9.0], [9.0, 0.0], [0.0, 9.0]]\n"
+            ),
+            "obstacles[0].vertices: the polygon crosses itself: edges 0 and 2 meet (edge k runs \
+             from vertex k to the next)",
+        ),
+        (
+            format!(
+                "{plume}\n[[kelp]]\nregion = [[0.0, 0.0], [90.0, 0.0], [90.0, 40.0]]\npatches = 2\nradius_m = [5.0, 1.0]\n"
+            ),
+            "kelp[0].radius_m: needs 0 < smallest <= largest, got [5, 1]",
+        ),
+        (
+            format!("{plume}\n[[kelp]]\nregion = [[0.0, 0.0], [90.0, 0.0]]\npatches = 2\n"),
+            "kelp[0].region: needs at least 3 vertices, got 2",
+        ),
+        (
+            vehicle("[vehicles.range_sensor]\ndetection_probability = 0.0\n"),
+            "vehicles[0].range_sensor.detection_probability: must be in (0, 1]",
+        ),
+        (
+            vehicle("[vehicles.range_sensor]\nfront_half_angle_deg = 100.0\n"),
+            "vehicles[0].range_sensor.side_outer_angle_deg: needs 0 < front_half_angle_deg < \
+             side_outer_angle_deg <= 180",
+        ),
+        (
+            demo.replace(
+                "op_area = [[60.0, -80.0], [460.0, -80.0], [460.0, 80.0], [60.0, 80.0]]",
+                "op_area = [[60.0, -80.0], [460.0, 80.0], [460.0, -40.0], [60.0, 80.0]]",
+            ),
+            "mission.op_area: the polygon crosses itself: edges 0 and 2 meet (edge k runs from \
+             vertex k to the next)",
+        ),
+        (
+            demo.replace(
+                "op_area = [[60.0, -80.0], [460.0, -80.0], [460.0, 80.0], [60.0, 80.0]]",
+                "op_area = [[60.0, -80.0], [260.0, -80.0], [460.0, -80.0]]",
+            ),
+            "mission.op_area: has zero area",
+        ),
+        (
+            demo.replace("env_dt_s = 5.0", "env_dt_s = 0.25"),
+            "mission.env_dt_s: must be a whole multiple of sim.dt_s (0.1), got 0.25",
+        ),
+        (
+            demo.replace(
+                "[planner]",
+                "[comms.ranging]\nsound_speed_mps = 0.0\n[planner]",
+            ),
+            "comms.ranging.sound_speed_mps: must be > 0.0 and <= 1000000000.0 (finite), got 0.0",
+        ),
+    ];
+    for (text, want) in cases {
+        let got = error_of(&text);
+        let got = got.strip_prefix("scenario.toml: ").unwrap_or(&got);
+        assert_eq!(got, want);
+    }
+}

@@ -59,20 +59,20 @@ impl ChannelParams {
         one_in_flight: false,
     };
 
-    /// Checks every parameter; `key` prefixes the names in errors.
-    pub fn validate(&self, key: &str) -> Result<(), EnvError> {
-        require_non_negative(&format!("{key}.latency_s"), self.latency_s)?;
+    /// Checks every parameter; errors name the field.
+    pub fn validate(&self) -> Result<(), EnvError> {
+        require_non_negative("latency_s", self.latency_s)?;
         if let Some(c) = self.sound_speed_mps {
-            require_positive(&format!("{key}.sound_speed_mps"), c)?;
+            require_positive("sound_speed_mps", c)?;
         }
         if !(self.loss_probability.is_finite() && (0.0..=1.0).contains(&self.loss_probability)) {
             return Err(EnvError::invalid(
-                format!("{key}.loss_probability"),
+                "loss_probability",
                 format!("must be in [0, 1], got {}", self.loss_probability),
             ));
         }
         if let Some(r) = self.max_range_m {
-            require_positive(&format!("{key}.max_range_m"), r)?;
+            require_positive("max_range_m", r)?;
         }
         Ok(())
     }
@@ -103,10 +103,10 @@ impl Default for RangingParams {
 }
 
 impl RangingParams {
-    /// Checks every parameter; `key` prefixes the names in errors.
-    pub fn validate(&self, key: &str) -> Result<(), EnvError> {
-        require_non_negative(&format!("{key}.timing_noise_sd_s"), self.timing_noise_sd_s)?;
-        require_positive(&format!("{key}.sound_speed_mps"), self.sound_speed_mps)
+    /// Checks every parameter; errors name the field.
+    pub fn validate(&self) -> Result<(), EnvError> {
+        require_non_negative("timing_noise_sd_s", self.timing_noise_sd_s)?;
+        require_positive("sound_speed_mps", self.sound_speed_mps)
     }
 
     /// Standard deviation of a measured range, m.
@@ -128,6 +128,13 @@ pub struct CommsParams {
 }
 
 impl CommsParams {
+    /// Checks every channel; errors name the channel's field (`acoustic.latency_s`).
+    pub fn validate(&self) -> Result<(), EnvError> {
+        self.acoustic.validate().map_err(|e| e.under("acoustic"))?;
+        self.radio.validate().map_err(|e| e.under("radio"))?;
+        self.ranging.validate().map_err(|e| e.under("ranging"))
+    }
+
     /// The model of one link.
     pub fn channel(&self, link: Link) -> &ChannelParams {
         match link {

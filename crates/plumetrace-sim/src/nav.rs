@@ -75,21 +75,15 @@ impl NavParams {
         }
     }
 
-    /// Checks every parameter; `key` prefixes the names in errors.
-    pub fn validate(&self, key: &str) -> Result<(), EnvError> {
-        require_positive(&format!("{key}.fix_interval_s"), self.fix_interval_s)?;
-        require_non_negative(&format!("{key}.fix_sigma_m"), self.fix_sigma_m)?;
-        require_non_negative(
-            &format!("{key}.velocity_error_sd_mps"),
-            self.velocity_error_sd_mps,
-        )?;
-        require_positive(
-            &format!("{key}.velocity_error_tau_s"),
-            self.velocity_error_tau_s,
-        )?;
-        require_non_negative(&format!("{key}.heading_sd_deg"), self.heading_sd_deg)?;
-        require_non_negative(&format!("{key}.speed_sd_mps"), self.speed_sd_mps)?;
-        require_non_negative(&format!("{key}.altimeter_sd_m"), self.altimeter_sd_m)
+    /// Checks every parameter; errors name the field.
+    pub fn validate(&self) -> Result<(), EnvError> {
+        require_positive("fix_interval_s", self.fix_interval_s)?;
+        require_non_negative("fix_sigma_m", self.fix_sigma_m)?;
+        require_non_negative("velocity_error_sd_mps", self.velocity_error_sd_mps)?;
+        require_positive("velocity_error_tau_s", self.velocity_error_tau_s)?;
+        require_non_negative("heading_sd_deg", self.heading_sd_deg)?;
+        require_non_negative("speed_sd_mps", self.speed_sd_mps)?;
+        require_non_negative("altimeter_sd_m", self.altimeter_sd_m)
     }
 }
 

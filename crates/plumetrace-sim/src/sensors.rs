@@ -95,20 +95,17 @@ impl Default for ChemSensorParams {
 }
 
 impl ChemSensorParams {
-    /// Checks every parameter; `key` prefixes the names in errors.
-    pub fn validate(&self, key: &str) -> Result<(), EnvError> {
-        require_positive(&format!("{key}.rate_hz"), self.rate_hz)?;
-        require_positive(&format!("{key}.volts_per_unit"), self.volts_per_unit)?;
-        require_positive(&format!("{key}.full_scale_v"), self.full_scale_v)?;
-        require_non_negative(&format!("{key}.noise_sd_v"), self.noise_sd_v)?;
-        require_non_negative(
-            &format!("{key}.lag_time_constant_s"),
-            self.lag_time_constant_s,
-        )?;
+    /// Checks every parameter; errors name the field.
+    pub fn validate(&self) -> Result<(), EnvError> {
+        require_positive("rate_hz", self.rate_hz)?;
+        require_positive("volts_per_unit", self.volts_per_unit)?;
+        require_positive("full_scale_v", self.full_scale_v)?;
+        require_non_negative("noise_sd_v", self.noise_sd_v)?;
+        require_non_negative("lag_time_constant_s", self.lag_time_constant_s)?;
         if let Some(s) = &self.salinity {
-            require_positive(&format!("{key}.medium_salinity_ppt"), s.medium_ppt)?;
-            require_positive(&format!("{key}.fresh_density_kgpm3"), s.fresh_density_kgpm3)?;
-            require_non_negative(&format!("{key}.noise_sd_ppt"), s.noise_sd_ppt)?;
+            require_positive("medium_salinity_ppt", s.medium_ppt)?;
+            require_positive("fresh_density_kgpm3", s.fresh_density_kgpm3)?;
+            require_non_negative("noise_sd_ppt", s.noise_sd_ppt)?;
         }
         Ok(())
     }
@@ -215,21 +212,18 @@ impl Default for FlowSensorParams {
 }
 
 impl FlowSensorParams {
-    /// Checks every parameter; `key` prefixes the names in errors.
-    pub fn validate(&self, key: &str) -> Result<(), EnvError> {
-        require_positive(&format!("{key}.rate_hz"), self.rate_hz)?;
-        require_non_negative(&format!("{key}.noise_sd_mps"), self.noise_sd_mps)?;
+    /// Checks every parameter; errors name the field.
+    pub fn validate(&self) -> Result<(), EnvError> {
+        require_positive("rate_hz", self.rate_hz)?;
+        require_non_negative("noise_sd_mps", self.noise_sd_mps)?;
         if !(self.bias_mps[0].is_finite() && self.bias_mps[1].is_finite()) {
-            return Err(EnvError::invalid(
-                format!("{key}.bias_mps"),
-                "must be finite",
-            ));
+            return Err(EnvError::invalid("bias_mps", "must be finite"));
         }
         if let Some(f) = self.fault
             && !(f.start_s.is_finite() && f.end_s.is_finite() && f.end_s >= f.start_s)
         {
             return Err(EnvError::invalid(
-                format!("{key}.fault_end_s"),
+                "fault_end_s",
                 "needs finite fault_start_s <= fault_end_s",
             ));
         }
@@ -307,6 +301,40 @@ impl Default for RangeSensorParams {
             noise_sd_m: 0.2,
             detection_probability: 0.8,
         }
+    }
+}
+
+impl RangeSensorParams {
+    /// The most rays per group: rays are cast at every step.
+    pub const MAX_RAYS_PER_GROUP: usize = 1000;
+
+    /// Checks every parameter; errors name the field (`rate_hz`).
+    pub fn validate(&self) -> Result<(), EnvError> {
+        require_positive("rate_hz", self.rate_hz)?;
+        require_non_negative("noise_sd_m", self.noise_sd_m)?;
+        if !(self.detection_probability > 0.0 && self.detection_probability <= 1.0) {
+            return Err(EnvError::invalid(
+                "detection_probability",
+                "must be in (0, 1]",
+            ));
+        }
+        require_positive("max_range_m", self.max_range_m)?;
+        if !(1..=Self::MAX_RAYS_PER_GROUP).contains(&self.rays_per_group) {
+            return Err(EnvError::invalid(
+                "rays_per_group",
+                format!("must be 1..={}", Self::MAX_RAYS_PER_GROUP),
+            ));
+        }
+        if !(self.front_half_angle_deg > 0.0
+            && self.side_outer_angle_deg > self.front_half_angle_deg
+            && self.side_outer_angle_deg <= 180.0)
+        {
+            return Err(EnvError::invalid(
+                "side_outer_angle_deg",
+                "needs 0 < front_half_angle_deg < side_outer_angle_deg <= 180",
+            ));
+        }
+        Ok(())
     }
 }
 
@@ -465,7 +493,6 @@ mod tests {
         let wall = SoftObstacle::new(
             "wall",
             &[[10.0, -50.0], [12.0, -50.0], [12.0, 50.0], [10.0, 50.0]],
-            "obstacles[0]",
         )
         .unwrap();
         let obstacles = ObstacleSet::new(vec![wall]);
@@ -500,7 +527,6 @@ mod tests {
         let wall = SoftObstacle::new(
             "wall",
             &[[10.0, -50.0], [12.0, -50.0], [12.0, 50.0], [10.0, 50.0]],
-            "obstacles[0]",
         )
         .unwrap();
         let obstacles = ObstacleSet::new(vec![wall]);

@@ -52,29 +52,14 @@ impl VehicleParams {
         }
     }
 
-    /// Checks every parameter; `key` prefixes the names in errors (e.g. `vehicles[0]`).
-    pub fn validate(&self, key: &str) -> Result<(), EnvError> {
-        require_positive(&format!("{key}.max_speed_mps"), self.max_speed_mps)?;
-        require_positive(
-            &format!("{key}.max_turn_rate_deg_s"),
-            self.max_turn_rate_deg_s,
-        )?;
-        require_positive(
-            &format!("{key}.speed_time_constant_s"),
-            self.speed_time_constant_s,
-        )?;
-        require_positive(
-            &format!("{key}.vertical_time_constant_s"),
-            self.vertical_time_constant_s,
-        )?;
-        require_non_negative(
-            &format!("{key}.altitude_error_sd_m"),
-            self.altitude_error_sd_m,
-        )?;
-        require_positive(
-            &format!("{key}.altitude_error_time_s"),
-            self.altitude_error_time_s,
-        )
+    /// Checks every parameter; errors name the field (`max_speed_mps`).
+    pub fn validate(&self) -> Result<(), EnvError> {
+        require_positive("max_speed_mps", self.max_speed_mps)?;
+        require_positive("max_turn_rate_deg_s", self.max_turn_rate_deg_s)?;
+        require_positive("speed_time_constant_s", self.speed_time_constant_s)?;
+        require_positive("vertical_time_constant_s", self.vertical_time_constant_s)?;
+        require_non_negative("altitude_error_sd_m", self.altitude_error_sd_m)?;
+        require_positive("altitude_error_time_s", self.altitude_error_time_s)
     }
 }
 
@@ -314,16 +299,17 @@ mod tests {
             v.step(&cmd(0.0, 1.0, 1.0), Vec2::zeros(), Some(4.0), 0.1, &mut rng);
         }
         assert!((v.state.z_m - 4.0).abs() < 1e-12);
-        assert!(VehicleParams::auv().validate("vehicles[0]").is_ok());
+        assert!(VehicleParams::auv().validate().is_ok());
         let bad = VehicleParams {
             max_speed_mps: -1.0,
             ..VehicleParams::auv()
         };
         assert!(
-            bad.validate("vehicles[0]")
+            bad.validate()
                 .unwrap_err()
+                .under("vehicles[0].dynamics")
                 .to_string()
-                .starts_with("vehicles[0].max_speed_mps")
+                .starts_with("vehicles[0].dynamics.max_speed_mps")
         );
     }
 }

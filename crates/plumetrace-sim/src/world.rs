@@ -418,6 +418,14 @@ impl World {
     }
 }
 
+/// How many vehicle steps of `dt_s` make one environment step of `env_dt_s`: `None` unless
+/// `env_dt_s` is a whole multiple (1 or more, within 1e-9) of `dt_s`.
+pub fn steps_per_env_step(env_dt_s: f64, dt_s: f64) -> Option<u64> {
+    let ratio = env_dt_s / dt_s;
+    (env_dt_s.is_finite() && ratio >= 1.0 - 1e-9 && (ratio - ratio.round()).abs() < 1e-9)
+        .then(|| ratio.round() as u64)
+}
+
 impl Fleet {
     /// A fleet stepping `vehicles` at `dt_s` in `env` (whose step must be a whole number of
     /// vehicle steps), with the given channel models, their losses drawn from the run `seed`.
@@ -429,17 +437,16 @@ impl Fleet {
         comms: CommsParams,
         seed: u64,
     ) -> Result<Self, EnvError> {
-        plumetrace_env::error::require_positive("sim.dt_s", dt_s)?;
-        let ratio = env.dt_s() / dt_s;
-        if (ratio - ratio.round()).abs() > 1e-9 || ratio < 0.5 {
+        plumetrace_env::error::require_positive("dt_s", dt_s)?;
+        let Some(env_every) = steps_per_env_step(env.dt_s(), dt_s) else {
             return Err(EnvError::invalid(
-                "mission.env_dt_s",
+                "env",
                 format!(
-                    "must be a whole multiple of sim.dt_s ({dt_s}), got {}",
+                    "its step must be a whole multiple of dt_s ({dt_s}), got {}",
                     env.dt_s()
                 ),
             ));
-        }
+        };
         if let Some(k) = vehicles
             .iter()
             .enumerate()
@@ -450,14 +457,12 @@ impl Fleet {
                 "vehicle ids must be their index in the list",
             ));
         }
-        comms.acoustic.validate("comms.acoustic")?;
-        comms.radio.validate("comms.radio")?;
-        comms.ranging.validate("comms.ranging")?;
+        comms.validate().map_err(|e| e.under("comms"))?;
         Ok(Fleet {
             vehicles,
             dt_s,
             env_dt_s: env.dt_s(),
-            env_every: ratio.round() as u64,
+            env_every,
             env_start: env.steps(),
             step: 0,
             water_depth_m,

@@ -116,7 +116,6 @@ fn a_vehicle_that_enters_kelp_or_leaves_the_domain_is_stopped_with_an_incident()
     let kelp = SoftObstacle::new(
         "kelp",
         &[[60.0, 40.0], [80.0, 40.0], [80.0, 60.0], [60.0, 60.0]],
-        "obstacles[0]",
     )
     .unwrap();
     let mut w = World::new(

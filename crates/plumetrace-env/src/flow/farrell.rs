@@ -40,9 +40,9 @@ use serde::{Deserialize, Serialize};
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct FarrellParams {
-    /// Grid nodes along x (East), >= 3.
+    /// Grid nodes along x (East), [`FarrellParams::MIN_NODES`] to [`FarrellParams::MAX_NODES`].
     pub nx: usize,
-    /// Grid nodes along y (North), >= 3.
+    /// Grid nodes along y (North), as `nx`.
     pub ny: usize,
     /// Diffusivity along x, m^2/s (`k_x` of the paper).
     pub diffusivity_x_m2ps: f64,
@@ -76,6 +76,35 @@ pub enum NoiseScheme {
     /// Explicit Euler-Maruyama, as in the reference implementation: its stationary variance
     /// grows with the step, and it limits the step to the oscillator's Euler limit.
     Euler,
+}
+
+impl FarrellParams {
+    /// The fewest grid nodes along an axis.
+    pub const MIN_NODES: usize = 3;
+    /// The most grid nodes along an axis: a million nodes at most (memory and step time).
+    pub const MAX_NODES: usize = 1000;
+
+    /// Checks every parameter; errors name the field (`nx`).
+    pub fn validate(&self) -> Result<(), EnvError> {
+        for (key, n) in [("nx", self.nx), ("ny", self.ny)] {
+            if !(Self::MIN_NODES..=Self::MAX_NODES).contains(&n) {
+                return Err(EnvError::invalid(
+                    key,
+                    format!(
+                        "must be >= {} and <= {}, got {n}",
+                        Self::MIN_NODES,
+                        Self::MAX_NODES
+                    ),
+                ));
+            }
+        }
+        require_positive("diffusivity_x_m2ps", self.diffusivity_x_m2ps)?;
+        require_positive("diffusivity_y_m2ps", self.diffusivity_y_m2ps)?;
+        require_non_negative("noise_gain", self.noise_gain)?;
+        require_non_negative("step_s", self.step_s)?;
+        require_positive("noise_damping", self.noise_damping)?;
+        require_positive("noise_bandwidth_radps", self.noise_bandwidth_radps)
+    }
 }
 
 impl Default for FarrellParams {
@@ -306,18 +335,19 @@ pub struct FarrellFlow {
 }
 
 impl FarrellFlow {
-    /// Builds the field over `region`, checking that `dt_s` is within the stable limit.
+    /// Builds the field over `region`, checking that `dt_s` is within the stable limit. Errors
+    /// name the parameters' fields (`nx`), the mean flow's under `mean` and the step as `dt_s`.
     pub fn new(
         region: Rect,
         mean: MeanFlow,
         params: FarrellParams,
         dt_s: f64,
     ) -> Result<Self, EnvError> {
-        require_positive("sim.dt_s", dt_s)?;
+        require_positive("dt_s", dt_s)?;
         let flow = Self::build(region, mean, params, dt_s)?;
         if dt_s >= flow.max_stable_dt_s {
             return Err(EnvError::invalid(
-                "sim.dt_s",
+                "dt_s",
                 format!(
                     "{dt_s} s is above the Farrell flow grid's stable limit of {:.4} s \
                      (grid step {:.2} m x {:.2} m); use a smaller dt_s, a coarser grid or larger diffusivities",
@@ -353,34 +383,8 @@ impl FarrellFlow {
         params: FarrellParams,
         dt_s: f64,
     ) -> Result<Self, EnvError> {
-        mean.validate("flow.mean")?;
-        if params.nx < 3 {
-            return Err(EnvError::invalid(
-                "flow.farrell.nx",
-                format!("must be >= 3, got {}", params.nx),
-            ));
-        }
-        if params.ny < 3 {
-            return Err(EnvError::invalid(
-                "flow.farrell.ny",
-                format!("must be >= 3, got {}", params.ny),
-            ));
-        }
-        if params.nx.saturating_mul(params.ny) > 4_000_000 {
-            return Err(EnvError::invalid(
-                "flow.farrell.nx",
-                "nx * ny must be at most 4,000,000",
-            ));
-        }
-        require_positive("flow.farrell.diffusivity_x_m2ps", params.diffusivity_x_m2ps)?;
-        require_positive("flow.farrell.diffusivity_y_m2ps", params.diffusivity_y_m2ps)?;
-        require_non_negative("flow.farrell.noise_gain", params.noise_gain)?;
-        require_non_negative("flow.farrell.step_s", params.step_s)?;
-        require_positive("flow.farrell.noise_damping", params.noise_damping)?;
-        require_positive(
-            "flow.farrell.noise_bandwidth_radps",
-            params.noise_bandwidth_radps,
-        )?;
+        mean.validate().map_err(|e| e.under("mean"))?;
+        params.validate()?;
         let dx_m = region.width_m() / (params.nx - 1) as f64;
         let dy_m = region.height_m() / (params.ny - 1) as f64;
         let noise = ColouredNoise::new(
@@ -1001,7 +1005,7 @@ mod tests {
             .err()
             .map(|e| e.to_string())
             .unwrap_or_default();
-        assert!(err.contains("sim.dt_s") && err.contains("1.0000"), "{err}");
+        assert!(err.starts_with("dt_s") && err.contains("1.0000"), "{err}");
         // The check is strict: at the limit itself Euler is only marginally stable.
         assert!(FarrellFlow::new(region, steady(0.1, 90.0), params, 1.0).is_err());
         assert!(FarrellFlow::new(region, steady(0.1, 90.0), params, 0.999).is_ok());
@@ -1044,7 +1048,7 @@ mod tests {
             .err()
             .map(|e| e.to_string())
             .unwrap_or_default();
-        assert!(err.contains("sim.dt_s"), "{err}");
+        assert!(err.starts_with("dt_s"), "{err}");
         let f = FarrellFlow::new(region, steady(0.1, 90.0), params, 0.5).unwrap();
         assert!((f.max_stable_dt_s().unwrap() - want).abs() < 1e-12);
         // Stepping at 2 s with these parameters diverges, at 0.5 s it stays bounded.
@@ -1106,7 +1110,7 @@ mod tests {
             .map(|e| e.to_string());
         let err = err.unwrap_or_default();
         assert!(
-            err.starts_with("sim.dt_s") && err.contains("stable limit"),
+            err.starts_with("dt_s") && err.contains("stable limit"),
             "{err}"
         );
         assert!(FarrellFlow::new(pompy_region(), steady(1.0, 90.0), params, 0.02).is_ok());

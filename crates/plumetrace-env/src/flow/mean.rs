@@ -38,15 +38,15 @@ pub enum MeanFlow {
 }
 
 impl MeanFlow {
-    /// Checks the parameters; `key` prefixes the names in errors.
-    pub fn validate(&self, key: &str) -> Result<(), EnvError> {
+    /// Checks the parameters; errors name the field (`speed_mps`).
+    pub fn validate(&self) -> Result<(), EnvError> {
         match *self {
             MeanFlow::Steady {
                 speed_mps,
                 toward_deg,
             } => {
-                require_non_negative(&format!("{key}.speed_mps"), speed_mps)?;
-                require_finite(&format!("{key}.toward_deg"), toward_deg)
+                require_non_negative("speed_mps", speed_mps)?;
+                require_finite("toward_deg", toward_deg)
             }
             MeanFlow::Tidal {
                 speed_min_mps,
@@ -56,18 +56,18 @@ impl MeanFlow {
                 period_s,
                 phase_deg,
             } => {
-                require_non_negative(&format!("{key}.speed_min_mps"), speed_min_mps)?;
-                require_non_negative(&format!("{key}.speed_max_mps"), speed_max_mps)?;
+                require_non_negative("speed_min_mps", speed_min_mps)?;
+                require_non_negative("speed_max_mps", speed_max_mps)?;
                 if speed_max_mps < speed_min_mps {
                     return Err(EnvError::invalid(
-                        format!("{key}.speed_max_mps"),
+                        "speed_max_mps",
                         format!("must be >= speed_min_mps ({speed_min_mps}), got {speed_max_mps}"),
                     ));
                 }
-                require_finite(&format!("{key}.toward_min_deg"), toward_min_deg)?;
-                require_finite(&format!("{key}.toward_max_deg"), toward_max_deg)?;
-                require_positive(&format!("{key}.period_s"), period_s)?;
-                require_finite(&format!("{key}.phase_deg"), phase_deg)
+                require_finite("toward_min_deg", toward_min_deg)?;
+                require_finite("toward_max_deg", toward_max_deg)?;
+                require_positive("period_s", period_s)?;
+                require_finite("phase_deg", phase_deg)
             }
         }
     }
@@ -120,7 +120,7 @@ mod tests {
             period_s: 3600.0,
             phase_deg: 0.0,
         };
-        assert!(m.validate("flow").is_ok());
+        assert!(m.validate().is_ok());
         let (mut smin, mut smax, mut dmin, mut dmax) = (f64::MAX, f64::MIN, f64::MAX, f64::MIN);
         for k in 0..3600 {
             let v = m.velocity_at(f64::from(k));
@@ -173,15 +173,15 @@ mod tests {
             phase_deg: 0.0,
         };
         let e = m
-            .validate("flow.mean")
+            .validate()
             .err()
             .map(|e| e.to_string())
             .unwrap_or_default();
-        assert!(e.contains("flow.mean.speed_max_mps"), "{e}");
+        assert!(e.starts_with("speed_max_mps:"), "{e}");
         let s = MeanFlow::Steady {
             speed_mps: -1.0,
             toward_deg: 0.0,
         };
-        assert!(s.validate("flow").is_err());
+        assert!(s.validate().is_err());
     }
 }

@@ -13,9 +13,9 @@ pub struct UniformFlow {
 }
 
 impl UniformFlow {
-    /// A uniform flow starting at t = 0.
+    /// A uniform flow starting at t = 0; errors name the mean flow's field under `mean`.
     pub fn new(mean: MeanFlow) -> Result<Self, EnvError> {
-        mean.validate("flow.mean")?;
+        mean.validate().map_err(|e| e.under("mean"))?;
         Ok(UniformFlow {
             mean,
             time_s: 0.0,

@@ -87,33 +87,31 @@ impl Default for FilamentParams {
 }
 
 impl FilamentParams {
-    /// Checks every parameter; errors name the `plume.*` key.
+    /// Checks every parameter; errors name the scenario's `[plume]` key of each
+    /// (`init_radius_m`, `horizontal_diffusivity_m2ps`), the water depth as `depth_m`.
     pub fn validate(&self) -> Result<(), EnvError> {
         match self.dispersion {
             Dispersion::Physical {
                 horizontal_m2ps,
                 vertical_m2ps,
             } => {
-                require_non_negative("plume.horizontal_diffusivity_m2ps", horizontal_m2ps)?;
-                require_non_negative("plume.vertical_diffusivity_m2ps", vertical_m2ps)?;
+                require_non_negative("horizontal_diffusivity_m2ps", horizontal_m2ps)?;
+                require_non_negative("vertical_diffusivity_m2ps", vertical_m2ps)?;
             }
             Dispersion::PompyCompatible { scale_mps } => {
                 for s in scale_mps {
-                    require_non_negative("plume.pompy_diff_scale_mps", s)?;
+                    require_non_negative("pompy_diff_scale_mps", s)?;
                 }
             }
         }
-        require_positive("plume.init_radius_m", self.init_radius_m)?;
-        require_non_negative("plume.growth_rate_m2ps", self.growth_rate_m2ps)?;
-        require_positive("plume.cutoff_radii", self.cutoff_radii)?;
+        require_positive("init_radius_m", self.init_radius_m)?;
+        require_non_negative("growth_rate_m2ps", self.growth_rate_m2ps)?;
+        require_positive("cutoff_radii", self.cutoff_radii)?;
         if self.max_filaments == 0 {
-            return Err(EnvError::invalid(
-                "plume.max_filaments",
-                "must be at least 1",
-            ));
+            return Err(EnvError::invalid("max_filaments", "must be at least 1"));
         }
         if let VerticalBoundary::Reflecting { depth_m: Some(d) } = self.vertical {
-            require_positive("domain.depth_m", d)?;
+            require_positive("depth_m", d)?;
         }
         Ok(())
     }
@@ -252,15 +250,24 @@ impl BlockBox {
 }
 
 impl FilamentPlume {
-    /// A plume with no filaments yet.
+    /// The most sources of a plume: the step and the query time grow with them (and a filament
+    /// keeps its source's index in 16 bits).
+    pub const MAX_SOURCES: usize = 1000;
+    const _SOURCE_INDEX_FITS: () = assert!(Self::MAX_SOURCES <= u16::MAX as usize);
+
+    /// A plume with no filaments yet. Errors name the parameters as [`FilamentParams::validate`]
+    /// does and a source as `sources[k]`.
     pub fn new(
         domain: Rect,
         sources: Vec<Source>,
         params: FilamentParams,
     ) -> Result<Self, EnvError> {
         params.validate()?;
-        if sources.len() > usize::from(u16::MAX) {
-            return Err(EnvError::invalid("sources", "at most 65535 sources"));
+        if sources.len() > Self::MAX_SOURCES {
+            return Err(EnvError::invalid(
+                "sources",
+                format!("at most {} sources", Self::MAX_SOURCES),
+            ));
         }
         for (k, s) in sources.iter().enumerate() {
             let key = |f: &str| format!("sources[{k}].{f}");

@@ -1,0 +1,236 @@
+//! The build phase: turns a parsed [`ScenarioConfig`] into models, checking every value and
+//! naming the key path of anything wrong.
+//!
+//! One module per section of the file, in the order the sections are built (the first error
+//! found is the one reported): `timing` (`[sim]`, `mission.env_dt_s`), `domain`, `flow`,
+//! `plume` (with `[[sources]]`), `obstacles` (with `[[kelp]]`), `vehicles` (their `sensors` and
+//! planners), `comms`, `mission` and `output`. Each section's key paths are spelled in its
+//! module: the models' errors name only their own fields
+//! ([`plumetrace_env::EnvError::under`]), and the section places them under its path. Every
+//! number's own bound is the limits table's ([`crate::limits`]), checked before anything is
+//! built; the sections check what involves several keys or a model's own validity.
+
+mod comms;
+mod domain;
+mod flow;
+mod mission;
+mod obstacles;
+mod output;
+mod plume;
+mod sensors;
+mod timing;
+mod vehicles;
+
+pub use mission::DEFAULT_DROP_MARGIN_M;
+
+use crate::config::ScenarioConfig;
+use crate::{Origin, ScenarioError};
+use plumetrace_core::Vec3;
+use plumetrace_env::{EnvError, Environment, GridSpec, ObstacleSet};
+use std::path::{Path, PathBuf};
+
+/// What a plume run writes and how often it samples.
+#[derive(Debug, Clone, PartialEq)]
+pub struct OutputSpec {
+    /// The snapshot / time-average grid.
+    pub grid: GridSpec,
+    /// Steps between time-average samples.
+    pub average_every_steps: u64,
+    /// First step of the time average.
+    pub average_start_step: u64,
+    /// Intermittency threshold.
+    pub threshold: f64,
+    /// Probe points (z above the seabed), each inside the domain; empty: no probe series.
+    pub probes: Vec<Vec3>,
+    /// Steps between probe samples: every step that is a multiple of it, from the first.
+    pub probe_every_steps: u64,
+    /// Steps between filament snapshots; `None`: no filament series.
+    pub filaments_every_steps: Option<u64>,
+}
+
+/// A vehicle ready to be put in a world: the truth at t = 0 and its navigation and sensors.
+#[derive(Debug, Clone)]
+pub struct VehicleSetup {
+    /// Name for logs and plots.
+    pub name: String,
+    /// Dynamics and true initial state.
+    pub vehicle: plumetrace_sim::Vehicle,
+    /// Navigation.
+    pub nav: plumetrace_sim::NavParams,
+    /// Chemical sensor.
+    pub chem_sensor: plumetrace_sim::ChemSensorParams,
+    /// Flow sensor.
+    pub flow_sensor: plumetrace_sim::FlowSensorParams,
+    /// Obstacle range sensors, if fitted.
+    pub range_sensor: Option<plumetrace_sim::RangeSensorParams>,
+    /// The planner it flies, as written (checked by the planner registry when the mission is
+    /// built); `None`: no planner, the vehicle keeps its last command.
+    pub planner: Option<PlannerRef>,
+    /// `[vehicles.chem_sensor] threshold_v`, if given: the detection threshold its planner gets.
+    pub detection_threshold_v: Option<f64>,
+    /// Mission time `[start, end)` in which its modem hears nothing, s.
+    pub deaf_window_s: Option<(f64, f64)>,
+}
+
+/// A vehicle's planner table as written in the scenario.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PlannerRef {
+    /// Its key path: `planner` or `planners.NAME`.
+    pub key: String,
+    /// The table (`kind` and the planner's keys; a legacy `strategy` is read as `kind`).
+    pub table: toml::Table,
+}
+
+/// The mission part of a scenario (present when it has vehicles to fly).
+#[derive(Debug, Clone, PartialEq)]
+pub struct MissionSpec {
+    /// Op-area polygon.
+    pub op_area: Vec<plumetrace_core::Vec2>,
+    /// Subregions searched in turn (empty: the whole op-area).
+    pub subregions: Vec<Vec<plumetrace_core::Vec2>>,
+    /// Time limit, s.
+    pub time_limit_s: f64,
+    /// Plume spin-up, s.
+    pub spinup_s: f64,
+    /// Spin-up step, s.
+    pub spinup_dt_s: f64,
+    /// Flow direction the planner assumes before measuring it, deg.
+    pub prior_flow_toward_deg: f64,
+    /// Whether the file gave it (otherwise it is North, 0).
+    pub prior_flow_given: bool,
+}
+
+/// A scenario ready to run.
+#[derive(Debug)]
+pub struct BuiltScenario {
+    /// Scenario name.
+    pub name: String,
+    /// The run seed actually used.
+    pub seed: u64,
+    /// The environment at t = 0.
+    pub env: Environment,
+    /// Number of steps to run.
+    pub steps: u64,
+    /// Output settings.
+    pub output: OutputSpec,
+    /// Vehicles, in the order of the file (their index is their `VehicleId`).
+    pub vehicles: Vec<VehicleSetup>,
+    /// The mission, if the scenario flies vehicles.
+    pub mission: Option<MissionSpec>,
+    /// Where the scenario came from (for errors found later, e.g. by the planner registry).
+    pub origin: Origin,
+    /// Message channels between vehicles.
+    pub comms: plumetrace_sim::CommsParams,
+    /// The vehicles' step, s (`sim.dt_s`; the environment may step more coarsely).
+    pub dt_s: f64,
+    /// Water depth, m.
+    pub depth_m: Option<f64>,
+}
+
+/// A value out of range or inconsistent with another, by key path ([`build`] adds the file).
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("{path}: {message}")]
+pub(crate) struct Invalid {
+    /// Key path.
+    pub path: String,
+    /// What is wrong.
+    pub message: String,
+}
+
+impl Invalid {
+    /// The value at `path` is wrong.
+    pub(crate) fn new(path: impl Into<String>, message: impl Into<String>) -> Self {
+        Invalid {
+            path: path.into(),
+            message: message.into(),
+        }
+    }
+
+    /// A model's error, placed under `path`: a parameter's key joined to it
+    /// ([`plumetrace_env::error::join_key`]), any other error whole at `path`.
+    pub(crate) fn env(path: &str, e: EnvError) -> Self {
+        match e {
+            EnvError::InvalidParameter { key, message } => Invalid {
+                path: plumetrace_env::error::join_key(path, &key),
+                message,
+            },
+            other => Invalid::new(path, other.to_string()),
+        }
+    }
+
+    /// The error of the scenario from `origin`.
+    fn at(self, origin: &Origin) -> ScenarioError {
+        ScenarioError::Invalid {
+            origin: origin.to_string(),
+            path: self.path,
+            message: self.message,
+        }
+    }
+}
+
+/// Builds a scenario; `seed` overrides the file's seed.
+pub fn build(
+    cfg: &ScenarioConfig,
+    origin: &Origin,
+    seed: Option<u64>,
+) -> Result<BuiltScenario, ScenarioError> {
+    build_sections(cfg, origin, seed).map_err(|e| e.at(origin))
+}
+
+/// [`build`], section by section.
+fn build_sections(
+    cfg: &ScenarioConfig,
+    origin: &Origin,
+    seed: Option<u64>,
+) -> Result<BuiltScenario, Invalid> {
+    // Every number and list within its documented bound (crate::limits) before anything is made.
+    check_limits(cfg)?;
+    let base_dir: PathBuf = match origin {
+        Origin::File(p) => p.parent().map(Path::to_path_buf).unwrap_or_default(),
+        Origin::Preset(_) => PathBuf::new(),
+    };
+    let seed = seed.unwrap_or(cfg.seed);
+    let timing = timing::timing(cfg)?;
+    let domain = domain::domain(&cfg.domain)?;
+    let flow = flow::flow(&cfg.flow, domain, &base_dir)?;
+    let plume = plume::plume(cfg, domain, &base_dir)?;
+    let obstacles = obstacles::obstacles(cfg, seed)?;
+    let vehicles = vehicles::vehicles(cfg, &domain)?;
+    let comms = comms::comms(&cfg.comms)?;
+    let mut env = Environment::new(
+        domain,
+        flow,
+        plume,
+        ObstacleSet::new(obstacles),
+        timing.env_dt_s,
+        seed,
+    )
+    .map_err(|e| Invalid::env("sim", e))?;
+    timing.check_run_flow_steps(env.flow())?;
+    let mission = mission::mission(cfg, &domain, &timing, &vehicles, &mut env)?;
+    let output = output::output(cfg, &domain, &timing)?;
+    Ok(BuiltScenario {
+        name: cfg.name.clone(),
+        seed,
+        env,
+        steps: timing.steps,
+        output,
+        vehicles,
+        mission,
+        origin: origin.clone(),
+        comms,
+        dt_s: timing.dt_s,
+        depth_m: cfg.domain.depth_m,
+    })
+}
+
+/// Every number and list of the scenario against [`crate::limits::LIMITS`].
+fn check_limits(cfg: &ScenarioConfig) -> Result<(), Invalid> {
+    match toml::Value::try_from(cfg) {
+        Ok(toml::Value::Table(t)) => {
+            crate::limits::check(&t).map_err(|e| Invalid::new(e.path, e.kind.to_string()))
+        }
+        Ok(_) => Ok(()),
+        Err(e) => Err(Invalid::new("", format!("cannot be checked: {e}"))),
+    }
+}

@@ -1,0 +1,220 @@
+//! `[[vehicles]]` with their planners (`[planner]`, `[planners.NAME]`): each vehicle's start,
+//! dynamics, modem and planner (its navigation and sensors are [`super::sensors`]).
+
+use super::sensors;
+use super::{Invalid, PlannerRef, VehicleSetup};
+use crate::config::{ModemConfig, ScenarioConfig, VehicleConfig};
+use plumetrace_core::params::quoted_key;
+use plumetrace_core::{Heading, Vec2, VehicleId, VehicleKind};
+use plumetrace_env::Rect;
+use plumetrace_sim::{Vehicle, VehicleParams};
+
+/// Every vehicle, with the planner it flies; every planner table must be flown.
+pub(super) fn vehicles(cfg: &ScenarioConfig, domain: &Rect) -> Result<Vec<VehicleSetup>, Invalid> {
+    let legacy = cfg.planner.as_ref().map(legacy_planner).transpose()?;
+    let mut vehicles = Vec::new();
+    for (k, v) in cfg.vehicles.iter().enumerate() {
+        let mut setup = vehicle_setup(v, k, domain, cfg.domain.depth_m)?;
+        setup.planner = match &v.planner {
+            Some(name) => Some(named_planner(cfg, k, name)?),
+            None if v.kind == VehicleKind::Auv => legacy.clone(),
+            None => None,
+        };
+        vehicles.push(setup);
+    }
+    if cfg.planner.is_some()
+        && !cfg
+            .vehicles
+            .iter()
+            .any(|v| v.planner.is_none() && v.kind == VehicleKind::Auv)
+    {
+        return Err(Invalid::new(
+            "planner",
+            "no vehicle flies it: [planner] is for the AUVs that name no planner, and every AUV \
+             names one (or there is none); remove it or name it as [planners.NAME]",
+        ));
+    }
+    if let Some(name) = cfg.planners.keys().find(|n| {
+        !cfg.vehicles
+            .iter()
+            .any(|v| v.planner.as_deref() == Some(n.as_str()))
+    }) {
+        return Err(Invalid::new(
+            format!("planners.{}", quoted_key(name)),
+            "no vehicle flies it (name it in a vehicle: planner = \"NAME\")",
+        ));
+    }
+    Ok(vehicles)
+}
+
+/// The legacy `[planner]` table (flown by every AUV that names no planner): `strategy` is read
+/// as `kind`.
+fn legacy_planner(t: &toml::Table) -> Result<PlannerRef, Invalid> {
+    let mut table = t.clone();
+    if let Some(s) = table.remove("strategy") {
+        if table.contains_key("kind") {
+            return Err(Invalid::new(
+                "planner.strategy",
+                "give `kind` (or the older `strategy`), not both",
+            ));
+        }
+        table.insert("kind".into(), s);
+    }
+    Ok(PlannerRef {
+        key: "planner".into(),
+        table,
+    })
+}
+
+/// The `[planners.NAME]` table vehicle `k` names.
+fn named_planner(cfg: &ScenarioConfig, k: usize, name: &str) -> Result<PlannerRef, Invalid> {
+    let table = cfg.planners.get(name).ok_or_else(|| {
+        let known: Vec<&str> = cfg.planners.keys().map(String::as_str).collect();
+        Invalid::new(
+            format!("vehicles[{k}].planner"),
+            if known.is_empty() {
+                format!(
+                    "no [planners.{}] table (the scenario defines none)",
+                    quoted_key(name)
+                )
+            } else {
+                format!(
+                    "no [planners.{}] table (defined: {})",
+                    quoted_key(name),
+                    known.join(", ")
+                )
+            },
+        )
+    })?;
+    Ok(PlannerRef {
+        key: format!("planners.{}", quoted_key(name)),
+        table: table.clone(),
+    })
+}
+
+/// Builds vehicle `k`, filling omitted parameters with its kind's defaults (its planner is set
+/// by the caller).
+fn vehicle_setup(
+    v: &VehicleConfig,
+    k: usize,
+    domain: &Rect,
+    depth_m: Option<f64>,
+) -> Result<VehicleSetup, Invalid> {
+    let key = format!("vehicles[{k}]");
+    if !domain.contains_xy(v.x_m, v.y_m) {
+        let off_x = v.x_m < domain.x_min_m || v.x_m > domain.x_max_m;
+        return Err(Invalid::new(
+            format!("{key}.{}", if off_x { "x_m" } else { "y_m" }),
+            format!(
+                "start ({}, {}) is outside the domain ({}..{} East, {}..{} North)",
+                v.x_m, v.y_m, domain.x_min_m, domain.x_max_m, domain.y_min_m, domain.y_max_m
+            ),
+        ));
+    }
+    let params = dynamics(v, &key)?;
+    let z_m = start_height(v, &key, depth_m)?;
+    let nav = sensors::nav(v, &key)?;
+    let chem_sensor = sensors::chem_sensor(&v.chem_sensor, &key)?;
+    let deaf_window_s = deaf_window(&v.modem, &key)?;
+    let flow_sensor = sensors::flow_sensor(&v.flow_sensor, &key)?;
+    let range_sensor = sensors::range_sensor(v.range_sensor.as_ref(), &key)?;
+    let vehicle = Vehicle::new(
+        VehicleId(k as u32),
+        params,
+        Vec2::new(v.x_m, v.y_m),
+        z_m,
+        Heading::from_deg(v.heading_deg),
+    );
+    let name = if v.name.is_empty() {
+        key
+    } else {
+        v.name.clone()
+    };
+    Ok(VehicleSetup {
+        name,
+        vehicle,
+        nav,
+        chem_sensor,
+        flow_sensor,
+        range_sensor,
+        planner: None,
+        detection_threshold_v: v.chem_sensor.threshold_v,
+        deaf_window_s,
+    })
+}
+
+/// `[vehicles.dynamics]` over its kind's defaults.
+fn dynamics(v: &VehicleConfig, key: &str) -> Result<VehicleParams, Invalid> {
+    let base = match v.kind {
+        VehicleKind::Auv => VehicleParams::auv(),
+        VehicleKind::Surface => VehicleParams::surface(),
+    };
+    let dy = &v.dynamics;
+    let params = VehicleParams {
+        kind: v.kind,
+        max_speed_mps: dy.max_speed_mps.unwrap_or(base.max_speed_mps),
+        max_turn_rate_deg_s: dy.max_turn_rate_deg_s.unwrap_or(base.max_turn_rate_deg_s),
+        speed_time_constant_s: dy
+            .speed_time_constant_s
+            .unwrap_or(base.speed_time_constant_s),
+        vertical_time_constant_s: dy
+            .vertical_time_constant_s
+            .unwrap_or(base.vertical_time_constant_s),
+        altitude_error_sd_m: dy.altitude_error_sd_m.unwrap_or(base.altitude_error_sd_m),
+        altitude_error_time_s: dy
+            .altitude_error_time_s
+            .unwrap_or(base.altitude_error_time_s),
+    };
+    params
+        .validate()
+        .map_err(|e| Invalid::env(&format!("{key}.dynamics"), e))?;
+    Ok(params)
+}
+
+/// The start's height above the seabed: an AUV's `altitude_m` (2 m by default), a surface
+/// craft's the water depth (0 without one).
+fn start_height(v: &VehicleConfig, key: &str, depth_m: Option<f64>) -> Result<f64, Invalid> {
+    match v.kind {
+        VehicleKind::Auv => {
+            let a = v.altitude_m.unwrap_or(2.0);
+            if let Some(d) = depth_m
+                && a > d
+            {
+                return Err(Invalid::new(
+                    format!("{key}.altitude_m"),
+                    format!("{a} m is above the surface ({d} m)"),
+                ));
+            }
+            Ok(a)
+        }
+        VehicleKind::Surface => {
+            if v.altitude_m.is_some() {
+                return Err(Invalid::new(
+                    format!("{key}.altitude_m"),
+                    "surface craft stay at the surface",
+                ));
+            }
+            Ok(depth_m.unwrap_or(0.0))
+        }
+    }
+}
+
+/// `[vehicles.modem]`: the mission time in which it hears nothing, if any.
+fn deaf_window(m: &ModemConfig, key: &str) -> Result<Option<(f64, f64)>, Invalid> {
+    match (m.deaf_start_s, m.deaf_end_s) {
+        (None, None) => Ok(None),
+        (Some(a), Some(b)) => {
+            if !(b.is_finite() && b >= a) {
+                return Err(Invalid::new(
+                    format!("{key}.modem.deaf_end_s"),
+                    format!("must be at or after deaf_start_s ({a}), got {b}"),
+                ));
+            }
+            Ok(Some((a, b)))
+        }
+        _ => Err(Invalid::new(
+            format!("{key}.modem.deaf_end_s"),
+            "give both deaf_start_s and deaf_end_s",
+        )),
+    }
+}
