@@ -359,23 +359,7 @@ pub fn error_chart(
         }
         for (m, (name, f)) in metrics.iter().enumerate() {
             let per_group: Vec<Vec<(u64, f64)>> = groups.iter().map(|g| values(g, *f)).collect();
-            let mut all: Vec<f64> = per_group.iter().flatten().map(|(_, v)| *v).collect();
-            all.sort_by(f64::total_cmp);
-            // The axis covers the bulk: at most 2.5 times the 95th percentile of |value| (and at
-            // least 5 m); runs beyond it are drawn at its edge as triangles and counted.
-            let mut abs: Vec<f64> = all.iter().map(|v| v.abs()).collect();
-            abs.sort_by(f64::total_cmp);
-            let limit = (2.5 * quantile(&abs, 0.95)).max(5.0);
-            let (mut lo, mut hi) = all
-                .iter()
-                .map(|v| v.clamp(-limit, limit))
-                .fold((f64::MAX, f64::MIN), |(a, b), v| (a.min(v), b.max(v)));
-            if all.is_empty() {
-                (lo, hi) = (0.0, 1.0);
-            }
-            if m == 0 {
-                lo = 0.0;
-            }
+            let (lo, hi, limit, all) = axis_range(&per_group, m == 0);
             let beyond = all.iter().filter(|v| v.abs() > limit).count();
             let desc = if beyond > 0 {
                 format!("{name}; {beyond} beyond the axis: ▷ ◁ at its edge")
@@ -410,53 +394,7 @@ pub fn error_chart(
             }
             for (i, vals) in per_group.iter().enumerate() {
                 let y = (n - 1 - i) as f64;
-                let col = PALETTE[i % PALETTE.len()];
-                let mut sorted: Vec<f64> = vals.iter().map(|(_, v)| *v).collect();
-                sorted.sort_by(f64::total_cmp);
-                if sorted.is_empty() {
-                    continue;
-                }
-                let q = |p| quantile(&sorted, p);
-                let (p5, q1, q2, q3, p95) = (q(0.05), q(0.25), q(0.5), q(0.75), q(0.95));
-                chart
-                    .draw_series([
-                        PathElement::new(vec![(p5, y), (q1, y)], col.stroke_width(1)),
-                        PathElement::new(vec![(q3, y), (p95, y)], col.stroke_width(1)),
-                        PathElement::new(vec![(p5, y - 0.1), (p5, y + 0.1)], col.stroke_width(1)),
-                        PathElement::new(vec![(p95, y - 0.1), (p95, y + 0.1)], col.stroke_width(1)),
-                    ])
-                    .map_err(&e)?;
-                chart
-                    .draw_series([Rectangle::new(
-                        [(q1, y - 0.28), (q3, y + 0.28)],
-                        col.mix(0.18).filled(),
-                    )])
-                    .map_err(&e)?;
-                chart
-                    .draw_series([
-                        Rectangle::new([(q1, y - 0.28), (q3, y + 0.28)], col.stroke_width(1)),
-                        Rectangle::new([(q2, y - 0.28), (q2, y + 0.28)], col.stroke_width(3)),
-                    ])
-                    .map_err(&e)?;
-                // Dots jittered by seed index (deterministic), inside the box's height; values
-                // beyond the axis as triangles at its edge.
-                let jitter =
-                    |s: u64| ((s.wrapping_mul(2_654_435_761) % 1000) as f64 / 1000.0 - 0.5) * 0.4;
-                chart
-                    .draw_series(
-                        vals.iter().filter(|(_, v)| v.abs() <= limit).map(|(s, v)| {
-                            Circle::new((*v, y + jitter(*s)), 2, col.mix(0.7).filled())
-                        }),
-                    )
-                    .map_err(&e)?;
-                chart
-                    .draw_series(vals.iter().filter(|(_, v)| v.abs() > limit).map(|(s, v)| {
-                        let x = v.clamp(-limit, limit);
-                        let tip = if *v > 0.0 { 7 } else { -7 };
-                        EmptyElement::at((x, y + jitter(*s)))
-                            + Polygon::new(vec![(0, -5), (0, 5), (tip, 0)], col.filled())
-                    }))
-                    .map_err(&e)?;
+                draw_box(&mut chart, y, PALETTE[i % PALETTE.len()], vals, limit).map_err(&e)?;
             }
             if m == 0 {
                 row_labels(&root, &chart, &labels).map_err(&e)?;
@@ -465,6 +403,76 @@ pub fn error_chart(
         root.present().map_err(&e)?;
     }
     Ok(svg)
+}
+
+/// The x range of an error panel: the bulk of the values (at most 2.5 times the 95th percentile
+/// of |value|, at least 5 m; from 0 for the first, unsigned panel), the limit beyond which runs
+/// are drawn at the edge, and every value sorted.
+fn axis_range(per_group: &[Vec<(u64, f64)>], from_zero: bool) -> (f64, f64, f64, Vec<f64>) {
+    let mut all: Vec<f64> = per_group.iter().flatten().map(|(_, v)| *v).collect();
+    all.sort_by(f64::total_cmp);
+    let mut abs: Vec<f64> = all.iter().map(|v| v.abs()).collect();
+    abs.sort_by(f64::total_cmp);
+    let limit = (2.5 * quantile(&abs, 0.95)).max(5.0);
+    let (mut lo, mut hi) = all
+        .iter()
+        .map(|v| v.clamp(-limit, limit))
+        .fold((f64::MAX, f64::MIN), |(a, b), v| (a.min(v), b.max(v)));
+    if all.is_empty() {
+        (lo, hi) = (0.0, 1.0);
+    }
+    if from_zero {
+        lo = 0.0;
+    }
+    (lo, hi, limit, all)
+}
+
+/// One group's row of an error panel at `y`: a box over the quartiles with the median, whiskers
+/// from the 5th to the 95th percentile, a dot per value (jittered by seed index) and a triangle
+/// at the axis's edge for a value beyond `limit`.
+fn draw_box<DB: DrawingBackend>(
+    chart: &mut ChartContext<'_, DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>,
+    y: f64,
+    col: RGBColor,
+    vals: &[(u64, f64)],
+    limit: f64,
+) -> Result<(), DrawingAreaErrorKind<DB::ErrorType>> {
+    let mut sorted: Vec<f64> = vals.iter().map(|(_, v)| *v).collect();
+    sorted.sort_by(f64::total_cmp);
+    if sorted.is_empty() {
+        return Ok(());
+    }
+    let q = |p| quantile(&sorted, p);
+    let (p5, q1, q2, q3, p95) = (q(0.05), q(0.25), q(0.5), q(0.75), q(0.95));
+    chart.draw_series([
+        PathElement::new(vec![(p5, y), (q1, y)], col.stroke_width(1)),
+        PathElement::new(vec![(q3, y), (p95, y)], col.stroke_width(1)),
+        PathElement::new(vec![(p5, y - 0.1), (p5, y + 0.1)], col.stroke_width(1)),
+        PathElement::new(vec![(p95, y - 0.1), (p95, y + 0.1)], col.stroke_width(1)),
+    ])?;
+    chart.draw_series([Rectangle::new(
+        [(q1, y - 0.28), (q3, y + 0.28)],
+        col.mix(0.18).filled(),
+    )])?;
+    chart.draw_series([
+        Rectangle::new([(q1, y - 0.28), (q3, y + 0.28)], col.stroke_width(1)),
+        Rectangle::new([(q2, y - 0.28), (q2, y + 0.28)], col.stroke_width(3)),
+    ])?;
+    // Dots jittered by seed index (deterministic), inside the box's height; values beyond the
+    // axis as triangles at its edge.
+    let jitter = |s: u64| ((s.wrapping_mul(2_654_435_761) % 1000) as f64 / 1000.0 - 0.5) * 0.4;
+    chart.draw_series(
+        vals.iter()
+            .filter(|(_, v)| v.abs() <= limit)
+            .map(|(s, v)| Circle::new((*v, y + jitter(*s)), 2, col.mix(0.7).filled())),
+    )?;
+    chart.draw_series(vals.iter().filter(|(_, v)| v.abs() > limit).map(|(s, v)| {
+        let x = v.clamp(-limit, limit);
+        let tip = if *v > 0.0 { 7 } else { -7 };
+        EmptyElement::at((x, y + jitter(*s)))
+            + Polygon::new(vec![(0, -5), (0, 5), (tip, 0)], col.filled())
+    }))?;
+    Ok(())
 }
 
 /// `trajectories.svg`: each group's example run (seed index 0) on a small map, with a team's

@@ -576,6 +576,79 @@ fn inside_convex(v: &[[f64; 2]], p: Vec2) -> bool {
     true
 }
 
+/// The source: uniform in the op-area, at least `inset` from every edge (the check made sure the
+/// smallest area has room; the ellipse of a convex area is smaller, so the inset shrinks after
+/// many tries rather than loop for ever).
+fn place_source(rng: &mut impl Rng, op_area: &[[f64; 2]], half: f64, inset: f64) -> Vec2 {
+    let mut inset = inset;
+    for _ in 0..20 {
+        for _ in 0..200 {
+            let q = Vec2::new(
+                rng.random_range(-half..=half),
+                rng.random_range(-half..=half),
+            );
+            if inside_convex(op_area, q) && edge_distance(op_area, q) >= inset {
+                return q;
+            }
+        }
+        inset *= 0.8;
+    }
+    Vec2::zeros()
+}
+
+/// The vehicle's start of kind `start` in the op-area, `toward` the flow's direction.
+fn start_position(
+    rng: &mut impl Rng,
+    start: StartKind,
+    op_area: &[[f64; 2]],
+    toward: f64,
+    half: f64,
+) -> Vec2 {
+    let centroid = op_area
+        .iter()
+        .fold(Vec2::zeros(), |s, v| s + Vec2::new(v[0], v[1]))
+        / op_area.len() as f64;
+    let towards_centre = |p: Vec2, d: f64| {
+        let c = centroid - p;
+        let n = c.norm();
+        if n > d { p + c / n * d } else { centroid }
+    };
+    match start {
+        StartKind::DownflowCorner => {
+            let down = unit(toward);
+            let corner = op_area
+                .iter()
+                .map(|v| Vec2::new(v[0], v[1]))
+                .max_by(|a, b| a.dot(&down).total_cmp(&b.dot(&down)))
+                .unwrap_or(centroid);
+            towards_centre(corner, 20.0)
+        }
+        StartKind::Edge => {
+            let k = rng.random_range(0..op_area.len());
+            let a = Vec2::new(op_area[k][0], op_area[k][1]);
+            let b = Vec2::new(
+                op_area[(k + 1) % op_area.len()][0],
+                op_area[(k + 1) % op_area.len()][1],
+            );
+            towards_centre(a + (b - a) * rng.random_range(0.0..1.0), 10.0)
+        }
+        StartKind::Inside => {
+            let mut p = centroid;
+            for _ in 0..1000 {
+                let q = Vec2::new(
+                    rng.random_range(-half..=half),
+                    rng.random_range(-half..=half),
+                );
+                if inside_convex(op_area, q) && edge_distance(op_area, q) >= 30.0 {
+                    p = q;
+                    break;
+                }
+            }
+            p
+        }
+    }
+}
+
 /// Draws a site.
 fn draw(f: &FamilyFile, seed: u64) -> Site {
     let mut rng = stream_rng(seed, StreamId::Custom(SITE_STREAM));
@@ -617,25 +690,8 @@ fn draw(f: &FamilyFile, seed: u64) -> Site {
                 .collect()
         }
     };
-    // The source: uniform in the op-area, at least inset_m from every edge (the check made sure
-    // the smallest area has room; the ellipse of a convex area is smaller, so the inset shrinks
-    // after many tries rather than loop for ever).
     let half = length.max(width) / 2.0;
-    let mut inset = f.source.inset_m;
-    let mut source = Vec2::zeros();
-    'place: for _ in 0..20 {
-        for _ in 0..200 {
-            let q = Vec2::new(
-                rng.random_range(-half..=half),
-                rng.random_range(-half..=half),
-            );
-            if inside_convex(&op_area, q) && edge_distance(&op_area, q) >= inset {
-                source = q;
-                break 'place;
-            }
-        }
-        inset *= 0.8;
-    }
+    let source = place_source(&mut rng, &op_area, half, f.source.inset_m);
     let source_edge_m = edge_distance(&op_area, source);
     let mass = f.source.mass_rate_per_s.map(|[a, b]| {
         if b > a {
@@ -645,49 +701,7 @@ fn draw(f: &FamilyFile, seed: u64) -> Site {
         }
     });
     let start = f.start.kinds[rng.random_range(0..f.start.kinds.len())];
-    let centroid = op_area
-        .iter()
-        .fold(Vec2::zeros(), |s, v| s + Vec2::new(v[0], v[1]))
-        / op_area.len() as f64;
-    let towards_centre = |p: Vec2, d: f64| {
-        let c = centroid - p;
-        let n = c.norm();
-        if n > d { p + c / n * d } else { centroid }
-    };
-    let start_pos = match start {
-        StartKind::DownflowCorner => {
-            let down = unit(toward);
-            let corner = op_area
-                .iter()
-                .map(|v| Vec2::new(v[0], v[1]))
-                .max_by(|a, b| a.dot(&down).total_cmp(&b.dot(&down)))
-                .unwrap_or(centroid);
-            towards_centre(corner, 20.0)
-        }
-        StartKind::Edge => {
-            let k = rng.random_range(0..op_area.len());
-            let a = Vec2::new(op_area[k][0], op_area[k][1]);
-            let b = Vec2::new(
-                op_area[(k + 1) % op_area.len()][0],
-                op_area[(k + 1) % op_area.len()][1],
-            );
-            towards_centre(a + (b - a) * rng.random_range(0.0..1.0), 10.0)
-        }
-        StartKind::Inside => {
-            let mut p = centroid;
-            for _ in 0..1000 {
-                let q = Vec2::new(
-                    rng.random_range(-half..=half),
-                    rng.random_range(-half..=half),
-                );
-                if inside_convex(&op_area, q) && edge_distance(&op_area, q) >= 30.0 {
-                    p = q;
-                    break;
-                }
-            }
-            p
-        }
-    };
+    let start_pos = start_position(&mut rng, start, &op_area, toward, half);
     let start_heading = rng.random_range(0.0..360.0);
     let prior_error = f.prior_flow_error_deg.map_or(0.0, |r| uniform(&mut rng, r));
     let (fix_interval, fix_sigma) = match &f.nav {
