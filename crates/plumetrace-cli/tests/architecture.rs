@@ -72,6 +72,29 @@ const RULES: &[(&str, Side, &[&str])] = &[
         ],
     ),
     (
+        "plumetrace-plume-run",
+        Side::App,
+        &[
+            "plumetrace-core",
+            "plumetrace-env",
+            "plumetrace-sim",
+            "plumetrace-scenario",
+            "plumetrace-mission",
+        ],
+    ),
+    (
+        "plumetrace-bench",
+        Side::App,
+        &[
+            "plumetrace-core",
+            "plumetrace-env",
+            "plumetrace-scenario",
+            "plumetrace-planner",
+            "plumetrace-mission",
+            "plumetrace-campaign",
+        ],
+    ),
+    (
         "plumetrace-cli",
         Side::App,
         &[
@@ -83,6 +106,8 @@ const RULES: &[(&str, Side, &[&str])] = &[
             "plumetrace-onboard",
             "plumetrace-mission",
             "plumetrace-campaign",
+            "plumetrace-plume-run",
+            "plumetrace-bench",
         ],
     ),
     (
