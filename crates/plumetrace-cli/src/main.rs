@@ -30,16 +30,12 @@ mod args;
 mod bench;
 mod campaign;
 mod frontseat;
-mod gridworld;
 mod mission;
-#[cfg(feature = "netcdf")]
-mod netcdf;
 mod onboard;
 mod output;
 mod progress;
 mod replay;
 mod run;
-mod series;
 
 use anyhow::Result;
 use clap::{Parser, Subcommand};
@@ -257,7 +253,7 @@ fn check(file: &std::path::Path) -> Result<()> {
     let (steps, dt) = (built.steps, built.dt_s);
     if built.mission.is_none() {
         let o = &built.output;
-        let d = series::time_decimals(dt);
+        let d = plumetrace_plume_run::time_decimals(dt);
         let mut series = String::new();
         if !o.probes.is_empty() {
             let _ = write!(

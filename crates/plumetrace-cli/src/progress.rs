@@ -34,3 +34,16 @@ impl Progress {
         self.bar.finish_and_clear();
     }
 }
+
+/// A progress callback `(done, total)` for a loop whose total only the loop knows: the bar is
+/// made at the first call and removed at the call with `done >= total`.
+pub fn reporter(unit: &'static str) -> impl FnMut(u64, u64) {
+    let mut bar: Option<Progress> = None;
+    move |done, total| {
+        let b = bar.get_or_insert_with(|| Progress::new(total, unit));
+        b.tick(done);
+        if done >= total {
+            b.finish();
+        }
+    }
+}

@@ -105,6 +105,28 @@ const RULES: &[(&str, Side, &[&str])] = &[
         ],
     ),
     (
+        "plumetrace-plume-run",
+        Side::App,
+        &[
+            "plumetrace-core",
+            "plumetrace-env",
+            "plumetrace-sim",
+            "plumetrace-scenario",
+            "plumetrace-mission",
+        ],
+    ),
+    (
+        "plumetrace-bench",
+        Side::App,
+        &[
+            "plumetrace-core",
+            "plumetrace-env",
+            "plumetrace-scenario",
+            "plumetrace-planner",
+            "plumetrace-mission",
+        ],
+    ),
+    (
         "plumetrace-cli",
         Side::App,
         &[
@@ -119,6 +141,8 @@ const RULES: &[(&str, Side, &[&str])] = &[
             "plumetrace-frontseat",
             "plumetrace-report",
             "plumetrace-campaign",
+            "plumetrace-plume-run",
+            "plumetrace-bench",
         ],
     ),
     (

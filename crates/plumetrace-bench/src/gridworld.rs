@@ -1,4 +1,4 @@
-//! `plumetrace bench infotaxis`: the windy grid-world benchmark of infotaxis (the OTTO project's
+//! The windy grid-world benchmark of infotaxis (`plumetrace bench infotaxis`; the OTTO project's
 //! windy case), to check the planner's move choice against published numbers.
 //!
 //! The model ([`plumetrace_planner::estimate::gridworld`]): 81 x 41 cells, wind along `+x`, start
@@ -14,7 +14,7 @@
 //! median 52, 0.1 % at the limit), space-aware infotaxis 64.5 +- 2.2 (median 49); `R = 0.25`,
 //! infotaxis 266 +- 14 (median 132, 1 % at the limit).
 
-use anyhow::{Result, bail};
+use crate::BenchError;
 use plumetrace_env::{StreamId, derive_seed, stream_rng};
 use plumetrace_planner::estimate::gridworld::{HitTable, WindyGrid};
 use plumetrace_planner::estimate::infotaxis::{bayes_update, choose, move_outcome};
@@ -23,31 +23,25 @@ use rand::Rng;
 use serde::Serialize;
 use std::time::Instant;
 
-/// Arguments of `plumetrace bench infotaxis`.
-#[derive(Debug, clap::Args)]
-pub struct InfotaxisBenchArgs {
+/// What to run.
+#[derive(Debug, Clone, PartialEq)]
+pub struct InfotaxisBenchOptions {
     /// Episodes (each its own source and hits).
-    #[arg(long, default_value_t = 1000, allow_hyphen_values = true, value_parser = crate::args::runs)]
-    episodes: u64,
-    /// Dimensionless emission rate R (the benchmark's: 2.5 or 0.25).
-    #[arg(long, default_value_t = 2.5, allow_hyphen_values = true, value_parser = crate::args::number)]
-    rate: f64,
+    pub episodes: u64,
+    /// Dimensionless emission rate R (the benchmark's: 2.5 or 0.25; > 0 and <= 1000).
+    pub rate: f64,
     /// Move choice.
-    #[arg(long, value_enum, default_value = "infotaxis")]
-    policy: Policy,
+    pub policy: Policy,
     /// Step limit of an episode (a failure when reached).
-    #[arg(long, default_value_t = 10_000, allow_hyphen_values = true, value_parser = crate::args::runs)]
-    max_steps: u64,
+    pub max_steps: u64,
     /// Base seed.
-    #[arg(long, default_value_t = 1, allow_hyphen_values = true, value_parser = crate::args::seed)]
-    seed: u64,
+    pub seed: u64,
     /// Worker threads (default: all cores); the results do not depend on it.
-    #[arg(long, allow_hyphen_values = true, value_parser = crate::args::jobs)]
-    jobs: Option<usize>,
+    pub jobs: Option<usize>,
 }
 
 /// The move choice of the benchmark.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Policy {
     /// Minimise the expected entropy.
@@ -57,7 +51,8 @@ pub enum Policy {
 }
 
 impl Policy {
-    fn objective(self) -> Objective {
+    /// The objective the moves minimise.
+    pub fn objective(self) -> Objective {
         match self {
             Policy::Infotaxis => Objective::Infotaxis,
             Policy::SpaceAware => Objective::SpaceAware,
@@ -205,7 +200,7 @@ pub fn run_episodes(
 
 /// The statistics of a set of episodes.
 pub fn statistics(
-    a: &InfotaxisBenchArgs,
+    a: &InfotaxisBenchOptions,
     runs: &[Episode],
     wall_s: f64,
     threads: usize,
@@ -253,10 +248,10 @@ pub fn statistics(
     }
 }
 
-/// Runs the benchmark.
-pub fn run(a: &InfotaxisBenchArgs) -> Result<InfotaxisBench> {
+/// Runs the benchmark on a pool of `jobs` threads.
+pub fn infotaxis(a: &InfotaxisBenchOptions) -> Result<InfotaxisBench, BenchError> {
     if !(a.rate > 0.0 && a.rate <= 1000.0) {
-        bail!("--rate must be > 0 and <= 1000, got {}", a.rate);
+        return Err(BenchError::Rate(a.rate));
     }
     let mut b = rayon::ThreadPoolBuilder::new();
     if let Some(j) = a.jobs {
@@ -286,8 +281,8 @@ pub fn run(a: &InfotaxisBenchArgs) -> Result<InfotaxisBench> {
 mod tests {
     use super::*;
 
-    fn args(rate: f64, policy: Policy, episodes: u64) -> InfotaxisBenchArgs {
-        InfotaxisBenchArgs {
+    fn args(rate: f64, policy: Policy, episodes: u64) -> InfotaxisBenchOptions {
+        InfotaxisBenchOptions {
             episodes,
             rate,
             policy,
@@ -323,6 +318,14 @@ mod tests {
         parity(2.5, Policy::Infotaxis, 1000, 74.4, 2.0, 0.01);
         parity(2.5, Policy::SpaceAware, 1000, 64.5, 2.2, 0.01);
         parity(0.25, Policy::Infotaxis, 1000, 266.0, 14.0, 0.03);
+    }
+
+    #[test]
+    fn a_rate_out_of_range_is_refused() {
+        let e = infotaxis(&args(0.0, Policy::Infotaxis, 1))
+            .err()
+            .map(|e| e.to_string());
+        assert_eq!(e.as_deref(), Some("--rate must be > 0 and <= 1000, got 0"));
     }
 
     #[test]

@@ -14,7 +14,6 @@
 //! <date>`; a plain `s` would not be read as time).
 
 use crate::series::ProbeSeries;
-use anyhow::{Result, bail, ensure};
 use plumetrace_env::GridSpec;
 
 const MAGIC: &[u8; 4] = b"CDF\x02";
@@ -26,6 +25,75 @@ const NC_INT: u32 = 4;
 const NC_DOUBLE: u32 = 6;
 /// The largest count or size of the classic format (a non-negative 32-bit integer).
 const MAX_NON_NEG: usize = i32::MAX as usize;
+
+/// What the classic format cannot hold, or a time average that does not fit its grid.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum NetcdfError {
+    /// A dimension's length is 0 (which would make it the record dimension) or too large.
+    #[error("NetCDF dimension {name} has length {len}; it needs 1..={MAX_NON_NEG}")]
+    DimensionLength {
+        /// The dimension.
+        name: String,
+        /// Its length.
+        len: usize,
+    },
+    /// A `double` attribute holds a number that is not finite.
+    #[error("NetCDF attribute {0} has a number that is not finite")]
+    AttributeNotFinite(String),
+    /// A variable names a dimension id that is not defined.
+    #[error("NetCDF variable {name} names dimension {dim}, which is not defined")]
+    UnknownDimension {
+        /// The variable.
+        name: String,
+        /// The dimension id.
+        dim: usize,
+    },
+    /// A variable's values do not fill it.
+    #[error("NetCDF variable {name} has {values} values for {places} places")]
+    ValueCount {
+        /// The variable.
+        name: String,
+        /// Values given.
+        values: usize,
+        /// Places of its dimensions.
+        places: usize,
+    },
+    /// A variable is larger than a classic file holds.
+    #[error(
+        "NetCDF variable {name} has {values} values; a classic file holds at most {} per variable",
+        MAX_NON_NEG / 8
+    )]
+    TooManyValues {
+        /// The variable.
+        name: String,
+        /// Its values.
+        values: usize,
+    },
+    /// A variable's value is not finite.
+    #[error("NetCDF variable {name} has a value that is not finite at {at}")]
+    ValueNotFinite {
+        /// The variable.
+        name: String,
+        /// The value's index.
+        at: usize,
+    },
+    /// A name outside the portable subset.
+    #[error("{0:?} is not a NetCDF name (a letter or _, then letters, digits or _)")]
+    Name(String),
+    /// A count or size too large for the format.
+    #[error("{0} is too large for a NetCDF classic file")]
+    TooLarge(usize),
+    /// The time average does not fit its grid.
+    #[error("the time average has {points} points for a {nx} x {ny} grid")]
+    GridMismatch {
+        /// Points of the time average.
+        points: usize,
+        /// Grid columns.
+        nx: usize,
+        /// Grid rows.
+        ny: usize,
+    },
+}
 
 /// The units of `time`.
 pub const TIME_UNITS: &str = "seconds since 1970-01-01 00:00:00";
@@ -119,7 +187,7 @@ impl Dataset {
     /// The file's bytes; a name the format does not allow, a dimension of length 0, values that
     /// do not fill their variable, a number that is not finite or a size the format cannot hold
     /// is an error.
-    pub fn to_bytes(&self) -> Result<Vec<u8>> {
+    pub fn to_bytes(&self) -> Result<Vec<u8>, NetcdfError> {
         self.check()?;
         let mut h = Vec::new();
         h.extend_from_slice(MAGIC);
@@ -169,14 +237,16 @@ impl Dataset {
         Ok(h)
     }
 
-    fn check(&self) -> Result<()> {
+    fn check(&self) -> Result<(), NetcdfError> {
         for (name, len) in &self.dims {
             check_name(name)?;
             // A length of 0 would make it the record dimension.
-            ensure!(
-                (1..=MAX_NON_NEG).contains(len),
-                "NetCDF dimension {name} has length {len}; it needs 1..={MAX_NON_NEG}"
-            );
+            if !(1..=MAX_NON_NEG).contains(len) {
+                return Err(NetcdfError::DimensionLength {
+                    name: name.clone(),
+                    len: *len,
+                });
+            }
         }
         for (name, value) in self
             .attrs
@@ -187,7 +257,7 @@ impl Dataset {
             if let AttrValue::Double(xs) = value
                 && xs.iter().any(|x| !x.is_finite())
             {
-                bail!("NetCDF attribute {name} has a number that is not finite");
+                return Err(NetcdfError::AttributeNotFinite(name.clone()));
             }
         }
         for v in &self.vars {
@@ -195,30 +265,31 @@ impl Dataset {
             let mut n = 1usize;
             for &d in &v.dims {
                 let Some((_, len)) = self.dims.get(d) else {
-                    bail!(
-                        "NetCDF variable {} names dimension {d}, which is not defined",
-                        v.name
-                    );
+                    return Err(NetcdfError::UnknownDimension {
+                        name: v.name.clone(),
+                        dim: d,
+                    });
                 };
                 n = n.saturating_mul(*len);
             }
-            ensure!(
-                v.data.len() == n,
-                "NetCDF variable {} has {} values for {n} places",
-                v.name,
-                v.data.len()
-            );
-            ensure!(
-                n <= MAX_NON_NEG / 8,
-                "NetCDF variable {} has {n} values; a classic file holds at most {} per variable",
-                v.name,
-                MAX_NON_NEG / 8
-            );
-            if let Some(k) = v.data.iter().position(|x| !x.is_finite()) {
-                bail!(
-                    "NetCDF variable {} has a value that is not finite at {k}",
-                    v.name
-                );
+            if v.data.len() != n {
+                return Err(NetcdfError::ValueCount {
+                    name: v.name.clone(),
+                    values: v.data.len(),
+                    places: n,
+                });
+            }
+            if n > MAX_NON_NEG / 8 {
+                return Err(NetcdfError::TooManyValues {
+                    name: v.name.clone(),
+                    values: n,
+                });
+            }
+            if let Some(at) = v.data.iter().position(|x| !x.is_finite()) {
+                return Err(NetcdfError::ValueNotFinite {
+                    name: v.name.clone(),
+                    at,
+                });
             }
         }
         Ok(())
@@ -227,16 +298,16 @@ impl Dataset {
 
 /// Names of the classic format, kept to the portable subset: a letter or `_`, then letters,
 /// digits and `_`.
-fn check_name(name: &str) -> Result<()> {
+fn check_name(name: &str) -> Result<(), NetcdfError> {
     let mut chars = name.chars();
     let first_ok = chars
         .next()
         .is_some_and(|c| c.is_ascii_alphabetic() || c == '_');
-    ensure!(
-        first_ok && chars.all(|c| c.is_ascii_alphanumeric() || c == '_'),
-        "{name:?} is not a NetCDF name (a letter or _, then letters, digits or _)"
-    );
-    Ok(())
+    if first_ok && chars.all(|c| c.is_ascii_alphanumeric() || c == '_') {
+        Ok(())
+    } else {
+        Err(NetcdfError::Name(name.to_string()))
+    }
 }
 
 fn put_u32(out: &mut Vec<u8>, v: u32) {
@@ -248,11 +319,10 @@ fn put_u64(out: &mut Vec<u8>, v: u64) {
 }
 
 /// A count or size (`NON_NEG`).
-fn put_len(out: &mut Vec<u8>, n: usize) -> Result<()> {
-    ensure!(
-        n <= MAX_NON_NEG,
-        "{n} is too large for a NetCDF classic file"
-    );
+fn put_len(out: &mut Vec<u8>, n: usize) -> Result<(), NetcdfError> {
+    if n > MAX_NON_NEG {
+        return Err(NetcdfError::TooLarge(n));
+    }
     put_u32(out, n as u32);
     Ok(())
 }
@@ -265,7 +335,7 @@ fn pad(out: &mut Vec<u8>) {
 }
 
 /// `name = nelems namestring`, padded.
-fn put_name(out: &mut Vec<u8>, name: &str) -> Result<()> {
+fn put_name(out: &mut Vec<u8>, name: &str) -> Result<(), NetcdfError> {
     put_len(out, name.len())?;
     out.extend_from_slice(name.as_bytes());
     pad(out);
@@ -273,7 +343,7 @@ fn put_name(out: &mut Vec<u8>, name: &str) -> Result<()> {
 }
 
 /// `att_list = ABSENT | NC_ATTRIBUTE nelems [attr ...]`.
-fn put_attrs(out: &mut Vec<u8>, attrs: &[(String, AttrValue)]) -> Result<()> {
+fn put_attrs(out: &mut Vec<u8>, attrs: &[(String, AttrValue)]) -> Result<(), NetcdfError> {
     if attrs.is_empty() {
         put_u64(out, 0);
         return Ok(());
@@ -328,14 +398,16 @@ pub struct PlumeFile<'a> {
 /// `plume.nc`: dimensions `time`, `probe`, `grid_x`, `grid_y`; variables `time(time)`,
 /// `x(probe)`, `y(probe)`, `z(probe)`, `concentration(time, probe)`, `grid_x(grid_x)`,
 /// `grid_y(grid_y)`, `grid_z` and `mean_concentration(grid_y, grid_x)`.
-pub fn plume_file(f: &PlumeFile<'_>) -> Result<Vec<u8>> {
+pub fn plume_file(f: &PlumeFile<'_>) -> Result<Vec<u8>, NetcdfError> {
     let p = f.probes;
     let (nx, ny) = (f.grid.nx, f.grid.ny);
-    ensure!(
-        f.mean.len() == nx * ny,
-        "the time average has {} points for a {nx} x {ny} grid",
-        f.mean.len()
-    );
+    if f.mean.len() != nx * ny {
+        return Err(NetcdfError::GridMismatch {
+            points: f.mean.len(),
+            nx,
+            ny,
+        });
+    }
     let grid_points = f.grid.points();
     let mut d = Dataset::default();
     let time = d.dim("time", p.times_s().len());

@@ -5,11 +5,32 @@
 //! Both are observers of the run: they read the plume after a step and never change it, so a run
 //! with series gives the same plume as one without.
 
-use anyhow::{Result, bail};
 use plumetrace_core::Vec3;
 use plumetrace_env::{ConcentrationField, FilamentPlume};
 use plumetrace_scenario::limits::MAX_FILAMENT_ROWS;
 use std::fmt::Write as _;
+
+/// A sample of a series that is not a finite number.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum SeriesError {
+    /// A probe's concentration is not finite.
+    #[error(
+        "the concentration at output.probes[{probe}] at t = {t_s} s is not a finite number: \
+         lower sources[].mass_rate_per_s or raise plume.init_radius_m"
+    )]
+    Probe {
+        /// The probe's index in `output.probes`.
+        probe: usize,
+        /// Simulation time, s.
+        t_s: f64,
+    },
+    /// A filament's position or radius is not finite.
+    #[error("a filament at t = {t_s} s has a position or radius that is not finite")]
+    Filament {
+        /// Simulation time, s.
+        t_s: f64,
+    },
+}
 
 /// The header of `probes.csv`.
 pub const PROBES_HEADER: &str = "t_s,probe,x_m,y_m,z_m,concentration\n";
@@ -52,13 +73,10 @@ impl ProbeSeries {
 
     /// Samples `field` at every probe (one batch query); a concentration that is not finite is an
     /// error naming the probe and the time.
-    pub fn sample(&mut self, t_s: f64, field: &dyn ConcentrationField) -> Result<()> {
+    pub fn sample(&mut self, t_s: f64, field: &dyn ConcentrationField) -> Result<(), SeriesError> {
         field.concentrations(&self.points, &mut self.scratch);
-        if let Some(k) = self.scratch.iter().position(|c| !c.is_finite()) {
-            bail!(
-                "the concentration at output.probes[{k}] at t = {t_s} s is not a finite number: \
-                 lower sources[].mass_rate_per_s or raise plume.init_radius_m"
-            );
+        if let Some(probe) = self.scratch.iter().position(|c| !c.is_finite()) {
+            return Err(SeriesError::Probe { probe, t_s });
         }
         self.times_s.push(t_s);
         self.values.extend_from_slice(&self.scratch);
@@ -76,7 +94,6 @@ impl ProbeSeries {
     }
 
     /// The concentrations, sample-major (`samples x probes`).
-    #[cfg(any(test, feature = "netcdf"))]
     pub fn values(&self) -> &[f64] {
         &self.values
     }
@@ -134,7 +151,7 @@ impl FilamentSeries {
     }
 
     /// Records every filament of `plume` at `t_s`; a filament that is not finite is an error.
-    pub fn record(&mut self, t_s: f64, plume: &FilamentPlume) -> Result<()> {
+    pub fn record(&mut self, t_s: f64, plume: &FilamentPlume) -> Result<(), SeriesError> {
         let live = plume.len() as u64;
         if self.skipped > 0 || self.rows + live > MAX_FILAMENT_ROWS {
             self.skipped += 1;
@@ -144,7 +161,7 @@ impl FilamentSeries {
         for (p, r2) in plume.filaments() {
             let r = r2.sqrt();
             if !(p.x.is_finite() && p.y.is_finite() && p.z.is_finite() && r.is_finite()) {
-                bail!("a filament at t = {t_s} s has a position or radius that is not finite");
+                return Err(SeriesError::Filament { t_s });
             }
             let _ = writeln!(
                 self.csv,
