@@ -18,7 +18,7 @@ done
 set -- "${args[@]}"
 cd "$(dirname "$0")/.."
 
-presets=(demo demo-survey demo-infotaxis duck-2003-st duck-2003-mt li-zhang-open li-zhang-kelp
+presets=(demo demo-survey demo-infotaxis demo-surge-cast duck-2003-st duck-2003-mt li-zhang-open li-zhang-kelp
     soares-freshwater soares-filaments plume-demo pompy freshwater)
 
 write() {
@@ -57,6 +57,10 @@ kind = "moth"
 name = "lawnmower"
 [configs.planner]
 kind = "lawnmower"
+[[configs]]
+name = "surge_cast"
+[configs.planner]
+kind = "surge_cast"
 TOML
     # the family sits next to the campaign file, so the outputs do not depend on the checkout's path
     cp examples/families/coastal.family.toml "$out/coastal.family.toml"
