@@ -58,13 +58,13 @@ enum Command {
     Presets,
     /// List every planner with its keys, defaults, units, bounds and a line of doc.
     Planners {
-        /// Print the README's Markdown tables instead.
+        /// Print the guide's Markdown tables instead (docs/planners.md).
         #[arg(long)]
         markdown: bool,
     },
     /// Print the bounds of every number and list in a scenario file, with the reason for each.
     Limits {
-        /// Print the README's Markdown table instead.
+        /// Print the guide's Markdown table instead (docs/scenarios.md).
         #[arg(long)]
         markdown: bool,
     },

@@ -297,7 +297,7 @@ fn mission_run_writes_summary_trajectory_events_and_plot() {
 }
 
 #[test]
-fn planners_lists_every_planner_with_its_keys_and_the_readme_has_the_table() {
+fn planners_lists_every_planner_with_its_keys_and_the_guide_has_the_table() {
     let text = stdout(run_ok(&["planners"]));
     assert!(
         text.contains("amp: REMUS Adaptive Mission Planner"),
@@ -312,16 +312,19 @@ fn planners_lists_every_planner_with_its_keys_and_the_readme_has_the_table() {
         assert!(text.contains(key), "{key} missing from:\n{text}");
     }
     let md = stdout(run_ok(&["planners", "--markdown"]));
-    let readme =
-        std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/../../README.md")).unwrap();
+    let readme = std::fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../docs/planners.md"
+    ))
+    .unwrap();
     let start = readme
         .find("<!-- planners:start -->\n")
-        .expect("README marks its planner table");
+        .expect("docs/planners.md marks its planner table");
     let end = readme.find("<!-- planners:end -->").unwrap();
     assert_eq!(
         &readme[start + "<!-- planners:start -->\n".len()..end],
         md,
-        "the README's planner table is not the registry's: paste `plumetrace planners --markdown`"
+        "docs/planners.md's planner table is not the registry's: run scripts/readme_tables.sh"
     );
 }
 
@@ -402,19 +405,22 @@ fn stdout(out: std::process::Output) -> String {
 }
 
 #[test]
-fn the_readme_has_the_limits_table() {
+fn the_guide_has_the_limits_table() {
     let md = stdout(run_ok(&["limits", "--markdown"]));
-    let readme =
-        std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/../../README.md")).unwrap();
+    let readme = std::fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../docs/scenarios.md"
+    ))
+    .unwrap();
     let start = readme
         .find("<!-- limits:start -->\n")
-        .expect("README marks its limits table")
+        .expect("docs/scenarios.md marks its limits table")
         + "<!-- limits:start -->\n".len();
     let end = readme.find("<!-- limits:end -->").unwrap();
     assert_eq!(
         &readme[start..end],
         md,
-        "the README's limits table is not the code's: paste `plumetrace limits --markdown`"
+        "docs/scenarios.md's limits table is not the code's: run scripts/readme_tables.sh"
     );
 }
 

@@ -779,7 +779,7 @@ pub fn markdown() -> String {
         let _ = writeln!(out, "| `{}` | {} | {} |", l.key, l.bound.describe(), l.why);
     }
     out.push_str(
-        "\nScenario families (`*.family.toml`, see [Scenario families](#scenario-families)); \
+        "\nScenario families (`*.family.toml`, see [Scenario families](campaigns.md#scenario-families)); \
          a range `[low, high]` needs `low <= high`, both within the bound:\n\n\
          | key | bound | why |\n| --- | --- | --- |\n",
     );
