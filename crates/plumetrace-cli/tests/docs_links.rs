@@ -1,5 +1,6 @@
-//! The user guide's links: every relative link of README.md, ARCHITECTURE.md and docs/ names a file
-//! that exists and, with a `#fragment`, a heading of that file (GitHub's anchors).
+//! The user guide's links: every relative link of README.md, ARCHITECTURE.md, docs/ and the
+//! crates' README files names a file that exists and, with a `#fragment`, a heading of that file
+//! (GitHub's anchors).
 
 use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};
@@ -12,6 +13,12 @@ fn root() -> PathBuf {
 fn pages() -> Vec<PathBuf> {
     let root = root();
     let mut out = vec![root.join("README.md"), root.join("ARCHITECTURE.md")];
+    for e in std::fs::read_dir(root.join("crates")).unwrap() {
+        let readme = e.unwrap().path().join("README.md");
+        if readme.exists() {
+            out.push(readme);
+        }
+    }
     let mut dirs = vec![root.join("docs")];
     while let Some(d) = dirs.pop() {
         for e in std::fs::read_dir(&d).unwrap() {
@@ -156,15 +163,27 @@ fn every_relative_link_of_the_guide_resolves() {
             }
         }
     }
-    assert!(checked > 30, "only {checked} links found: is the parser broken?");
+    assert!(
+        checked > 30,
+        "only {checked} links found: is the parser broken?"
+    );
     assert!(broken.is_empty(), "broken links:\n{}", broken.join("\n"));
 }
 
 #[test]
 fn the_anchor_rules_match_githubs() {
-    assert_eq!(slug("On a vehicle: backseat links, rehearsal and MOOS logs"), "on-a-vehicle-backseat-links-rehearsal-and-moos-logs");
-    assert_eq!(slug("`kind = \"amp\"`".replace('`', "").as_str()), "kind--amp");
+    assert_eq!(
+        slug("On a vehicle: backseat links, rehearsal and MOOS logs"),
+        "on-a-vehicle-backseat-links-rehearsal-and-moos-logs"
+    );
+    assert_eq!(
+        slug("`kind = \"amp\"`".replace('`', "").as_str()),
+        "kind--amp"
+    );
     let a = anchors("# A\n## A\n```\n# not a heading\n```\n### B c\n");
     assert_eq!(a.into_iter().collect::<Vec<_>>(), vec!["a", "a-1", "b-c"]);
-    assert_eq!(links("see [x](a.md#b) and ![i](img.png)."), vec!["a.md#b", "img.png"]);
+    assert_eq!(
+        links("see [x](a.md#b) and ![i](img.png)."),
+        vec!["a.md#b", "img.png"]
+    );
 }
