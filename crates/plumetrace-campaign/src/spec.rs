@@ -804,6 +804,35 @@ mod tests {
     use super::*;
 
     #[test]
+    fn the_campaigns_success_radius_replaces_the_scenarios() {
+        let text = "name = \"c\"\nseed = 1\nseeds = 1\nscenarios = [\"demo\", \"li-zhang-open\"]\n\
+                    [[configs]]\nname = \"a\"\n[[configs]]\nname = \"wide\"\n\
+                    [configs.set]\n\"mission.success_radius_m\" = 80\n";
+        let path = Path::new("c.toml");
+        let resolve = |text: &str| {
+            let file = parse_campaign(text, path).unwrap();
+            Campaign::resolve(file, path, text.to_string(), true).unwrap()
+        };
+        let c = resolve(text);
+        // Without the campaign's key: each group's scenario (and configuration) says.
+        assert_eq!(c.located_radius_m(0, 0, 0), 50.0, "the default");
+        assert_eq!(c.located_radius_m(1, 0, 0), 10.0, "the preset's");
+        assert_eq!(c.located_radius_m(1, 1, 0), 80.0, "the configuration's");
+        assert_eq!(c.located_radii_m(), vec![10.0, 50.0, 80.0]);
+        assert_eq!(
+            c.success_within_text(),
+            "within its scenario's `mission.success_radius_m` (10, 50, 80 m)"
+        );
+        assert_eq!(c.metric_context().success_radius_m, None);
+        // With it: every run's.
+        let c = resolve(&format!("success_radius_m = 5.0\n{text}"));
+        assert_eq!(c.located_radius_m(1, 1, 0), 5.0);
+        assert_eq!(c.located_radii_m(), vec![5.0]);
+        assert_eq!(c.success_within_text(), "within 5 m");
+        assert_eq!(c.metric_context().success_radius_m, Some(5.0));
+    }
+
+    #[test]
     fn a_config_can_replace_the_scenarios_planner_and_the_registry_checks_it() {
         let text = "name = \"c\"\nseed = 1\nseeds = 1\nscenarios = [\"demo\"]\n\
                     [[configs]]\nname = \"survey\"\n[configs.planner]\nkind = \"lawnmower\"\n\
