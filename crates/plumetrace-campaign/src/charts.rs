@@ -143,10 +143,15 @@ pub fn success_chart(c: &Campaign, groups: &[GroupSummary]) -> Result<String, Ca
 }
 
 fn success_desc(c: &Campaign, groups: &[GroupSummary]) -> String {
-    match c.success_radius_m() {
-        _ if multi_source(groups) => "fraction of runs locating every source".into(),
-        Some(r) => format!("fraction of runs declaring within {r} m of a source"),
-        None => "fraction of runs declaring a source".into(),
+    if multi_source(groups) {
+        "fraction of runs locating every source".into()
+    } else if let Some(r) = c.success_radius_m() {
+        format!("fraction of runs declaring within {r} m of a source")
+    } else {
+        format!(
+            "fraction of runs declaring {} of a source",
+            c.success_within_text().replace('`', "")
+        )
     }
 }
 

@@ -27,8 +27,9 @@ pub struct CampaignFile {
     /// Preset names, or paths relative to the campaign file: scenarios ending in `.toml`, families
     /// of sites ending in `.family.toml`.
     pub scenarios: Vec<String>,
-    /// A run succeeds when it declares; with this set, only when it also declares within this
-    /// distance of a true source, m.
+    /// The success radius of every run, m: it replaces each scenario's
+    /// `mission.success_radius_m` (a run succeeds when its first declaration lies within it of
+    /// the true source; with several sources, when every source has a declaration within it).
     #[serde(default)]
     pub success_radius_m: Option<f64>,
     /// Planner configurations (none: one configuration, "default", as the scenario has it).
@@ -277,10 +278,50 @@ impl Campaign {
         self.file.success_radius_m
     }
 
-    /// Within this distance of a declaration a source counts as located: the success radius, or
-    /// the mission's 50 m without one.
-    pub fn located_radius_m(&self) -> f64 {
-        self.metric_context().located_radius_m()
+    /// Within this distance of a declaration a source of a group's runs counts as located: the
+    /// campaign's `success_radius_m`, or else the scenario's `mission.success_radius_m` (with the
+    /// configuration's and the sweep point's keys set), or else its default.
+    pub fn located_radius_m(&self, scenario: usize, config: usize, point: usize) -> f64 {
+        if let Some(r) = self.file.success_radius_m {
+            return r;
+        }
+        let table = self.group_table(scenario, config, point, 0).ok();
+        let given = table.as_ref().and_then(|t| {
+            let v = t.get("mission")?.get("success_radius_m")?;
+            v.as_float().or_else(|| v.as_integer().map(|i| i as f64))
+        });
+        given.unwrap_or(plumetrace_scenario::DEFAULT_SUCCESS_RADIUS_M)
+    }
+
+    /// Every group's located radius ([`Campaign::located_radius_m`]), sorted, each once.
+    pub fn located_radii_m(&self) -> Vec<f64> {
+        let mut radii = Vec::new();
+        for scenario in 0..self.scenarios.len() {
+            for config in 0..self.configs.len() {
+                for point in 0..self.points.len() {
+                    radii.push(self.located_radius_m(scenario, config, point));
+                }
+            }
+        }
+        radii.sort_by(f64::total_cmp);
+        radii.dedup();
+        radii
+    }
+
+    /// The success radius in words, after "a declaration": `within 10 m`, or without the
+    /// campaign's key `within 50 m (the scenarios' mission.success_radius_m)`.
+    pub fn success_within_text(&self) -> String {
+        if let Some(r) = self.file.success_radius_m {
+            return format!("within {r} m");
+        }
+        let radii: Vec<String> = self.located_radii_m().iter().map(f64::to_string).collect();
+        match radii.as_slice() {
+            [one] => format!("within {one} m (the scenarios' `mission.success_radius_m`)"),
+            many => format!(
+                "within its scenario's `mission.success_radius_m` ({} m)",
+                many.join(", ")
+            ),
+        }
     }
 
     /// What runs are judged against besides their summaries (the success radius).
@@ -761,6 +802,35 @@ pub(crate) fn fnv1a(bytes: &[u8]) -> u64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_campaigns_success_radius_replaces_the_scenarios() {
+        let text = "name = \"c\"\nseed = 1\nseeds = 1\nscenarios = [\"demo\", \"li-zhang-open\"]\n\
+                    [[configs]]\nname = \"a\"\n[[configs]]\nname = \"wide\"\n\
+                    [configs.set]\n\"mission.success_radius_m\" = 80\n";
+        let path = Path::new("c.toml");
+        let resolve = |text: &str| {
+            let file = parse_campaign(text, path).unwrap();
+            Campaign::resolve(file, path, text.to_string(), true).unwrap()
+        };
+        let c = resolve(text);
+        // Without the campaign's key: each group's scenario (and configuration) says.
+        assert_eq!(c.located_radius_m(0, 0, 0), 50.0, "the default");
+        assert_eq!(c.located_radius_m(1, 0, 0), 10.0, "the preset's");
+        assert_eq!(c.located_radius_m(1, 1, 0), 80.0, "the configuration's");
+        assert_eq!(c.located_radii_m(), vec![10.0, 50.0, 80.0]);
+        assert_eq!(
+            c.success_within_text(),
+            "within its scenario's `mission.success_radius_m` (10, 50, 80 m)"
+        );
+        assert_eq!(c.metric_context().success_radius_m, None);
+        // With it: every run's.
+        let c = resolve(&format!("success_radius_m = 5.0\n{text}"));
+        assert_eq!(c.located_radius_m(1, 1, 0), 5.0);
+        assert_eq!(c.located_radii_m(), vec![5.0]);
+        assert_eq!(c.success_within_text(), "within 5 m");
+        assert_eq!(c.metric_context().success_radius_m, Some(5.0));
+    }
 
     #[test]
     fn a_config_can_replace_the_scenarios_planner_and_the_registry_checks_it() {

@@ -141,7 +141,7 @@ fn summarise_group(c: &Campaign, key: &RunKey, rows: &[&RunRow]) -> GroupSummary
     let decl = sorted(dec.iter().filter_map(|r| r.metrics.declaration_s));
     let path = sorted(rows.iter().filter_map(|r| r.metrics.path_length_m));
     let ratio = sorted(dec.iter().filter_map(|r| r.metrics.path_ratio));
-    let radius = c.located_radius_m();
+    let radius = c.located_radius_m(key.scenario, key.config, key.point);
     let located = sorted(
         rows.iter()
             .flat_map(|r| r.metrics.source_errors_m.split(';'))
@@ -272,7 +272,7 @@ pub fn summary_md(c: &Campaign, groups: &[GroupSummary], expected_runs: u64) -> 
     }
     let recorded: u64 = groups.iter().map(|g| g.runs).sum();
     let multi_source = multi_source(groups);
-    let radius = c.located_radius_m();
+    let within = c.success_within_text();
     let _ = writeln!(
         s,
         "{recorded} of {expected_runs} runs recorded; campaign seed {}, {} seeds per group. \
@@ -283,24 +283,22 @@ pub fn summary_md(c: &Campaign, groups: &[GroupSummary], expected_runs: u64) -> 
          line from the first detection to the source.\n",
         c.file.seed,
         c.file.seeds,
-        match (c.success_radius_m(), multi_source) {
-            (Some(r), false) => format!("a declaration within {r} m of a true source"),
-            (None, false) => "a declaration".to_string(),
-            (_, true) => format!(
-                "with one source, a declaration{}; with several, every source located \
-                 (a declaration within {radius} m of it; edge declarations of subregions \
-                 count for the source they are nearest to)",
-                c.success_radius_m()
-                    .map_or(String::new(), |r| format!(" within {r} m"))
-            ),
+        if multi_source {
+            format!(
+                "with one source, a declaration {within}; with several, every source located \
+                 (a declaration {within} of it; edge declarations of subregions count for the \
+                 source they are nearest to)"
+            )
+        } else {
+            format!("a declaration {within} of a true source")
         }
     );
     if multi_source {
         let _ = writeln!(
             s,
             "Several sources: the first declaration is often at the edge of a subregion, so \
-             its error says little; `sources located` counts sources with a declaration within \
-             {radius} m, and `located error` is the distance from each located source to its \
+             its error says little; `sources located` counts sources with a declaration \
+             {within}, and `located error` is the distance from each located source to its \
              nearest declaration (all runs' sources pooled).\n"
         );
     }

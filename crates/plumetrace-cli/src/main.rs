@@ -185,11 +185,12 @@ fn family(a: &FamilyArgs) -> Result<()> {
     for k in 0..a.sample {
         let seed = plumetrace_env::derive_seed(a.seed, k);
         let site = f.draw(seed);
-        let text = site.to_toml(&f.file, &f.base, seed);
+        let site_name = format!("{}-site-{k:0width$}", f.file.name);
+        let text = site.to_toml(&f.file, &f.base, seed, &site_name);
         let path = a.out.join(format!("site-{k:0width$}.toml"));
         let origin = plumetrace_scenario::Origin::File(path.clone());
         let cfg = plumetrace_scenario::parse(&text, &origin)?;
-        plumetrace_scenario::build(&cfg, &origin, Some(seed))?;
+        plumetrace_scenario::build(&cfg, &origin, None)?;
         plumetrace_mission::output::write_atomic(&path, text.as_bytes())?;
     }
     crate::outln!(

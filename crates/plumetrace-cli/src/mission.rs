@@ -4,7 +4,7 @@ use crate::output::write_atomic;
 use anyhow::{Context, Result};
 use plumetrace_log::snapshot::Header;
 use plumetrace_mission::snapshot_log::SnapshotLogWriter;
-use plumetrace_mission::{Mission, MissionOptions, MissionRun, MissionSetup};
+use plumetrace_mission::{Mission, MissionOptions, MissionRun, MissionSetup, Outcome};
 use plumetrace_scenario::BuiltScenario;
 use serde::Serialize;
 use std::fmt::Write as _;
@@ -88,11 +88,11 @@ pub fn run(
     Ok(())
 }
 
-/// The one-line result: outcome, the first declaration with its time and error, and when and
-/// why the mission ended.
+/// The one-line result: whether the mission located the source (within the scenario's success
+/// radius, with the error), the declarations, the outcome and when and why the mission ended.
 pub fn run_line(run: &MissionRun, name: &str, wall: f64) -> String {
     let s = &run.summary;
-    let result = if s.sources.len() > 1 || s.declarations.len() > 1 {
+    let detail = if s.sources.len() > 1 || s.declarations.len() > 1 {
         let nearest: Vec<String> = s
             .sources
             .iter()
@@ -102,24 +102,22 @@ pub fn run_line(run: &MissionRun, name: &str, wall: f64) -> String {
             })
             .collect();
         format!(
-            "{} declarations; {} of {} sources located within {:.0} m (nearest declaration per source: {})",
+            "; {} declarations, nearest declaration per source: {}",
             s.declarations.len(),
-            s.sources_located,
-            s.sources.len(),
-            plumetrace_mission::LOCATED_RADIUS_M,
             nearest.join(", ")
         )
     } else if let Some(d) = &s.first_declaration {
         format!(
-            "declared at {:.0} s at ({:.1}, {:.1}), {:.1} m from the source ({:+.1} m along, {:+.1} m across the flow)",
-            d.t_s, d.x_m, d.y_m, d.error_m, d.error_along_m, d.error_cross_m
+            "; declared at {:.0} s at ({:.1}, {:.1}), {:+.1} m along and {:+.1} m across the flow",
+            d.t_s, d.x_m, d.y_m, d.error_along_m, d.error_cross_m
         )
     } else {
-        "no source declared".to_string()
+        String::new()
     };
     let ended = plumetrace_core::variant_name(&s.ended.reason).unwrap_or("?");
     format!(
-        "{name}: {}; {result}; mission ended at {:.0} s ({ended}), {wall:.1} s of wall time",
+        "{name}: {}{detail}; outcome {}, mission ended at {:.0} s ({ended}), {wall:.1} s of wall time",
+        s.verdict(),
         s.outcome.name(),
         s.ended.t_s,
     )
@@ -199,17 +197,17 @@ fn write_outputs(run: &MissionRun, out: &Path, name: &str, wall: f64) -> Result<
         serde_json::to_string_pretty(&file)?.as_bytes(),
     )?;
     let s = &run.summary;
-    let title = if s.sources.len() > 1 {
-        format!(
-            "{name}: {}, {} of {} sources located (seed {})",
-            s.outcome.name(),
-            s.sources_located,
-            s.sources.len(),
-            s.seed
-        )
+    // The verdict, and the outcome where a vehicle failed (the verdict tells the others).
+    let failed = !matches!(
+        s.outcome,
+        Outcome::Declared | Outcome::NoDeclaration | Outcome::TimedOut
+    );
+    let outcome = if failed {
+        format!("; {}", s.outcome.name())
     } else {
-        format!("{name}: {} (seed {})", s.outcome.name(), s.seed)
+        String::new()
     };
+    let title = format!("{name} (seed {}): {}{outcome}", s.seed, s.verdict());
     let svg = plumetrace_report::mission_figure(run, &title)?;
     write_atomic(&out.join("plot.svg"), svg.as_bytes())?;
     if let Some(team) = plumetrace_report::team_figure(run, &title) {

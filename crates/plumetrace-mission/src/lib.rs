@@ -47,7 +47,7 @@ pub use record::{
 };
 pub use setup::{MissionError, MissionSetup, PlannedVehicle};
 pub use shared::fly_shared;
-pub use summary::{DeclarationRecord, LOCATED_RADIUS_M, SourceRecord, Summary, VehicleSummary};
+pub use summary::{DeclarationRecord, SourceRecord, Summary, VehicleSummary};
 pub use team::{TeamStats, TeamSummary};
 
 /// serde, for the code [`columns!`] makes in other crates.

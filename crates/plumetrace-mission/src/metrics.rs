@@ -9,7 +9,7 @@
 //! ([`columns_of`]) and values ([`values_of`]), and is written and read by serde as one flat
 //! record (a group's columns take its place), which is how `runs.csv` is written.
 
-use crate::summary::{DeclarationRecord, LOCATED_RADIUS_M, Summary};
+use crate::summary::{DeclarationRecord, Summary};
 use crate::team::TeamSummary;
 use serde::de::{DeserializeOwned, MapAccess};
 use serde::ser::SerializeStruct;
@@ -355,16 +355,17 @@ macro_rules! columns {
 /// What a run is judged against besides its summary.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub struct MetricContext {
-    /// A single-source run succeeds when it declares; with this set, only when it also declares
-    /// within this distance of a true source, m. It is also the located radius.
+    /// A success radius that replaces the mission's own (its scenario's
+    /// `mission.success_radius_m`, in [`Summary::success_radius_m`]), m: a campaign's
+    /// `success_radius_m`.
     pub success_radius_m: Option<f64>,
 }
 
 impl MetricContext {
-    /// Within this distance of a declaration a source counts as located: the success radius, or
-    /// the mission's [`LOCATED_RADIUS_M`] without one.
-    pub fn located_radius_m(&self) -> f64 {
-        self.success_radius_m.unwrap_or(LOCATED_RADIUS_M)
+    /// Within this distance of a declaration a source of this run counts as located: the
+    /// context's success radius, or the mission's own without one.
+    pub fn located_radius_m(&self, s: &Summary) -> f64 {
+        self.success_radius_m.unwrap_or(s.success_radius_m)
     }
 }
 
@@ -372,17 +373,18 @@ crate::columns! {
     /// A run's metrics: one field per column of a campaign's `runs.csv` after its keys and
     /// outcome. Missing numbers (no declaration, no detection, no team) are `None`.
     pub struct RunMetrics from (s: &Summary, cx: &MetricContext) {
-        /// Single source: declared (within the success radius, if the campaign sets one). Several
-        /// sources: every source located (`sources_located == sources`).
-        success: bool = success(s, cx);
+        /// Single source: the first declaration lies within the success radius (the campaign's,
+        /// or the scenario's `mission.success_radius_m`). Several sources: every source located
+        /// (`sources_located == sources`).
+        success: bool = s.success_within(cx.located_radius_m(s));
         /// Declared at all.
         declared: bool = s.declared;
         /// Number of declarations (several on multi-source missions).
         declarations: u32 = count(s.declarations.len());
         /// Number of true sources.
         sources: u32 = count(s.sources.len());
-        /// Sources with a declaration within the success radius (the mission's 50 m without one).
-        sources_located: u32 = count(located(s, cx));
+        /// Sources with a declaration within the success radius.
+        sources_located: u32 = count(s.located_within(cx.located_radius_m(s)));
         /// First declared position, m.
         declared_x: Option<f64> ["m"] = first(s).map(|d| d.x_m);
         /// First declared position, m.
@@ -464,27 +466,6 @@ fn first(s: &Summary) -> Option<&DeclarationRecord> {
     s.first_declaration.as_ref()
 }
 
-/// Sources with a declaration within the located radius.
-fn located(s: &Summary, cx: &MetricContext) -> usize {
-    let radius = cx.located_radius_m();
-    s.sources
-        .iter()
-        .filter(|src| src.nearest_error_m.is_some_and(|e| e <= radius))
-        .count()
-}
-
-/// Single source: declared (within the success radius, if any); several: every source located.
-fn success(s: &Summary, cx: &MetricContext) -> bool {
-    if s.sources.len() > 1 {
-        located(s, cx) == s.sources.len()
-    } else {
-        s.declared
-            && cx
-                .success_radius_m
-                .is_none_or(|r| first(s).is_some_and(|d| d.error_m <= r))
-    }
-}
-
 /// The traced path over the straight line from the first detection to the source.
 fn path_ratio(s: &Summary) -> Option<f64> {
     s.trace_length_m
@@ -529,8 +510,9 @@ mod tests {
         assert!(cols.iter().all(|c| !c.description().is_empty()));
         assert_eq!(
             cols[0].description(),
-            "Single source: declared (within the success radius, if the campaign sets one). \
-             Several sources: every source located (`sources_located == sources`)."
+            "Single source: the first declaration lies within the success radius (the \
+             campaign's, or the scenario's `mission.success_radius_m`). Several sources: every \
+             source located (`sources_located == sources`)."
         );
         let m = RunMetrics {
             error_m: Some(2.5),

@@ -137,6 +137,7 @@ pub(crate) struct Flight {
     geometry: MissionGeometry,
     op_area: Vec<Vec2>,
     subregions: Vec<Vec<Vec2>>,
+    success_radius_m: f64,
     spinup_wall_s: f64,
 }
 
@@ -297,6 +298,7 @@ impl Flight {
                 geometry,
                 op_area: spec.op_area,
                 subregions: spec.subregions,
+                success_radius_m: spec.success_radius_m,
                 spinup_wall_s,
             };
             Ok(flight)
@@ -552,6 +554,7 @@ impl Flight {
                 .map(|v| (v.name.clone(), v.kind, v.planner))
                 .collect(),
             sources: &self.sources,
+            success_radius_m: self.success_radius_m,
             mean_flow_mps: mean_flow,
             team: self.team.summary(),
         });

@@ -10,11 +10,6 @@ use plumetrace_core::{BehaviourKind, DeclarationKind, Heading, Vec2, Vec3, Vehic
 use plumetrace_planner::PlannerKind;
 use serde::Serialize;
 
-/// A source counts as located when a declaration lies within this distance of it, m. The field
-/// declarations were within 31 m of the sonar positions, and the plume of a bottom source reaches
-/// a vehicle 1.5-2 m up only some tens of metres downflow.
-pub const LOCATED_RADIUS_M: f64 = 50.0;
-
 /// A declaration with its errors.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct DeclarationRecord {
@@ -52,7 +47,7 @@ pub struct SourceRecord {
     pub declarations: usize,
     /// Distance of the nearest declaration, m (`None`: none).
     pub nearest_error_m: Option<f64>,
-    /// A declaration lies within [`LOCATED_RADIUS_M`].
+    /// A declaration lies within the mission's success radius (`success_radius_m`).
     pub located: bool,
 }
 
@@ -97,6 +92,9 @@ pub struct Summary {
     pub ended: MissionEnd,
     /// Whether any source was declared.
     pub declared: bool,
+    /// Whether the mission found what it looked for: with one true source, its first
+    /// declaration lies within `success_radius_m` of it; with several, every source is located.
+    pub success: bool,
     /// The first declaration (its time against `ended.t_s` tells which came first).
     pub first_declaration: Option<DeclarationRecord>,
     /// Time of the lead vehicle's first detection, s.
@@ -112,7 +110,10 @@ pub struct Summary {
     pub sim_time_s: f64,
     /// Every declaration, in time order.
     pub declarations: Vec<DeclarationRecord>,
-    /// Sources with a declaration within [`LOCATED_RADIUS_M`].
+    /// A source counts as located when a declaration lies within this distance of it, m (the
+    /// scenario's `mission.success_radius_m`).
+    pub success_radius_m: f64,
+    /// Sources with a declaration within `success_radius_m`.
     pub sources_located: usize,
     /// Every true source, with its nearest declaration.
     pub sources: Vec<SourceRecord>,
@@ -137,6 +138,7 @@ pub(crate) struct SummaryInput<'a> {
     pub tracks: &'a [VehicleTrack],
     pub vehicles: Vec<(String, VehicleKind, Option<PlannerKind>)>,
     pub sources: &'a [Vec3],
+    pub success_radius_m: f64,
     pub mean_flow_mps: Vec2,
     pub team: Option<crate::team::TeamSummary>,
 }
@@ -179,7 +181,7 @@ impl Summary {
             .as_ref()
             .map(|r| Vec2::new(r.source_x_m, r.source_y_m))
             .or_else(|| i.sources.first().map(|s| s.xy()));
-        let sources = source_records(i.sources, &declarations);
+        let sources = source_records(i.sources, &declarations, i.success_radius_m);
         let vehicles = i
             .vehicles
             .into_iter()
@@ -211,12 +213,13 @@ impl Summary {
             .filter_map(|v| v.longest_quiet_s)
             .max_by(f64::total_cmp);
         let max_outside_m = with_planner.map(|v| v.max_outside_m).fold(0.0, f64::max);
-        Summary {
+        let mut summary = Summary {
             scenario: i.scenario,
             seed: i.seed,
             outcome,
             ended: i.end,
             declared: first.is_some(),
+            success: false,
             first_detection_s: track.first_detection.map(|d| d.0),
             path_length_m: track.path_length_m,
             trace_length_m: first.as_ref().map(|_| track.trace_length_m),
@@ -227,12 +230,65 @@ impl Summary {
             sim_time_s: i.end.t_s,
             first_declaration: first,
             declarations,
+            success_radius_m: i.success_radius_m,
             sources_located: sources.iter().filter(|s| s.located).count(),
             sources,
             longest_quiet_s,
             max_outside_m,
             vehicles,
             team: i.team,
+        };
+        summary.success = summary.success_within(i.success_radius_m);
+        summary
+    }
+
+    /// Sources with a declaration within `radius_m` of them.
+    pub fn located_within(&self, radius_m: f64) -> usize {
+        self.sources
+            .iter()
+            .filter(|src| src.nearest_error_m.is_some_and(|e| e <= radius_m))
+            .count()
+    }
+
+    /// Whether the mission succeeded with this success radius: with one true source, its first
+    /// declaration lies within `radius_m` of it; with several, every source has a declaration
+    /// within `radius_m`.
+    pub fn success_within(&self, radius_m: f64) -> bool {
+        if self.sources.len() > 1 {
+            self.located_within(radius_m) == self.sources.len()
+        } else {
+            self.first_declaration
+                .as_ref()
+                .is_some_and(|d| d.error_m <= radius_m)
+        }
+    }
+
+    /// Whether the mission succeeded, in words, with the error and the success radius:
+    /// `located: declared 8.2 m from the source (success radius 50 m)`, `NOT located: declared
+    /// 258.5 m from the source (success radius 50 m)`, `NOT located: no declaration (time
+    /// limit)`; with several sources, how many were located.
+    pub fn verdict(&self) -> String {
+        let word = if self.success {
+            "located"
+        } else {
+            "NOT located"
+        };
+        let r = self.success_radius_m;
+        let Some(first) = &self.first_declaration else {
+            let why = plumetrace_core::variant_name(&self.ended.reason).unwrap_or("?");
+            return format!("{word}: no declaration ({})", why.replace('_', " "));
+        };
+        if self.sources.len() > 1 {
+            format!(
+                "{word}: {} of {} sources declared within the success radius ({r} m)",
+                self.sources_located,
+                self.sources.len()
+            )
+        } else {
+            format!(
+                "{word}: declared {:.1} m from the source (success radius {r} m)",
+                first.error_m
+            )
         }
     }
 
@@ -279,7 +335,11 @@ fn nearest_source(p: Vec2, sources: &[Vec3]) -> Option<usize> {
 }
 
 /// Each true source with the declarations attributed to it (those nearest to it).
-fn source_records(sources: &[Vec3], declarations: &[DeclarationRecord]) -> Vec<SourceRecord> {
+fn source_records(
+    sources: &[Vec3],
+    declarations: &[DeclarationRecord],
+    radius_m: f64,
+) -> Vec<SourceRecord> {
     let owner: Vec<Option<usize>> = declarations
         .iter()
         .map(|d| nearest_source(Vec2::new(d.x_m, d.y_m), sources))
@@ -300,7 +360,7 @@ fn source_records(sources: &[Vec3], declarations: &[DeclarationRecord]) -> Vec<S
                 y_m: s.y,
                 declarations: mine.len(),
                 nearest_error_m: nearest,
-                located: nearest.is_some_and(|e| e <= LOCATED_RADIUS_M),
+                located: nearest.is_some_and(|e| e <= radius_m),
             }
         })
         .collect()
@@ -334,7 +394,7 @@ mod tests {
         .iter()
         .map(|(t, p, rule)| declaration_record(*t, 0, *p, rule.clone(), &sources, flow))
         .collect();
-        let recs = source_records(&sources, &decl);
+        let recs = source_records(&sources, &decl, 50.0);
         assert_eq!(recs[0].declarations, 3, "the edge declaration counts too");
         assert_eq!(recs[0].nearest_error_m, Some(68f64.sqrt()));
         assert!(recs[0].located);
@@ -342,14 +402,9 @@ mod tests {
         assert_eq!(recs[1].nearest_error_m, None);
         assert!(!recs[1].located);
         // Only the edge declaration: attributed, but 300 m away is not located.
-        let recs = source_records(&sources, &decl[..1]);
+        let recs = source_records(&sources, &decl[..1], 50.0);
         assert_eq!(recs[0].declarations, 1);
-        assert!(
-            recs[0]
-                .nearest_error_m
-                .is_some_and(|e| e > LOCATED_RADIUS_M)
-                && !recs[0].located
-        );
+        assert!(recs[0].nearest_error_m.is_some_and(|e| e > 50.0) && !recs[0].located);
         assert_eq!(decl[0].rule, DeclarationKind::new("upflow_edge"));
     }
 

@@ -15,8 +15,13 @@ pub struct ScenarioConfig {
     /// One line saying what the scenario is for.
     #[serde(default)]
     pub description: String,
-    /// Run seed (overridable with `--seed`).
-    #[serde(default)]
+    /// Run seed (overridable with `--seed`): a whole number, written as a string of digits
+    /// beyond 2^63 - 1, where TOML integers stop ([`seed`]).
+    #[serde(
+        default,
+        deserialize_with = "seed::read",
+        serialize_with = "seed::write"
+    )]
     pub seed: u64,
     /// Time stepping.
     pub sim: SimConfig,
@@ -527,6 +532,9 @@ pub struct MissionConfig {
     /// Filaments farther than this beyond the downflow edge of every vehicle's reach are
     /// dropped, m (default 200; see the README's plume model).
     pub drop_margin_m: Option<f64>,
+    /// A source counts as located when a declaration lies within this distance of it, m
+    /// (default [`DEFAULT_SUCCESS_RADIUS_M`](crate::DEFAULT_SUCCESS_RADIUS_M)).
+    pub success_radius_m: Option<f64>,
 }
 
 /// `[comms]`: one channel model per link kind (absent: ideal, no delay and no loss).
@@ -627,5 +635,54 @@ mod points {
             .into_iter()
             .map(|l| l.into_iter().map(|p| p.0).collect())
             .collect())
+    }
+}
+
+/// Run seeds: any whole number 0..2^64. TOML integers stop at 2^63 - 1, so a larger seed (half
+/// of those a campaign derives) is written as a string of digits: `seed = "10451216379200822465"`.
+pub mod seed {
+    use serde::de::{Deserializer, Error, Visitor};
+    use serde::ser::Serializer;
+    use std::fmt;
+
+    const EXPECTED: &str = "a whole number from 0 to 18446744073709551615 (beyond \
+                            9223372036854775807 a string of digits, \"18446744073709551615\")";
+
+    /// The seed as a TOML value: an integer where TOML has one, else a string of digits.
+    pub fn value(seed: u64) -> toml::Value {
+        match i64::try_from(seed) {
+            Ok(i) => toml::Value::Integer(i),
+            Err(_) => toml::Value::String(seed.to_string()),
+        }
+    }
+
+    /// Reads a seed written as an integer or a string of digits.
+    pub fn read<'de, D: Deserializer<'de>>(d: D) -> Result<u64, D::Error> {
+        struct Seed;
+        impl Visitor<'_> for Seed {
+            type Value = u64;
+            fn expecting(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+                f.write_str(EXPECTED)
+            }
+            fn visit_u64<E: Error>(self, v: u64) -> Result<u64, E> {
+                Ok(v)
+            }
+            fn visit_i64<E: Error>(self, v: i64) -> Result<u64, E> {
+                u64::try_from(v).map_err(|_| E::custom(format!("expected {EXPECTED}, got {v}")))
+            }
+            fn visit_str<E: Error>(self, v: &str) -> Result<u64, E> {
+                v.parse()
+                    .map_err(|_| E::custom(format!("expected {EXPECTED}, got \"{v}\"")))
+            }
+        }
+        d.deserialize_any(Seed)
+    }
+
+    /// Writes a seed as [`value`] does.
+    pub fn write<S: Serializer>(seed: &u64, s: S) -> Result<S::Ok, S::Error> {
+        match i64::try_from(*seed) {
+            Ok(i) => s.serialize_i64(i),
+            Err(_) => s.serialize_str(&seed.to_string()),
+        }
     }
 }

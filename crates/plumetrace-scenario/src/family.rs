@@ -970,13 +970,17 @@ impl Site {
         t
     }
 
-    /// The site as a commented scenario file.
-    pub fn to_toml(&self, f: &FamilyFile, base: &toml::Table, seed: u64) -> String {
-        let table = self.apply(f, base);
-        // The seed stays on the command line: TOML integers stop at 2^63, run seeds do not.
+    /// The site as a commented scenario file, named `NAME` (unique among the family's sites,
+    /// e.g. `faults-site-003`) and carrying `seed`: flown as written it is the campaign's run of
+    /// the site drawn from `seed`.
+    pub fn to_toml(&self, f: &FamilyFile, base: &toml::Table, seed: u64, name: &str) -> String {
+        let mut table = self.apply(f, base);
+        table.insert("name".into(), toml::Value::String(name.to_string()));
+        table.insert("seed".into(), crate::config::seed::value(seed));
         let mut out = format!(
-            "# Site of family '{}' drawn from seed {seed}; fly it as the campaign did with\n\
-             #   plumetrace run FILE --seed {seed}\n# Drawn:\n",
+            "# Site '{name}' of family '{}', drawn from seed {seed}, which is also its run seed:\n\
+             # flown as written (plumetrace run FILE) it is the campaign's run of this site.\n\
+             # Drawn:\n",
             f.name.replace('\n', " ")
         );
         for (k, v) in Site::COLUMNS.iter().zip(self.values()) {

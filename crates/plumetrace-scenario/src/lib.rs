@@ -14,7 +14,10 @@ pub mod limits;
 pub mod overrides;
 pub mod presets;
 
-pub use build::{BuiltScenario, MissionSpec, OutputSpec, PlannerRef, VehicleSetup, build};
+pub use build::{
+    BuiltScenario, DEFAULT_SUCCESS_RADIUS_M, MissionSpec, OutputSpec, PlannerRef, VehicleSetup,
+    build,
+};
 pub use config::ScenarioConfig;
 pub use error::ScenarioError;
 pub use family::{Family, Site, is_family_path};

@@ -99,7 +99,7 @@ pub const LIMITS: &[Limit] = &[
     Limit {
         key: "seed",
         bound: Bound::Any,
-        why: "any whole number 0..2^64",
+        why: "any whole number 0..2^64 (beyond 2^63 - 1, where TOML integers stop, a string of digits)",
     },
     pos(
         "sim.dt_s",
@@ -566,6 +566,11 @@ pub const LIMITS: &[Limit] = &[
         COORD,
         "filaments this far beyond every vehicle's reach are dropped; at least 50 m",
     ),
+    pos(
+        "mission.success_radius_m",
+        COORD,
+        "a radius > 0 in a local frame: 10,000 km is not local",
+    ),
     num("comms.acoustic.latency_s", 0.0, 1e5, "a day at most"),
     pos("comms.acoustic.sound_speed_mps", 1e9, "finite"),
     num("comms.acoustic.loss_probability", 0.0, 1.0, "a probability"),
@@ -832,6 +837,11 @@ mod tests {
                 "[domain]\nwidth_m = 3.0",
                 "domain.width_m",
                 "no documented bound",
+            ),
+            (
+                "[mission]\nsuccess_radius_m = 0.0",
+                "mission.success_radius_m",
+                "> 0.0 and <= 10000000.0",
             ),
         ];
         let error = |text: &str| {

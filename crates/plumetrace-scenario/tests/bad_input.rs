@@ -585,3 +585,53 @@ fn model_errors_are_placed_under_their_section() {
         assert_eq!(got, want);
     }
 }
+
+#[test]
+fn seeds_beyond_toml_integers_are_strings_of_digits() {
+    let origin = Origin::File("scenario.toml".into());
+    let with_seed =
+        |seed: &str| demo_with(|t| t.replacen("seed = 1\n", &format!("seed = {seed}\n"), 1));
+    assert_ne!(with_seed("2"), find_preset("plume-demo").unwrap().toml);
+    for (written, seed) in [
+        ("7", 7),
+        ("\"18446744073709551615\"", u64::MAX),
+        ("\"10451216379200822465\"", 10_451_216_379_200_822_465),
+    ] {
+        let cfg = parse(&with_seed(written), &origin).unwrap();
+        assert_eq!(cfg.seed, seed, "{written}");
+        assert_eq!(build(&cfg, &origin, None).unwrap().seed, seed, "{written}");
+        let back = plumetrace_scenario::config::seed::value(seed);
+        assert_eq!(back.to_string(), written);
+    }
+    for bad in ["-1", "\"12x\"", "\"18446744073709551616\"", "1.5"] {
+        let e = error_of(&with_seed(bad));
+        assert!(
+            e.starts_with("scenario.toml: seed:") && e.contains("a whole number from 0 to"),
+            "{bad}: {e}"
+        );
+    }
+}
+
+#[test]
+fn the_success_radius_is_a_mission_key_with_a_default() {
+    let origin = Origin::File("scenario.toml".into());
+    let demo = find_preset("demo").unwrap().toml;
+    let radius = |text: &str| {
+        let cfg = parse(text, &origin).unwrap();
+        build(&cfg, &origin, None)
+            .unwrap()
+            .mission
+            .unwrap()
+            .success_radius_m
+    };
+    assert_eq!(radius(demo), plumetrace_scenario::DEFAULT_SUCCESS_RADIUS_M);
+    assert_eq!(plumetrace_scenario::DEFAULT_SUCCESS_RADIUS_M, 50.0);
+    let set = demo.replacen("[mission]\n", "[mission]\nsuccess_radius_m = 12.5\n", 1);
+    assert_eq!(radius(&set), 12.5);
+    let bad = demo.replacen("[mission]\n", "[mission]\nsuccess_radius_m = -3.0\n", 1);
+    let e = error_of(&bad);
+    assert!(
+        e.contains("mission.success_radius_m") && e.contains("> 0.0"),
+        "{e}"
+    );
+}

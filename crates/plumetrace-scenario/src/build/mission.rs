@@ -11,6 +11,12 @@ use plumetrace_env::{Environment, FlowField, Rect};
 /// The default of `mission.drop_margin_m`, m.
 pub const DEFAULT_DROP_MARGIN_M: f64 = 200.0;
 
+/// The default of `mission.success_radius_m`: a source counts as located when a declaration lies
+/// within this distance of it, m. The field declarations were within 31 m of the sonar positions,
+/// and the plume of a bottom source reaches a vehicle 1.5-2 m up only some tens of metres
+/// downflow.
+pub const DEFAULT_SUCCESS_RADIUS_M: f64 = 50.0;
+
 /// How far outside the op-area a vehicle can be: the cage aborts a planner whose vehicle is more
 /// than 30 m out (`plumetrace-guidance`'s `ABORT_DISTANCE_M`).
 const CAGE_REACH_M: f64 = 30.0;
@@ -143,6 +149,7 @@ fn mission_spec(
         spinup_dt_s,
         prior_flow_toward_deg: prior,
         prior_flow_given: m.prior_flow_toward_deg.is_some(),
+        success_radius_m: m.success_radius_m.unwrap_or(DEFAULT_SUCCESS_RADIUS_M),
     })
 }
 

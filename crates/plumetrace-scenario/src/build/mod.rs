@@ -21,7 +21,7 @@ mod sensors;
 mod timing;
 mod vehicles;
 
-pub use mission::DEFAULT_DROP_MARGIN_M;
+pub use mission::{DEFAULT_DROP_MARGIN_M, DEFAULT_SUCCESS_RADIUS_M};
 
 use crate::config::ScenarioConfig;
 use crate::{Origin, ScenarioError};
@@ -98,6 +98,9 @@ pub struct MissionSpec {
     pub prior_flow_toward_deg: f64,
     /// Whether the file gave it (otherwise it is North, 0).
     pub prior_flow_given: bool,
+    /// A source counts as located when a declaration lies within this distance of it, m
+    /// (`mission.success_radius_m`).
+    pub success_radius_m: f64,
 }
 
 /// A scenario ready to run.
