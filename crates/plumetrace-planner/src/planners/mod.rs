@@ -583,6 +583,22 @@ mod tests {
                 "unknown planner 'butterfly'",
             ),
             ("kind = 3", "planners.a.kind", "must be a string"),
+            // The older name of `kind` is read too, and errors name the key as written.
+            (
+                "strategy = \"ampp\"",
+                "planners.a.strategy",
+                "unknown planner 'ampp'; did you mean 'amp'? (known: ",
+            ),
+            (
+                "strategy = \"amp\"\nkind = \"amp\"",
+                "planners.a.strategy",
+                "give `kind` (or the older `strategy`), not both",
+            ),
+            (
+                "strategy = \"amp\"\nmaping_lines = 3",
+                "planners.a.maping_lines",
+                "unknown field `maping_lines`; did you mean `mapping_lines`? (`plumetrace planners` lists every key)",
+            ),
             (
                 "kind = \"amp\"\nbeta = 3.0",
                 "planners.a.beta",
