@@ -64,7 +64,7 @@ pub enum SetError {
         /// A hint for a bare word (a string is quoted).
         hint: String,
         /// The parser's message.
-        error: toml::de::Error,
+        error: Box<toml::de::Error>,
     },
     /// Nothing after `=`.
     #[error("--set {0:?}: no value")]
@@ -100,7 +100,7 @@ pub fn apply_sets(table: &mut toml::Table, sets: &[String]) -> Result<Vec<String
                 } else {
                     String::new()
                 },
-                error,
+                error: Box::new(error),
             })?
             .remove("v")
             .ok_or_else(|| SetError::NoValue(s.clone()))?;
