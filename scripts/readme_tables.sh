@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # Rewrites the guide's generated tables (planners in docs/planners.md, limits in
-# docs/scenarios.md) from the code that owns them:
-# `plumetrace planners --markdown` and `plumetrace limits --markdown`. The CLI tests fail when
-# the guide and the code disagree; run this after changing a planner key or a limit.
+# docs/scenarios.md, presets in README.md) from the code that owns them:
+# `plumetrace planners --markdown`, `plumetrace limits --markdown` and
+# `plumetrace presets --markdown`. The CLI tests fail when
+# the guide and the code disagree; run this after changing a planner key, a limit or a preset.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 cargo build --quiet --bin plumetrace
@@ -11,7 +12,8 @@ python3 - "$bin" <<'PY'
 import subprocess, sys
 bin = sys.argv[1]
 for name, cmd, path in [("planners", ["planners", "--markdown"], "docs/planners.md"),
-                        ("limits", ["limits", "--markdown"], "docs/scenarios.md")]:
+                        ("limits", ["limits", "--markdown"], "docs/scenarios.md"),
+                        ("presets", ["presets", "--markdown"], "README.md")]:
     text = open(path).read()
     md = subprocess.run([bin] + cmd, check=True, capture_output=True, text=True).stdout
     start, end = f"<!-- {name}:start -->\n", f"<!-- {name}:end -->"

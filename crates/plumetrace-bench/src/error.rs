@@ -37,28 +37,9 @@ pub enum BenchError {
     /// No preset has this name.
     #[error("unknown preset '{0}' (see `plumetrace presets`)")]
     UnknownPreset(String),
-    /// A `--set` override without `=`.
-    #[error("--set {0:?}: expected KEY=VALUE")]
-    SetSyntax(String),
-    /// A `--set` override whose value is not TOML.
-    #[error("--set {set:?}: the value is not TOML: {error}")]
-    SetValue {
-        /// The override.
-        set: String,
-        /// The parser's message.
-        error: toml::de::Error,
-    },
-    /// A `--set` override without a value.
-    #[error("--set {0:?}: no value")]
-    SetNoValue(String),
-    /// A `--set` override the scenario does not take.
-    #[error("--set {set:?}: {error}")]
-    SetKey {
-        /// The override.
-        set: String,
-        /// Why the key was refused.
-        error: plumetrace_scenario::overrides::OverrideError,
-    },
+    /// A `--set` override that could not be applied.
+    #[error(transparent)]
+    Set(#[from] plumetrace_scenario::overrides::SetError),
     /// The map's cell size is out of range.
     #[error("--resolution must be >= 0.5 and <= 1000, got {0}")]
     Resolution(f64),

@@ -119,24 +119,7 @@ fn preset_with_sets(preset: &str, sets: &[String]) -> Result<ScenarioConfig, Ben
         .ok_or_else(|| BenchError::UnknownPreset(preset.to_string()))?
         .toml;
     let mut table: toml::Table = toml::from_str(text)?;
-    for s in sets {
-        let (key, value) = s
-            .split_once('=')
-            .ok_or_else(|| BenchError::SetSyntax(s.clone()))?;
-        let value: toml::Value = toml::from_str::<toml::Table>(&format!("v = {value}"))
-            .map_err(|error| BenchError::SetValue {
-                set: s.clone(),
-                error,
-            })?
-            .remove("v")
-            .ok_or_else(|| BenchError::SetNoValue(s.clone()))?;
-        plumetrace_scenario::set_key(&mut table, key.trim(), value).map_err(|error| {
-            BenchError::SetKey {
-                set: s.clone(),
-                error,
-            }
-        })?;
-    }
+    plumetrace_scenario::overrides::apply_sets(&mut table, sets)?;
     Ok(plumetrace_scenario::from_table(
         table,
         &plumetrace_scenario::Origin::Preset(preset.to_string()),

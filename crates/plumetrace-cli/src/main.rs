@@ -30,6 +30,7 @@ mod args;
 mod bench;
 mod campaign;
 mod frontseat;
+mod load;
 mod mission;
 mod onboard;
 mod output;
@@ -55,7 +56,14 @@ enum Command {
     /// Run a scenario (a file or a built-in preset) and write its outputs into a directory.
     Run(run::RunArgs),
     /// List the built-in scenarios, one line each.
-    Presets,
+    Presets {
+        /// Print this preset's TOML file (to copy as a starting point).
+        #[arg(long, value_name = "NAME", conflicts_with = "markdown")]
+        show: Option<String>,
+        /// Print the README's Markdown table instead.
+        #[arg(long)]
+        markdown: bool,
+    },
     /// List every planner with its keys, defaults, units, bounds and a line of doc.
     Planners {
         /// Print the guide's Markdown tables instead (docs/planners.md).
@@ -68,11 +76,9 @@ enum Command {
         #[arg(long)]
         markdown: bool,
     },
-    /// Validate a scenario file (planners included) and print the first error with its key path.
-    Check {
-        /// The scenario file (TOML).
-        file: PathBuf,
-    },
+    /// Validate a scenario file or preset (planners included) and print the first error with its
+    /// key path and line, and a warning for each key that has no effect.
+    Check(load::ScenarioArgs),
     /// Feed a snapshot log (`snapshots.jsonl` of a run) to fresh planners and report the
     /// decisions that differ from the logged ones.
     Replay(replay::ReplayArgs),
@@ -104,17 +110,7 @@ fn main() {
 fn dispatch(cli: Cli) -> Result<()> {
     match cli.command {
         Command::Run(args) => run::run(&args),
-        Command::Presets => {
-            let width = plumetrace_scenario::PRESETS
-                .iter()
-                .map(|p| p.name.len())
-                .max()
-                .unwrap_or(0);
-            for p in plumetrace_scenario::PRESETS {
-                crate::outln!("{:width$}  {}", p.name, p.summary);
-            }
-            Ok(())
-        }
+        Command::Presets { show, markdown } => presets(show.as_deref(), markdown),
         Command::Planners { markdown } => {
             if markdown {
                 crate::out!("{}", plumetrace_planner::registry_markdown());
@@ -138,7 +134,7 @@ fn dispatch(cli: Cli) -> Result<()> {
             }
             Ok(())
         }
-        Command::Check { file } => check(&file),
+        Command::Check(args) => check(&args),
         Command::Replay(args) => {
             if !replay::run(&args)? {
                 std::process::exit(replay::DIFFER);
@@ -152,6 +148,37 @@ fn dispatch(cli: Cli) -> Result<()> {
         Command::Family(args) => family(&args),
         Command::Bench(b) => bench::run(&b),
     }
+}
+
+/// `plumetrace presets`: a line per preset, its TOML file (`--show`) or the README's table
+/// (`--markdown`).
+fn presets(show: Option<&str>, markdown: bool) -> Result<()> {
+    use plumetrace_scenario::PRESETS;
+    if let Some(name) = show {
+        let p = plumetrace_scenario::find_preset(name).ok_or_else(|| {
+            plumetrace_scenario::load_preset(name)
+                .err()
+                .map_or_else(|| anyhow::anyhow!("no preset named '{name}'"), Into::into)
+        })?;
+        crate::out!("{}", p.toml);
+    } else if markdown {
+        crate::out!("{}", presets_markdown());
+    } else {
+        let width = PRESETS.iter().map(|p| p.name.len()).max().unwrap_or(0);
+        for p in PRESETS {
+            crate::outln!("{:width$}  {}", p.name, p.summary);
+        }
+    }
+    Ok(())
+}
+
+/// The README's preset table.
+fn presets_markdown() -> String {
+    let mut out = String::from("| preset | what it is |\n| --- | --- |\n");
+    for p in plumetrace_scenario::PRESETS {
+        let _ = writeln!(out, "| `{}` | {} |", p.name, p.summary.replace('|', "\\|"));
+    }
+    out
 }
 
 /// `plumetrace family`.
@@ -246,11 +273,11 @@ fn flow_steps(flow: &dyn plumetrace_env::FlowField, dt_s: f64) -> String {
     }
 }
 
-/// `plumetrace check FILE`: everything `run` would reject, rejected here with the same message.
-fn check(file: &std::path::Path) -> Result<()> {
-    let cfg = plumetrace_scenario::load_file(file)?;
-    let origin = plumetrace_scenario::Origin::File(file.to_path_buf());
-    let built = plumetrace_scenario::build(&cfg, &origin, None)?;
+/// `plumetrace check FILE` (or `--preset NAME`, with `--planner` and `--set` as for `run`):
+/// everything `run` would reject, rejected here with the same message, and the same warnings.
+fn check(args: &load::ScenarioArgs) -> Result<()> {
+    let load::Loaded { built, place } = load::load(args, None)?;
+    let file = &built.origin.clone();
     let (steps, dt) = (built.steps, built.dt_s);
     if built.mission.is_none() {
         let o = &built.output;
@@ -274,15 +301,12 @@ fn check(file: &std::path::Path) -> Result<()> {
         if plumetrace_env::flow_schedule(built.env.flow(), dt) != (1, 1) {
             let _ = write!(series, "; {}", flow_steps(built.env.flow(), dt));
         }
-        crate::outln!(
-            "{}: ok (plume run, {steps} steps of {dt} s{series})",
-            file.display()
-        );
+        crate::outln!("{file}: ok (plume run, {steps} steps of {dt} s{series})");
         return Ok(());
     }
-    let setup = plumetrace_mission::MissionSetup::new(built)?;
+    let setup = plumetrace_mission::MissionSetup::new(built).map_err(|e| place.locate(e.into()))?;
     for w in &setup.warnings {
-        eprintln!("warning: {}: {w}", file.display());
+        eprintln!("warning: {file}: {w}");
     }
     let vehicles: Vec<String> = setup
         .vehicles
@@ -318,7 +342,7 @@ fn check(file: &std::path::Path) -> Result<()> {
     };
     crate::outln!(
         "{}: ok (mission of up to {} s after {} s of plume spin-up, steps of {dt} s, {plume_steps}{dropping}; {})",
-        file.display(),
+        file,
         setup.spec.time_limit_s,
         setup.spec.spinup_s,
         vehicles.join("; ")

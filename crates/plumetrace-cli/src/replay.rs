@@ -12,8 +12,8 @@ use std::path::PathBuf;
 pub struct ReplayArgs {
     /// The snapshot log (`snapshots.jsonl.gz` written by `plumetrace run`).
     pub log: PathBuf,
-    /// A planner table (TOML: `kind` and its keys) to replay with instead of the logged
-    /// configuration.
+    /// A planner table (TOML: `kind` and its keys), or a scenario file with one planner table
+    /// (`[planner]` or `[planners.NAME]`), to replay with instead of the logged configuration.
     #[arg(long)]
     pub planner_file: Option<PathBuf>,
     /// With `--planner-file`: replace only this vehicle's planner (its index in the scenario);
@@ -24,6 +24,33 @@ pub struct ReplayArgs {
     /// replayed planners' behaviours and events.
     #[arg(long)]
     pub page: Option<PathBuf>,
+}
+
+/// The planner table of a `--planner-file`: the file itself (`kind` and keys), or the one
+/// planner table of a scenario file (`[planner]` or a single `[planners.NAME]`), with its key
+/// path for errors.
+fn planner_table(mut file: toml::Table) -> Result<(toml::Table, String)> {
+    if file.contains_key("kind") || file.contains_key("strategy") {
+        return Ok((file, String::new()));
+    }
+    if !file.contains_key("planner") && !file.contains_key("planners") {
+        return Ok((file, String::new()));
+    }
+    let path = plumetrace_scenario::overrides::planner_path(&file)
+        .map_err(|e| anyhow::anyhow!("{e}; give a file with one planner table"))?;
+    let mut here = toml::Value::Table(std::mem::take(&mut file));
+    for segment in path.split('.') {
+        here = match here {
+            toml::Value::Table(mut t) => t
+                .remove(segment.trim_matches('"'))
+                .unwrap_or(toml::Value::Table(toml::Table::new())),
+            other => other,
+        };
+    }
+    match here {
+        toml::Value::Table(t) => Ok((t, path)),
+        other => anyhow::bail!("{path} is a {}, not a table", other.type_str()),
+    }
 }
 
 /// The exit status when decisions differ.
@@ -37,9 +64,16 @@ pub fn run(args: &ReplayArgs) -> Result<bool> {
                 .map_err(anyhow::Error::msg)
                 .with_context(|| format!("reading {}", p.display()))?;
             let table: toml::Table = text.parse().with_context(|| format!("{}", p.display()))?;
-            // Checked here so that errors name this file, not the log's planner.
-            plumetrace_planner::PlannerConfig::from_table(&table, "")
-                .with_context(|| format!("{}", p.display()))?;
+            let (table, prefix) =
+                planner_table(table).with_context(|| format!("{}", p.display()))?;
+            // Checked here so that errors name this file (and the key's line), not the log's
+            // planner.
+            plumetrace_planner::PlannerConfig::from_table(&table, &prefix).map_err(|e| {
+                let line = plumetrace_scenario::locate::line_of(&text, &e.key)
+                    .map(|l| format!(":{l}"))
+                    .unwrap_or_default();
+                anyhow::anyhow!("{}{line}: {e}", p.display())
+            })?;
             Some(table)
         }
         None => None,

@@ -6,18 +6,16 @@
 //! and when `[output]` asks for them the probe series and filament snapshots (with the `netcdf`
 //! feature also `plume.nc`).
 
-use anyhow::{Context, Result, bail};
-use plumetrace_scenario::{BuiltScenario, Origin};
+use anyhow::{Context, Result};
+use plumetrace_scenario::BuiltScenario;
 use std::path::{Path, PathBuf};
 
 /// Arguments of `plumetrace run`.
 #[derive(Debug, clap::Args)]
 pub struct RunArgs {
-    /// Scenario file (TOML); give this or --preset.
-    scenario: Option<PathBuf>,
-    /// Built-in scenario (see `plumetrace presets`).
-    #[arg(long, conflicts_with = "scenario")]
-    preset: Option<String>,
+    /// The scenario, with `--preset`, `--planner` and `--set`.
+    #[command(flatten)]
+    scenario: crate::load::ScenarioArgs,
     /// Run seed (overrides the scenario's).
     #[arg(long, allow_hyphen_values = true, value_parser = crate::args::seed)]
     seed: Option<u64>,
@@ -37,37 +35,31 @@ pub struct RunArgs {
     alog: bool,
 }
 
-/// Loads a scenario from a file or preset.
+/// Loads a scenario from a file or preset (printing its warnings).
 pub fn load(
     scenario: Option<&Path>,
     preset: Option<&str>,
     seed: Option<u64>,
 ) -> Result<BuiltScenario> {
-    let (cfg, origin) = match (scenario, preset) {
-        (Some(path), None) => (
-            plumetrace_scenario::load_file(path)?,
-            Origin::File(path.to_path_buf()),
-        ),
-        (None, Some(name)) => (
-            plumetrace_scenario::load_preset(name)?,
-            Origin::Preset(name.to_string()),
-        ),
-        (None, None) => bail!("give a scenario file or --preset NAME (see `plumetrace presets`)"),
-        (Some(_), Some(_)) => bail!("give a scenario file or --preset, not both"),
+    let a = crate::load::ScenarioArgs {
+        scenario: scenario.map(Path::to_path_buf),
+        preset: preset.map(str::to_string),
+        ..Default::default()
     };
-    Ok(plumetrace_scenario::build(&cfg, &origin, seed)?)
+    Ok(crate::load::load(&a, seed)?.built)
 }
 
 /// Runs the scenario: a mission when it has one, otherwise the plume alone.
 pub fn run(args: &RunArgs) -> Result<()> {
-    let sc = load(args.scenario.as_deref(), args.preset.as_deref(), args.seed)?;
+    let crate::load::Loaded { built: sc, place } = crate::load::load(&args.scenario, args.seed)?;
     std::fs::create_dir_all(&args.out)
         .with_context(|| format!("creating {}", args.out.display()))?;
-    if let Some(path) = &args.scenario {
+    if let Some(path) = &args.scenario.scenario {
         crate::output::refuse_overwriting(path, &args.out, OUTPUTS)?;
     }
     if sc.mission.is_some() {
         crate::mission::run(sc, &args.out, args.stats, !args.no_snapshot_log, args.alog)
+            .map_err(|e| place.locate(e))
     } else {
         run_plume(sc, args)
     }

@@ -391,11 +391,11 @@ fn check_names_bad_planner_and_mission_keys() {
     );
 }
 
-/// A scenario's text without its `[planner]` table (up to the next table, `[output]`).
+/// A scenario's text without its `[planner]` table (up to the next table or the end).
 fn without_legacy_planner(text: &str) -> String {
     let (a, b) = (
         text.find("[planner]").unwrap(),
-        text.find("[output]").unwrap(),
+        text.find("[output]").unwrap_or(text.len()),
     );
     format!("{}{}", &text[..a], &text[b..])
 }

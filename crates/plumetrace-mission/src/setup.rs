@@ -272,10 +272,7 @@ fn with_sensor_threshold(
         return Ok(table.clone());
     };
     let sensor_key = format!("vehicles[{vehicle}].chem_sensor.threshold_v");
-    let kind = table
-        .get("kind")
-        .and_then(toml::Value::as_str)
-        .unwrap_or("");
+    let kind = planners::kind_name(table).unwrap_or("");
     match PlannerKind::from_name(kind).map(planners::entry) {
         Some(e) if e.threshold_key.is_some() => {
             let name = e.threshold_key.unwrap_or_default();

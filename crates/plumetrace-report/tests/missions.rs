@@ -65,7 +65,7 @@ fn demo_text_with(vehicles_and_planners: &str) -> String {
     let start = base.find("[[vehicles]]").unwrap();
     let mission = base.find("[mission]").unwrap();
     let planner = base.find("[planner]").unwrap();
-    let output = base.find("[output]").unwrap();
+    let output = base.find("[output]").unwrap_or(base.len());
     format!(
         "{}{}\n{}{}",
         &base[..start],

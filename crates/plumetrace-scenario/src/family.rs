@@ -354,6 +354,7 @@ pub const FAMILY_LIMITS: &[(&str, f64, f64, &str)] = &[
 fn invalid(file: &Path, key: &str, message: String) -> ScenarioError {
     ScenarioError::Parse {
         origin: file.display().to_string(),
+        line: None,
         path: key.to_string(),
         message,
     }

@@ -11,12 +11,13 @@ pub mod config;
 pub mod error;
 pub mod family;
 pub mod limits;
+pub mod locate;
 pub mod overrides;
 pub mod presets;
 
 pub use build::{
     BuiltScenario, DEFAULT_SUCCESS_RADIUS_M, MissionSpec, OutputSpec, PlannerRef, VehicleSetup,
-    build,
+    Warning, build,
 };
 pub use config::ScenarioConfig;
 pub use error::ScenarioError;
@@ -52,16 +53,18 @@ pub fn parse(text: &str, origin: &Origin) -> Result<ScenarioConfig, ScenarioErro
     {
         return Err(ScenarioError::Parse {
             origin: origin.to_string(),
+            line: locate::line_of(text, &key),
             path: key,
             message: format!("is a date/time ({value}); no scenario key takes one"),
         });
     }
     let de = toml::Deserializer::parse(text).map_err(|e| ScenarioError::Parse {
         origin: origin.to_string(),
+        line: None,
         path: String::new(),
         message: e.to_string(),
     })?;
-    deserialize(de, origin)
+    deserialize(de, origin).map_err(|e| e.located(text))
 }
 
 /// Reads a scenario from an already parsed TOML table (e.g. a scenario with overrides applied);
@@ -70,17 +73,27 @@ pub fn from_table(table: toml::Table, origin: &Origin) -> Result<ScenarioConfig,
     deserialize(toml::Value::Table(table), origin)
 }
 
-/// Deserializes the scenario, turning serde's error into one that names the key path.
-fn deserialize<'de, D: serde::Deserializer<'de>>(
+/// Deserializes the scenario, turning serde's error into one that names the key path (and the
+/// nearest known key or name, for an unknown one).
+fn deserialize<'de, D: serde::Deserializer<'de, Error = toml::de::Error>>(
     de: D,
     origin: &Origin,
 ) -> Result<ScenarioConfig, ScenarioError> {
     serde_path_to_error::deserialize(de).map_err(|e| {
         let path = e.path().to_string();
+        let inner = e.into_inner();
+        // With a key path, the message alone (the line is added from the path); without one,
+        // the parser's whole report, which shows where.
+        let (path, message) = if path == "." {
+            (String::new(), inner.to_string())
+        } else {
+            (path, locate::suggest(inner.message()))
+        };
         ScenarioError::Parse {
             origin: origin.to_string(),
-            path: if path == "." { String::new() } else { path },
-            message: e.into_inner().to_string(),
+            line: None,
+            path,
+            message,
         }
     })
 }
@@ -98,8 +111,10 @@ pub fn load_file(path: &Path) -> Result<ScenarioConfig, ScenarioError> {
 
 /// Parses a built-in preset by name.
 pub fn load_preset(name: &str) -> Result<ScenarioConfig, ScenarioError> {
+    let names: Vec<&str> = PRESETS.iter().map(|p| p.name).collect();
     let preset = find_preset(name).ok_or_else(|| ScenarioError::UnknownPreset {
         name: name.to_string(),
+        near: plumetrace_core::closest(name, &names).map(str::to_string),
         known: PRESETS
             .iter()
             .map(|p| p.name)

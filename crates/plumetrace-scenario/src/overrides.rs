@@ -49,6 +49,82 @@ pub enum OverrideError {
     },
 }
 
+/// Why a `KEY=VALUE` override (`--set` of `run`, `check` and `bench missions`) could not be
+/// applied.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum SetError {
+    /// No `=`.
+    #[error("--set {0:?}: expected KEY=VALUE")]
+    Syntax(String),
+    /// The value is not TOML.
+    #[error("--set {set:?}: the value is not TOML{hint}: {error}")]
+    Value {
+        /// The override.
+        set: String,
+        /// A hint for a bare word (a string is quoted).
+        hint: String,
+        /// The parser's message.
+        error: Box<toml::de::Error>,
+    },
+    /// Nothing after `=`.
+    #[error("--set {0:?}: no value")]
+    NoValue(String),
+    /// The key cannot be set in this scenario.
+    #[error("--set {set:?}: {error}")]
+    Key {
+        /// The override.
+        set: String,
+        /// Why the key was refused.
+        error: OverrideError,
+    },
+}
+
+/// Applies `KEY=VALUE` overrides in order, each as a campaign's `set` ([`set_key`]); VALUE is
+/// TOML (`0.5`, `"moth"`, `[1, 2]`). Returns the key paths set, as written.
+pub fn apply_sets(table: &mut toml::Table, sets: &[String]) -> Result<Vec<String>, SetError> {
+    let mut keys = Vec::with_capacity(sets.len());
+    for s in sets {
+        let (key, value) = s
+            .split_once('=')
+            .ok_or_else(|| SetError::Syntax(s.clone()))?;
+        let value = value.trim();
+        let value: toml::Value = toml::from_str::<toml::Table>(&format!("v = {value}"))
+            .map_err(|error| SetError::Value {
+                set: s.clone(),
+                hint: if !value.is_empty()
+                    && value
+                        .chars()
+                        .all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '-')
+                {
+                    format!(" (a string is quoted: {}='\"{value}\"')", key.trim())
+                } else {
+                    String::new()
+                },
+                error: Box::new(error),
+            })?
+            .remove("v")
+            .ok_or_else(|| SetError::NoValue(s.clone()))?;
+        set_key(table, key.trim(), value).map_err(|error| SetError::Key {
+            set: s.clone(),
+            error,
+        })?;
+        keys.push(key.trim().to_string());
+    }
+    Ok(keys)
+}
+
+/// Replaces the scenario's single planner table ([`planner_path`]) by `kind = KIND` alone: the
+/// planner at its defaults, as a campaign's `[configs.planner]` with only `kind`. Returns the
+/// table's key path. A scenario with several planner tables (a team, a formation) is refused.
+pub fn set_planner_kind(table: &mut toml::Table, kind: &str) -> Result<String, OverrideError> {
+    let path = planner_path(table)?;
+    let segments: Vec<&str> = path.split('.').map(|s| s.trim_matches('"')).collect();
+    let mut planner = toml::Table::new();
+    planner.insert("kind".into(), toml::Value::String(kind.to_string()));
+    set_path(table, &segments, toml::Value::Table(planner))?;
+    Ok(path)
+}
+
 /// The key path of a scenario's single planner table: `planner`, or `planners.NAME` when it has
 /// exactly one named planner.
 pub fn planner_path(table: &toml::Table) -> Result<String, OverrideError> {

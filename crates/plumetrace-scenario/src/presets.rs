@@ -106,6 +106,7 @@ mod tests {
             let built =
                 build(&cfg, &Origin::Preset(p.name.into()), None).unwrap_or_else(|e| panic!("{e}"));
             assert!(built.steps > 0);
+            assert_eq!(built.warnings, [], "{}: keys with no effect", p.name);
         }
     }
 }

@@ -242,11 +242,7 @@ fn planner_tables_are_wired_to_vehicles_with_key_paths() {
     let built = build(&cfg, &origin, None).unwrap();
     let p = built.vehicles[0].planner.as_ref().unwrap();
     assert_eq!(p.key, "planner");
-    assert_eq!(
-        p.table.get("kind").and_then(|v| v.as_str()),
-        Some("amp"),
-        "strategy is read as kind"
-    );
+    assert_eq!(p.table.get("kind").and_then(|v| v.as_str()), Some("amp"));
     let named = |extra: &str| {
         format!(
             "{}\n[[vehicles]]\nkind = \"surface\"\nx_m = 300.0\ny_m = 0.0\nplanner = \"tracer\"\n{extra}",
@@ -260,20 +256,9 @@ fn planner_tables_are_wired_to_vehicles_with_key_paths() {
             "planners.spare: no vehicle flies it",
         ),
         (
-            find_preset("demo")
-                .unwrap()
-                .toml
-                .replace("strategy = \"amp\"", "strategy = \"amp\"\nkind = \"amp\""),
-            "planner.strategy: give `kind`",
-        ),
-        (
             {
                 let demo = find_preset("demo").unwrap().toml;
-                let (a, b) = (
-                    demo.find("[planner]").unwrap(),
-                    demo.find("[output]").unwrap(),
-                );
-                format!("{}{}", &demo[..a], &demo[b..])
+                demo[..demo.find("[planner]").unwrap()].to_string()
             },
             "a [mission] needs a vehicle with a planner",
         ),
@@ -382,7 +367,7 @@ fn bad_probe_and_series_keys_are_rejected_with_their_key_path() {
     for (keys, key, message) in &cases {
         let e = error_of(&demo_output(keys));
         assert!(
-            e.starts_with("scenario.toml: ")
+            e.starts_with("scenario.toml:")
                 && e.contains(&format!("{key}: "))
                 && e.contains(message),
             "{keys}: error {e:?} does not name {key} with {message:?}"
@@ -412,7 +397,7 @@ fn bad_probe_and_series_keys_are_rejected_with_their_key_path() {
     );
     // A mission writes no series.
     let mission = format!(
-        "{}probes = [[100.0, 0.0, 2.0]]\n",
+        "{}\n[output]\nprobes = [[100.0, 0.0, 2.0]]\n",
         find_preset("demo").unwrap().toml
     );
     let e = error_of(&mission);
@@ -587,6 +572,95 @@ fn model_errors_are_placed_under_their_section() {
 }
 
 #[test]
+fn keys_with_no_effect_in_this_kind_of_run_are_warned_of() {
+    let warnings = |text: &str| {
+        let origin = Origin::File("scenario.toml".into());
+        let cfg = parse(text, &origin).unwrap();
+        let built = build(&cfg, &origin, None).unwrap();
+        built
+            .warnings
+            .iter()
+            .map(ToString::to_string)
+            .collect::<Vec<_>>()
+    };
+    let demo = find_preset("demo").unwrap().toml;
+    let plume = find_preset("plume-demo").unwrap().toml;
+    let vehicle = "\n[[vehicles]]\nkind = \"auv\"\nx_m = 50.0\ny_m = 0.0\n";
+    let cases: Vec<(String, Vec<&str>)> = vec![
+        (
+            demo.replace("duration_s = 2400.0", "duration_s = 100.0"),
+            vec![
+                "sim.duration_s: 100 s has no effect on a mission, which runs until its vehicles \
+                 are done or mission.time_limit_s (2400 s); set that instead (or make the two equal)",
+            ],
+        ),
+        (
+            format!("{demo}\n[output]\nnx = 50\nz_m = 2.0\nthreshold = 0.2\n"),
+            vec![
+                "output.nx: has no effect on a mission: the [output] grid and time average are \
+                 written by plume runs only (a scenario without [mission]); remove it",
+                "output.z_m: has no effect on a mission: the [output] grid and time average are \
+                 written by plume runs only (a scenario without [mission]); remove it",
+            ],
+        ),
+        (
+            format!("{plume}{vehicle}"),
+            vec![
+                "vehicles: 1 vehicle(s) not flown: a scenario without [mission] is a plume run \
+                 (give [mission] and a planner to fly them)",
+            ],
+        ),
+        (
+            format!("{plume}\n[comms.acoustic]\nlatency_s = 1.0\n"),
+            vec![
+                "comms: has no effect on a plume run (a scenario without [mission]): no vehicle \
+                 sends messages",
+            ],
+        ),
+        (demo.to_string(), vec![]),
+        (plume.to_string(), vec![]),
+    ];
+    for (text, want) in cases {
+        assert_eq!(warnings(&text), want);
+    }
+}
+
+#[test]
+fn unknown_keys_name_their_line_and_the_nearest_key() {
+    let demo = find_preset("demo").unwrap().toml;
+    let line = |needle: &str| demo.lines().position(|l| l.starts_with(needle)).unwrap() + 1;
+    let e = error_of(&demo.replace("dt_s = 0.1", "dtt_s = 0.1"));
+    assert_eq!(
+        e,
+        format!(
+            "scenario.toml:{}: sim.dtt_s: unknown field `dtt_s`; did you mean `dt_s`?",
+            line("dt_s")
+        )
+    );
+    let e = error_of(&demo.replace("model = \"farrell\"", "model = \"farel\""));
+    assert_eq!(
+        e,
+        format!(
+            "scenario.toml:{}: flow.model: unknown variant `farel`; did you mean `farrell`?",
+            line("model = \"farrell\"")
+        )
+    );
+    // Nothing near: the known keys are listed.
+    let e = error_of(&demo.replace("dt_s = 0.1", "zzzzzz = 0.1"));
+    assert!(
+        e.ends_with("unknown field `zzzzzz`, expected `dt_s` or `duration_s`"),
+        "{e}"
+    );
+    let e = plumetrace_scenario::load_preset("dmeo")
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.starts_with("no preset named 'dmeo'; did you mean 'demo'? (known: demo, "),
+        "{e}"
+    );
+}
+
+#[test]
 fn seeds_beyond_toml_integers_are_strings_of_digits() {
     let origin = Origin::File("scenario.toml".into());
     let with_seed =
@@ -606,7 +680,7 @@ fn seeds_beyond_toml_integers_are_strings_of_digits() {
     for bad in ["-1", "\"12x\"", "\"18446744073709551616\"", "1.5"] {
         let e = error_of(&with_seed(bad));
         assert!(
-            e.starts_with("scenario.toml: seed:") && e.contains("a whole number from 0 to"),
+            e.starts_with("scenario.toml:4: seed:") && e.contains("a whole number from 0 to"),
             "{bad}: {e}"
         );
     }

@@ -284,6 +284,14 @@ pub fn entry(kind: PlannerKind) -> &'static PlannerEntry {
         .unwrap_or(&PLANNERS[0])
 }
 
+/// The kind a planner table names (`kind`, or the older `strategy`), if it names one by a string.
+pub fn kind_name(table: &toml::Table) -> Option<&str> {
+    table
+        .get("kind")
+        .or_else(|| table.get("strategy"))
+        .and_then(toml::Value::as_str)
+}
+
 /// The kinds as `"amp", "lawnmower"` for messages.
 fn kinds() -> String {
     PlannerKind::ALL
@@ -303,29 +311,45 @@ pub struct PlannerConfig {
 }
 
 impl PlannerConfig {
-    /// Reads a planner table (`kind` plus keys); errors name `prefix.key`.
+    /// Reads a planner table (`kind`, or its older name `strategy`, plus keys); errors name
+    /// `prefix.key`, the kind's key as written.
     pub fn from_table(table: &toml::Table, prefix: &str) -> Result<Self, ParamError> {
         let mut t = table.clone();
-        let kind = match t.remove("kind") {
-            Some(toml::Value::String(s)) => PlannerKind::from_name(&s).ok_or_else(|| {
-                ParamError::at(
-                    prefix,
-                    "kind",
-                    format!("unknown planner '{s}' (known: {})", kinds()),
-                )
-            })?,
-            Some(other) => {
+        let (name, value) = match (t.remove("kind"), t.remove("strategy")) {
+            (Some(_), Some(_)) => {
                 return Err(ParamError::at(
                     prefix,
-                    "kind",
-                    format!("must be a string, one of {}; got {other}", kinds()),
+                    "strategy",
+                    "give `kind` (or the older `strategy`), not both",
                 ));
             }
-            None => {
+            (Some(v), None) => ("kind", v),
+            (None, Some(v)) => ("strategy", v),
+            (None, None) => {
                 return Err(ParamError::at(
                     prefix,
                     "kind",
                     format!("missing: name the planner, one of {}", kinds()),
+                ));
+            }
+        };
+        let kind = match value {
+            toml::Value::String(s) => PlannerKind::from_name(&s).ok_or_else(|| {
+                let names: Vec<&str> = PlannerKind::ALL.iter().map(|k| k.name()).collect();
+                let hint = plumetrace_core::closest(&s, &names)
+                    .map(|n| format!("; did you mean '{n}'?"))
+                    .unwrap_or_default();
+                ParamError::at(
+                    prefix,
+                    name,
+                    format!("unknown planner '{s}'{hint} (known: {})", kinds()),
+                )
+            })?,
+            other => {
+                return Err(ParamError::at(
+                    prefix,
+                    name,
+                    format!("must be a string, one of {}; got {other}", kinds()),
                 ));
             }
         };
@@ -559,6 +583,22 @@ mod tests {
                 "unknown planner 'butterfly'",
             ),
             ("kind = 3", "planners.a.kind", "must be a string"),
+            // The older name of `kind` is read too, and errors name the key as written.
+            (
+                "strategy = \"ampp\"",
+                "planners.a.strategy",
+                "unknown planner 'ampp'; did you mean 'amp'? (known: ",
+            ),
+            (
+                "strategy = \"amp\"\nkind = \"amp\"",
+                "planners.a.strategy",
+                "give `kind` (or the older `strategy`), not both",
+            ),
+            (
+                "strategy = \"amp\"\nmaping_lines = 3",
+                "planners.a.maping_lines",
+                "unknown field `maping_lines`; did you mean `mapping_lines`? (`plumetrace planners` lists every key)",
+            ),
             (
                 "kind = \"amp\"\nbeta = 3.0",
                 "planners.a.beta",

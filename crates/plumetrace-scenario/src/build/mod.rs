@@ -19,6 +19,7 @@ mod output;
 mod plume;
 mod sensors;
 mod timing;
+mod unused;
 mod vehicles;
 
 pub use mission::{DEFAULT_DROP_MARGIN_M, DEFAULT_SUCCESS_RADIUS_M};
@@ -77,7 +78,7 @@ pub struct VehicleSetup {
 pub struct PlannerRef {
     /// Its key path: `planner` or `planners.NAME`.
     pub key: String,
-    /// The table (`kind` and the planner's keys; a legacy `strategy` is read as `kind`).
+    /// The table as written (`kind`, or the older `strategy`, and the planner's keys).
     pub table: toml::Table,
 }
 
@@ -128,6 +129,33 @@ pub struct BuiltScenario {
     pub dt_s: f64,
     /// Water depth, m.
     pub depth_m: Option<f64>,
+    /// Keys that have no effect in this kind of run (`check` and `run` print them).
+    pub warnings: Vec<Warning>,
+}
+
+/// A key that has no effect in this kind of run (a mission or a plume run): the run goes on, and
+/// `check` and `run` say so.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Warning {
+    /// Key path, as errors name it.
+    pub path: String,
+    /// Why it has no effect and what to do instead.
+    pub message: String,
+}
+
+impl Warning {
+    fn new(path: impl Into<String>, message: impl Into<String>) -> Self {
+        Warning {
+            path: path.into(),
+            message: message.into(),
+        }
+    }
+}
+
+impl std::fmt::Display for Warning {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{}: {}", self.path, self.message)
+    }
 }
 
 /// A value out of range or inconsistent with another, by key path ([`build`] adds the file).
@@ -165,6 +193,7 @@ impl Invalid {
     fn at(self, origin: &Origin) -> ScenarioError {
         ScenarioError::Invalid {
             origin: origin.to_string(),
+            line: None,
             path: self.path,
             message: self.message,
         }
@@ -212,6 +241,7 @@ fn build_sections(
     timing.check_run_flow_steps(env.flow())?;
     let mission = mission::mission(cfg, &domain, &timing, &vehicles, &mut env)?;
     let output = output::output(cfg, &domain, &timing)?;
+    let warnings = unused::unused_keys(cfg, mission.is_some());
     Ok(BuiltScenario {
         name: cfg.name.clone(),
         seed,
@@ -224,6 +254,7 @@ fn build_sections(
         comms,
         dt_s: timing.dt_s,
         depth_m: cfg.domain.depth_m,
+        warnings,
     })
 }
 

@@ -47,22 +47,12 @@ pub(super) fn vehicles(cfg: &ScenarioConfig, domain: &Rect) -> Result<Vec<Vehicl
     Ok(vehicles)
 }
 
-/// The legacy `[planner]` table (flown by every AUV that names no planner): `strategy` is read
-/// as `kind`.
+/// The `[planner]` table (flown by every AUV that names no planner); its kind may be given by
+/// the older name `strategy` (the planner registry reads either, and names the one written).
 fn legacy_planner(t: &toml::Table) -> Result<PlannerRef, Invalid> {
-    let mut table = t.clone();
-    if let Some(s) = table.remove("strategy") {
-        if table.contains_key("kind") {
-            return Err(Invalid::new(
-                "planner.strategy",
-                "give `kind` (or the older `strategy`), not both",
-            ));
-        }
-        table.insert("kind".into(), s);
-    }
     Ok(PlannerRef {
         key: "planner".into(),
-        table,
+        table: t.clone(),
     })
 }
 

@@ -1,0 +1,374 @@
+//! Commands and errors as a new user meets them: `--set` and `--planner` on `run` and `check`,
+//! `check --preset`, `presets --show` and `--markdown`, "did you mean" for keys, presets,
+//! planners and commands, errors at the line of the key as written, and warnings for keys with
+//! no effect. Each runs the built binary and reads what it prints.
+
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
+use std::path::Path;
+
+mod common;
+use common::{bin, run_ok};
+
+fn demo() -> String {
+    plumetrace_scenario::find_preset("demo")
+        .unwrap()
+        .toml
+        .to_string()
+}
+
+/// The 1-based line of the first line of `text` that starts with `start`.
+fn line(text: &str, start: &str) -> usize {
+    text.lines().position(|l| l.starts_with(start)).unwrap() + 1
+}
+
+/// Runs `plumetrace ARGS` in `dir`: (status, stdout, stderr).
+fn plumetrace(dir: &Path, args: &[&str]) -> (i32, String, String) {
+    let out = bin().current_dir(dir).args(args).output().unwrap();
+    (
+        out.status.code().unwrap_or(-1),
+        String::from_utf8(out.stdout).unwrap(),
+        String::from_utf8(out.stderr).unwrap(),
+    )
+}
+
+/// `check FILE` of `text` written as `name` in `dir`: its standard error (and whether it passed).
+fn check(dir: &Path, name: &str, text: &str) -> (bool, String) {
+    std::fs::write(dir.join(name), text).unwrap();
+    let (status, _, err) = plumetrace(dir, &["check", name]);
+    (status == 0, err)
+}
+
+#[test]
+fn a_planner_key_typo_names_the_file_line_key_and_the_key_meant() {
+    let dir = tempfile::tempdir().unwrap();
+    let text = demo().replace("mapping_lines = 3", "maping_lines = 3");
+    let (ok, err) = check(dir.path(), "typo.toml", &text);
+    assert!(!ok);
+    assert_eq!(
+        err,
+        format!(
+            "error: typo.toml:{}: planner.maping_lines: unknown field `maping_lines`; did you \
+             mean `mapping_lines`? (`plumetrace planners` lists every key)\n",
+            line(&text, "maping_lines")
+        )
+    );
+    // The same in a named planner table.
+    let named = demo()
+        .replace("[planner]", "[planners.tracer]")
+        .replace(
+            "heading_deg = 270.0",
+            "heading_deg = 270.0\nplanner = \"tracer\"",
+        )
+        .replace("mapping_lines = 3", "maping_lines = 3");
+    let (_, err) = check(dir.path(), "named.toml", &named);
+    assert!(
+        err.starts_with(&format!(
+            "error: named.toml:{}: planners.tracer.maping_lines: unknown field `maping_lines`; \
+             did you mean `mapping_lines`?",
+            line(&named, "maping_lines")
+        )),
+        "{err}"
+    );
+}
+
+#[test]
+fn the_kind_is_named_as_written_with_its_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let text = demo().replace("kind = \"amp\"", "strategy = \"ampp\"");
+    let (_, err) = check(dir.path(), "kind.toml", &text);
+    assert!(
+        err.starts_with(&format!(
+            "error: kind.toml:{}: planner.strategy: unknown planner 'ampp'; did you mean 'amp'? \
+             (known: ",
+            line(&text, "strategy")
+        )),
+        "{err}"
+    );
+    // `strategy` is read in a named table too (it once said "kind: missing").
+    let named = demo()
+        .replace("[planner]", "[planners.tracer]")
+        .replace(
+            "heading_deg = 270.0",
+            "heading_deg = 270.0\nplanner = \"tracer\"",
+        )
+        .replace("kind = \"amp\"", "strategy = \"amp\"");
+    assert_eq!(
+        check(dir.path(), "named.toml", &named),
+        (true, String::new())
+    );
+}
+
+#[test]
+fn an_unknown_scenario_key_gets_its_line_and_the_nearest_key() {
+    let dir = tempfile::tempdir().unwrap();
+    let text = demo().replace("dt_s = 0.1", "dtt_s = 0.1");
+    let (_, err) = check(dir.path(), "sim.toml", &text);
+    assert_eq!(
+        err,
+        format!(
+            "error: sim.toml:{}: sim.dtt_s: unknown field `dtt_s`; did you mean `dt_s`?\n",
+            line(&text, "dtt_s")
+        )
+    );
+}
+
+#[test]
+fn a_missing_file_named_like_a_preset_suggests_the_preset() {
+    let dir = tempfile::tempdir().unwrap();
+    for args in [
+        &["run", "demo"][..],
+        &["check", "demo"],
+        &["check", "demo.toml"],
+    ] {
+        let (status, _, err) = plumetrace(dir.path(), args);
+        assert_eq!(status, 1);
+        assert!(
+            err.ends_with(
+                ": no such file; did you mean the built-in scenario `--preset demo`? \
+                 (`plumetrace presets` lists them)\n"
+            ),
+            "{args:?}: {err}"
+        );
+    }
+    let (_, _, err) = plumetrace(dir.path(), &["run", "--preset", "dmeo"]);
+    assert!(
+        err.starts_with("error: no preset named 'dmeo'; did you mean 'demo'? (known: demo, "),
+        "{err}"
+    );
+    let (_, _, err) = plumetrace(dir.path(), &["presets", "--show", "dmeo"]);
+    assert!(err.contains("did you mean 'demo'?"), "{err}");
+}
+
+#[test]
+fn commands_and_flags_get_the_parsers_suggestion() {
+    let dir = tempfile::tempdir().unwrap();
+    let (status, _, err) = plumetrace(dir.path(), &["chek", "x.toml"]);
+    assert_eq!(status, 2);
+    assert!(
+        err.contains("a similar subcommand exists: 'check'"),
+        "{err}"
+    );
+    let (_, _, err) = plumetrace(dir.path(), &["run", "--prest", "demo"]);
+    assert!(
+        err.contains("a similar argument exists: '--preset'"),
+        "{err}"
+    );
+}
+
+#[test]
+fn check_takes_a_preset_and_every_preset_is_quiet() {
+    let dir = tempfile::tempdir().unwrap();
+    for p in plumetrace_scenario::PRESETS {
+        let (status, out, err) = plumetrace(dir.path(), &["check", "--preset", p.name]);
+        assert_eq!(status, 0, "{}: {err}", p.name);
+        assert!(
+            out.starts_with(&format!("preset '{}': ok (", p.name)),
+            "{out}"
+        );
+        assert!(!err.contains("warning: preset"), "{}: {err}", p.name);
+        // presets --show prints the file the preset is.
+        let (_, shown, _) = plumetrace(dir.path(), &["presets", "--show", p.name]);
+        assert_eq!(shown, p.toml);
+    }
+}
+
+#[test]
+fn examples_are_quiet() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/plumes");
+    for entry in std::fs::read_dir(root).unwrap() {
+        let path = entry.unwrap().path();
+        let (status, _, err) = plumetrace(Path::new("."), &["check", path.to_str().unwrap()]);
+        assert_eq!(status, 0, "{}: {err}", path.display());
+        assert!(!err.contains("warning"), "{}: {err}", path.display());
+    }
+}
+
+#[test]
+fn set_and_planner_change_the_scenario_as_a_campaign_does() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let (status, out, err) = plumetrace(
+        d,
+        &[
+            "check",
+            "--preset",
+            "demo",
+            "--planner",
+            "moth",
+            "--set",
+            "mission.time_limit_s=600",
+        ],
+    );
+    assert_eq!(status, 0, "{err}");
+    assert!(
+        out.contains("mission of up to 600 s") && out.contains("auv flies moth (planner)"),
+        "{out}"
+    );
+    // The file's duration, left behind by a time limit set here, is no news.
+    assert_eq!(err, "");
+    let cases: &[(&[&str], &str)] = &[
+        (
+            &["--planner", "mothh"],
+            "error: --planner mothh: no such planner; did you mean 'moth'? (known: amp, ",
+        ),
+        (
+            &["--set", "beta_deg=-5"],
+            "error: preset 'demo': planner.beta_deg: must be >= 0 and <= 90, got -5",
+        ),
+        (
+            &["--set", "beta_deg"],
+            "error: --set \"beta_deg\": expected KEY=VALUE",
+        ),
+        (
+            &["--set", "kind=moth"],
+            "error: --set \"kind=moth\": the value is not TOML (a string is quoted: \
+             kind='\"moth\"'): ",
+        ),
+        (
+            &["--set", "sources.3.x_m=1"],
+            "error: --set \"sources.3.x_m=1\": 'sources.3': index 3 past the 1 entries",
+        ),
+    ];
+    for (extra, want) in cases {
+        let mut args = vec!["check", "--preset", "demo"];
+        args.extend_from_slice(extra);
+        let (status, _, err) = plumetrace(d, &args);
+        assert_eq!(status, 1, "{extra:?}");
+        assert!(err.starts_with(want), "{extra:?}: {err}");
+    }
+    // A team of several planner tables: --planner cannot say which; refused.
+    let (_, _, err) = plumetrace(
+        d,
+        &[
+            "check",
+            "--preset",
+            "soares-freshwater",
+            "--planner",
+            "moth",
+        ],
+    );
+    assert!(
+        err.starts_with(
+            "error: --planner moth: the scenario has several planner tables (planners.follower, \
+             planners.leader_left, planners.leader_right) and --planner replaces a scenario's \
+             one planner table; change one of them with --set planners.NAME.kind='\"moth\"'"
+        ),
+        "{err}"
+    );
+    // run flies what check checked.
+    let (status, _, err) = plumetrace(
+        d,
+        &[
+            "run",
+            "--preset",
+            "demo",
+            "--planner",
+            "lawnmower",
+            "--set",
+            "mission.time_limit_s=60",
+            "--set",
+            "mission.spinup_s=60",
+            "--out",
+            "o",
+            "--no-snapshot-log",
+        ],
+    );
+    assert_eq!(status, 0, "{err}");
+    let summary = std::fs::read_to_string(d.join("o/summary.json")).unwrap();
+    assert!(summary.contains("\"lawnmower\""), "{summary}");
+}
+
+#[test]
+fn keys_with_no_effect_are_warned_of_by_check_and_run() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let text =
+        demo().replace("duration_s = 2400.0", "duration_s = 100.0") + "\n[output]\nnx = 50\n";
+    std::fs::write(d.join("w.toml"), &text).unwrap();
+    let want = format!(
+        "warning: w.toml:{}: sim.duration_s: 100 s has no effect on a mission, which runs until \
+         its vehicles are done or mission.time_limit_s (2400 s); set that instead (or make the \
+         two equal)\nwarning: w.toml:{}: output.nx: has no effect on a mission: the [output] grid \
+         and time average are written by plume runs only (a scenario without [mission]); remove \
+         it\n",
+        line(&text, "duration_s"),
+        line(&text, "nx = 50"),
+    );
+    let (status, _, err) = plumetrace(d, &["check", "w.toml"]);
+    assert_eq!((status, err.as_str()), (0, want.as_str()));
+    let (status, _, err) = plumetrace(
+        d,
+        &[
+            "run",
+            "w.toml",
+            "--set",
+            "mission.spinup_s=10",
+            "--out",
+            "o",
+            "--no-snapshot-log",
+        ],
+    );
+    assert_eq!(status, 0, "{err}");
+    assert!(err.starts_with(&want), "{err}");
+}
+
+#[test]
+fn replay_takes_the_planner_table_of_a_scenario_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    run_ok(&[
+        "run",
+        "--preset",
+        "demo",
+        "--set",
+        "mission.time_limit_s=30",
+        "--set",
+        "mission.spinup_s=10",
+        "--out",
+        d.join("o").to_str().unwrap(),
+    ]);
+    let log = d.join("o/snapshots.jsonl.gz");
+    std::fs::write(
+        d.join("p.toml"),
+        "[planner]\nkind = \"amp\"\nbeta_dg = 25.0\n",
+    )
+    .unwrap();
+    let (status, _, err) = plumetrace(
+        d,
+        &["replay", log.to_str().unwrap(), "--planner-file", "p.toml"],
+    );
+    assert_eq!(status, 1);
+    assert_eq!(
+        err,
+        "error: p.toml:3: planner.beta_dg: unknown field `beta_dg`; did you mean `beta_deg`? \
+         (`plumetrace planners` lists every key)\n"
+    );
+    std::fs::write(d.join("p.toml"), demo()).unwrap();
+    let (status, out, err) = plumetrace(
+        d,
+        &["replay", log.to_str().unwrap(), "--planner-file", "p.toml"],
+    );
+    assert_eq!(status, 0, "{err}");
+    assert!(out.contains(", 0 differ"), "{out}");
+}
+
+#[test]
+fn the_readme_has_the_preset_table() {
+    let md = String::from_utf8(run_ok(&["presets", "--markdown"]).stdout).unwrap();
+    let readme =
+        std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/../../README.md")).unwrap();
+    let start = readme
+        .find("<!-- presets:start -->\n")
+        .expect("README.md marks its preset table")
+        + "<!-- presets:start -->\n".len();
+    let end = readme.find("<!-- presets:end -->").unwrap();
+    assert_eq!(
+        &readme[start..end],
+        md,
+        "README.md's preset table is not the code's: run scripts/readme_tables.sh"
+    );
+    for p in plumetrace_scenario::PRESETS {
+        assert!(md.contains(&format!("| `{}` | {} |", p.name, p.summary)));
+    }
+}

@@ -1,0 +1,142 @@
+//! Where a key path is written in a scenario's text (its line, from the TOML parser's spans), and
+//! "did you mean" for the serde layer's unknown keys and names.
+
+use toml::de::{DeTable, DeValue};
+
+/// The 1-based line at which `path` (`planner.beta_deg`, `vehicles[0].x_m`,
+/// `planners."a b".kind`) is written in `text`: the key itself, or when it is absent (a missing
+/// key, a key set from elsewhere) the deepest table on its way that is written. `None` when the
+/// text does not parse or nothing of the path is in it.
+pub fn line_of(text: &str, path: &str) -> Option<usize> {
+    let root = DeValue::Table(DeTable::parse(text).ok()?.into_inner());
+    let mut here = &root;
+    let mut found: Option<usize> = None;
+    for segment in segments(path) {
+        let next = match (&segment, here) {
+            (Segment::Key(k), DeValue::Table(t)) => t
+                .iter()
+                .find(|(name, _)| name.get_ref().as_ref() == k.as_str())
+                .map(|(name, value)| (name.span().start, value.get_ref())),
+            (Segment::Index(i), DeValue::Array(a)) => {
+                a.get(*i).map(|v| (v.span().start, v.get_ref()))
+            }
+            _ => None,
+        };
+        let Some((start, value)) = next else { break };
+        found = Some(start);
+        here = value;
+    }
+    found.map(|start| line_at(text, start))
+}
+
+/// The 1-based line of byte `offset` in `text`.
+pub fn line_at(text: &str, offset: usize) -> usize {
+    text.get(..offset)
+        .map_or(0, |head| head.matches('\n').count())
+        + 1
+}
+
+/// One step of a key path.
+#[derive(Debug, PartialEq)]
+enum Segment {
+    Key(String),
+    Index(usize),
+}
+
+/// The steps of a key path as the errors write them: dotted keys (quoted when not plain words)
+/// and `[N]` indices.
+fn segments(path: &str) -> Vec<Segment> {
+    let mut out = Vec::new();
+    let mut chars = path.chars().peekable();
+    let mut key = String::new();
+    let flush = |key: &mut String, out: &mut Vec<Segment>| {
+        if !key.is_empty() {
+            out.push(Segment::Key(std::mem::take(key)));
+        }
+    };
+    while let Some(c) = chars.next() {
+        match c {
+            '"' => {
+                while let Some(q) = chars.next() {
+                    match q {
+                        '"' => break,
+                        '\\' => key.extend(chars.next()),
+                        _ => key.push(q),
+                    }
+                }
+            }
+            '.' => flush(&mut key, &mut out),
+            '[' => {
+                flush(&mut key, &mut out);
+                let index: String = chars.by_ref().take_while(|&d| d != ']').collect();
+                if let Ok(i) = index.parse() {
+                    out.push(Segment::Index(i));
+                }
+            }
+            _ => key.push(c),
+        }
+    }
+    flush(&mut key, &mut out);
+    out
+}
+
+/// serde's message for an unknown key or name (`unknown field `dtt_s`, expected `dt_s` or
+/// `duration_s``, `unknown variant ...`) with the nearest known one suggested in place of the
+/// list when one is near; any other message unchanged.
+pub fn suggest(message: &str) -> String {
+    let Some((what, rest)) = ["unknown field `", "unknown variant `"]
+        .iter()
+        .find_map(|p| message.strip_prefix(p).map(|rest| (*p, rest)))
+    else {
+        return message.to_string();
+    };
+    let Some((word, list)) = rest.split_once('`') else {
+        return message.to_string();
+    };
+    let known: Vec<&str> = list.split('`').skip(1).step_by(2).collect();
+    match plumetrace_core::closest(word, &known) {
+        Some(near) => format!("{what}{word}`; did you mean `{near}`?"),
+        None => message.to_string(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const TEXT: &str = "name = \"x\"\n[sim]\ndt_s = 0.1\n\n[[vehicles]]\nx_m = 1.0\n\n\
+                        [[vehicles]]\nx_m = 2.0\n[planners.\"a b\"]\nkind = \"amp\"\n";
+
+    #[test]
+    fn key_paths_find_their_lines_or_the_table_they_belong_to() {
+        let cases = [
+            ("sim.dt_s", Some(3)),
+            ("sim", Some(2)),
+            ("vehicles[1].x_m", Some(9)),
+            ("vehicles[1]", Some(8)),
+            ("planners.\"a b\".kind", Some(11)),
+            ("planners.\"a b\".beta_deg", Some(10)),
+            ("sim.duration_s", Some(2)),
+            ("mission.time_limit_s", None),
+        ];
+        for (path, line) in cases {
+            assert_eq!(line_of(TEXT, path), line, "{path}");
+        }
+        assert_eq!(line_of("not = = toml", "not"), None);
+    }
+
+    #[test]
+    fn unknown_keys_and_names_get_the_nearest_known_one() {
+        assert_eq!(
+            suggest("unknown field `dtt_s`, expected `dt_s` or `duration_s`"),
+            "unknown field `dtt_s`; did you mean `dt_s`?"
+        );
+        assert_eq!(
+            suggest("unknown variant `farel`, expected one of `uniform`, `farrell`, `gridded`"),
+            "unknown variant `farel`; did you mean `farrell`?"
+        );
+        let far = "unknown field `zzz`, expected `dt_s` or `duration_s`";
+        assert_eq!(suggest(far), far);
+        assert_eq!(suggest("invalid type"), "invalid type");
+    }
+}
