@@ -29,8 +29,9 @@ def main() -> None:
 
     p = plumetrace.Plume("demo", seed=args.seed)
     p.spin_up(600.0)
-    print("concentration at (0, 0, 1):", p.concentrations([0.0, 0.0, 1.0]))
-    xy = np.column_stack([np.linspace(0, 100, 5), np.zeros(5)])
+    centre = p.filaments()[:, :3].mean(axis=0)  # x, y, z of the plume's filaments' centroid
+    print("concentration at the filaments' centroid:", p.concentrations(centre))
+    xy = np.column_stack([np.linspace(100, 400, 7), np.zeros(7)])  # x, y: at height p.z_m
     print(f"along y = 0 at z = {p.z_m} m:", np.round(p.concentrations(xy), 4))
 
 

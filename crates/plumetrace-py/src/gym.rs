@@ -28,7 +28,7 @@ use plumetrace_core::{
 };
 use plumetrace_env::derive_seed;
 use plumetrace_guidance::OpArea;
-use plumetrace_mission::{Mission, MissionOptions, MissionSetup, VehicleStatus};
+use plumetrace_mission::{EndReason, Mission, MissionOptions, MissionSetup, VehicleStatus};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use rayon::prelude::*;
@@ -308,20 +308,19 @@ impl Episode {
             out.terminated = true;
             out.success = true;
             out.reason = "reached_source";
+        } else if ended.is_some_and(|e| !matches!(e.reason, EndReason::TimeLimit)) {
+            // An incident (leaving the domain, a collision) names itself, even where the
+            // vehicle also left the op-area.
+            out.reward -= 1.0;
+            out.terminated = true;
+            out.reason = end_reason(self.mission.statuses(), st.vehicle);
         } else if !self.area.contains(truth) && self.entered {
             out.reward -= 1.0;
             out.terminated = true;
             out.reason = "left_op_area";
-        } else if let Some(end) = ended {
-            let timed_out = matches!(end.reason, plumetrace_mission::EndReason::TimeLimit);
-            if timed_out {
-                out.truncated = true;
-                out.reason = "time_limit";
-            } else {
-                out.reward -= 1.0;
-                out.terminated = true;
-                out.reason = end_reason(self.mission.statuses(), st.vehicle);
-            }
+        } else if ended.is_some() {
+            out.truncated = true;
+            out.reason = "time_limit";
         } else if self.mission.time_s() + st.decision_period_s > self.mission.time_limit_s() {
             out.truncated = true;
             out.reason = "time_limit";
