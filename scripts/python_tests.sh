@@ -24,7 +24,9 @@ rm -rf "$venv"
 python3 -m venv "$venv"
 "$venv/bin/pip" install --quiet "maturin==1.16.0" "gymnasium==1.4.0" "pytest>=7" "pandas" "pyarrow" \
     "tqdm" "dask[distributed]" "matplotlib"
+start=$SECONDS
 "$venv/bin/pip" install --quiet "$py"
+echo "pip install of the package: $((SECONDS - start)) s"
 (cd "$py/tests" && PLUMETRACE_BIN="$cli_target/release/plumetrace" "$venv/bin/python" -m pytest -q "$@")
 
 # The examples, small: each must run to its end.

@@ -318,10 +318,9 @@ impl Episode {
             out.reward -= 1.0;
             out.terminated = true;
             out.reason = "left_op_area";
-        } else if ended.is_some() {
-            out.truncated = true;
-            out.reason = "time_limit";
-        } else if self.mission.time_s() + st.decision_period_s > self.mission.time_limit_s() {
+        } else if ended.is_some()
+            || self.mission.time_s() + st.decision_period_s > self.mission.time_limit_s()
+        {
             out.truncated = true;
             out.reason = "time_limit";
         }

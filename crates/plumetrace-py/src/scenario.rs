@@ -46,8 +46,11 @@ impl Source {
                 .iter()
                 .map(|p| p.name)
                 .collect();
+            let hint = plumetrace_core::closest(name, &names)
+                .map(|n| format!("; did you mean {n}?"))
+                .unwrap_or_default();
             return Err(msg(format!(
-                "'{name}' is neither a preset ({}) nor a file",
+                "'{name}' is neither a preset ({}) nor a file{hint}",
                 names.join(", ")
             )));
         }

@@ -183,6 +183,7 @@ def test_python_m_plumetrace_runs_as_the_command_line(cli, tmp_path):
     _same_files(tmp_path / "cli-p", tmp_path / "py-p")
     bad = _module("run", "--preset", "dmeo")
     assert bad.returncode == 2 and "error: 'dmeo' is neither a preset" in bad.stderr
+    assert "nor a file; did you mean demo?" in bad.stderr
     assert "demo" in _module("presets").stdout
 
 
