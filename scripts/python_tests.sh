@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # The Python package's checks: formatting and lints of its Rust crate, then `pip install` of the
-# package from the repository (maturin builds the wheel) into a fresh virtual environment, and
-# its pytest suite (which compares with the release command line, so it builds that too).
+# package from the repository (maturin builds the wheel) into a fresh virtual environment, its
+# pytest suite (which compares with the release command line, so it builds that too), and every
+# example of examples/python at a small size.
 #
 # Usage: scripts/python_tests.sh [pytest arguments]
 set -euo pipefail
@@ -21,8 +22,29 @@ cargo clippy --release --manifest-path "$py/Cargo.toml" --all-targets -- -D warn
 
 rm -rf "$venv"
 python3 -m venv "$venv"
-"$venv/bin/pip" install --quiet "maturin==1.16.0" "gymnasium==1.4.0" "pytest>=7" "pandas" "tqdm" \
-    "dask[distributed]"
+"$venv/bin/pip" install --quiet "maturin==1.16.0" "gymnasium==1.4.0" "pytest>=7" "pandas" "pyarrow" \
+    "tqdm" "dask[distributed]" "matplotlib"
+start=$SECONDS
 "$venv/bin/pip" install --quiet "$py"
-cd "$py/tests"
-PLUMETRACE_BIN="$cli_target/release/plumetrace" "$venv/bin/python" -m pytest -q "$@"
+echo "pip install of the package: $((SECONDS - start)) s"
+(cd "$py/tests" && PLUMETRACE_BIN="$cli_target/release/plumetrace" "$venv/bin/python" -m pytest -q "$@")
+
+# The examples, small: each must run to its end.
+examples="$root/examples/python"
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+cd "$work"
+run_example() {
+    echo "examples/python/$*"
+    "$venv/bin/python" "$examples/$@" >"$work/example.log" 2>&1 || {
+        cat "$work/example.log"
+        echo "examples/python/$1 failed" >&2
+        exit 1
+    }
+}
+run_example quick_start.py --seed 7 --out "$work/quick"
+run_example python_planner.py --seed 9
+run_example plot_trajectory.py --seed 7 --out "$work/track.png"
+run_example gym_training.py --iterations 2 --envs 2 --steps 50
+run_example dask_campaign.py --example "$work/dask" --seeds 1 --shards 2 --workers 1
+echo "examples: 5 passed, 0 failed"

@@ -1,31 +1,14 @@
 //! `plumetrace run` on a mission scenario: fly it and write its outputs.
 
-use crate::output::write_atomic;
 use anyhow::{Context, Result};
 use plumetrace_log::snapshot::Header;
 use plumetrace_mission::snapshot_log::SnapshotLogWriter;
-use plumetrace_mission::{Mission, MissionOptions, MissionRun, MissionSetup, Outcome};
+use plumetrace_mission::{Mission, MissionOptions, MissionRun, MissionSetup};
 use plumetrace_scenario::BuiltScenario;
-use serde::Serialize;
-use std::fmt::Write as _;
 use std::path::Path;
 use std::time::Instant;
 
-/// The replay page's file name in a run's output directory.
-pub const REPLAY_PAGE: &str = "replay.html";
-
-/// The snapshot log's file name in a run's output directory.
-pub const SNAPSHOT_LOG: &str = "snapshots.jsonl.gz";
-
-#[derive(Serialize)]
-struct SummaryFile<'a> {
-    #[serde(flatten)]
-    summary: &'a plumetrace_mission::Summary,
-    wall_s: f64,
-    real_time_factor: f64,
-    spinup_wall_s: f64,
-    stage_times: plumetrace_sim::StageTimes,
-}
+pub use plumetrace_report::run_dir::{REPLAY_PAGE, SNAPSHOT_LOG};
 
 /// Flies the mission and writes `summary.json`, `trajectory.csv`, `events.jsonl`, `plot.svg`,
 /// `replay.html` and (unless `snapshot_log` is false) `snapshots.jsonl.gz`.
@@ -68,7 +51,7 @@ pub fn run(
     progress.finish();
     let run = mission.finish()?;
     let wall = started.elapsed().as_secs_f64();
-    write_outputs(&run, out, &name, wall)?;
+    plumetrace_report::write_mission_outputs(&run, out, &name, wall)?;
     if stats {
         let t = run.stage_times;
         eprintln!(
@@ -121,99 +104,4 @@ pub fn run_line(run: &MissionRun, name: &str, wall: f64) -> String {
         s.outcome.name(),
         s.ended.t_s,
     )
-}
-
-/// `x` with `digits` decimals, or an empty field.
-fn opt(x: Option<f64>, digits: usize) -> String {
-    x.map_or(String::new(), |v| format!("{v:.digits$}"))
-}
-
-fn write_outputs(run: &MissionRun, out: &Path, name: &str, wall: f64) -> Result<()> {
-    let mut csv = String::from(
-        "t_s,vehicle,true_x_m,true_y_m,true_z_m,est_x_m,est_y_m,heading_deg,speed_mps,behaviour,reading_v,detection\n",
-    );
-    for r in &run.trajectory {
-        let numbers = [
-            r.t_s,
-            r.true_x_m,
-            r.true_y_m,
-            r.true_z_m,
-            r.heading_deg,
-            r.speed_mps,
-            r.reading_v,
-        ];
-        if numbers
-            .iter()
-            .chain(r.est_x_m.iter())
-            .chain(r.est_y_m.iter())
-            .any(|v| !v.is_finite())
-        {
-            anyhow::bail!(
-                "vehicle {} at t = {} s has a state that is not finite; nothing written",
-                r.vehicle,
-                r.t_s
-            );
-        }
-        let _ = writeln!(
-            csv,
-            "{:.1},{},{:.2},{:.2},{:.2},{},{},{:.1},{:.2},{},{:.3},{}",
-            r.t_s,
-            r.vehicle,
-            r.true_x_m,
-            r.true_y_m,
-            r.true_z_m,
-            opt(r.est_x_m, 2),
-            opt(r.est_y_m, 2),
-            r.heading_deg,
-            r.speed_mps,
-            r.behaviour
-                .and_then(|b| plumetrace_core::variant_name(&b))
-                .unwrap_or(""),
-            r.reading_v,
-            u8::from(r.detection)
-        );
-    }
-    write_atomic(&out.join("trajectory.csv"), csv.as_bytes())?;
-    let mut jsonl = String::new();
-    for e in &run.events {
-        jsonl.push_str(&serde_json::to_string(e).context("encoding an event")?);
-        jsonl.push('\n');
-    }
-    write_atomic(&out.join("events.jsonl"), jsonl.as_bytes())?;
-    let file = SummaryFile {
-        summary: &run.summary,
-        wall_s: wall,
-        real_time_factor: run.summary.sim_time_s / (wall - run.spinup_wall_s).max(1e-9),
-        spinup_wall_s: run.spinup_wall_s,
-        stage_times: run.stage_times,
-    };
-    if let Some(at) = plumetrace_mission::output::first_non_finite(&file) {
-        anyhow::bail!(
-            "the mission's summary has a number that is not finite ({at}); nothing written"
-        );
-    }
-    write_atomic(
-        &out.join("summary.json"),
-        serde_json::to_string_pretty(&file)?.as_bytes(),
-    )?;
-    let s = &run.summary;
-    // The verdict, and the outcome where a vehicle failed (the verdict tells the others).
-    let failed = !matches!(
-        s.outcome,
-        Outcome::Declared | Outcome::NoDeclaration | Outcome::TimedOut
-    );
-    let outcome = if failed {
-        format!("; {}", s.outcome.name())
-    } else {
-        String::new()
-    };
-    let title = format!("{name} (seed {}): {}{outcome}", s.seed, s.verdict());
-    let svg = plumetrace_report::mission_figure(run, &title)?;
-    write_atomic(&out.join("plot.svg"), svg.as_bytes())?;
-    if let Some(team) = plumetrace_report::team_figure(run, &title) {
-        write_atomic(&out.join("team.svg"), team?.as_bytes())?;
-    }
-    let page = plumetrace_report::replay_page(run, &title)?;
-    write_atomic(&out.join(REPLAY_PAGE), page.as_bytes())?;
-    Ok(())
 }

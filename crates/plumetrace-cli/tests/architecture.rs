@@ -155,8 +155,11 @@ const RULES: &[(&str, Side, &[&str])] = &[
             "plumetrace-scenario",
             "plumetrace-guidance",
             "plumetrace-planner",
+            "plumetrace-log",
             "plumetrace-mission",
+            "plumetrace-report",
             "plumetrace-campaign",
+            "plumetrace-plume-run",
         ],
     ),
     (

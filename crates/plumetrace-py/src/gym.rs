@@ -28,7 +28,7 @@ use plumetrace_core::{
 };
 use plumetrace_env::derive_seed;
 use plumetrace_guidance::OpArea;
-use plumetrace_mission::{Mission, MissionOptions, MissionSetup};
+use plumetrace_mission::{EndReason, Mission, MissionOptions, MissionSetup, VehicleStatus};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use rayon::prelude::*;
@@ -307,24 +307,22 @@ impl Episode {
             out.reward += 1.0;
             out.terminated = true;
             out.success = true;
-            out.reason = "reached the source";
+            out.reason = "reached_source";
+        } else if ended.is_some_and(|e| !matches!(e.reason, EndReason::TimeLimit)) {
+            // An incident (leaving the domain, a collision) names itself, even where the
+            // vehicle also left the op-area.
+            out.reward -= 1.0;
+            out.terminated = true;
+            out.reason = end_reason(self.mission.statuses(), st.vehicle);
         } else if !self.area.contains(truth) && self.entered {
             out.reward -= 1.0;
             out.terminated = true;
-            out.reason = "left the op-area";
-        } else if let Some(end) = ended {
-            let timed_out = matches!(end.reason, plumetrace_mission::EndReason::TimeLimit);
-            if timed_out {
-                out.truncated = true;
-                out.reason = "time limit";
-            } else {
-                out.reward -= 1.0;
-                out.terminated = true;
-                out.reason = "the mission ended";
-            }
-        } else if self.mission.time_s() + st.decision_period_s > self.mission.time_limit_s() {
+            out.reason = "left_op_area";
+        } else if ended.is_some()
+            || self.mission.time_s() + st.decision_period_s > self.mission.time_limit_s()
+        {
             out.truncated = true;
-            out.reason = "time limit";
+            out.reason = "time_limit";
         }
         self.over = out.terminated || out.truncated;
         Ok(out)
@@ -384,6 +382,34 @@ impl Episode {
         }
     }
 }
+
+/// Why the mission ended before its time limit, from the vehicles' statuses: the agent's own
+/// end (`left_domain`, `collided`) or, failing that, the first other vehicle's.
+fn end_reason(statuses: &[VehicleStatus], agent: usize) -> &'static str {
+    let named = |s: &VehicleStatus| match s {
+        VehicleStatus::LeftDomain => Some("left_domain"),
+        VehicleStatus::Collided => Some("collided"),
+        VehicleStatus::Aborted => Some("aborted"),
+        VehicleStatus::Finished => Some("finished"),
+        VehicleStatus::Active | VehicleStatus::NoPlanner => None,
+    };
+    statuses
+        .get(agent)
+        .and_then(named)
+        .or_else(|| statuses.iter().find_map(named))
+        .unwrap_or("mission_ended")
+}
+
+/// The environment's settings, as `gym.make` takes them.
+pub const SETTINGS: [&str; 7] = [
+    "vehicle",
+    "decision_period_s",
+    "max_turn_deg",
+    "speed_min_mps",
+    "speed_max_mps",
+    "success_radius_m",
+    "detection_reward",
+];
 
 fn settings<'py>(
     kw: Option<&Bound<'py, PyDict>>,
@@ -449,13 +475,52 @@ fn maker(
     kwargs: Option<&Bound<'_, PyDict>>,
 ) -> PyResult<Maker> {
     let (settings, rest) = settings(kwargs)?;
-    Ok(Maker {
+    let maker = Maker {
         source: Source::open(scenario)?,
         overrides: overrides(set, rest.as_ref())?,
         settings,
         spun: Mutex::new(VecDeque::new()),
-    })
+    };
+    check_overrides(&maker, rest.as_ref())?;
+    Ok(maker)
 }
+
+/// Builds the scenario and its mission once (without spinning up), so that a bad keyword fails
+/// at `gym.make`, naming the environment's settings and the one a typo meant.
+fn check_overrides(maker: &Maker, rest: Option<&Bound<'_, PyDict>>) -> PyResult<()> {
+    let built = maker
+        .source
+        .build(Some(0), &maker.overrides)
+        .and_then(|sc| {
+            MissionSetup::new(sc)
+                .map(|_| ())
+                .map_err(crate::error::to_py)
+        });
+    let Err(e) = built else { return Ok(()) };
+    let keys: Vec<String> = rest
+        .map(|d| d.keys().iter().filter_map(|k| k.extract().ok()).collect())
+        .unwrap_or_default();
+    let reason = Python::attach(|py| e.value(py).to_string());
+    if keys.is_empty() {
+        return Err(msg(reason));
+    }
+    for k in &keys {
+        if let Some(near) = plumetrace_core::closest(k, &SETTINGS) {
+            return Err(msg(format!(
+                "{k}: not a setting of {ENV_ID}; did you mean {near}? (its settings: {}; any \
+                 other keyword is a scenario override, and as one {k} fails: {reason})",
+                SETTINGS.join(", ")
+            )));
+        }
+    }
+    Err(msg(format!(
+        "{reason} (the settings of {ENV_ID} are {}; any other keyword is a scenario override)",
+        SETTINGS.join(", ")
+    )))
+}
+
+/// The registered environment's id.
+const ENV_ID: &str = "plumetrace/PlumeTracing-v0";
 
 fn info<'py>(py: Python<'py>, ep: &Episode, out: &StepOut) -> PyResult<Bound<'py, PyDict>> {
     let d = PyDict::new(py);
@@ -624,7 +689,8 @@ impl VecEnvCore {
     }
 
     /// Steps every environment with `actions` of shape `(n, 2)`; returns `(observations,
-    /// rewards, terminated, truncated, successes)`.
+    /// rewards, terminated, truncated, successes, reasons)` (a reason is empty while an episode
+    /// goes on).
     #[allow(clippy::type_complexity)]
     fn step<'py>(
         &mut self,
@@ -636,6 +702,7 @@ impl VecEnvCore {
         Bound<'py, PyArray1<bool>>,
         Bound<'py, PyArray1<bool>>,
         Bound<'py, PyArray1<bool>>,
+        Vec<&'static str>,
     )> {
         let n = self.episodes.len();
         let shape = actions.shape();
@@ -695,6 +762,7 @@ impl VecEnvCore {
             Vec::with_capacity(n),
             Vec::with_capacity(n),
         );
+        let mut reasons = Vec::with_capacity(n);
         for (i, o) in outs.into_iter().enumerate() {
             let (out, was_reset) = o.map_err(|e| msg(format!("environment {i}: {e}")))?;
             if was_reset {
@@ -706,6 +774,7 @@ impl VecEnvCore {
             term.push(out.terminated);
             trunc.push(out.truncated);
             succ.push(out.success);
+            reasons.push(out.reason);
         }
         let obs = Array2::from_shape_vec((n, 12), flat).map_err(|e| msg(e.to_string()))?;
         Ok((
@@ -714,6 +783,7 @@ impl VecEnvCore {
             term.into_pyarray(py),
             trunc.into_pyarray(py),
             succ.into_pyarray(py),
+            reasons,
         ))
     }
 }

@@ -10,6 +10,18 @@ use pyo3::prelude::*;
 use pyo3::types::{PyBool, PyDict, PyFloat, PyInt, PyList, PyString, PyTuple};
 use std::path::{Path, PathBuf};
 
+/// How to open a scenario again elsewhere (a pickled `Plume`): a preset by name, a scenario
+/// file by its text, a family file by its path.
+#[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
+pub enum Recipe {
+    /// A preset.
+    Preset(String),
+    /// A scenario file's table, as TOML text, and its path (for messages).
+    File(PathBuf, String),
+    /// A family file (read again where it is re-created).
+    Family(PathBuf),
+}
+
 /// Where a scenario comes from: a preset, a scenario file or a family file (a site per seed).
 pub enum Source {
     /// A scenario table and where it came from.
@@ -34,8 +46,11 @@ impl Source {
                 .iter()
                 .map(|p| p.name)
                 .collect();
+            let hint = plumetrace_core::closest(name, &names)
+                .map(|n| format!("; did you mean {n}?"))
+                .unwrap_or_default();
             return Err(msg(format!(
-                "'{name}' is neither a preset ({}) nor a file",
+                "'{name}' is neither a preset ({}) nor a file{hint}",
                 names.join(", ")
             )));
         }
@@ -49,6 +64,29 @@ impl Source {
             .parse::<toml::Table>()
             .map_err(|e| msg(format!("{}: {e}", path.display())))?;
         Ok(Source::Table(table, Origin::File(path.to_path_buf())))
+    }
+
+    /// How to open it again.
+    pub fn recipe(&self) -> Recipe {
+        match self {
+            Source::Table(_, Origin::Preset(name)) => Recipe::Preset(name.clone()),
+            Source::Table(t, Origin::File(path)) => Recipe::File(path.clone(), t.to_string()),
+            Source::Family(_, path) => Recipe::Family(path.clone()),
+        }
+    }
+
+    /// Opens a recipe.
+    pub fn from_recipe(r: &Recipe) -> PyResult<Self> {
+        match r {
+            Recipe::Preset(name) => Source::open(name),
+            Recipe::File(path, text) => {
+                let table = text
+                    .parse::<toml::Table>()
+                    .map_err(|e| msg(format!("{}: {e}", path.display())))?;
+                Ok(Source::Table(table, Origin::File(path.clone())))
+            }
+            Recipe::Family(path) => Source::open(&path.to_string_lossy()),
+        }
     }
 
     /// The scenario table of a run with `seed` (a family draws its site from it).

@@ -1,15 +1,11 @@
 """A campaign's shards on a Dask LocalCluster of two workers equal one local run."""
 
-import pathlib
-import sys
-
 import pytest
 
 import plumetrace
 
 distributed = pytest.importorskip("dask.distributed")
-sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1] / "examples"))
-import dask_campaign  # noqa: E402
+import plumetrace.dask  # noqa: E402
 
 CAMPAIGN = """
 name = "py-dask"
@@ -38,7 +34,7 @@ def test_shards_on_two_dask_workers_merge_to_the_local_campaign(tmp_path):
                                        dashboard_address=None)
     try:
         with distributed.Client(cluster) as client:
-            report = dask_campaign.run_on_dask(client, str(f), str(tmp_path / "dask"), shards=3)
+            report = plumetrace.dask.run_on_dask(client, f, tmp_path / "dask", shards=3)
     finally:
         cluster.close()
     assert report["runs"] == report["expected"] == 4
@@ -63,3 +59,16 @@ def test_a_bad_campaign_names_the_file(tmp_path):
     f.write_text('name = "x"\nseeds = 0\n')
     with pytest.raises(plumetrace.PlumetraceError, match="bad.toml"):
         plumetrace.campaign(f, tmp_path / "o", progress=False)
+
+
+def test_the_number_of_seeds_is_chosen_per_call(tmp_path):
+    f = tmp_path / "c.toml"
+    f.write_text(CAMPAIGN)
+    cluster = distributed.LocalCluster(n_workers=1, threads_per_worker=1, processes=False,
+                                       dashboard_address=None)
+    try:
+        with distributed.Client(cluster) as client:
+            report = plumetrace.dask.run_on_dask(client, f, tmp_path / "d", shards=2, seeds=1)
+    finally:
+        cluster.close()
+    assert report["runs"] == report["expected"] == 2

@@ -66,8 +66,8 @@ def test_flying_upflow_with_the_mean_flow_reaches_the_source_for_a_reward():
         total += r
         if term or trunc:
             break
-    assert info["reason"] in {"reached the source", "left the op-area", "time limit",
-                              "the mission ended"}
+    assert info["reason"] in {"reached_source", "left_op_area", "left_domain", "collided",
+                              "time_limit"}
     assert np.isfinite(total)
 
 

@@ -73,7 +73,10 @@ def test_the_same_seed_gives_the_same_plume():
 @pytest.mark.parametrize(
     "points, words",
     [
-        (np.zeros((4, 2)), ["(N, 3)"]),
+        (np.zeros((4, 4)), ["(N, 3)", "(N, 2)", "not (4, 4)"]),
+        (np.zeros(5), ["(3,)", "not (5,)"]),
+        (7.0, ["(3,)", "not ()"]),
+        ([[0.0, 1.0, 2.0], [1.0]], ["points is not an array of numbers"]),
         (np.array([[0.0, np.nan, 1.0]]), ["points[0]", "not finite"]),
     ],
 )

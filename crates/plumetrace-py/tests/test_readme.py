@@ -13,4 +13,6 @@ def test_the_readmes_python_examples_run():
     for b in blocks:
         exec(compile(b, "docs/python.md", "exec"), scope)
     assert scope["r"].outcome
+    # The Python planner of the guide declares on the demo.
+    assert scope["d"] is not None and scope["d"]["rule"] == "custom"
     assert scope["obs"].shape == (12,)

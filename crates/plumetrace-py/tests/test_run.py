@@ -102,4 +102,4 @@ def test_read_runs_reads_each_column_by_its_kind(tmp_path):
     rows = plumetrace.read_runs(tmp_path / "o", frame=False)
     assert list(rows) == [c["name"] for c in plumetrace.run_columns()]
     assert isinstance(rows["seed"][0], int) and isinstance(rows["success"][0], bool)
-    assert rows["scenario"] == ["demo"] and rows["message"] == [None]
+    assert rows["scenario"] == ["demo"] and rows["message"] == [""]

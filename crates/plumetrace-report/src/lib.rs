@@ -11,6 +11,8 @@
 //! - [`mod@plume_figure`]: the plume figure of a plume-only run (`plume.svg`);
 //! - [`mod@replay_page`]: the self-contained replay page (`replay.html`), of a flown mission or a
 //!   replayed log;
+//! - [`run_dir`]: a flown mission's output directory (what `plumetrace run` and Python's
+//!   `RunResult.save` write);
 //! - [`chart`]: the map panel and dashed outlines every figure and chart shares;
 //! - [`error`]: what can go wrong ([`ReportError`]).
 
@@ -19,6 +21,7 @@ pub mod error;
 pub mod figure;
 pub mod plume_figure;
 pub mod replay_page;
+pub mod run_dir;
 pub mod team_figure;
 
 pub use chart::{dashed, map_chart};
@@ -26,4 +29,5 @@ pub use error::ReportError;
 pub use figure::{DETECTION_GAP_S, mission_figure};
 pub use plume_figure::plume_figure;
 pub use replay_page::{LogPageBuilder, PageData, replay_page};
+pub use run_dir::{RunDirError, write_mission_outputs};
 pub use team_figure::team_figure;

@@ -37,7 +37,22 @@ answers.
 Reward: ``-decision_period_s / time_limit`` per step, ``+detection_reward`` (0.01) per step with
 a detection, ``+1`` on coming within ``success_radius_m`` (10 m) of a source (terminated), ``-1``
 on leaving the op-area (once inside it) or any other end of the mission (terminated); truncated at the
-scenario's time limit. ``info`` has ``time_s``, ``success`` and ``reason``.
+scenario's time limit. ``info`` has ``time_s``, ``success`` and ``reason``: empty while the
+episode goes on, then why it ended:
+
+================  ===========  =====================================================
+reason            ends as      meaning
+================  ===========  =====================================================
+reached_source    terminated   within ``success_radius_m`` of a source (+1)
+left_op_area      terminated   outside the op-area after being inside it (-1)
+left_domain       terminated   the vehicle left the simulated domain (-1)
+collided          terminated   the vehicle entered an obstacle (-1)
+time_limit        truncated    the scenario's time limit
+================  ===========  =====================================================
+
+Settings are checked at ``gym.make``: a keyword that is neither a setting nor a valid scenario
+override fails there, with the settings' names and the one a typo meant
+(``max_turn_dgr`` -> ``max_turn_deg``).
 
 ``reset(seed=s)`` makes the episode's run seed ``s``: the plume, the flow, the sensors'
 noise and, for a family file, the site all follow from it, so the episode meets the same plume
@@ -165,8 +180,9 @@ class PlumeTracingVecEnv(gymnasium.vector.VectorEnv):
         self, actions: Any
     ) -> Tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, Dict[str, Any]]:
         a = np.asarray(actions, dtype=np.float64).reshape(self.num_envs, 2)
-        obs, rewards, terminated, truncated, success = self._core.step(a)
-        return obs, rewards, terminated, truncated, {"success": success}
+        obs, rewards, terminated, truncated, success, reasons = self._core.step(a)
+        info = {"success": success, "reason": np.asarray(reasons, dtype=object)}
+        return obs, rewards, terminated, truncated, info
 
 
 gymnasium.register(
