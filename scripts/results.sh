@@ -8,7 +8,13 @@
 #
 # Options: --jobs N (worker threads, default: one per core), --bin PATH (a built plumetrace,
 # default: builds the release binary of this checkout), --keep (resume into target/results/NAME
-# instead of starting afresh). Each page names the commit, the command, the machine and the time.
+# instead of starting afresh; the page then says how many runs this call flew). Each page names
+# the commit, the command, the machine and the time.
+#
+# Two-sample comparisons: every line `# two-sample: A B` of the campaign file appends to its page
+# the comparison of configurations A and B over the campaign's runs.csv, per scenario
+# (scripts/two_sample.sh: Fisher's exact test for the rates, Kolmogorov-Smirnov and Mann-Whitney U
+# for the errors and times; it makes a virtual environment with scipy on first use).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -28,7 +34,7 @@ while [ $# -gt 0 ]; do
             done
             shift ;;
         --index) shift ;;
-        -h|--help) sed -n '2,11p' "$0"; exit 0 ;;
+        -h|--help) sed -n '2,17p' "$0"; exit 0 ;;
         -*) echo "results.sh: unknown option $1 (see --help)" >&2; exit 2 ;;
         *) names+=("$1"); shift ;;
     esac
@@ -54,16 +60,69 @@ fi
 cores="$(nproc)"
 cpu="$(sed -n 's/^model name[[:space:]]*: //p' /proc/cpuinfo | head -1)"
 
+# The `# two-sample: A B` lines of campaign file $1, one "LINE A B" per line.
+two_sample_pairs() {
+    awk '/^# two-sample:/ { if (NF == 4) print NR, $3, $4; else print NR, "-", "-" }' "$1"
+}
+
+# Refuses a two-sample line naming a configuration the campaign file $1 does not have (before
+# anything runs: a typo would otherwise show only after the whole campaign).
+check_two_sample() {
+    local file="$1" line a b c configs
+    configs="$(sed -n 's/^name *= *"\(.*\)"$/\1/p' "$file" | tail -n +2 | tr '\n' ' ')"
+    while read -r line a b; do
+        [ -n "$line" ] || continue
+        if [ "$a" = "-" ]; then
+            echo "results.sh: $file:$line: a two-sample line names two configurations: # two-sample: A B" >&2
+            exit 2
+        fi
+        for c in "$a" "$b"; do
+            if ! grep -qx "name *= *\"$c\"" "$file"; then
+                echo "results.sh: $file:$line: two-sample names configuration '$c', which the campaign does not have (its configurations: ${configs% })" >&2
+                exit 2
+            fi
+        done
+    done <<< "$(two_sample_pairs "$file")"
+}
+
+# Appends a section per `# two-sample: A B` line of the campaign file $1, over its runs.csv $2.
+two_sample() {
+    local file="$1" runs="$2" line a b table
+    while read -r line a b; do
+        [ -n "$line" ] || continue
+        table="$(bash scripts/two_sample.sh "$runs" "$a" "$b" </dev/null)" || true
+        if ! grep -q '^smallest p-value' <<< "$table" || ! grep -q "^| [^|]* | declared |" <<< "$table"; then
+            echo "results.sh: bash scripts/two_sample.sh $runs $a $b gave no comparison (see its errors above)" >&2
+            exit 2
+        fi
+        echo
+        echo "### Two-sample comparison: \`$a\` against \`$b\`"
+        echo
+        echo "The same seeds in both configurations; per scenario, Fisher's exact test for the rates and"
+        echo "the two-sample Kolmogorov-Smirnov and Mann-Whitney U tests for the rest (runs without a"
+        echo "value left out), by \`bash scripts/two_sample.sh $runs $a $b\`:"
+        echo
+        echo "$table"
+    done <<< "$(two_sample_pairs "$file")"
+}
+
+for n in "${names[@]}"; do
+    check_two_sample "examples/campaigns/$n.toml"
+done
+
 for n in "${names[@]}"; do
     file="examples/campaigns/$n.toml"
     out="target/results/$n"
+    mkdir -p target/results
     if [ "$keep" -eq 0 ]; then rm -rf "$out"; fi
     cmd=("$bin" campaign "$file" --out "$out")
     if [ -n "$jobs" ]; then cmd+=(--jobs "$jobs"); fi
     echo "== $n: ${cmd[*]}" >&2
     start=$(date +%s)
-    "${cmd[@]}"
+    "${cmd[@]}" 2>&1 | tee "$out.log" >&2
     secs=$(( $(date +%s) - start ))
+    # The campaign's own count line: "NAME: P runs planned, R already recorded, F run now ...".
+    resumed="$(sed -n 's/^.*: \([0-9]*\) runs planned, \([1-9][0-9]*\) already recorded, \([0-9]*\) run now.*$/; \3 of its \1 runs flown in this call, \2 resumed from an earlier one/p' "$out.log" | tail -1)"
     desc="$(sed -n 's/^description *= *"\(.*\)"$/\1/p' "$file" | head -1)"
     shown="plumetrace campaign $file --out $out"
     if [ -n "$jobs" ]; then shown="$shown --jobs $jobs"; fi
@@ -73,7 +132,7 @@ for n in "${names[@]}"; do
         echo
         if [ -n "$desc" ]; then echo "${desc^}."; echo; fi
         echo "Produced at commit \`$commit\` on $(date -u +%Y-%m-%d) by \`scripts/results.sh $n\`,"
-        echo "which ran (release build, $cores cores, $cpu; ${secs} s of wall time):"
+        echo "which ran (release build, $cores cores, $cpu; ${secs} s of wall time$resumed):"
         echo
         echo "    $shown"
         echo
@@ -82,6 +141,7 @@ for n in "${names[@]}"; do
         echo
         # The summary's own title becomes a section; its other headings move down one level.
         sed -e '1s/^# /## /' -e '2,$s/^## /### /' "$out/summary.md"
+        two_sample "$file" "$out/runs.csv"
     } > "$page.tmp"
     mv "$page.tmp" "$page"
     echo "wrote $page" >&2
@@ -91,9 +151,10 @@ done
 {
     echo "# Results"
     echo
-    echo "Every page here is written whole by a script, from a campaign or benchmark anyone can run"
-    echo "again; each names the commit, the command and the machine that produced it. Campaign pages"
-    echo "are regenerated by \`scripts/results.sh NAME\` (\`--all\` for every one)."
+    echo "A campaign's page is written whole by \`scripts/results.sh NAME\` (\`--all\` for every one),"
+    echo "from a campaign anyone can run again; each names the commit, the command and the machine"
+    echo "that produced it. The other pages are records of measurements no script regenerates (timings,"
+    echo "and campaigns flown at older code to choose a default), each table with its commit and command."
     echo
     echo "| page | what it measures |"
     echo "| --- | --- |"
