@@ -2,6 +2,8 @@
 //! crates' README files names a file that exists and, with a `#fragment`, a heading of that file
 //! (GitHub's anchors).
 
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
 use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};
 
