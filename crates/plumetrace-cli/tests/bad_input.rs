@@ -7,14 +7,7 @@
 use std::path::{Path, PathBuf};
 
 mod common;
-use common::{bin, run_ok};
-
-fn demo() -> String {
-    plumetrace_scenario::find_preset("demo")
-        .unwrap()
-        .toml
-        .to_string()
-}
+use common::{bin, demo, run_ok};
 
 /// `demo` with `from` replaced by `to` (which must match).
 fn demo_with(from: &str, to: &str) -> String {

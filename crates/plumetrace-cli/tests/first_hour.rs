@@ -8,14 +8,7 @@
 use std::path::Path;
 
 mod common;
-use common::{bin, run_ok};
-
-fn demo() -> String {
-    plumetrace_scenario::find_preset("demo")
-        .unwrap()
-        .toml
-        .to_string()
-}
+use common::{bin, demo, run_ok};
 
 /// The 1-based line of the first line of `text` that starts with `start`.
 fn line(text: &str, start: &str) -> usize {

@@ -17,3 +17,12 @@ pub fn run_ok(args: &[&str]) -> Output {
     );
     out
 }
+
+/// The `demo` preset's scenario text.
+#[allow(dead_code)] // not every test file that shares these helpers needs it
+pub fn demo() -> String {
+    plumetrace_scenario::find_preset("demo")
+        .unwrap()
+        .toml
+        .to_string()
+}
