@@ -50,6 +50,28 @@ fn rendered_figures_have_no_overlapping_labels_and_sound_axes() {
                     faults.push(format!("{name}: no {key}"));
                 }
             }
+            // Each legend entry's key is the mark it names.
+            let legend = state
+                .split("data-legend=\"")
+                .nth(1)
+                .and_then(|r| r.split('"').next())
+                .unwrap_or("");
+            for entry in legend.split('|').filter(|e| !e.is_empty()) {
+                let (kind, label) = entry.split_once(':').unwrap_or(("", entry));
+                let want = match label {
+                    "true source" => "triangle",
+                    "declared source" => "dot",
+                    "lost point" => "circle",
+                    "reference target" => "diamond",
+                    "detection" => "square",
+                    "flow" => "arrow",
+                    l if l.starts_with("track") => "line",
+                    _ => kind,
+                };
+                if kind != want {
+                    faults.push(format!("{name}: legend {label:?} keyed {kind}, not {want}"));
+                }
+            }
             if state.contains("data-timeline-rows=\"\"") && state.contains("data-events=\"0\"") {
                 continue;
             }

@@ -424,6 +424,25 @@ pub(super) fn map_layout(
         (f64::from(key_px.0), f64::from(key_px.1)),
         &taken,
     );
+    // With no free corner, the map grows by the key's height on the key's side, so the key
+    // sits clear of what is drawn (the op-area's border, a track) rather than over it.
+    let (fx, fy) = (f64::from(key_px.0 + 10) * m, f64::from(key_px.1 + 10) * m);
+    let (kx, ky) = key_corner.box_in(&x, &y, fx, fy);
+    let hides = points
+        .iter()
+        .any(|(px, py)| kx.contains(px) && ky.contains(py));
+    let (y, plot_h) = if hides {
+        let grow = key_px.1 + 14;
+        let dy = f64::from(grow) * m;
+        let y = if key_corner.upper() {
+            y.start..y.end + dy
+        } else {
+            y.start - dy..y.end
+        };
+        (y, plot_h + grow)
+    } else {
+        (y, plot_h)
+    };
     Ok(MapLayout {
         map_h_px: plot_h + over_h,
         plot_px: (WIDTH_PX - over_w, plot_h),
