@@ -20,6 +20,10 @@ if [ -z "$browser" ]; then
     echo "figure_pictures.sh: no headless Chromium: install chromium-headless-shell or set PLUMETRACE_BROWSER" >&2
     exit 1
 fi
+if [ ! -x "$browser" ]; then
+    echo "figure_pictures.sh: the browser $browser is not an executable file (PLUMETRACE_BROWSER?)" >&2
+    exit 1
+fi
 out="target/figure-pictures"
 rm -rf "$out"
 mkdir -p "$out" docs/images

@@ -26,10 +26,18 @@ if [ -z "$bin" ]; then
     cargo build --release --bin plumetrace
     bin="target/release/plumetrace"
 fi
+if [ ! -x "$bin" ]; then
+    echo "visual_check.sh: no plumetrace binary at $bin (build it: cargo build --release --bin plumetrace)" >&2
+    exit 1
+fi
 bin=$(realpath "$bin")
 browser="${PLUMETRACE_BROWSER:-$(command -v chromium-headless-shell || command -v chromium || true)}"
 if [ -z "$browser" ]; then
     echo "visual_check.sh: no headless Chromium: install chromium-headless-shell or set PLUMETRACE_BROWSER" >&2
+    exit 1
+fi
+if [ ! -x "$browser" ]; then
+    echo "visual_check.sh: the browser $browser is not an executable file (PLUMETRACE_BROWSER?)" >&2
     exit 1
 fi
 rm -rf "$out"
