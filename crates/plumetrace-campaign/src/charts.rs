@@ -385,6 +385,7 @@ pub fn error_chart(
                 .disable_y_mesh()
                 .y_labels(0)
                 .x_labels(6)
+                .x_label_formatter(&|v| axis_number(*v))
                 .x_desc(desc)
                 .label_style(("sans-serif", 15))
                 .draw()
@@ -451,14 +452,21 @@ fn draw_box<DB: DrawingBackend>(
     let (p5, q1, q2, q3, p95) = (q(0.05), q(0.25), q(0.5), q(0.75), q(0.95));
     if sorted.len() < MIN_BOX_VALUES {
         // Too few for quartiles: the values themselves and their median.
-        chart.draw_series([Rectangle::new(
-            [(q2, y - 0.28), (q2, y + 0.28)],
+        chart.draw_series([PathElement::new(
+            vec![(q2, y - 0.28), (q2, y + 0.28)],
             col.stroke_width(3),
         )])?;
     } else {
         draw_quartiles(chart, y, col, (p5, q1, q2, q3, p95))?;
     }
     dots(chart, y, col, vals, limit)
+}
+
+/// An axis number with the decimals it needs (up to 2), and never "-0".
+fn axis_number(v: f64) -> String {
+    let s = format!("{v:.2}");
+    let s = s.trim_end_matches('0').trim_end_matches('.');
+    if s == "-0" { "0".into() } else { s.into() }
 }
 
 /// Fewer values than this in a group are drawn as dots and a median, without a box.
@@ -794,5 +802,10 @@ mod tests {
         assert!(!boxed(&draw(3)), "{}", draw(3));
         assert!(boxed(&draw(6)), "{}", draw(6));
         assert_eq!(draw(3).matches("<circle").count(), 3);
+        assert!(draw(3).contains("stroke-width=\"3\""), "the median");
+        assert_eq!(
+            [-0.0, 0.2, -0.4, 1.0].map(axis_number),
+            ["0", "0.2", "-0.4", "1"]
+        );
     }
 }
