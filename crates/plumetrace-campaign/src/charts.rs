@@ -98,7 +98,7 @@ pub fn success_chart(c: &Campaign, groups: &[GroupSummary]) -> Result<String, Ca
             .disable_y_mesh()
             .y_labels(0)
             .x_desc(success_desc(c, groups))
-            .label_style(("sans-serif", 13))
+            .label_style(("sans-serif", 15))
             .draw()
             .map_err(&e)?;
         for (i, g) in groups.iter().enumerate() {
@@ -131,7 +131,7 @@ pub fn success_chart(c: &Campaign, groups: &[GroupSummary]) -> Result<String, Ca
                         g.successes, g.runs, g.success_rate, g.success_ci_low, g.success_ci_high
                     ),
                     (px.min(width as i32 - 190) + 8, py - 20),
-                    ("sans-serif", 12).into_font().color(&BLACK),
+                    ("sans-serif", 15).into_font().color(&BLACK),
                 ))
                 .map_err(&e)?;
             }
@@ -165,7 +165,7 @@ fn row_labels<DB: DrawingBackend>(
     let x0 = chart.x_range().start;
     for (i, l) in labels.iter().enumerate() {
         let (px, py) = chart.backend_coord(&(x0, (n - 1 - i) as f64));
-        let style = ("sans-serif", 13)
+        let style = ("sans-serif", 15)
             .into_font()
             .color(&BLACK)
             .pos(text_anchor::Pos::new(
@@ -210,7 +210,7 @@ fn success_vs_sweep(
             .configure_mesh()
             .x_desc(key)
             .y_desc(success_desc(c, groups))
-            .label_style(("sans-serif", 13))
+            .label_style(("sans-serif", 15))
             .draw()
             .map_err(&e)?;
         let series: Vec<(String, String)> = {
@@ -271,7 +271,7 @@ fn success_vs_sweep(
             .configure_series_labels()
             .background_style(WHITE.mix(0.9))
             .border_style(BLACK)
-            .label_font(("sans-serif", 13))
+            .label_font(("sans-serif", 15))
             .position(SeriesLabelPosition::LowerRight)
             .draw()
             .map_err(&e)?;
@@ -342,7 +342,7 @@ pub fn error_chart(
         title
             .draw(&Text::new(
                 format!(
-                    "{}: {} (box: quartiles and median; whiskers: 5th–95th percentile; dots: {})",
+                    "{}: {} (box: quartiles and median, for 5 or more; whiskers: 5th–95th percentile; dots: {})",
                     c.file.name,
                     if k == 1 {
                         "nearest declaration to each source"
@@ -385,8 +385,9 @@ pub fn error_chart(
                 .disable_y_mesh()
                 .y_labels(0)
                 .x_labels(6)
+                .x_label_formatter(&|v| axis_number(*v))
                 .x_desc(desc)
-                .label_style(("sans-serif", 12))
+                .label_style(("sans-serif", 15))
                 .draw()
                 .map_err(&e)?;
             if m > 0 && lo < 0.0 && hi > 0.0 {
@@ -449,6 +450,35 @@ fn draw_box<DB: DrawingBackend>(
     }
     let q = |p| quantile(&sorted, p);
     let (p5, q1, q2, q3, p95) = (q(0.05), q(0.25), q(0.5), q(0.75), q(0.95));
+    if sorted.len() < MIN_BOX_VALUES {
+        // Too few for quartiles: the values themselves and their median.
+        chart.draw_series([PathElement::new(
+            vec![(q2, y - 0.28), (q2, y + 0.28)],
+            col.stroke_width(3),
+        )])?;
+    } else {
+        draw_quartiles(chart, y, col, (p5, q1, q2, q3, p95))?;
+    }
+    dots(chart, y, col, vals, limit)
+}
+
+/// An axis number with the decimals it needs (up to 2), and never "-0".
+fn axis_number(v: f64) -> String {
+    let s = format!("{v:.2}");
+    let s = s.trim_end_matches('0').trim_end_matches('.');
+    if s == "-0" { "0".into() } else { s.into() }
+}
+
+/// Fewer values than this in a group are drawn as dots and a median, without a box.
+const MIN_BOX_VALUES: usize = 5;
+
+/// The box (quartiles, median) and whiskers (5th to 95th percentile) of one group's row.
+fn draw_quartiles<DB: DrawingBackend>(
+    chart: &mut ChartContext<'_, DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>,
+    y: f64,
+    col: RGBColor,
+    (p5, q1, q2, q3, p95): (f64, f64, f64, f64, f64),
+) -> Result<(), DrawingAreaErrorKind<DB::ErrorType>> {
     chart.draw_series([
         PathElement::new(vec![(p5, y), (q1, y)], col.stroke_width(1)),
         PathElement::new(vec![(q3, y), (p95, y)], col.stroke_width(1)),
@@ -463,13 +493,25 @@ fn draw_box<DB: DrawingBackend>(
         Rectangle::new([(q1, y - 0.28), (q3, y + 0.28)], col.stroke_width(1)),
         Rectangle::new([(q2, y - 0.28), (q2, y + 0.28)], col.stroke_width(3)),
     ])?;
+    Ok(())
+}
+
+/// A dot per value of one group's row (jittered by seed index), a triangle at the axis's edge
+/// for a value beyond `limit`.
+fn dots<DB: DrawingBackend>(
+    chart: &mut ChartContext<'_, DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>,
+    y: f64,
+    col: RGBColor,
+    vals: &[(u64, f64)],
+    limit: f64,
+) -> Result<(), DrawingAreaErrorKind<DB::ErrorType>> {
     // Dots jittered by seed index (deterministic), inside the box's height; values beyond the
     // axis as triangles at its edge.
     let jitter = |s: u64| ((s.wrapping_mul(2_654_435_761) % 1000) as f64 / 1000.0 - 0.5) * 0.4;
     chart.draw_series(
         vals.iter()
             .filter(|(_, v)| v.abs() <= limit)
-            .map(|(s, v)| Circle::new((*v, y + jitter(*s)), 2, col.mix(0.7).filled())),
+            .map(|(s, v)| Circle::new((*v, y + jitter(*s)), 3, col.mix(0.7).filled())),
     )?;
     chart.draw_series(vals.iter().filter(|(_, v)| v.abs() > limit).map(|(s, v)| {
         let x = v.clamp(-limit, limit);
@@ -488,21 +530,17 @@ pub fn trajectory_chart(c: &Campaign, examples: &[ExampleRun]) -> Result<String,
     let shown = &examples[..examples.len().min(12)];
     let cols = shown.len().clamp(1, 3);
     let rows = shown.len().div_ceil(cols).max(1);
-    // Common extent: every op-area, source and track point.
-    let (mut x0, mut x1, mut y0, mut y1) = (f64::MAX, f64::MIN, f64::MAX, f64::MIN);
-    for ex in shown {
-        for p in ex.op_area.iter().chain(&ex.sources).chain(&ex.track) {
-            (x0, x1, y0, y1) = (x0.min(p[0]), x1.max(p[0]), y0.min(p[1]), y1.max(p[1]));
-        }
-    }
-    if x0 > x1 {
-        (x0, x1, y0, y1) = (0.0, 1.0, 0.0, 1.0);
-    }
-    let pad = 0.04 * (x1 - x0).max(y1 - y0);
-    let (x0, x1, y0, y1) = (x0 - pad, x1 + pad, y0 - pad, y1 + pad);
+    // Each panel its own extent (its op-area, sources, tracks and declarations), at one scale
+    // in x and y: a campaign over several scenarios keeps every panel's runs readable.
+    let extents: Vec<[f64; 4]> = shown.iter().map(panel_extent).collect();
     let panel_w = 430u32;
-    let panel_h =
-        ((f64::from(panel_w) - 80.0) * (y1 - y0) / (x1 - x0) + 110.0).clamp(260.0, 900.0) as u32;
+    let plot_w = f64::from(panel_w) - 97.0;
+    let tallest = extents
+        .iter()
+        .map(|b| (b[3] - b[2]) / (b[1] - b[0]))
+        .fold(0.0, f64::max);
+    let panel_h = (plot_w * tallest + 110.0).clamp(260.0, 900.0) as u32;
+    let plot_h = f64::from(panel_h) - 110.0;
     let (width, height) = (panel_w * cols as u32, panel_h * rows as u32 + 40);
     let mut svg = String::new();
     {
@@ -526,7 +564,7 @@ pub fn trajectory_chart(c: &Campaign, examples: &[ExampleRun]) -> Result<String,
             ))
             .map_err(&e)?;
         let panels = body.split_evenly((rows, cols));
-        for (ex, area) in shown.iter().zip(panels.iter()) {
+        for (k, (ex, area)) in shown.iter().zip(panels.iter()).enumerate() {
             let mut name = ex.config.clone();
             if !ex.point.is_empty() {
                 name = format!("{name} · {}", ex.point.replace(';', ", "));
@@ -538,13 +576,32 @@ pub fn trajectory_chart(c: &Campaign, examples: &[ExampleRun]) -> Result<String,
                 Some(d) => format!("{}, {d:.1} m", ex.outcome.name()),
                 None => ex.outcome.name().to_string(),
             };
-            let mut chart =
-                map_chart(area, &format!("{name}: {result}"), x0..x1, y0..y1).map_err(|m| {
-                    CampaignError::Chart {
-                        what: "trajectories.svg".into(),
-                        message: m.to_string(),
-                    }
-                })?;
+            let radius = c
+                .scenarios
+                .iter()
+                .position(|s| s.label == ex.scenario)
+                .zip(c.configs.iter().position(|k| k.name == ex.config))
+                .zip(c.points.iter().position(|p| p.label() == ex.point))
+                .map(|((s, k), p)| c.located_radius_m(s, k, p));
+            let failed = !example_located(ex, radius);
+            let title = if failed {
+                format!("FAILED · {name}: {result}")
+            } else {
+                format!("{name}: {result}")
+            };
+            let (x, y) = fit_panel(extents[k], plot_w, plot_h);
+            if failed {
+                // A failed run's panel is framed in red, as well as named so.
+                area.draw(&Rectangle::new(
+                    [(1, 1), (panel_w as i32 - 2, panel_h as i32 - 2)],
+                    RGBColor(210, 0, 0).stroke_width(3),
+                ))
+                .map_err(&e)?;
+            }
+            let mut chart = map_chart(area, &title, x, y).map_err(|m| CampaignError::Chart {
+                what: "trajectories.svg".into(),
+                message: m.to_string(),
+            })?;
             let poly = |pts: &[[f64; 2]]| -> Vec<Vec2> {
                 pts.iter().map(|p| Vec2::new(p[0], p[1])).collect()
             };
@@ -597,6 +654,50 @@ pub fn trajectory_chart(c: &Campaign, examples: &[ExampleRun]) -> Result<String,
     Ok(svg)
 }
 
+/// Whether an example run located its source: it declared, within `radius` (m) when it is
+/// known.
+fn example_located(ex: &ExampleRun, radius: Option<f64>) -> bool {
+    ex.outcome == plumetrace_mission::Outcome::Declared
+        && match (ex.error_m, radius) {
+            (Some(d), Some(r)) => d <= r,
+            _ => true,
+        }
+}
+
+/// A panel's extent: west, east, south, north over its op-area, sources, tracks, declarations
+/// and lost points, with a margin of 4 % of its larger side (at least 1 m).
+fn panel_extent(ex: &ExampleRun) -> [f64; 4] {
+    let (mut x0, mut x1, mut y0, mut y1) = (f64::MAX, f64::MIN, f64::MAX, f64::MIN);
+    let points = ex
+        .op_area
+        .iter()
+        .chain(&ex.sources)
+        .chain(&ex.track)
+        .chain(&ex.declared)
+        .chain(&ex.lost_points)
+        .chain(ex.others.iter().flatten())
+        .filter(|p| p[0].is_finite() && p[1].is_finite());
+    for p in points {
+        (x0, x1, y0, y1) = (x0.min(p[0]), x1.max(p[0]), y0.min(p[1]), y1.max(p[1]));
+    }
+    if x0 > x1 {
+        (x0, x1, y0, y1) = (0.0, 1.0, 0.0, 1.0);
+    }
+    let pad = (0.04 * (x1 - x0).max(y1 - y0)).max(1.0);
+    [x0 - pad, x1 + pad, y0 - pad, y1 + pad]
+}
+
+/// The ranges that show extent `b` at one scale in x and y on a plotting area of `w` x `h` px
+/// (the shorter side widened about its middle).
+fn fit_panel(b: [f64; 4], w: f64, h: f64) -> (std::ops::Range<f64>, std::ops::Range<f64>) {
+    let m = ((b[1] - b[0]) / w).max((b[3] - b[2]) / h);
+    let (cx, cy) = ((b[0] + b[1]) / 2.0, (b[2] + b[3]) / 2.0);
+    (
+        cx - m * w / 2.0..cx + m * w / 2.0,
+        cy - m * h / 2.0..cy + m * h / 2.0,
+    )
+}
+
 /// Writes the three charts into `out`.
 pub fn write_charts(
     c: &Campaign,
@@ -636,5 +737,75 @@ mod tests {
         );
         let success = success_chart(&c, &groups).unwrap();
         assert!(success.contains("fraction of runs locating every source"));
+    }
+
+    /// An example run over a square op-area `side` metres wide, its track along the diagonal.
+    fn example(
+        side: f64,
+        outcome: plumetrace_mission::Outcome,
+        error_m: Option<f64>,
+    ) -> ExampleRun {
+        ExampleRun {
+            scenario: "duck-2003-mt".into(),
+            config: "default".into(),
+            point: String::new(),
+            seed: 1,
+            outcome,
+            error_m,
+            op_area: vec![[0.0, 0.0], [side, 0.0], [side, side], [0.0, side]],
+            subregions: Vec::new(),
+            sources: vec![[0.1 * side, 0.5 * side]],
+            declared: Vec::new(),
+            lost_points: Vec::new(),
+            track: (0..10).map(|k| [f64::from(k) * side / 10.0; 2]).collect(),
+            others: Vec::new(),
+        }
+    }
+
+    #[test]
+    fn each_trajectory_panel_fits_its_own_runs_and_failed_runs_are_marked() {
+        use plumetrace_mission::Outcome;
+        let (c, _) = multi_source_fixture();
+        let small = example(100.0, Outcome::Declared, Some(2.0));
+        let big = example(1200.0, Outcome::TimedOut, None);
+        let svg = trajectory_chart(&c, &[small, big]).unwrap();
+        let rows = plumetrace_report::inspect::tick_rows(&svg);
+        let top = |r: &Vec<String>| {
+            r.iter()
+                .filter_map(|v| v.parse::<f64>().ok())
+                .fold(f64::MIN, f64::max)
+        };
+        // The first panel's East axis ends near its 100 m op-area, the second's near 1200 m.
+        let east: Vec<f64> = rows.iter().step_by(2).map(top).collect();
+        assert!(east[0] <= 150.0, "{rows:?}");
+        assert!(east[1] >= 1000.0, "{rows:?}");
+        assert_eq!(svg.matches("FAILED").count(), 1, "the timed-out run only");
+        assert!(plumetrace_report::inspect::bad_tick_rows(&svg).is_empty());
+    }
+
+    #[test]
+    fn a_group_of_few_runs_has_dots_and_a_median_but_no_box() {
+        let draw = |n: u64| {
+            let mut svg = String::new();
+            {
+                let root = SVGBackend::with_string(&mut svg, (300, 100)).into_drawing_area();
+                let mut chart = ChartBuilder::on(&root)
+                    .build_cartesian_2d(0.0..10.0, -1.0..1.0)
+                    .unwrap();
+                let vals: Vec<(u64, f64)> = (0..n).map(|k| (k, 1.0 + k as f64)).collect();
+                draw_box(&mut chart, 0.0, PALETTE[0], &vals, 100.0).unwrap();
+                root.present().unwrap();
+            }
+            svg
+        };
+        let boxed = |svg: &str| svg.contains("fill-opacity") || svg.contains("opacity=\"0.18\"");
+        assert!(!boxed(&draw(3)), "{}", draw(3));
+        assert!(boxed(&draw(6)), "{}", draw(6));
+        assert_eq!(draw(3).matches("<circle").count(), 3);
+        assert!(draw(3).contains("stroke-width=\"3\""), "the median");
+        assert_eq!(
+            [-0.0, 0.2, -0.4, 1.0].map(axis_number),
+            ["0", "0.2", "-0.4", "1"]
+        );
     }
 }

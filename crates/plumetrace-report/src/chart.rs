@@ -40,7 +40,7 @@ where
         .y_label_formatter(&|v| format!("{v:.0}"))
         .x_desc("East (m)")
         .y_desc("North (m)")
-        .label_style(("sans-serif", 13))
+        .label_style(("sans-serif", 15))
         .draw()
         .map_err(ReportError::figure)?;
     Ok(chart)

@@ -13,12 +13,15 @@
 //!   replayed log;
 //! - [`run_dir`]: a flown mission's output directory (what `plumetrace run` and Python's
 //!   `RunResult.save` write);
+//! - [`inspect`]: measurable properties of a drawn figure (label boxes, overlaps, axes), read
+//!   back from its SVG;
 //! - [`chart`]: the map panel and dashed outlines every figure and chart shares;
 //! - [`error`]: what can go wrong ([`ReportError`]).
 
 pub mod chart;
 pub mod error;
 pub mod figure;
+pub mod inspect;
 pub mod plume_figure;
 pub mod replay_page;
 pub mod run_dir;

@@ -46,6 +46,10 @@ fn level(c: f64, max: f64) -> Option<f64> {
     Some((c / max).sqrt())
 }
 
+/// The plume's concentration unit: the release rate's mass unit per cubic metre (a source
+/// releases mass units a second).
+pub const CONCENTRATION_UNIT: &str = "mass units/m³";
+
 /// Two stacked heat maps (instantaneous and time-averaged concentration) with the source,
 /// obstacles and mean flow, as an SVG string.
 pub fn plume_figure(
@@ -68,14 +72,18 @@ pub fn plume_figure(
         let t = sc.env.time_s();
         let steady = matches!(sc.env.plume(), Plume::Steady(_));
         let top_title = if steady {
-            format!("{}: steady concentration at z = {} m", sc.name, g.z_m)
+            format!(
+                "{}: steady concentration ({CONCENTRATION_UNIT}) at z = {} m",
+                sc.name, g.z_m
+            )
         } else {
             format!(
-                "{}: concentration at z = {} m, t = {:.0} s",
+                "{}: concentration ({CONCENTRATION_UNIT}) at z = {} m, t = {:.0} s",
                 sc.name, g.z_m, t
             )
         };
-        let bottom_title = format!("time-averaged concentration ({samples} samples)");
+        let bottom_title =
+            format!("time-averaged concentration ({CONCENTRATION_UNIT}; {samples} samples)");
         panel(&top, sc, &g, snapshot, &top_title)?;
         panel(&bottom, sc, &g, mean, &bottom_title)?;
         root.present().map_err(plume_err)?;
@@ -155,17 +163,31 @@ where
         );
         let u = v / v.norm() * len;
         let end = (start.0 + u.x, start.1 + u.y);
+        // An arrow: the shaft and a head of two strokes a quarter of its length.
+        let head = |turn: f64| {
+            let (s, c) = turn.sin_cos();
+            let b = -u * 0.25;
+            (end.0 + b.x * c - b.y * s, end.1 + b.x * s + b.y * c)
+        };
         chart
             .draw_series(std::iter::once(PathElement::new(
-                vec![start, end],
+                vec![start, end, head(0.45), end, head(-0.45)],
                 BLUE.stroke_width(2),
             )))
             .map_err(err)?
-            .label(format!("flow {:.2} m/s", v.norm()))
-            .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], BLUE.stroke_width(2)));
-        chart
-            .draw_series(std::iter::once(Circle::new(end, 3, BLUE.filled())))
-            .map_err(err)?;
+            .label(format!("mean flow {:.2} m/s", v.norm()))
+            .legend(|(x, y)| {
+                PathElement::new(
+                    vec![
+                        (x, y),
+                        (x + 16, y),
+                        (x + 11, y - 4),
+                        (x + 16, y),
+                        (x + 11, y + 4),
+                    ],
+                    BLUE.stroke_width(2),
+                )
+            });
     }
     // Colour key: swatches at 1 %, 10 %, 50 % and 100 % of the maximum.
     if max > 0.0 {
@@ -177,7 +199,7 @@ where
                     c.filled(),
                 )))
                 .map_err(err)?
-                .label(format!("{name} of max {max:.3}"))
+                .label(format!("{name} of max {max:.3} {CONCENTRATION_UNIT}"))
                 .legend(move |(x, y)| Rectangle::new([(x, y - 5), (x + 14, y + 5)], c.filled()));
         }
     }
@@ -190,4 +212,42 @@ where
         .draw()
         .map_err(err)?;
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    #![allow(clippy::unwrap_used, clippy::expect_used)]
+
+    use super::*;
+    use plumetrace_scenario::{Origin, build, load_preset};
+
+    #[test]
+    fn the_plume_figure_names_the_concentrations_unit_and_draws_the_flow_as_an_arrow() {
+        let cfg = load_preset("plume-demo").unwrap();
+        let sc = build(&cfg, &Origin::Preset("plume-demo".into()), Some(1)).unwrap();
+        let g = sc.output.grid;
+        let field: Vec<f64> = (0..g.nx * g.ny).map(|k| (k % 7) as f64).collect();
+        let svg = plume_figure(&sc, &field, &field, 3).unwrap();
+        assert!(svg.contains(&format!("of max 6.000 {CONCENTRATION_UNIT}")));
+        assert!(svg.contains(&format!(
+            "time-averaged concentration ({CONCENTRATION_UNIT}"
+        )));
+        // The flow: a shaft and a two-stroke head (five points), not a line ending in a dot.
+        let arrow = svg
+            .split("<polyline")
+            .filter(|p| p.contains("stroke=\"#0000FF\""))
+            .filter(|p| {
+                let pts = p.split("points=\"").nth(1).unwrap_or("");
+                pts.split('"')
+                    .next()
+                    .unwrap_or("")
+                    .split_whitespace()
+                    .count()
+                    == 5
+            })
+            .count();
+        assert!(arrow >= 2, "{arrow} arrows");
+        assert!(!svg.contains("<circle"), "no dot at the flow's end");
+        assert!(crate::inspect::bad_tick_rows(&svg).is_empty());
+    }
 }

@@ -67,6 +67,19 @@ pub struct PageVehicle {
     pub faults: Vec<(f64, f64, String)>,
     /// Its track.
     pub track: PageTrack,
+    /// Its sensor's unit (`V`, `ppt`; empty when the source does not say, as in a log).
+    pub unit: String,
+}
+
+/// Where a replayed planner first decided otherwise than the logged one.
+#[derive(Debug, Clone, Serialize)]
+pub struct PageDivergence {
+    /// When, s.
+    pub t_s: f64,
+    /// Which vehicle.
+    pub vehicle: u32,
+    /// Where it was (its logged estimate), m.
+    pub pos_m: [f64; 2],
 }
 
 /// The plume sampled during the run: a level (0-255, square root of the concentration over the
@@ -120,6 +133,10 @@ pub struct PageData {
     pub events: Vec<Value>,
     /// The plume, if sampled.
     pub plume: Option<PagePlume>,
+    /// A replayed log's page.
+    pub replayed: bool,
+    /// A replayed log: the first decision that differs from the logged one.
+    pub divergence: Option<PageDivergence>,
 }
 
 /// Rounds to `digits` decimals (shorter JSON).
@@ -340,6 +357,7 @@ impl PageData {
                     .map(|f| (f.start_s, f.end_s, f.what.to_string()))
                     .collect(),
                 track,
+                unit: v.reading_unit.to_string(),
             })
             .collect();
         let result = match &s.first_declaration {
@@ -354,11 +372,17 @@ impl PageData {
             ),
             None => "no source declared".into(),
         };
+        // The outcome's word once: "declared at 702 s, ..." rather than "declared: declared at".
+        let outcome = s.outcome.name();
+        let result = if result.starts_with(outcome) {
+            result
+        } else {
+            format!("{outcome}: {result}")
+        };
         PageData {
             title: title.to_string(),
             subtitle: format!(
-                "{}: {result}; ended at {:.0} s ({}); seed {}",
-                s.outcome.name(),
+                "{result}; ended at {:.0} s ({}); seed {}",
                 t_end,
                 plumetrace_core::variant_name(&s.ended.reason).unwrap_or("?"),
                 s.seed
@@ -380,6 +404,8 @@ impl PageData {
             vehicles,
             events: events_json(&run.events),
             plume: run.plume_frames.as_ref().and_then(PagePlume::from_frames),
+            replayed: false,
+            divergence: None,
         }
     }
 
@@ -412,6 +438,8 @@ impl PageData {
             vehicles,
             events: events_json(events),
             plume: None,
+            replayed: false,
+            divergence: None,
         }
     }
 
@@ -442,6 +470,7 @@ pub struct LogPageBuilder {
     behaviour: std::collections::BTreeMap<u32, BehaviourKind>,
     vehicles: std::collections::BTreeMap<u32, (String, String, Option<String>)>,
     geometry: Option<(Vec<Vec2>, Vec<Vec<Vec2>>)>,
+    divergence: Option<PageDivergence>,
 }
 
 impl LogPageBuilder {
@@ -476,6 +505,15 @@ impl LogPageBuilder {
         let (l, d) = (r.line, r.replayed);
         let t = l.snapshot.time_s;
         let v = l.vehicle;
+        if self.divergence.is_none() && !same_decision(d, &l.decision) {
+            // Where the vehicle believed it was (the origin when it had no estimate).
+            let p = l.snapshot.nav.pos_m.unwrap_or_default();
+            self.divergence = Some(PageDivergence {
+                t_s: round(t, 1),
+                vehicle: v,
+                pos_m: [round(p.x, 2), round(p.y, 2)],
+            });
+        }
         if let Some(b) = d
             .events
             .iter()
@@ -538,18 +576,30 @@ impl LogPageBuilder {
                     planner,
                     faults: Vec::new(),
                     track,
+                    unit: String::new(),
                 }
             })
             .collect();
         let (op_area, subregions) = self.geometry.unwrap_or_default();
-        PageData::bare(
+        let mut page = PageData::bare(
             title,
             subtitle,
             &op_area,
             &subregions,
             vehicles,
             &self.events,
-        )
+        );
+        page.replayed = true;
+        page.divergence = self.divergence;
+        page
+    }
+}
+
+/// Whether two decisions are the same to the bit (as the replay compares them: their text).
+fn same_decision(a: &plumetrace_core::Decision, b: &plumetrace_core::Decision) -> bool {
+    match (serde_json::to_string(a), serde_json::to_string(b)) {
+        (Ok(x), Ok(y)) => x == y,
+        _ => false,
     }
 }
 

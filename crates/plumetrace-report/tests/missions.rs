@@ -228,4 +228,54 @@ fn a_replayed_log_makes_a_page_of_the_logged_track_and_the_replayed_behaviours()
     assert_eq!(switches(&page.events), switches(&from_run.events));
     assert_eq!(page.op_area, from_run.op_area);
     assert!(page.html().is_ok());
+    // The same planner decides the same: no divergence to mark.
+    assert!(page.replayed && page.divergence.is_none());
+    // Another planner decides otherwise at some point, which the page marks.
+    let mut other = LogPageBuilder::default();
+    let lawnmower: toml::Table = "kind = \"lawnmower\"".parse().unwrap();
+    let report = replay_with(
+        open(&path).unwrap(),
+        &|_| Some(lawnmower.clone()),
+        &mut |r| other.add(r),
+    )
+    .unwrap();
+    assert!(report.differing > 0);
+    let page = other.page("replay", "lawnmower");
+    let d = page.divergence.as_ref().expect("the first divergence");
+    assert_eq!(d.t_s, (report.first[0].t_s * 10.0).round() / 10.0);
+    let html = page.html().unwrap();
+    assert!(html.contains("\"divergence\":{\"t_s\""));
+    assert!(html.contains("'data-divergence'"));
+    // A log says nothing of the sensor's unit: the page assumes none.
+    assert!(page.vehicles.iter().all(|v| v.unit.is_empty()));
+}
+
+#[test]
+fn the_page_names_the_sensors_unit_and_says_the_outcome_once() {
+    let run = run_mission(shortened("demo", 2000.0, 1500.0, 1), &mut |_, _| {}).unwrap();
+    let page = PageData::from_run(&run, "demo");
+    assert_eq!(page.vehicles[0].unit, "V");
+    assert!(
+        !page.subtitle.contains("declared: declared"),
+        "{}",
+        page.subtitle
+    );
+    if run.summary.first_declaration.is_some() {
+        assert!(
+            page.subtitle.starts_with("declared at "),
+            "{}",
+            page.subtitle
+        );
+    }
+    let html = page.html().unwrap();
+    // The timeline's rows are labelled, the legend's keys are the marks they name, event
+    // lines are not cut.
+    for s in [
+        "data-timeline-rows",
+        "keyCanvas(it[0], it[2])",
+        "overflow-wrap: anywhere",
+    ] {
+        assert!(html.contains(s), "{s}");
+    }
+    assert!(!html.contains("text-overflow: ellipsis"));
 }

@@ -374,7 +374,12 @@ pub(super) fn map_layout(
     if layers.iter().all(|l| l.jumps.is_empty()) {
         legend.retain(|e| e.icon != Icon::Dotted(BLACK));
     }
-    hide_crowded_times(&mut layers, m);
+    let mut mark_points: Vec<(f64, f64)> = run.sources.iter().map(|s| (s.x, s.y)).collect();
+    mark_points.extend(&over.declared);
+    mark_points.extend(&over.lost);
+    mark_points.extend(&over.targets);
+    mark_points.extend(over.marks.iter().map(|k| k.pos));
+    place_time_labels(&mut layers, &mark_points, m);
     let mut plume = plume_cells(run, &x, &y);
     plume.extend(posterior_cells(run, &x, &y));
     let obstacles = run
@@ -419,6 +424,25 @@ pub(super) fn map_layout(
         (f64::from(key_px.0), f64::from(key_px.1)),
         &taken,
     );
+    // With no free corner, the map grows by the key's height on the key's side, so the key
+    // sits clear of what is drawn (the op-area's border, a track) rather than over it.
+    let (fx, fy) = (f64::from(key_px.0 + 10) * m, f64::from(key_px.1 + 10) * m);
+    let (kx, ky) = key_corner.box_in(&x, &y, fx, fy);
+    let hides = points
+        .iter()
+        .any(|(px, py)| kx.contains(px) && ky.contains(py));
+    let (y, plot_h) = if hides {
+        let grow = key_px.1 + 14;
+        let dy = f64::from(grow) * m;
+        let y = if key_corner.upper() {
+            y.start..y.end + dy
+        } else {
+            y.start - dy..y.end
+        };
+        (y, plot_h + grow)
+    } else {
+        (y, plot_h)
+    };
     Ok(MapLayout {
         map_h_px: plot_h + over_h,
         plot_px: (WIDTH_PX - over_w, plot_h),
@@ -466,8 +490,9 @@ fn fit_map(
     marked.extend(&over.declared);
     marked.extend(run.sources.iter().map(|s| (s.x, s.y)));
     marked.extend(over.marks.iter().map(|k| k.pos));
-    // Nor the plume's core or the source map's likely cells.
+    // Nor the plume's core or the source map's likely cells, nor the op-area's border.
     marked.extend(hot_points(run));
+    marked.extend(outline_points(&run.op_area));
     let (x, y, plot_h) = fit_aspect(
         bx.clone(),
         by.clone(),
@@ -533,21 +558,40 @@ fn vehicle_layers(
     layers
 }
 
-/// Leaves out the time labels that would overlap an earlier one (their ticks stay).
-fn hide_crowded_times(layers: &mut [VehicleLayer], m: f64) {
-    let mut boxes: Vec<(f64, f64, f64)> = Vec::new();
+/// Places each time label on the side of its tick where it hides no marker (true and declared
+/// sources, lost points, reference targets, aborts and incidents: `marks`, each about 9 px
+/// across) and overlaps no earlier label; with no such side, leaves the label out (its tick
+/// stays).
+fn place_time_labels(layers: &mut [VehicleLayer], marks: &[(f64, f64)], m: f64) {
+    let mark_half = 9.0 * m;
+    // Boxes taken: centre and half sizes.
+    let mut boxes: Vec<(f64, f64, f64, f64)> = marks
+        .iter()
+        .map(|&(x, y)| (x, y, mark_half, mark_half))
+        .collect();
     for l in layers {
         for t in &mut l.times {
             let half_w = (text_px(&t.label, TIME_FONT_PX) / 2.0 + 2.0) * m;
             let half_h = 7.0 * m;
-            let (cx, cy) = t.label_at;
-            if boxes
-                .iter()
-                .any(|&(x, y, w)| (cx - x).abs() < half_w + w && (cy - y).abs() < 2.0 * half_h)
-            {
-                t.label.clear();
-            } else {
-                boxes.push((cx, cy, half_w));
+            let mid = (
+                (t.tick[0].0 + t.tick[1].0) / 2.0,
+                (t.tick[0].1 + t.tick[1].1) / 2.0,
+            );
+            let sides = [
+                t.label_at,
+                (2.0 * mid.0 - t.label_at.0, 2.0 * mid.1 - t.label_at.1),
+            ];
+            let free = sides.into_iter().find(|&(cx, cy)| {
+                !boxes
+                    .iter()
+                    .any(|&(x, y, w, h)| (cx - x).abs() < half_w + w && (cy - y).abs() < half_h + h)
+            });
+            match free {
+                Some(at) => {
+                    t.label_at = at;
+                    boxes.push((at.0, at.1, half_w, half_h));
+                }
+                None => t.label.clear(),
             }
         }
     }
@@ -566,7 +610,23 @@ fn drawn_points(run: &MissionRun, layers: &[VehicleLayer], over: &Overlays) -> V
     points.extend(&over.declared);
     points.extend(run.sources.iter().map(|s| (s.x, s.y)));
     points.extend(over.marks.iter().map(|k| k.pos));
+    // The op-area's border, and the plume's core: a key over them hides them.
+    points.extend(outline_points(&run.op_area));
+    points.extend(hot_points(run));
     points
+}
+
+/// Points along a closed outline, 40 to an edge (so a box over its border counts as hiding it).
+fn outline_points(poly: &[Vec2]) -> Vec<(f64, f64)> {
+    let mut out = Vec::new();
+    for (k, a) in poly.iter().enumerate() {
+        let b = poly[(k + 1) % poly.len()];
+        out.extend((0..40).map(|i| {
+            let f = f64::from(i) / 40.0;
+            (a.x + (b.x - a.x) * f, a.y + (b.y - a.y) * f)
+        }));
+    }
+    out
 }
 
 #[cfg(test)]
@@ -777,5 +837,41 @@ mod tests {
             svg.contains(&format!("\n{:.0} m\n", lay.scale_m)),
             "the scale bar"
         );
+    }
+
+    #[test]
+    fn a_time_label_moves_off_a_marker_in_its_place() {
+        let mut run = demo(240.0);
+        let before = layout(&run);
+        let first = before.layers[0].times[0].clone();
+        assert_eq!(first.label, "1 min");
+        // A true source just where the label went.
+        let (x, y) = first.label_at;
+        run.sources = vec![plumetrace_core::Vec3::new(x, y, 0.0)];
+        let lay = layout(&run);
+        let t = &lay.layers[0].times[0];
+        let half = 9.0 * lay.m_per_px;
+        assert!(
+            t.label.is_empty()
+                || (t.label_at.0 - x).abs() > half + 10.0 * lay.m_per_px
+                || (t.label_at.1 - y).abs() > half + 6.0 * lay.m_per_px,
+            "{t:?} over the source at ({x}, {y})"
+        );
+        let svg = mission_figure(&run, "marks").unwrap();
+        let over = crate::inspect::texts_over_marks(&svg);
+        assert!(over.iter().all(|t| !t.ends_with(" min")), "{over:?}");
+    }
+
+    #[test]
+    fn the_key_and_legend_keep_off_the_op_areas_border() {
+        let run = demo(240.0);
+        let area = outline_points(&run.op_area);
+        assert_eq!(area.len(), 40 * run.op_area.len());
+        let points = drawn_points(
+            &run,
+            &layout(&run).layers,
+            &Overlays::of(&run, &super::super::model::rows_by_vehicle(&run)),
+        );
+        assert!(area.iter().all(|p| points.contains(p)));
     }
 }

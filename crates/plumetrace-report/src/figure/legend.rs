@@ -148,6 +148,16 @@ fn track_rows(
         // Jumps of 5 m or more may be drawn (those shorter than 10 px are not).
         has_jumps |= !est_track(rs, 5.0).1.is_empty();
         let info = run.vehicles.get(vid as usize);
+        if multi && !runs.iter().any(|(_, p)| moves(p)) {
+            // No estimate of its own to draw: its true track is all the map has of it.
+            if let Some(v) = info {
+                add(
+                    legend,
+                    format!("{}: true track only (no position estimate)", v.name),
+                    Icon::Line(TRUE_TRACK, 1),
+                );
+            }
+        }
         for (b, _) in runs.iter().filter(|(_, p)| moves(p)) {
             match (b, info) {
                 (Some(b), _) if !multi => add(

@@ -7,7 +7,7 @@ use super::layout::MapLayout;
 use super::model::{MarkKind, behaviour_spans};
 use super::style::{
     ABORT_MARK, ENTROPY_LINE, FAULT_FILL, READING_LINE, READING_PX, STRIP_PX, TRACK_COLOURS,
-    behaviour_colour, label_style,
+    behaviour_colour, label_style, text_px,
 };
 use crate::error::ReportError;
 use plotters::coord::types::RangedCoordf64;
@@ -58,6 +58,31 @@ pub(super) fn min_max_columns(
     out
 }
 
+/// A tick label with as many decimals as it needs (up to 2): `0.5`, `1`, `2.25`.
+pub(crate) fn tick_label(v: f64) -> String {
+    let s = format!("{v:.2}");
+    let s = s.trim_end_matches('0').trim_end_matches('.');
+    if s == "-0" { "0".into() } else { s.into() }
+}
+
+/// The reading axis' range for readings `values`: from 0 to a little over the largest, or, for
+/// readings that stay far from 0 (a salinity probe's 35 ppt), a little around their own range.
+pub(super) fn reading_range(values: impl Iterator<Item = f64>) -> (f64, f64) {
+    let (lo, hi) = values
+        .filter(|v| v.is_finite())
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| {
+            (a.min(v), b.max(v))
+        });
+    if !lo.is_finite() || hi <= 0.0 {
+        return (0.0, 1.0);
+    }
+    if lo < 0.3 * hi {
+        return (0.0, 1.08 * hi);
+    }
+    let pad = ((hi - lo) * 0.08).max(hi.abs() * 1e-3).max(1e-6);
+    (lo - pad, hi + pad)
+}
+
 /// A vertical line in the reading panel: when, what, and its colour.
 type PanelLine = (f64, String, RGBColor, bool);
 
@@ -71,7 +96,10 @@ struct PanelData<'a> {
     vehicles: &'a [u32],
     /// The time axis' end, min.
     t_max_min: f64,
-    /// The reading axis' top.
+    /// The plotting area's width, px.
+    plot_w_px: f64,
+    /// The reading axis' bottom and top.
+    y_lo: f64,
     y_hi: f64,
 }
 
@@ -111,28 +139,30 @@ where
     };
     let (_, h) = area.dim_in_pixel();
     let (upper, lower) = area.split_vertically(h.saturating_sub(strips_h));
-    let y_max = vehicles
-        .iter()
-        .filter_map(|v| rows.get(v))
-        .flatten()
-        .map(|r| r.reading_v)
-        .filter(|v| v.is_finite())
-        .fold(0.0, f64::max);
-    let y_hi = if y_max > 0.0 { 1.08 * y_max } else { 1.0 };
+    let (y_lo, y_hi) = reading_range(
+        vehicles
+            .iter()
+            .filter_map(|v| rows.get(v))
+            .flatten()
+            .map(|r| r.reading_v),
+    );
     let mut chart = ChartBuilder::on(&upper)
         .margin(12)
         .margin_right(25)
         .margin_bottom(0)
         .x_label_area_size(0)
         .y_label_area_size(60)
-        .build_cartesian_2d(0.0..t_max_min, 0.0..y_hi)
+        .build_cartesian_2d(0.0..t_max_min, y_lo..y_hi)
         .map_err(ReportError::figure)?;
-    let digits = if y_hi >= 10.0 {
+    let span = y_hi - y_lo;
+    let digits = if span >= 10.0 {
         0
-    } else if y_hi >= 1.0 {
+    } else if span >= 1.0 {
         1
-    } else {
+    } else if span >= 0.1 {
         2
+    } else {
+        3
     };
     chart
         .configure_mesh()
@@ -149,6 +179,8 @@ where
         lay,
         vehicles,
         t_max_min,
+        plot_w_px: f64::from(upper.dim_in_pixel().0.saturating_sub(97)),
+        y_lo,
         y_hi,
     };
     draw_readings(&mut chart, p, upper.dim_in_pixel().0 as usize)?;
@@ -172,7 +204,9 @@ where
         lay,
         vehicles,
         t_max_min,
+        y_lo,
         y_hi,
+        ..
     } = p;
     // Fault windows.
     let windows: Vec<(f64, f64)> = vehicles
@@ -185,7 +219,7 @@ where
     chart
         .draw_series(
             windows.iter().map(|&(a, b)| {
-                Rectangle::new([(a, 0.0), (b, y_hi)], FAULT_FILL.mix(0.35).filled())
+                Rectangle::new([(a, y_lo), (b, y_hi)], FAULT_FILL.mix(0.35).filled())
             }),
         )
         .map_err(ReportError::figure)?;
@@ -196,14 +230,7 @@ where
             .filter(|r| r.reading_v.is_finite())
             .map(|r| (r.t_s / 60.0, r.reading_v))
             .collect();
-        let colour = if lay.multi {
-            lay.layers
-                .iter()
-                .find(|l| l.vehicle == v)
-                .map_or(TRACK_COLOURS[k % TRACK_COLOURS.len()], |l| l.colour)
-        } else {
-            READING_LINE
-        };
+        let colour = reading_colour(lay, v, k);
         chart
             .draw_series(std::iter::once(PathElement::new(
                 min_max_columns(&pts, t_max_min, cols),
@@ -214,8 +241,11 @@ where
     Ok(())
 }
 
+/// The entropy line's top, as a share of the panel's height: its label sits above it.
+const ENTROPY_TOP: f64 = 0.8;
+
 /// The source map's entropy (a planner that keeps a map reports it), scaled to the panel's
-/// height: 0 at the bottom, the largest reported value at the top.
+/// height: 0 at the bottom, the largest reported value at [`ENTROPY_TOP`] with its label above.
 fn draw_entropy<DB: DrawingBackend>(
     chart: &mut ReadingChart<'_, DB>,
     p: PanelData<'_>,
@@ -227,6 +257,7 @@ where
         run,
         vehicles,
         t_max_min,
+        y_lo,
         y_hi,
         ..
     } = p;
@@ -245,7 +276,7 @@ where
     if entropy.len() > 1 && h_max > 0.0 {
         let scaled: Vec<(f64, f64)> = entropy
             .iter()
-            .map(|&(t, h)| (t, h / h_max * y_hi * 0.95))
+            .map(|&(t, h)| (t, y_lo + h / h_max * (y_hi - y_lo) * ENTROPY_TOP))
             .collect();
         chart
             .draw_series(std::iter::once(PathElement::new(
@@ -256,7 +287,7 @@ where
         chart
             .draw_series(std::iter::once(Text::new(
                 format!("source map entropy (0-{h_max:.1} bits)"),
-                (t_max_min * 0.01, y_hi * 0.99),
+                (t_max_min * 0.01, y_hi),
                 ("sans-serif", 12).into_font().color(&ENTROPY_LINE),
             )))
             .map_err(ReportError::figure)?;
@@ -277,6 +308,7 @@ where
         lay,
         vehicles,
         t_max_min,
+        y_lo,
         y_hi,
         ..
     } = p;
@@ -299,36 +331,59 @@ where
                 (k.t_s / 60.0, k.kind.short().to_string(), c, true)
             }),
     );
+    // One line for the same event at the same time (several vehicles declaring together).
+    lines.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let same = t_max_min * 0.005;
+    lines.dedup_by(|b, a| a.1 == b.1 && (b.0 - a.0).abs() < same);
+    let min_per_px = t_max_min / p.plot_w_px.max(1.0);
+    // Labels taken, per row from the top: their extents, min.
+    let mut taken: Vec<Vec<(f64, f64)>> = Vec::new();
     for (t, label, c, dash) in &lines {
         let segs: Vec<PathElement<(f64, f64)>> = if *dash {
-            let d = y_hi / 24.0;
+            let d = (y_hi - y_lo) / 24.0;
             (0..24)
                 .step_by(2)
                 .map(|i| {
                     PathElement::new(
-                        vec![(*t, f64::from(i) * d), (*t, f64::from(i + 1) * d)],
+                        vec![
+                            (*t, y_lo + f64::from(i) * d),
+                            (*t, y_lo + f64::from(i + 1) * d),
+                        ],
                         c.stroke_width(2),
                     )
                 })
                 .collect()
         } else {
             vec![PathElement::new(
-                vec![(*t, 0.0), (*t, y_hi)],
+                vec![(*t, y_lo), (*t, y_hi)],
                 c.stroke_width(1),
             )]
         };
         chart.draw_series(segs).map_err(ReportError::figure)?;
-        let (dx, h) = if *t < 0.8 * t_max_min {
-            (4, HPos::Left)
+        let w = (text_px(label, 11.0) + 6.0) * min_per_px;
+        let (dx, h, span) = if *t < 0.8 * t_max_min {
+            (4, HPos::Left, (*t, *t + w))
         } else {
-            (-4, HPos::Right)
+            (-4, HPos::Right, (*t - w, *t))
         };
+        // The first row where the label meets no other.
+        let row = (0..)
+            .find(|&r| {
+                taken.get(r).is_none_or(|row: &Vec<(f64, f64)>| {
+                    row.iter().all(|&(a, b)| span.1 <= a || b <= span.0)
+                })
+            })
+            .unwrap_or(0);
+        if taken.len() <= row {
+            taken.resize(row + 1, Vec::new());
+        }
+        taken[row].push(span);
         chart
             .draw_series(std::iter::once(
                 EmptyElement::at((*t, y_hi))
                     + Text::new(
                         label.clone(),
-                        (dx, 3),
+                        (dx, 3 + 13 * row as i32),
                         label_style(11, *c, Pos::new(h, VPos::Top)),
                     ),
             ))
@@ -348,6 +403,7 @@ where
     let PanelData {
         run,
         rows,
+        lay,
         vehicles,
         t_max_min,
         ..
@@ -367,7 +423,7 @@ where
         .disable_mesh()
         .disable_y_axis()
         .x_labels(12)
-        .x_label_formatter(&|v| format!("{v:.0}"))
+        .x_label_formatter(&|v| tick_label(*v))
         .x_desc("mission time (min)")
         .label_style(("sans-serif", 13))
         .draw()
@@ -375,14 +431,38 @@ where
     for (k, &v) in vehicles.iter().enumerate() {
         let Some(rs) = rows.get(&v) else { continue };
         let y0 = (n - 1 - k) as f64;
+        let spans = behaviour_spans(rs);
         strips
-            .draw_series(behaviour_spans(rs).into_iter().map(|(b, a, e)| {
+            .draw_series(spans.iter().map(|&(b, a, e)| {
                 Rectangle::new(
                     [(a / 60.0, y0 + 0.12), (e / 60.0, y0 + 0.88)],
                     behaviour_colour(b).filled(),
                 )
             }))
             .map_err(ReportError::figure)?;
+        if spans.is_empty() {
+            // A planner that reports no behaviour: said so, not an empty strip.
+            strips
+                .draw_series(std::iter::once(Rectangle::new(
+                    [(0.0, y0 + 0.12), (t_max_min, y0 + 0.88)],
+                    RGBColor(235, 235, 235).filled(),
+                )))
+                .map_err(ReportError::figure)?;
+            strips
+                .draw_series(std::iter::once(
+                    EmptyElement::at((t_max_min / 2.0, y0 + 0.5))
+                        + Text::new(
+                            "no behaviour reported".to_string(),
+                            (0, 0),
+                            label_style(
+                                11,
+                                RGBColor(90, 90, 90),
+                                Pos::new(HPos::Center, VPos::Center),
+                            ),
+                        ),
+                ))
+                .map_err(ReportError::figure)?;
+        }
         let name = if n > 1 {
             run.vehicles
                 .get(v as usize)
@@ -390,18 +470,44 @@ where
         } else {
             "behaviour".to_string()
         };
+        // With several vehicles the name is their reading line's key: a swatch of the line.
+        let (name_dx, swatch) = if lay.multi {
+            (-24, Some(reading_colour(lay, v, k)))
+        } else {
+            (-6, None)
+        };
+        if let Some(c) = swatch {
+            strips
+                .draw_series(std::iter::once(
+                    EmptyElement::at((0.0, y0 + 0.5))
+                        + PathElement::new(vec![(-20, 0), (-6, 0)], c.stroke_width(2)),
+                ))
+                .map_err(ReportError::figure)?;
+        }
         strips
             .draw_series(std::iter::once(
                 EmptyElement::at((0.0, y0 + 0.5))
                     + Text::new(
                         name,
-                        (-6, 0),
+                        (name_dx, 0),
                         label_style(11, BLACK, Pos::new(HPos::Right, VPos::Center)),
                     ),
             ))
             .map_err(ReportError::figure)?;
     }
     Ok(())
+}
+
+/// The colour of vehicle `v`'s reading line (`k`: its place in the panel).
+fn reading_colour(lay: &MapLayout, v: u32, k: usize) -> RGBColor {
+    if lay.multi {
+        lay.layers
+            .iter()
+            .find(|l| l.vehicle == v)
+            .map_or(TRACK_COLOURS[k % TRACK_COLOURS.len()], |l| l.colour)
+    } else {
+        READING_LINE
+    }
 }
 
 #[cfg(test)]
@@ -423,6 +529,133 @@ mod tests {
             thinned.windows(2).all(|w| w[0].0 <= w[1].0),
             "in time order"
         );
+    }
+
+    use crate::inspect::{bad_tick_rows, overlapping_texts, text_boxes};
+    use plumetrace_mission::DeclarationRecord;
+
+    #[test]
+    fn tick_labels_have_the_decimals_they_need() {
+        let labels: Vec<String> = [0.0, 0.5, 1.0, 1.5, 2.25, -0.0].map(tick_label).to_vec();
+        assert_eq!(labels, ["0", "0.5", "1", "1.5", "2.25", "0"]);
+    }
+
+    #[test]
+    fn a_short_missions_time_axis_reads_distinct_increasing_minutes() {
+        // 150 s: half-minute ticks, which whole minutes would read 0, 0, 1, 1, 2, 2.
+        let svg = mission_figure(&demo(150.0), "short").unwrap();
+        assert!(bad_tick_rows(&svg).is_empty(), "{:?}", bad_tick_rows(&svg));
+        assert!(svg.contains(">\n0.5\n<"), "a half-minute tick");
+    }
+
+    #[test]
+    fn readings_far_from_zero_get_an_axis_around_them() {
+        let (lo, hi) = reading_range([35.0, 34.9, 31.2].into_iter());
+        assert!(
+            lo > 30.0 && lo < 31.2 && hi > 35.0 && hi < 36.0,
+            "{lo} {hi}"
+        );
+        assert_eq!(reading_range([0.0, 2.0].into_iter()), (0.0, 2.16));
+        assert_eq!(reading_range(std::iter::empty()), (0.0, 1.0));
+        assert_eq!(reading_range([f64::NAN].into_iter()), (0.0, 1.0));
+        // A salinity probe's readings: the axis no longer starts at 0.
+        let mut run = demo(120.0);
+        run.vehicles[0].reading_unit = "ppt";
+        for r in &mut run.trajectory {
+            r.reading_v = 35.0 - r.reading_v.min(4.0);
+        }
+        let svg = mission_figure(&run, "salinity").unwrap();
+        let ticks = crate::inspect::tick_rows(&svg);
+        assert!(
+            ticks.iter().any(|r| r
+                .iter()
+                .all(|v| v.parse::<f64>().is_ok_and(|v| (28.0..37.0).contains(&v)))),
+            "{ticks:?}"
+        );
+    }
+
+    /// A declaration by vehicle `v` at `t_s`.
+    fn declaration(t_s: f64, v: u32) -> DeclarationRecord {
+        DeclarationRecord {
+            t_s,
+            vehicle: v,
+            x_m: 0.0,
+            y_m: 0.0,
+            source_x_m: 0.0,
+            source_y_m: 0.0,
+            error_m: 1.0,
+            error_along_m: 1.0,
+            error_cross_m: 0.0,
+            rule: plumetrace_core::DeclarationKind::new("test"),
+        }
+    }
+
+    #[test]
+    fn declarations_together_are_labelled_once_and_near_ones_apart() {
+        let mut run = demo(120.0);
+        run.summary.declarations = vec![
+            declaration(60.0, 0),
+            declaration(60.0, 0),
+            declaration(62.0, 0),
+        ];
+        let svg = mission_figure(&run, "two declarations").unwrap();
+        assert!(
+            overlapping_texts(&svg).is_empty(),
+            "{:?}",
+            overlapping_texts(&svg)
+        );
+        let labels: Vec<_> = text_boxes(&svg)
+            .into_iter()
+            .filter(|t| t.text == "declared")
+            .collect();
+        assert_eq!(labels.len(), 2, "{labels:?}");
+    }
+
+    #[test]
+    fn the_entropy_label_sits_above_its_line() {
+        let mut run = demo(120.0);
+        for (t, h) in [(10.0, 11.0), (60.0, 9.0), (110.0, 7.0)] {
+            run.events.push(plumetrace_mission::EventRecord {
+                t_s: t,
+                vehicle: 0,
+                event: EventKind::Telemetry(plumetrace_core::Telemetry::SourceMap {
+                    entropy_bits: h,
+                    peak_m: plumetrace_core::Vec2::new(0.0, 0.0),
+                    mass: 0.1,
+                }),
+            });
+        }
+        let svg = mission_figure(&run, "entropy").unwrap();
+        let label = text_boxes(&svg)
+            .into_iter()
+            .find(|t| t.text.starts_with("source map entropy"))
+            .unwrap();
+        // The entropy line: its highest point (smallest y) is below the label's box.
+        let line = svg
+            .split("<polyline")
+            .find(|p| p.contains("stroke=\"#28783C\"") && p.contains("stroke-width=\"2\""))
+            .unwrap();
+        let pts = line.split("points=\"").nth(1).unwrap();
+        let top = pts
+            .split_whitespace()
+            .filter_map(|p| p.split_once(','))
+            .filter_map(|(_, y)| y.trim_end_matches('"').parse::<f64>().ok())
+            .fold(f64::MAX, f64::min);
+        assert!(
+            top > label.rect.3,
+            "line top {top}, label bottom {}",
+            label.rect.3
+        );
+    }
+
+    #[test]
+    fn a_vehicle_with_no_behaviour_says_so_in_its_strip() {
+        let mut run = demo(60.0);
+        for r in &mut run.trajectory {
+            r.behaviour = None;
+        }
+        let svg = mission_figure(&run, "none").unwrap();
+        assert!(svg.contains("no behaviour reported"));
     }
 
     #[test]

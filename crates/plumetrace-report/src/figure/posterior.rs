@@ -14,7 +14,9 @@ use plumetrace_mission::{MissionRun, TrajectoryRow};
 use std::collections::BTreeMap;
 
 /// The height of the row of source-map panels, px.
-pub(super) const POSTERIOR_PX: u32 = 300;
+pub(super) const POSTERIOR_PX: u32 = 316;
+/// The key under each source-map panel, px.
+const NOTE_PX: u32 = 16;
 
 /// The source maps of `snaps` side by side, each zoomed on its most likely cell, the true
 /// sources and the first declaration, with the estimated tracks over them.
@@ -37,7 +39,10 @@ where
         .declarations
         .first()
         .map(|d| Vec2::new(d.x_m, d.y_m));
-    for (panel, (title, r)) in panels.iter().zip(snaps) {
+    for (whole, (title, r)) in panels.iter().zip(snaps) {
+        // The key goes under the map, clear of its axis' name.
+        let (panel, key) = whole.split_vertically(h_px.saturating_sub(NOTE_PX));
+        let h_px = h_px.saturating_sub(NOTE_PX);
         let peak = raster_peak(r);
         let mut pts = vec![peak];
         pts.extend(run.sources.iter().map(|s| Vec2::new(s.x, s.y)));
@@ -58,7 +63,7 @@ where
         let half_x = half_y * pw / ph;
         let c = (lo + hi) * 0.5;
         let (x, y) = (c.x - half_x..c.x + half_x, c.y - half_y..c.y + half_y);
-        let mut chart = map_chart(panel, title, x.clone(), y.clone())?;
+        let mut chart = map_chart(&panel, title, x.clone(), y.clone())?;
         chart
             .draw_series(
                 raster_cells(r, &x, &y)
@@ -107,13 +112,12 @@ where
             .map_err(ReportError::figure)?;
         let (px0, _) = chart.plotting_area().get_pixel_range();
         let note = "+ most likely cell   \u{25b2} source   \u{25cf} declared";
-        panel
-            .draw(&Text::new(
-                note,
-                (px0.start + 4, h_px as i32 - 14),
-                ("sans-serif", 11).into_font().color(&BLACK),
-            ))
-            .map_err(ReportError::figure)?;
+        key.draw(&Text::new(
+            note,
+            (px0.start + 4, 2),
+            ("sans-serif", 11).into_font().color(&BLACK),
+        ))
+        .map_err(ReportError::figure)?;
     }
     Ok(())
 }

@@ -1,0 +1,88 @@
+//! The visual check of rendered outputs: every SVG figure under `PLUMETRACE_VISUAL_DIR` (written
+//! by `scripts/visual_check.sh`) has no two labels overlapping and distinct, increasing tick
+//! labels on every axis, and every replay page's state (read from the browser into
+//! `*.state.txt`) names its timeline rows. Ignored unless the variable is set.
+
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
+use plumetrace_report::inspect::{bad_tick_rows, overlapping_texts, texts_over_marks};
+use std::path::{Path, PathBuf};
+
+fn files(dir: &Path, out: &mut Vec<PathBuf>) {
+    for e in std::fs::read_dir(dir).unwrap() {
+        let p = e.unwrap().path();
+        if p.is_dir() {
+            files(&p, out);
+        } else {
+            out.push(p);
+        }
+    }
+}
+
+#[test]
+fn rendered_figures_have_no_overlapping_labels_and_sound_axes() {
+    let Ok(dir) = std::env::var("PLUMETRACE_VISUAL_DIR") else {
+        return;
+    };
+    let mut all = Vec::new();
+    files(Path::new(&dir), &mut all);
+    all.sort();
+    let mut faults = Vec::new();
+    let mut svgs = 0;
+    for p in &all {
+        let name = p.display().to_string();
+        if name.ends_with(".svg") {
+            svgs += 1;
+            let svg = std::fs::read_to_string(p).unwrap();
+            for (a, b) in overlapping_texts(&svg) {
+                faults.push(format!("{name}: labels overlap: {a:?} and {b:?}"));
+            }
+            for t in texts_over_marks(&svg) {
+                faults.push(format!("{name}: a label over a mark: {t:?}"));
+            }
+            for r in bad_tick_rows(&svg) {
+                faults.push(format!("{name}: tick labels not increasing: {r:?}"));
+            }
+        } else if name.ends_with(".state.txt") {
+            let state = std::fs::read_to_string(p).unwrap();
+            for key in ["data-timeline-rows=", "data-legend="] {
+                if !state.contains(key) {
+                    faults.push(format!("{name}: no {key}"));
+                }
+            }
+            // Each legend entry's key is the mark it names.
+            let legend = state
+                .split("data-legend=\"")
+                .nth(1)
+                .and_then(|r| r.split('"').next())
+                .unwrap_or("");
+            for entry in legend.split('|').filter(|e| !e.is_empty()) {
+                let (kind, label) = entry.split_once(':').unwrap_or(("", entry));
+                let want = match label {
+                    "true source" => "triangle",
+                    "declared source" => "dot",
+                    "lost point" => "circle",
+                    "reference target" => "diamond",
+                    "detection" => "square",
+                    "flow" => "arrow",
+                    l if l.starts_with("track") => "line",
+                    _ => kind,
+                };
+                if kind != want {
+                    faults.push(format!("{name}: legend {label:?} keyed {kind}, not {want}"));
+                }
+            }
+            if state.contains("data-timeline-rows=\"\"") && state.contains("data-events=\"0\"") {
+                continue;
+            }
+            if state.contains("data-timeline-rows=\"\"") {
+                faults.push(format!("{name}: the timeline rows have no labels"));
+            }
+            if state.contains("data-replayed=\"true\"") && !state.contains("data-divergence=\"") {
+                faults.push(format!("{name}: a replayed page with no divergence marker"));
+            }
+        }
+    }
+    assert!(svgs > 0, "no figures under {dir}");
+    assert!(faults.is_empty(), "{}", faults.join("\n"));
+}
