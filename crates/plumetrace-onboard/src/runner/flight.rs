@@ -100,8 +100,7 @@ impl<'a> Flight<'a> {
             LinkEvent::Clock(t) => {
                 s.front_time = t;
                 if s.lock_step {
-                    let first = *s.first_time.get_or_insert(t);
-                    s.clock_s = s.clock_s.max(t.since(first));
+                    s.tick(t);
                     // Checked at every tick of the front seat's clock, so a pause starts
                     // at the same mission time whatever the batching of lines.
                     if s.last_nav_s.is_some_and(|n| s.clock_s - n > l.stale_nav_s) {
