@@ -349,6 +349,24 @@ impl FrontSeat {
     }
 }
 
+impl FrontSeat {
+    /// After the clock's last tick, takes what the back seat sends until it says it finished
+    /// (its final stop and status), so the connection does not close under them.
+    fn await_finish(&mut self, time: UtcTime) {
+        let wait = if self.lock_step {
+            self.wait
+        } else {
+            self.wait.min(Duration::from_secs(2))
+        };
+        let deadline = Instant::now() + wait;
+        while Instant::now() < deadline && self.connected() && !self.gone() {
+            for line in self.read_lines(Duration::from_millis(50)) {
+                self.take(&line, time);
+            }
+        }
+    }
+}
+
 impl Planner for FrontSeat {
     fn decision_period_s(&self) -> f64 {
         self.nav_period_s
@@ -389,6 +407,7 @@ impl Planner for FrontSeat {
                 accepting: false,
             };
             self.send(&tick.encode());
+            self.await_finish(end);
         }
         let finished = self
             .stats

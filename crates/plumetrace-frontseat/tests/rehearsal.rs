@@ -110,6 +110,14 @@ fn the_onboard_runner_flies_against_the_front_seat_in_lock_step_every_record_ans
         "{fs:?}"
     );
     assert_eq!(ob.end, RunEnd::TimeLimit, "{ob:?}");
+    // The front seat waits for the back seat's end: one final stop, received, and the
+    // back seat's "Finished".
+    assert!(fs.finished, "{fs:?}");
+    assert_eq!(fs.stops, 1, "{fs:?}");
+    assert!(
+        ob.pauses.iter().all(|p| !p.reason.starts_with("link lost")),
+        "{ob:?}"
+    );
     assert_eq!(ob.lines.rejected_total(), 0, "{ob:?}");
     assert_eq!(ob.decisions, decisions);
     assert!(ob.decisions > 0 && ob.commands_sent > 0, "{ob:?}");
@@ -137,4 +145,26 @@ fn the_onboard_runner_flies_against_the_front_seat_in_lock_step_every_record_ans
     ] {
         assert!(json.get(key).is_some(), "{key} in {json}");
     }
+}
+
+#[test]
+fn a_ten_second_front_seat_restart_is_rehearsed_to_the_time_limit() {
+    let mut options = lock_step(20.0);
+    options.faults.restart_at = Some(5.0);
+    options.faults.restart_for = 10.0;
+    let rehearsal = Rehearsal::prepare(demo(), &options).unwrap();
+    let onboard = Onboard::from_toml(&rehearsal.onboard_file().unwrap()).unwrap();
+    assert_eq!(onboard.file.link.give_up_s, 15.0);
+    assert_eq!(onboard.file.link.reconnect_max_s, 1.0);
+    let back_seat = std::thread::spawn(move || {
+        let mut link = runner::link_for(&onboard, None).unwrap();
+        runner::run(&onboard, &mut *link, None, &mut |_, _| {}).unwrap()
+    });
+    let report = rehearsal.start().unwrap().fly().unwrap();
+    let ob = back_seat.join().unwrap();
+    let fs = &report.stats;
+    assert_eq!(ob.end, RunEnd::TimeLimit, "{ob:?}");
+    assert_eq!((fs.restarts, fs.connections), (1, 2), "{fs:?}");
+    assert_eq!(fs.unsafe_commands, 0, "{fs:?}");
+    assert!(fs.finished, "{fs:?}");
 }

@@ -122,7 +122,10 @@ impl<'a> Flight<'a> {
             }
             LinkEvent::Accepting(a) => {
                 s.accepting = a;
-                if !a {
+                // The front seat's last tick at the time limit: the run's end sends the final
+                // stop, once.
+                let ending = s.lock_step && s.clock_s >= onboard.file.run.time_limit_s;
+                if !a && !ending {
                     s.pause(link, "the front seat does not accept commands".into());
                 }
             }
