@@ -200,7 +200,7 @@ impl Link for LineLink {
                         self.log('#', "the line speaks again");
                     }
                     self.lines.push(&chunk[..n]);
-                    while let Some(piece) = self.lines.next() {
+                    while let Some(piece) = self.lines.next_piece() {
                         match piece {
                             Piece::Line(line) if line.trim().is_empty() => {}
                             Piece::Line(line) => self.take_line(&line, &mut events),
@@ -291,7 +291,6 @@ mod tests {
     use super::*;
     use crate::protocol::sentence::frame;
     use crate::protocol::session::{Bluefin, BluefinSettings};
-    use std::io::Write as _;
     use std::net::TcpListener;
 
     /// Everything a link reports until the other side closes.

@@ -43,7 +43,7 @@ impl LineBuffer {
 
     /// The next whole line, or a line too long (reported once however it arrives), if one is
     /// there.
-    pub fn next(&mut self) -> Option<Piece> {
+    pub fn next_piece(&mut self) -> Option<Piece> {
         loop {
             let end = self.buf.iter().position(|b| *b == b'\n');
             if self.skipping {
@@ -83,7 +83,7 @@ impl LineBuffer {
     /// one is there; lines too long are skipped.
     pub fn next_line(&mut self) -> Option<String> {
         loop {
-            match self.next()? {
+            match self.next_piece()? {
                 Piece::Line(l) => return Some(l),
                 Piece::TooLong(_) => {}
             }
@@ -135,14 +135,14 @@ mod tests {
         long.push_str("$TAIL*00\r\n$OK*00\r\n");
         for chunk in long.as_bytes().chunks(7) {
             b.push(chunk);
-            while let Some(p) = b.next() {
+            while let Some(p) = b.next_piece() {
                 got.push(p);
             }
         }
         assert_eq!(got, [Piece::TooLong(21), Piece::Line("$OK*00\r\n".into())]);
         // A long line arriving whole in one chunk.
         b.push(format!("{}\n$OK*00\n", "Y".repeat(30)).as_bytes());
-        assert_eq!(b.next(), Some(Piece::TooLong(31)));
-        assert_eq!(b.next(), Some(Piece::Line("$OK*00\n".into())));
+        assert_eq!(b.next_piece(), Some(Piece::TooLong(31)));
+        assert_eq!(b.next_piece(), Some(Piece::Line("$OK*00\n".into())));
     }
 }
