@@ -481,6 +481,24 @@ fn a_registered_planner_flies_against_a_fake_moosdb() {
     // Heartbeats: a timing message about once a second.
     let timings = rec.seen.iter().filter(|s| s.m.kind == kind::TIMING).count();
     assert!((2..=5).contains(&timings), "{timings} timing messages");
+    // pMarineViewer draws the op-area: posted once, at the connection.
+    let polygons = rec.values("VIEW_POLYGON");
+    assert_eq!(polygons.len(), 1, "{polygons:?}");
+    assert_eq!(
+        polygons[0].m.text(),
+        Some(
+            "pts={60.00,-80.00:460.00,-80.00:460.00,80.00:60.00,80.00},label=cpt_op_area,edge_color=yellow,vertex_color=yellow,vertex_size=2,edge_size=1"
+        )
+    );
+    // The AMP's estimate, once it has one, as a marker.
+    for m in rec.values("VIEW_MARKER") {
+        assert!(
+            m.m.text().is_some_and(
+                |t| t.starts_with("type=diamond,x=") && t.contains(",label=cpt_estimate,")
+            ),
+            "{m:?}"
+        );
+    }
     // The behaviour went out as the .alog writer names it.
     let behaviour = rec.values("CPT_BEHAVIOUR");
     assert!(!behaviour.is_empty());

@@ -4,6 +4,7 @@
 //! and the raw traffic log (one line per message).
 
 use super::nav::{NAV_VARIABLES, NavState};
+use super::view::{self, Views};
 use super::wire::{
     Framer, Message, MoosError, PROTOCOL, TIMING_PERIOD, decode_messages, encode_packet, kind,
     protocol_bytes, unix_now,
@@ -72,6 +73,10 @@ pub struct MoosLink {
     clock: f64,
     paused: bool,
     outbox: Vec<Message>,
+    // What pMarineViewer draws: the mission's polygons (posted at each welcome) and the
+    // planner's points.
+    geometry: Vec<(&'static str, String)>,
+    views: Views,
 }
 
 impl MoosLink {
@@ -108,6 +113,8 @@ impl MoosLink {
             clock: f64::NEG_INFINITY,
             paused: false,
             outbox: Vec::new(),
+            geometry: Vec::new(),
+            views: Views::default(),
         }
     }
 
@@ -120,6 +127,8 @@ impl MoosLink {
         let l = &onboard.file.link;
         let m = l.moos.clone().unwrap_or_default();
         let frame = LocalFrame::new(l.origin)?;
+        let mission = &onboard.file.mission;
+        let geometry = view::geometry(&mission.op_area, &mission.subregions);
         Ok(MoosLink::new(
             MoosSettings {
                 host: m.host,
@@ -132,7 +141,14 @@ impl MoosLink {
             },
             frame,
             traffic,
-        ))
+        )
+        .with_geometry(geometry))
+    }
+
+    /// The same client posting `geometry` (`VIEW_POLYGON` postings) at each connection.
+    pub fn with_geometry(mut self, geometry: Vec<(&'static str, String)>) -> Self {
+        self.geometry = geometry;
+        self
     }
 
     /// The clock skew in use (server minus this computer), s.
@@ -326,7 +342,7 @@ impl MoosLink {
         let mut vars: Vec<String> = NAV_VARIABLES.iter().map(|v| (*v).to_string()).collect();
         vars.extend(self.settings.chem_variable.clone());
         let t = self.moos_time();
-        let regs: Vec<Message> = vars
+        let mut regs: Vec<Message> = vars
             .iter()
             .map(|v| {
                 let mut r = Message::with_double(kind::REGISTER, v, 0.0, t);
@@ -336,6 +352,10 @@ impl MoosLink {
                 r
             })
             .collect();
+        for (key, value) in self.geometry.clone() {
+            let m = self.post(key, PostValue::Text(value));
+            regs.push(m);
+        }
         self.send_messages(regs, events);
     }
 
@@ -605,6 +625,8 @@ impl Link for MoosLink {
     }
 
     fn decided(&mut self, _snapshot: &SensorSnapshot, d: &Decision) {
+        // Counted whether or not they can go out now, so labels stay unique.
+        let drawn = self.views.of(d);
         if !self.connected() {
             return;
         }
@@ -632,6 +654,12 @@ impl Link for MoosLink {
             if let Some((key, value)) = posting
                 && self.outbox.len() < 1000
             {
+                let m = self.post(key, PostValue::Text(value));
+                self.outbox.push(m);
+            }
+        }
+        for (key, value) in drawn {
+            if self.outbox.len() < 1000 {
                 let m = self.post(key, PostValue::Text(value));
                 self.outbox.push(m);
             }
