@@ -39,6 +39,8 @@ pub(crate) struct FrontSeat {
     pub(crate) command: Option<Command>,
     pub(crate) rng: FaultRng,
     pub(crate) drop: f64,
+    // Lines the drop fault has dropped.
+    pub(crate) dropped: u64,
     pub(crate) garbage: f64,
     pub(crate) delay: Duration,
     pub(crate) silent: Option<(f64, f64)>,
@@ -81,6 +83,7 @@ impl FrontSeat {
             command: None,
             rng: FaultRng(f.seed),
             drop: f.drop,
+            dropped: 0,
             garbage: f.garbage,
             delay: Duration::from_secs_f64(f.delay_s),
             silent: f.silent_at.map(|a| (a, f.silent_for)),
@@ -392,13 +395,18 @@ impl Planner for FrontSeat {
                 };
                 self.send(&tick.encode());
             }
-        } else {
+        }
+        let dropped = self.dropped;
+        if !silent {
             for line in self.nav_lines(s, time) {
                 self.send(&line);
             }
             self.stat(|st| st.nav_records += 1);
         }
-        self.await_answer(time, silent, answered);
+        // A record the drop fault broke gets no answer: in lock-step the front seat steps on
+        // at once, as a vehicle's clock would, instead of waiting for one.
+        let broken = self.dropped != dropped;
+        self.await_answer(time, silent || broken, answered);
         if self.protocol == Protocol::Bluefin && t + self.nav_period_s >= self.time_limit_s - 1e-9 {
             // The last record: the clock's last tick tells the back seat the time is up.
             let end = UtcTime::from_seconds(START_S + self.time_limit_s);
