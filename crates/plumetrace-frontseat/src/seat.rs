@@ -387,14 +387,12 @@ impl Planner for FrontSeat {
         let answered =
             self.protocol == Protocol::Iver && self.lock_step && !silent && self.await_poll(time);
         self.send_readings(s, time);
-        if silent {
-            if self.protocol == Protocol::Bluefin {
-                let tick = bluefin::Sentence::Ctl {
-                    time,
-                    accepting: true,
-                };
-                self.send(&tick.encode());
-            }
+        if silent && self.protocol == Protocol::Bluefin {
+            let tick = bluefin::Sentence::Ctl {
+                time,
+                accepting: true,
+            };
+            self.send(&tick.encode());
         }
         let dropped = self.dropped;
         if !silent {
