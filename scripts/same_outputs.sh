@@ -8,7 +8,8 @@
 #
 # Run `write` on the commit before a change and on the commit after it, then `compare`. Wall times
 # (summary.json's wall_s, real_time_factor, spinup_wall_s and stage times; campaign run times) and
-# the `.alog` header's file path are left out of the comparison; every other byte counts.
+# the `.alog` header's file path and opening time are left out of the comparison; every other byte
+# counts.
 set -euo pipefail
 # paths given relative to where the script is called from
 args=()
@@ -98,7 +99,9 @@ def normal(path, data):
     if name == "summary.json" or name == "stats.json":
         return json.dumps(strip(json.loads(data)), sort_keys=True).encode()
     if name.endswith(".alog"):
-        return b"\n".join(l for l in data.split(b"\n") if not l.startswith(b"%% LOG FILE"))
+        # the file path and the opening time (the wall clock, as pLogger's) are left out
+        skip = (b"%% LOG FILE", b"%% FILE OPENED ON", b"%% LOGSTART")
+        return b"\n".join(l for l in data.split(b"\n") if not l.startswith(skip))
     if name == "runs.csv":
         lines = data.decode().split("\n")
         head = lines[0].split(",")

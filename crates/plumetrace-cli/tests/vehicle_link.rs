@@ -211,7 +211,7 @@ fn read_alog(path: &Path) -> Vec<(String, String)> {
             continue;
         }
         header = false;
-        let f: Vec<&str> = line.split(' ').collect();
+        let f: Vec<&str> = line.split_whitespace().collect();
         assert_eq!(f.len(), 4, "{line}");
         let t: f64 = f[0].parse().unwrap();
         assert!(t >= last, "time order: {line}");

@@ -70,9 +70,16 @@ fn open_wire(options: &FrontSeatOptions) -> Result<(toml::Table, Wire, String), 
     link.insert("origin".into(), origin_t.into());
     // A rehearsal's back seat stops soon after its front seat is gone for good; over a
     // pseudo-terminal it must not reopen the device at all (its number may soon belong to
-    // another terminal), so it gives up before its first retry.
+    // another terminal), so it gives up before its first retry. Over TCP it tries again at
+    // least every second, and gives up 5 s after a restart fault's end at the earliest.
     let give_up = match options.protocol {
-        Protocol::Bluefin => 5.0,
+        Protocol::Bluefin => {
+            link.insert("reconnect_max_s".into(), 1.0.into());
+            5.0 + options
+                .faults
+                .restart_at
+                .map_or(0.0, |_| options.faults.restart_for)
+        }
         Protocol::Iver => 0.05,
     };
     link.insert("give_up_s".into(), give_up.into());

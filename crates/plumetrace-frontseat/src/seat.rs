@@ -39,6 +39,8 @@ pub(crate) struct FrontSeat {
     pub(crate) command: Option<Command>,
     pub(crate) rng: FaultRng,
     pub(crate) drop: f64,
+    // Lines the drop fault has dropped.
+    pub(crate) dropped: u64,
     pub(crate) garbage: f64,
     pub(crate) delay: Duration,
     pub(crate) silent: Option<(f64, f64)>,
@@ -81,6 +83,7 @@ impl FrontSeat {
             command: None,
             rng: FaultRng(f.seed),
             drop: f.drop,
+            dropped: 0,
             garbage: f.garbage,
             delay: Duration::from_secs_f64(f.delay_s),
             silent: f.silent_at.map(|a| (a, f.silent_for)),
@@ -349,6 +352,24 @@ impl FrontSeat {
     }
 }
 
+impl FrontSeat {
+    /// After the clock's last tick, takes what the back seat sends until it says it finished
+    /// (its final stop and status), so the connection does not close under them.
+    fn await_finish(&mut self, time: UtcTime) {
+        let wait = if self.lock_step {
+            self.wait
+        } else {
+            self.wait.min(Duration::from_secs(2))
+        };
+        let deadline = Instant::now() + wait;
+        while Instant::now() < deadline && self.connected() && !self.gone() {
+            for line in self.read_lines(Duration::from_millis(50)) {
+                self.take(&line, time);
+            }
+        }
+    }
+}
+
 impl Planner for FrontSeat {
     fn decision_period_s(&self) -> f64 {
         self.nav_period_s
@@ -366,21 +387,24 @@ impl Planner for FrontSeat {
         let answered =
             self.protocol == Protocol::Iver && self.lock_step && !silent && self.await_poll(time);
         self.send_readings(s, time);
-        if silent {
-            if self.protocol == Protocol::Bluefin {
-                let tick = bluefin::Sentence::Ctl {
-                    time,
-                    accepting: true,
-                };
-                self.send(&tick.encode());
-            }
-        } else {
+        if silent && self.protocol == Protocol::Bluefin {
+            let tick = bluefin::Sentence::Ctl {
+                time,
+                accepting: true,
+            };
+            self.send(&tick.encode());
+        }
+        let dropped = self.dropped;
+        if !silent {
             for line in self.nav_lines(s, time) {
                 self.send(&line);
             }
             self.stat(|st| st.nav_records += 1);
         }
-        self.await_answer(time, silent, answered);
+        // A record the drop fault broke gets no answer: in lock-step the front seat steps on
+        // at once, as a vehicle's clock would, instead of waiting for one.
+        let broken = self.dropped != dropped;
+        self.await_answer(time, silent || broken, answered);
         if self.protocol == Protocol::Bluefin && t + self.nav_period_s >= self.time_limit_s - 1e-9 {
             // The last record: the clock's last tick tells the back seat the time is up.
             let end = UtcTime::from_seconds(START_S + self.time_limit_s);
@@ -389,6 +413,7 @@ impl Planner for FrontSeat {
                 accepting: false,
             };
             self.send(&tick.encode());
+            self.await_finish(end);
         }
         let finished = self
             .stats

@@ -58,6 +58,7 @@ impl FrontSeat {
     /// Sends a line, unless the drop fault draws it; a failed write loses the connection.
     pub(crate) fn send(&mut self, line: &str) {
         if self.drop > 0.0 && self.rng.unit() < self.drop {
+            self.dropped += 1;
             return;
         }
         let failed = match &mut self.wire {

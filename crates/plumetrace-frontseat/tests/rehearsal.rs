@@ -110,6 +110,14 @@ fn the_onboard_runner_flies_against_the_front_seat_in_lock_step_every_record_ans
         "{fs:?}"
     );
     assert_eq!(ob.end, RunEnd::TimeLimit, "{ob:?}");
+    // The front seat waits for the back seat's end: one final stop, received, and the
+    // back seat's "Finished".
+    assert!(fs.finished, "{fs:?}");
+    assert_eq!(fs.stops, 1, "{fs:?}");
+    assert!(
+        ob.pauses.iter().all(|p| !p.reason.starts_with("link lost")),
+        "{ob:?}"
+    );
     assert_eq!(ob.lines.rejected_total(), 0, "{ob:?}");
     assert_eq!(ob.decisions, decisions);
     assert!(ob.decisions > 0 && ob.commands_sent > 0, "{ob:?}");
@@ -137,4 +145,168 @@ fn the_onboard_runner_flies_against_the_front_seat_in_lock_step_every_record_ans
     ] {
         assert!(json.get(key).is_some(), "{key} in {json}");
     }
+}
+
+#[test]
+fn a_ten_second_front_seat_restart_is_rehearsed_to_the_time_limit() {
+    let mut options = lock_step(20.0);
+    options.faults.restart_at = Some(5.0);
+    options.faults.restart_for = 10.0;
+    let rehearsal = Rehearsal::prepare(demo(), &options).unwrap();
+    let onboard = Onboard::from_toml(&rehearsal.onboard_file().unwrap()).unwrap();
+    assert_eq!(onboard.file.link.give_up_s, 15.0);
+    assert_eq!(onboard.file.link.reconnect_max_s, 1.0);
+    let back_seat = std::thread::spawn(move || {
+        let mut link = runner::link_for(&onboard, None).unwrap();
+        runner::run(&onboard, &mut *link, None, &mut |_, _| {}).unwrap()
+    });
+    let report = rehearsal.start().unwrap().fly().unwrap();
+    let ob = back_seat.join().unwrap();
+    let fs = &report.stats;
+    assert_eq!(ob.end, RunEnd::TimeLimit, "{ob:?}");
+    assert_eq!((fs.restarts, fs.connections), (1, 2), "{fs:?}");
+    assert_eq!(fs.unsafe_commands, 0, "{fs:?}");
+    assert!(fs.finished, "{fs:?}");
+}
+
+/// A writer whose bytes the test reads afterwards (the back seat's traffic log).
+#[derive(Clone, Default)]
+struct Shared(std::sync::Arc<std::sync::Mutex<Vec<u8>>>);
+
+impl std::io::Write for Shared {
+    fn write(&mut self, b: &[u8]) -> std::io::Result<usize> {
+        self.0.lock().unwrap().extend_from_slice(b);
+        Ok(b.len())
+    }
+    fn flush(&mut self) -> std::io::Result<()> {
+        Ok(())
+    }
+}
+
+/// The `p`-quantile of `v` (sorted in place).
+fn quantile(v: &mut [f64], p: f64) -> f64 {
+    v.sort_by(f64::total_cmp);
+    v[((v.len() - 1) as f64 * p).round() as usize]
+}
+
+/// Real time, end to end: the front seat flies 66 s of the demo paced by the wall clock, the
+/// back seat runs 62 s of it and ends first. Checks the timing (command period, latency from
+/// the navigation record to the command) and the safety properties of the lock-step
+/// rehearsals. About 66 s of wall time: `cargo test -p plumetrace-frontseat --test rehearsal
+/// -- --ignored`.
+#[test]
+#[ignore = "66 s of wall time"]
+fn in_real_time_for_a_minute_commands_keep_their_period_and_latency_and_stay_safe() {
+    let options = FrontSeatOptions {
+        listen: "127.0.0.1:0".into(),
+        lock_step: false,
+        time_limit_s: Some(66.0),
+        ..FrontSeatOptions::default()
+    };
+    let rehearsal = Rehearsal::prepare(demo(), &options).unwrap();
+    let text = rehearsal.onboard_file().unwrap();
+    assert!(text.contains("mode = \"real_time\""), "{text}");
+    let text = text.replace("time_limit_s = 66.0", "time_limit_s = 62.0");
+    let onboard = Onboard::from_toml(&text).unwrap();
+    assert_eq!(onboard.file.run.time_limit_s, 62.0);
+    let traffic = Shared::default();
+    let log = traffic.clone();
+    let back_seat = std::thread::spawn(move || {
+        let mut link = runner::link_for(&onboard, Some(Box::new(traffic))).unwrap();
+        runner::run(&onboard, &mut *link, None, &mut |_, _| {}).unwrap()
+    });
+    let report = rehearsal.start().unwrap().fly().unwrap();
+    let ob = back_seat.join().unwrap();
+    let fs = &report.stats;
+    let log = String::from_utf8(log.0.lock().unwrap().clone()).unwrap();
+
+    // Safety, as in lock-step: nothing unsafe or malformed either way, no pause, every
+    // command acknowledged, one final stop received and the end said.
+    assert_eq!(ob.end, RunEnd::TimeLimit, "{ob:?}");
+    assert!((61.9..62.5).contains(&ob.time_s), "{}", ob.time_s);
+    assert!(ob.pauses.is_empty(), "{:?}", ob.pauses);
+    assert_eq!((fs.unsafe_commands, fs.bad_lines), (0, 0), "{fs:?}");
+    assert_eq!(ob.lines.rejected_total(), 0, "{ob:?}");
+    assert_eq!((ob.acks_given_up, ob.commands_rejected), (0, 0), "{ob:?}");
+    assert_eq!(fs.commands, ob.commands_sent, "{fs:?} {ob:?}");
+    assert!(fs.finished, "{fs:?}");
+    assert_eq!(fs.stops, 1, "{fs:?}");
+    assert_eq!(fs.connections, 1, "{fs:?}");
+
+    // Timing, from the back seat's traffic log (seconds since the link started, `<` received,
+    // `>` sent).
+    let secs = |l: &str| l.split(' ').next().unwrap().parse::<f64>().unwrap();
+    let mut last_nav: Option<f64> = None;
+    let mut latency = Vec::new();
+    let mut sent = Vec::new();
+    for l in log.lines() {
+        if l.contains("< $BFNVR,") {
+            last_nav = Some(secs(l));
+        } else if l.contains("> $BPRMB,") && !l.contains(",2,0,0,1*") {
+            let t = secs(l);
+            sent.push(t);
+            if let Some(n) = last_nav {
+                latency.push(t - n);
+            }
+        }
+    }
+    let records = ob.nav_records as f64;
+    assert!(
+        (0.95 * 620.0..=1.02 * 620.0).contains(&records),
+        "{records} records"
+    );
+    let mut period: Vec<f64> = sent.windows(2).map(|w| w[1] - w[0]).collect();
+    let mean = period.iter().sum::<f64>() / period.len() as f64;
+    let p99 = quantile(&mut period, 0.99);
+    let (p50_l, p99_l, max_l) = (
+        quantile(&mut latency, 0.5),
+        quantile(&mut latency, 0.99),
+        quantile(&mut latency, 1.0),
+    );
+    println!(
+        "real time, 62 s: {} records, {} commands; command period mean {:.4} s, p99 {:.4} s; \
+         latency from the navigation record to the command p50 {:.2} ms, p99 {:.2} ms, max {:.2} ms",
+        ob.nav_records,
+        sent.len(),
+        mean,
+        p99,
+        p50_l * 1e3,
+        p99_l * 1e3,
+        max_l * 1e3
+    );
+    // One command per navigation record (the AMP decides at the navigation period, 0.1 s).
+    assert!((0.095..=0.105).contains(&mean), "command period {mean}");
+    assert!(p99 < 0.2, "command period p99 {p99}");
+    assert!(p50_l < 0.005 && p99_l < 0.05, "latency {p50_l} {p99_l}");
+}
+
+/// A line the drop fault drops breaks its navigation record; in lock-step the front seat steps
+/// on at once instead of waiting for an answer that cannot come (the back seat, hearing nothing
+/// meanwhile, used to drop the connection after its silence timeout).
+#[test]
+fn in_lock_step_a_dropped_line_does_not_stall_the_rehearsal() {
+    let mut options = lock_step(30.0);
+    options.faults.drop = 0.01;
+    options.faults.seed = 3;
+    let rehearsal = Rehearsal::prepare(demo(), &options).unwrap();
+    let onboard = Onboard::from_toml(&rehearsal.onboard_file().unwrap()).unwrap();
+    let started = std::time::Instant::now();
+    let back_seat = std::thread::spawn(move || {
+        let mut link = runner::link_for(&onboard, None).unwrap();
+        runner::run(&onboard, &mut *link, None, &mut |_, _| {}).unwrap()
+    });
+    let report = rehearsal.start().unwrap().fly().unwrap();
+    let ob = back_seat.join().unwrap();
+    let wall = started.elapsed().as_secs_f64();
+    let fs = &report.stats;
+    assert_eq!(ob.end, RunEnd::TimeLimit, "{ob:?}");
+    assert!(
+        ob.pauses.iter().all(|p| !p.reason.starts_with("link lost")),
+        "{:?}",
+        ob.pauses
+    );
+    assert_eq!(fs.connections, 1, "{fs:?}");
+    // Some records were broken (about 1 % of some 1,200 lines), none waited for.
+    assert!(ob.nav_records < fs.nav_records, "{ob:?} {fs:?}");
+    assert!(wall < 9.0, "{wall} s of wall time");
 }

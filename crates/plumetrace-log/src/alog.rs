@@ -1,14 +1,21 @@
 //! A MOOS `.alog` writer, so MOOS users can open plumetrace missions and onboard runs in their
-//! own tools (`alogview`, `alogscan`, ...).
+//! own tools (`alogview`, `alogscan`, `aloggrep`, `alogclip`, ...).
 //!
-//! Layout: header lines starting with `%%`, then one line per posting,
-//! `TIME VARIABLE SOURCE VALUE`, separated by spaces, `TIME` in seconds since `LOGSTART`.
+//! Layout, as pLogger writes it: header lines starting with `%%` (`LOG FILE`, `FILE OPENED ON`
+//! with the start as a UTC date, `LOGSTART` with the start in Unix seconds), then one line per
+//! posting, `TIME VARIABLE SOURCE VALUE`, columns padded with spaces (MOOS tools split on white
+//! space), `TIME` in seconds since `LOGSTART`, numbers written with every digit they need to read
+//! back exactly. The source is the process that would post the variable in a MOOS community: the
+//! vehicle's interface for what it measures (`NAV_*`, `CPT_READING`), the planner's process for
+//! the rest.
+//!
 //! Variables: `NAV_X`, `NAV_Y` (m, east and north), `NAV_HEADING` (deg), `NAV_SPEED` (m/s),
-//! `NAV_DEPTH`, `NAV_ALTITUDE` (m), `DESIRED_HEADING`, `DESIRED_SPEED`, `DESIRED_DEPTH` or
-//! `DESIRED_ALTITUDE` (the vertical set-point the planner chose), and the plume-tracing ones:
-//! `CPT_BEHAVIOUR` (when it changes), `CPT_READING` (every chemical sample, at its time),
-//! `CPT_DETECTION` and `CPT_DECLARATION` (`x=..,y=..[,rule=..]`), `CPT_STATUS` (when the plan
-//! finishes or aborts). Values never contain spaces.
+//! `NAV_DEPTH`, `NAV_ALTITUDE` (m), `DESIRED_HEADING`, `DESIRED_SPEED`, `DESIRED_DEPTH` (for an
+//! altitude hold: the depth that leaves that altitude over the water depth measured, as the MOOS
+//! and Iver links send it) and `DESIRED_ALTITUDE` (an altitude hold, as the Bluefin link sends
+//! it), and the plume-tracing ones: `CPT_BEHAVIOUR` (when it changes), `CPT_READING` (every
+//! chemical sample, at its time), `CPT_DETECTION` and `CPT_DECLARATION` (`x=..,y=..[,rule=..]`),
+//! `CPT_STATUS` (when the plan finishes or aborts). Values never contain spaces.
 
 use plumetrace_core::{
     Decision, PlanStatus, PlannerEvent, SensorSnapshot, VerticalCommand, variant_name, wrap_deg_360,
@@ -38,6 +45,7 @@ pub const VARIABLES: &[&str] = &[
 pub struct AlogWriter<W: Write> {
     out: W,
     source: String,
+    sensor_source: String,
     last_time: f64,
 }
 
@@ -47,29 +55,89 @@ fn clean(s: &str) -> String {
         .collect()
 }
 
+/// The start of a log when its caller gives none: `SOURCE_DATE_EPOCH` when set (for
+/// reproducible files), else the wall clock.
+fn start_now() -> f64 {
+    if let Some(s) = std::env::var("SOURCE_DATE_EPOCH")
+        .ok()
+        .and_then(|v| v.trim().parse::<f64>().ok())
+        .filter(|v| v.is_finite() && *v > 0.0)
+    {
+        return s;
+    }
+    std::time::SystemTime::now()
+        .duration_since(std::time::UNIX_EPOCH)
+        .map_or(0.0, |d| d.as_secs_f64())
+}
+
+/// `unix_s` as a UTC date, `Www Mmm dd hh:mm:ss yyyy` (as pLogger writes its opening time).
+pub fn utc_date(unix_s: f64) -> String {
+    let secs = unix_s.floor() as i64;
+    let days = secs.div_euclid(86_400);
+    let tod = secs.rem_euclid(86_400);
+    // Civil date from days since 1970-01-01 (proleptic Gregorian).
+    let z = days + 719_468;
+    let era = z.div_euclid(146_097);
+    let doe = z - era * 146_097;
+    let yoe = (doe - doe / 1460 + doe / 36_524 - doe / 146_096) / 365;
+    let doy = doe - (365 * yoe + yoe / 4 - yoe / 100);
+    let mp = (5 * doy + 2) / 153;
+    let day = doy - (153 * mp + 2) / 5 + 1;
+    let month = if mp < 10 { mp + 3 } else { mp - 9 };
+    let year = yoe + era * 400 + i64::from(month <= 2);
+    const WEEKDAYS: [&str; 7] = ["Thu", "Fri", "Sat", "Sun", "Mon", "Tue", "Wed"];
+    const MONTHS: [&str; 12] = [
+        "Jan", "Feb", "Mar", "Apr", "May", "Jun", "Jul", "Aug", "Sep", "Oct", "Nov", "Dec",
+    ];
+    format!(
+        "{} {} {:02} {:02}:{:02}:{:02} {year}",
+        WEEKDAYS[days.rem_euclid(7) as usize],
+        MONTHS[(month - 1).clamp(0, 11) as usize],
+        day,
+        tod / 3600,
+        tod / 60 % 60,
+        tod % 60
+    )
+}
+
 impl<W: Write> AlogWriter<W> {
     /// Starts a log: the header (`name` is the log's name, `logstart_unix_s` the start of
-    /// mission time in Unix seconds) and the source column's process name.
+    /// mission time in Unix seconds; one that is not positive means "now": the wall clock, or
+    /// `SOURCE_DATE_EPOCH` when set) and the source column's process name for the planner's
+    /// postings (the vehicle's are `iVehicle` until [`AlogWriter::sensor_source`] names them).
     pub fn new(
         mut out: W,
         name: &str,
         logstart_unix_s: f64,
         source: &str,
     ) -> std::io::Result<Self> {
+        let start = if logstart_unix_s.is_finite() && logstart_unix_s > 0.0 {
+            logstart_unix_s
+        } else {
+            start_now()
+        };
         let bar = "%".repeat(80);
         writeln!(out, "{bar}")?;
         writeln!(out, "%% LOG FILE:       {}", clean(name))?;
-        writeln!(out, "%% FILE OPENED ON  plumetrace")?;
-        writeln!(out, "%% LOGSTART               {logstart_unix_s:.2}")?;
+        writeln!(out, "%% FILE OPENED ON  {}", utc_date(start))?;
+        writeln!(out, "%% LOGSTART               {start:.2}")?;
         writeln!(out, "{bar}")?;
         Ok(AlogWriter {
             out,
             source: clean(source),
+            sensor_source: "iVehicle".into(),
             last_time: f64::NEG_INFINITY,
         })
     }
 
-    fn post(&mut self, t: f64, var: &str, value: &str) -> std::io::Result<()> {
+    /// The same writer with `source` in the source column of the vehicle's postings
+    /// (`NAV_*`, `CPT_READING`).
+    pub fn sensor_source(mut self, source: &str) -> Self {
+        self.sensor_source = clean(source);
+        self
+    }
+
+    fn post_from(&mut self, t: f64, var: &str, sensor: bool, value: &str) -> std::io::Result<()> {
         // Lines stay in time order even if a sample's time ran ahead of its snapshot.
         let t = if t.is_finite() {
             t.max(self.last_time)
@@ -77,40 +145,69 @@ impl<W: Write> AlogWriter<W> {
             self.last_time.max(0.0)
         };
         self.last_time = t;
-        writeln!(self.out, "{t:.3} {var} {} {}", self.source, clean(value))
+        let source = if sensor {
+            &self.sensor_source
+        } else {
+            &self.source
+        };
+        writeln!(
+            self.out,
+            "{:<14} {var:<20} {source:<16} {}",
+            format!("{t:.3}"),
+            clean(value)
+        )
     }
 
-    fn num(&mut self, t: f64, var: &str, v: f64) -> std::io::Result<()> {
+    fn post(&mut self, t: f64, var: &str, value: &str) -> std::io::Result<()> {
+        self.post_from(t, var, false, value)
+    }
+
+    /// A number with every digit it needs to read back exactly.
+    fn num_from(&mut self, t: f64, var: &str, sensor: bool, v: f64) -> std::io::Result<()> {
         if v.is_finite() {
-            self.post(t, var, &format!("{v:.3}"))
+            self.post_from(t, var, sensor, &format!("{v}"))
         } else {
             Ok(())
         }
     }
 
+    fn num(&mut self, t: f64, var: &str, v: f64) -> std::io::Result<()> {
+        self.num_from(t, var, false, v)
+    }
+
+    fn sensed(&mut self, t: f64, var: &str, v: f64) -> std::io::Result<()> {
+        self.num_from(t, var, true, v)
+    }
+
     /// Posts what one snapshot and its decision say.
     pub fn decision(&mut self, s: &SensorSnapshot, d: &Decision) -> std::io::Result<()> {
         for c in &s.chem {
-            self.num(c.time_s, "CPT_READING", c.reading)?;
+            self.sensed(c.time_s, "CPT_READING", c.reading)?;
         }
         let t = s.time_s;
         if let Some(p) = s.nav.pos_m {
-            self.num(t, "NAV_X", p.x)?;
-            self.num(t, "NAV_Y", p.y)?;
+            self.sensed(t, "NAV_X", p.x)?;
+            self.sensed(t, "NAV_Y", p.y)?;
         }
-        self.num(t, "NAV_HEADING", wrap_deg_360(s.nav.heading.deg()))?;
-        self.num(t, "NAV_SPEED", s.nav.speed_mps)?;
+        self.sensed(t, "NAV_HEADING", wrap_deg_360(s.nav.heading.deg()))?;
+        self.sensed(t, "NAV_SPEED", s.nav.speed_mps)?;
         if let Some(v) = s.nav.depth_m {
-            self.num(t, "NAV_DEPTH", v)?;
+            self.sensed(t, "NAV_DEPTH", v)?;
         }
         if let Some(v) = s.nav.altitude_m {
-            self.num(t, "NAV_ALTITUDE", v)?;
+            self.sensed(t, "NAV_ALTITUDE", v)?;
         }
         self.num(t, "DESIRED_HEADING", wrap_deg_360(d.command.heading.deg()))?;
         self.num(t, "DESIRED_SPEED", d.command.speed_mps)?;
         match d.command.vertical {
             VerticalCommand::Depth(v) => self.num(t, "DESIRED_DEPTH", v)?,
-            VerticalCommand::Altitude(v) => self.num(t, "DESIRED_ALTITUDE", v)?,
+            VerticalCommand::Altitude(v) => {
+                // The depth that leaves this altitude over the water depth measured.
+                if let (Some(depth), Some(alt)) = (s.nav.depth_m, s.nav.altitude_m) {
+                    self.num(t, "DESIRED_DEPTH", (depth + alt - v).max(0.0))?;
+                }
+                self.num(t, "DESIRED_ALTITUDE", v)?;
+            }
             VerticalCommand::Surface => self.num(t, "DESIRED_DEPTH", 0.0)?,
         }
         for e in &d.events {
@@ -168,7 +265,7 @@ mod tests {
             },
             chem: vec![ChemSample {
                 time_s: t - 0.05,
-                reading: 0.3,
+                reading: 1.2345678901234e-4,
             }],
             flow: None,
             ranges: None,
@@ -178,7 +275,7 @@ mod tests {
             Command {
                 heading: Heading::from_deg(45.0),
                 speed_mps: 2.0,
-                vertical: VerticalCommand::Altitude(2.0),
+                vertical: VerticalCommand::Altitude(2.5),
             },
             PlanStatus::Running,
         );
@@ -204,23 +301,51 @@ mod tests {
                 header += 1;
                 continue;
             }
-            let f: Vec<&str> = line.split(' ').collect();
+            let f: Vec<&str> = line.split_whitespace().collect();
             assert_eq!(f.len(), 4, "{line}");
             let t: f64 = f[0].parse().unwrap_or(f64::NAN);
             assert!(t >= last, "time order: {line}");
             last = t;
             assert!(VARIABLES.contains(&f[1]), "{line}");
-            assert_eq!(f[2], "pPlumetrace");
+            let sensor = f[1].starts_with("NAV_") || f[1] == "CPT_READING";
+            assert_eq!(
+                f[2],
+                if sensor { "iVehicle" } else { "pPlumetrace" },
+                "{line}"
+            );
             seen.insert(f[1].to_string(), f[3].to_string());
         }
         assert_eq!(header, 5);
-        assert!(text.contains("%% LOGSTART"));
-        assert_eq!(seen["NAV_HEADING"], "270.000");
-        assert_eq!(seen["NAV_X"], "10.200");
-        assert_eq!(seen["DESIRED_ALTITUDE"], "2.000");
+        assert!(
+            text.contains("%% LOGSTART               1700000000.00\n"),
+            "{text}"
+        );
+        assert!(
+            text.contains("%% FILE OPENED ON  Tue Nov 14 22:13:20 2023\n"),
+            "{text}"
+        );
+        assert_eq!(seen["NAV_HEADING"], "270");
+        assert_eq!(seen["NAV_X"], "10.2");
+        // The altitude hold as the depth a MOOS or Iver vehicle is sent (6 + 2 - 2.5 m).
+        assert_eq!(seen["DESIRED_ALTITUDE"], "2.5");
+        assert_eq!(seen["DESIRED_DEPTH"], "5.5");
         assert_eq!(seen["CPT_BEHAVIOUR"], "track_in");
-        assert_eq!(seen["CPT_READING"], "0.300");
+        assert_eq!(seen["CPT_READING"], "0.00012345678901234");
         assert_eq!(seen["CPT_DECLARATION"], "x=100.00,y=0.50,rule=along_flow");
         assert_eq!(seen["CPT_STATUS"], "finished");
+    }
+
+    #[test]
+    fn a_log_without_a_start_starts_now_and_dates_are_utc() {
+        let w = AlogWriter::new(Vec::new(), "x.alog", 0.0, "p").unwrap_or_else(|e| panic!("{e}"));
+        let text = String::from_utf8(w.finish().unwrap_or_default()).unwrap_or_default();
+        let start: f64 = text
+            .lines()
+            .find_map(|l| l.strip_prefix("%% LOGSTART"))
+            .and_then(|v| v.trim().parse().ok())
+            .unwrap_or(0.0);
+        assert!(start > 1.7e9, "{text}");
+        assert_eq!(utc_date(0.0), "Thu Jan 01 00:00:00 1970");
+        assert_eq!(utc_date(951_782_400.0), "Tue Feb 29 00:00:00 2000");
     }
 }

@@ -9,7 +9,7 @@ use plumetrace_onboard::protocol::bluefin::{
 use plumetrace_onboard::protocol::chem::ChemFormat;
 use plumetrace_onboard::protocol::current::{Cur, DirectionRef, FlowFormat};
 use plumetrace_onboard::protocol::iver::{self, Mode, Oms, Osi, Units};
-use plumetrace_onboard::protocol::sentence::{LineCounts, SentenceError, UtcTime, checksum};
+use plumetrace_onboard::protocol::sentence::{LineCounts, SentenceError, UtcTime, checksum, frame};
 
 fn t(text: &str) -> UtcTime {
     UtcTime::parse(text).unwrap()
@@ -214,6 +214,32 @@ fn the_chemical_input_reads_its_sentence_and_plain_readings() {
         sentence.parse("$PTCHM,120000.000,0.125000*48"),
         Err(SentenceError::BadChecksum { .. })
     ));
+}
+
+#[test]
+fn chemical_readings_beyond_any_instrument_are_refused() {
+    let sentence = ChemFormat::default();
+    for v in ["100000000000000000000000", "-100000000000000000000000"] {
+        let line = frame(&format!("PTCHM,120000.000,{v}"));
+        let err = sentence.parse(&line).err();
+        assert_eq!(
+            err.map(|e| e.to_string()),
+            Some(format!(
+                "chemical: reading = {} is outside [-1e6, 1e9]",
+                v.parse::<f64>().unwrap_or_default()
+            )),
+            "{line}"
+        );
+    }
+    let plain = ChemFormat::Plain;
+    for v in ["100000000000000000000000", "-100000000000000000000000"] {
+        assert!(
+            matches!(plain.parse(v), Err(SentenceError::OutOfRange { .. })),
+            "{v}"
+        );
+    }
+    assert_eq!(plain.parse("999999999"), Ok(999_999_999.0));
+    assert_eq!(sentence.parse(&frame("PTCHM,120000.000,-0.5")), Ok(-0.5));
 }
 
 fn cur_golden() -> Vec<(&'static str, Cur)> {

@@ -38,6 +38,17 @@ struct Script {
     poison_first: bool,
     /// `MOOS_MANUAL_OVERRIDE` is `true` in `[from, to)` (posted at both ends).
     manual_override: Option<(f64, f64)>,
+    /// At each registration, send the variable's stored value posted this many seconds ago
+    /// (as a MOOSDB does), for the navigation variables.
+    stored_age_s: Option<f64>,
+    /// At the registration of the chemical variable, send a stored string of more than 1 MiB.
+    huge_stored_value: bool,
+    /// The consolidation period in the timing replies, s.
+    consolidation_s: f64,
+    /// The welcome names this computer's host (a MOOSDB on the same host).
+    same_host: bool,
+    /// The first timing reply's clock is this far off.
+    first_reply_off_s: f64,
     /// Stop serving.
     end_at: f64,
 }
@@ -164,10 +175,16 @@ fn fake_moosdb(script: Script) -> (u16, std::thread::JoinHandle<Record>) {
             }
             let mut w = Message::with_double(kind::WELCOME, "", SERVER_AHEAD_S, moos_now());
             w.string = b"asynchronous".to_vec();
-            w.source_aux = "hostname=fake".into();
+            w.source_aux = if script.same_host {
+                let h = std::fs::read_to_string("/proc/sys/kernel/hostname").unwrap();
+                format!("hostname={}", h.trim())
+            } else {
+                "hostname=fake".into()
+            };
             w.community = "#1".into();
             s.write_all(&encode_packet(&[w]).unwrap()).unwrap();
             let mut registered: BTreeSet<String> = BTreeSet::new();
+            let mut replies = 0;
             let mut framer = Framer::default();
             let mut last_nav = f64::NEG_INFINITY;
             let mut last_step = now();
@@ -236,11 +253,18 @@ fn fake_moosdb(script: Script) -> (u16, std::thread::JoinHandle<Record>) {
                         match m.kind {
                             kind::REGISTER => {
                                 registered.insert(m.key.clone());
+                                stored(&script, &m.key, moos_now(), &mut s);
                             }
                             kind::TIMING => {
                                 let mut r = m.clone();
-                                r.double = moos_now();
-                                r.double2 = 0.0;
+                                replies += 1;
+                                let off = if replies == 1 {
+                                    script.first_reply_off_s
+                                } else {
+                                    0.0
+                                };
+                                r.double = moos_now() + off;
+                                r.double2 = script.consolidation_s;
                                 reply.push(r);
                             }
                             kind::NOTIFY if m.data_type == data::DOUBLE => match m.key.as_str() {
@@ -295,6 +319,41 @@ fn fake_moosdb(script: Script) -> (u16, std::thread::JoinHandle<Record>) {
         rec
     });
     (port, handle)
+}
+
+/// What a MOOSDB sends at a registration under `script`: the stored value.
+fn stored(script: &Script, key: &str, now: f64, s: &mut TcpStream) {
+    if let Some(age) = script.stored_age_s.filter(|_| key.starts_with("NAV_")) {
+        let v = if key == "NAV_X" { 100.0 } else { 1.0 };
+        let _ = s.write_all(&encode_packet(&[notify(key, v, now - age)]).unwrap());
+    }
+    if script.huge_stored_value && key == "CHEM_READING" {
+        let mut m = Message::with_string(kind::NOTIFY, key, &"9".repeat(1_100_000), now - 30.0);
+        m.source = "uSensor".into();
+        // Framed by hand: more than the encoder writes.
+        let len = 9 + m.wire_len();
+        let mut p = Vec::with_capacity(len);
+        p.extend_from_slice(&(len as i32).to_le_bytes());
+        p.extend_from_slice(&1i32.to_le_bytes());
+        p.push(0);
+        p.extend_from_slice(&message_bytes(&m));
+        let _ = s.write_all(&p);
+    }
+}
+
+/// A message's bytes as a packet carries them (the packet's 9-byte header removed).
+fn message_bytes(m: &Message) -> Vec<u8> {
+    let mut small = m.clone();
+    let string = std::mem::take(&mut small.string);
+    // Encode with an empty string, then patch the lengths and append the string.
+    let p = encode_packet(&[small]).unwrap();
+    let mut b = p[9..].to_vec();
+    let total = (b.len() + string.len()) as i32;
+    b[..4].copy_from_slice(&total.to_le_bytes());
+    let at = b.len() - 4;
+    b[at..].copy_from_slice(&(string.len() as i32).to_le_bytes());
+    b.extend_from_slice(&string);
+    b
 }
 
 fn onboard(port: u16, time_limit_s: f64, mode: &str) -> Onboard {
@@ -422,6 +481,24 @@ fn a_registered_planner_flies_against_a_fake_moosdb() {
     // Heartbeats: a timing message about once a second.
     let timings = rec.seen.iter().filter(|s| s.m.kind == kind::TIMING).count();
     assert!((2..=5).contains(&timings), "{timings} timing messages");
+    // pMarineViewer draws the op-area: posted once, at the connection.
+    let polygons = rec.values("VIEW_POLYGON");
+    assert_eq!(polygons.len(), 1, "{polygons:?}");
+    assert_eq!(
+        polygons[0].m.text(),
+        Some(
+            "pts={60.00,-80.00:460.00,-80.00:460.00,80.00:60.00,80.00},label=cpt_op_area,edge_color=yellow,vertex_color=yellow,vertex_size=2,edge_size=1"
+        )
+    );
+    // The AMP's estimate, once it has one, as a marker.
+    for m in rec.values("VIEW_MARKER") {
+        assert!(
+            m.m.text().is_some_and(
+                |t| t.starts_with("type=diamond,x=") && t.contains(",label=cpt_estimate,")
+            ),
+            "{m:?}"
+        );
+    }
     // The behaviour went out as the .alog writer names it.
     let behaviour = rec.values("CPT_BEHAVIOUR");
     assert!(!behaviour.is_empty());
@@ -437,7 +514,11 @@ fn a_registered_planner_flies_against_a_fake_moosdb() {
     assert_eq!(r.get("bad_field"), Some(&2), "{r:?}");
     assert_eq!(r.get("unknown"), Some(&1), "{r:?}");
     assert!(report.lines.accepted > 100);
-    assert!(log.contains(" ! a packet of"), "{log}");
+    // One bad message costs only itself (libMOOS reads the rest of its packet).
+    assert!(
+        log.contains(" ! a message: unknown message type 0x5a"),
+        "{log}"
+    );
     assert!(log.contains(" > N DESIRED_HEADING D"), "{log}");
     assert!(log.contains(" < N NAV_X D"), "{log}");
     // Set-points were stamped with the server's clock: the welcome's skew, kept by the timing
@@ -582,4 +663,145 @@ fn in_lock_step_mission_time_comes_from_the_postings() {
         rec.values("DESIRED_HEADING").len() as u64,
         report.commands_sent
     );
+}
+
+/// A stored value larger than 1 MiB (MOOS sets no limit) is skipped, not a reason to reconnect:
+/// the MOOSDB would send it again at every registration.
+#[test]
+fn a_stored_value_over_a_mebibyte_is_skipped_and_the_connection_stays() {
+    let (report, rec, log) = fly(
+        Script {
+            huge_stored_value: true,
+            ..Script::default()
+        },
+        3.0,
+    );
+    assert_eq!(rec.handshakes.len(), 1, "{log}");
+    assert_eq!(report.connections, 1, "{report:?}");
+    assert_eq!(
+        report.lines.rejected.get("too_large"),
+        Some(&1),
+        "{report:?}"
+    );
+    assert_eq!(report.end, RunEnd::TimeLimit);
+    assert!(report.decisions >= 5, "{report:?}");
+    assert_eq!(
+        rec.values("CPT_STATUS").last().and_then(|s| s.m.text()),
+        Some("ended")
+    );
+}
+
+/// The values a MOOSDB stores and sends at registration are as old as their MOOS time says:
+/// 49.8 s old, they make no navigation record.
+#[test]
+fn stored_navigation_older_than_the_limit_is_not_steered_on() {
+    let (report, rec, _) = fly(
+        Script {
+            stored_age_s: Some(49.8),
+            silent: Some((0.0, 1.5)),
+            ..Script::default()
+        },
+        3.0,
+    );
+    let early: Vec<f64> = rec
+        .values("DESIRED_HEADING")
+        .iter()
+        .map(|s| s.t)
+        .filter(|t| *t < 1.5)
+        .collect();
+    assert!(early.is_empty(), "steered on stale values at {early:?}");
+    assert!(
+        report.lines.rejected.get("stale").is_some_and(|n| *n >= 6),
+        "{report:?}"
+    );
+    assert!(rec.values("DESIRED_HEADING").iter().any(|s| s.t >= 1.5));
+}
+
+/// A pause published before the connection was lost is ended in the community when the
+/// planner steers again on the next connection.
+#[test]
+fn cpt_paused_goes_back_to_false_after_a_reconnection() {
+    let (_, rec, _) = fly(
+        Script {
+            silent: Some((1.0, 2.0)),
+            close_at: vec![1.6],
+            ..Script::default()
+        },
+        3.5,
+    );
+    let paused = rec.values("CPT_PAUSED");
+    let texts: Vec<(usize, &str)> = paused
+        .iter()
+        .filter_map(|s| Some((s.conn, s.m.text()?)))
+        .collect();
+    assert_eq!(texts, vec![(1, "true"), (2, "false")], "{paused:?}");
+}
+
+/// The consolidation period in the timing replies paces outgoing mail, as libMOOS's writing
+/// thread does.
+#[test]
+fn the_consolidation_period_paces_the_set_points() {
+    let (report, rec, _) = fly(
+        Script {
+            consolidation_s: 0.5,
+            ..Script::default()
+        },
+        4.0,
+    );
+    let times: Vec<f64> = rec.values("DESIRED_HEADING").iter().map(|s| s.t).collect();
+    assert!(times.len() >= 4, "{times:?}");
+    // After the first reply set the period, packets are 0.5 s apart on average (the server's
+    // receipt times jitter on a loaded machine).
+    let gaps: Vec<f64> = times
+        .windows(2)
+        .filter(|w| w[0] > 1.5)
+        .map(|w| w[1] - w[0])
+        .collect();
+    let mean = gaps.iter().sum::<f64>() / gaps.len().max(1) as f64;
+    assert!(gaps.len() >= 3 && mean >= 0.45, "{gaps:?}");
+    assert!(gaps.iter().all(|g| *g >= 0.25), "{gaps:?}");
+    assert!(report.decisions as usize > times.len(), "{report:?}");
+}
+
+/// A MOOSDB on this host: no skew correction (libMOOS turns it off), so postings carry this
+/// computer's clock even though the welcome says 0.25 s.
+#[test]
+fn no_skew_correction_for_a_moosdb_on_this_host() {
+    let (_, rec, log) = fly(
+        Script {
+            same_host: true,
+            ..Script::default()
+        },
+        2.0,
+    );
+    assert!(
+        log.contains("not estimated: the MOOSDB is on this host"),
+        "{log}"
+    );
+    for s in rec.values("DESIRED_HEADING") {
+        let ahead = s.m.time - s.unix;
+        assert!(ahead.abs() < 0.1, "posted {ahead:.3} s ahead");
+    }
+}
+
+/// The first timing reply does not count towards the skew (libMOOS skips it): one that is 5 s
+/// off leaves the set-points stamped with the welcome's skew.
+#[test]
+fn the_first_timing_reply_does_not_move_the_skew() {
+    let (_, rec, _) = fly(
+        Script {
+            first_reply_off_s: 5.0,
+            ..Script::default()
+        },
+        3.0,
+    );
+    let heading = rec.values("DESIRED_HEADING");
+    assert!(heading.len() >= 5);
+    for s in heading {
+        let ahead = s.m.time - s.unix;
+        assert!(
+            (ahead - SERVER_AHEAD_S).abs() < 0.1,
+            "posted {ahead:.3} s ahead"
+        );
+    }
 }

@@ -4,9 +4,10 @@
 //! and the raw traffic log (one line per message).
 
 use super::nav::{NAV_VARIABLES, NavState};
+use super::view::{self, Views};
 use super::wire::{
-    Framer, Message, PROTOCOL, TIMING_PERIOD, decode_packet, encode_packet, kind, protocol_bytes,
-    unix_now,
+    Framer, Message, MoosError, PROTOCOL, TIMING_PERIOD, decode_messages, encode_packet, kind,
+    protocol_bytes, unix_now,
 };
 use crate::config::Onboard;
 use crate::geo::{LocalFrame, OriginError};
@@ -31,6 +32,8 @@ pub struct MoosSettings {
     pub chem_variable: Option<String>,
     /// Publish `DESIRED_SPEED = 0` when the planner pauses.
     pub safe_stop: bool,
+    /// A navigation or chemical posting older than this (by its MOOS time) is not taken, s.
+    pub stale_nav_s: f64,
     /// Silence, reconnection.
     pub timing: LinkTiming,
 }
@@ -56,6 +59,13 @@ pub struct MoosLink {
     started: Instant,
     deferred: Vec<LinkEvent>,
     skew: f64,
+    // Whether the skew is estimated (not for a MOOSDB on this host), and the timing replies
+    // on this connection (the first does not count).
+    skew_on: bool,
+    timing_replies: u64,
+    // The MOOSDB's consolidation period: outgoing mail is paced by it.
+    outgoing_delay: Duration,
+    last_send: Option<Instant>,
     community: String,
     next_id: i32,
     last_timing: Option<Instant>,
@@ -63,6 +73,10 @@ pub struct MoosLink {
     clock: f64,
     paused: bool,
     outbox: Vec<Message>,
+    // What pMarineViewer draws: the mission's polygons (posted at each welcome) and the
+    // planner's points.
+    geometry: Vec<(&'static str, String)>,
+    views: Views,
 }
 
 impl MoosLink {
@@ -88,6 +102,10 @@ impl MoosLink {
             started: now,
             deferred: Vec::new(),
             skew: 0.0,
+            skew_on: true,
+            timing_replies: 0,
+            outgoing_delay: Duration::ZERO,
+            last_send: None,
             community: String::new(),
             next_id: 0,
             last_timing: None,
@@ -95,6 +113,8 @@ impl MoosLink {
             clock: f64::NEG_INFINITY,
             paused: false,
             outbox: Vec::new(),
+            geometry: Vec::new(),
+            views: Views::default(),
         }
     }
 
@@ -107,6 +127,8 @@ impl MoosLink {
         let l = &onboard.file.link;
         let m = l.moos.clone().unwrap_or_default();
         let frame = LocalFrame::new(l.origin)?;
+        let mission = &onboard.file.mission;
+        let geometry = view::geometry(&mission.op_area, &mission.subregions);
         Ok(MoosLink::new(
             MoosSettings {
                 host: m.host,
@@ -114,11 +136,19 @@ impl MoosLink {
                 app_name: m.app_name,
                 chem_variable: m.chem_variable,
                 safe_stop: l.safe_command == crate::config::SafeAction::Stop,
+                stale_nav_s: l.stale_nav_s,
                 timing,
             },
             frame,
             traffic,
-        ))
+        )
+        .with_geometry(geometry))
+    }
+
+    /// The same client posting `geometry` (`VIEW_POLYGON` postings) at each connection.
+    pub fn with_geometry(mut self, geometry: Vec<(&'static str, String)>) -> Self {
+        self.geometry = geometry;
+        self
     }
 
     /// The clock skew in use (server minus this computer), s.
@@ -199,10 +229,18 @@ impl MoosLink {
             }
         };
         if self.write_raw(&packet, events) {
+            self.last_send = Some(now);
             for m in &messages {
                 self.log('>', &m.summary());
             }
         }
+    }
+
+    /// Whether outgoing mail may go now: the MOOSDB's consolidation period has passed since the
+    /// last packet (as libMOOS's writing thread waits it out).
+    fn mail_due(&self) -> bool {
+        self.last_send
+            .is_none_or(|t| t.elapsed() >= self.outgoing_delay)
     }
 
     fn post(&mut self, key: &str, value: PostValue) -> Message {
@@ -269,27 +307,42 @@ impl MoosLink {
     }
 
     fn welcome(&mut self, m: &Message, events: &mut Vec<LinkEvent>) {
-        self.skew = if m.double.is_finite() && m.double.abs() < 1e9 {
+        // As libMOOS: no skew correction for a MOOSDB on this host (the welcome's source aux
+        // names the DB's host), else the welcome's skew, then the timing replies'.
+        let db_host = m
+            .source_aux
+            .split(',')
+            .find_map(|kv| kv.trim().strip_prefix("hostname="))
+            .unwrap_or("");
+        self.skew_on = local_host_name().is_none_or(|h| h != db_host);
+        self.skew = if self.skew_on && m.double.is_finite() && m.double.abs() < 1e9 {
             m.double
         } else {
             0.0
         };
+        self.timing_replies = 0;
         self.community = m.community.clone();
         self.phase = Phase::Ready;
         self.backoff = self.settings.timing.reconnect_min;
-        self.paused = false;
+        // `paused` is kept: a `CPT_PAUSED = true` published before the connection was lost is
+        // still the community's value, and the next set-point publishes `false`.
         self.log(
             '#',
             &format!(
-                "welcome to community {} (skew {:.3} s)",
-                self.community, self.skew
+                "welcome to community {} (skew {})",
+                self.community,
+                if self.skew_on {
+                    format!("{:.3} s", self.skew)
+                } else {
+                    "not estimated: the MOOSDB is on this host".into()
+                }
             ),
         );
         events.push(LinkEvent::Connected);
         let mut vars: Vec<String> = NAV_VARIABLES.iter().map(|v| (*v).to_string()).collect();
         vars.extend(self.settings.chem_variable.clone());
         let t = self.moos_time();
-        let regs: Vec<Message> = vars
+        let mut regs: Vec<Message> = vars
             .iter()
             .map(|v| {
                 let mut r = Message::with_double(kind::REGISTER, v, 0.0, t);
@@ -299,10 +352,23 @@ impl MoosLink {
                 r
             })
             .collect();
+        for (key, value) in self.geometry.clone() {
+            let m = self.post(key, PostValue::Text(value));
+            regs.push(m);
+        }
         self.send_messages(regs, events);
     }
 
     fn timing_reply(&mut self, m: &Message) {
+        // The MOOSDB's consolidation period paces outgoing mail (bounded: a second at most).
+        if m.double2.is_finite() {
+            self.outgoing_delay = Duration::from_secs_f64(m.double2.clamp(0.0, 1.0));
+        }
+        self.timing_replies += 1;
+        // As libMOOS: the first reply does not count towards the skew.
+        if !self.skew_on || self.timing_replies < 2 {
+            return;
+        }
         let rx = unix_now();
         let (rq, tx) = (m.time, m.double);
         if !(rq.is_finite() && tx.is_finite()) {
@@ -322,6 +388,12 @@ impl MoosLink {
     /// Takes one notification; `Err` with a count kind when it is not acted on. The posting's
     /// time, when later than any before, is the front seat's clock.
     fn notify(&mut self, m: &Message, events: &mut Vec<LinkEvent>) -> Result<(), &'static str> {
+        // A MOOSDB sends each variable's stored value at registration, however old: a reading
+        // or a position older than the staleness limit by its MOOS time is not taken.
+        let measured = m.key != "MOOS_MANUAL_OVERRIDE";
+        if measured && m.time.is_finite() && self.moos_time() - m.time > self.settings.stale_nav_s {
+            return Err("stale");
+        }
         self.nav
             .take(m, self.settings.chem_variable.as_deref(), events)?;
         if m.time.is_finite() && m.time > self.clock && m.time > 0.0 {
@@ -334,7 +406,7 @@ impl MoosLink {
     }
 
     fn take_packet(&mut self, packet: &[u8], events: &mut Vec<LinkEvent>) {
-        let messages = match decode_packet(packet) {
+        let decoded = match decode_messages(packet) {
             Ok(m) => m,
             Err(e) => {
                 let why = format!("a packet of {} bytes: {e}", packet.len());
@@ -342,6 +414,13 @@ impl MoosLink {
                 return;
             }
         };
+        let mut messages = Vec::with_capacity(decoded.len());
+        for m in decoded {
+            match m {
+                Ok(m) => messages.push(m),
+                Err(e) => self.reject(e.kind(), &format!("a message: {e}")),
+            }
+        }
         let before = events.len();
         for m in &messages {
             self.log('<', &m.summary());
@@ -403,6 +482,15 @@ impl MoosLink {
     }
 }
 
+/// This computer's host name, as `gethostname` gives it (what a MOOSDB puts in its welcome).
+fn local_host_name() -> Option<String> {
+    ["/proc/sys/kernel/hostname", "/etc/hostname"]
+        .iter()
+        .find_map(|p| std::fs::read_to_string(p).ok())
+        .map(|h| h.trim().to_string())
+        .filter(|h| !h.is_empty())
+}
+
 enum PostValue {
     Double(f64),
     Text(String),
@@ -433,6 +521,9 @@ impl Link for MoosLink {
                     while let Some(p) = self.framer.next_packet() {
                         match p {
                             Ok(packet) => self.take_packet(&packet, &mut events),
+                            Err(e @ MoosError::TooLarge(_)) => {
+                                self.reject(e.kind(), &format!("skipped: {e}"));
+                            }
                             Err(e) => {
                                 self.reject(e.kind(), &format!("the stream: {e}"));
                                 self.drop_conn(format!("unreadable stream: {e}"), &mut events);
@@ -465,7 +556,12 @@ impl Link for MoosLink {
             }
         }
         if self.conn.is_some() && self.phase == Phase::Ready {
-            let out = std::mem::take(&mut self.outbox);
+            let out = if self.mail_due() {
+                std::mem::take(&mut self.outbox)
+            } else {
+                Vec::new()
+            };
+            // The heartbeat goes out whatever the pacing.
             self.send_messages(out, &mut events);
         }
         if let Some(t) = self.traffic.as_mut() {
@@ -486,10 +582,16 @@ impl Link for MoosLink {
                     self.paused = false;
                     out.push(self.post("CPT_PAUSED", PostValue::Text("false".into())));
                 }
+                // A newer set-point replaces one still waiting for the consolidation period.
+                out.retain(|m| !m.key.starts_with("DESIRED_"));
                 out.push(self.post("DESIRED_HEADING", PostValue::Double(c.heading_deg())));
                 out.push(self.post("DESIRED_SPEED", PostValue::Double(c.speed_mps())));
                 if let Some(d) = self.nav.depth_of(&c) {
                     out.push(self.post("DESIRED_DEPTH", PostValue::Double(d)));
+                }
+                if !self.mail_due() {
+                    self.outbox = out;
+                    return;
                 }
             }
             Outgoing::Safe => {
@@ -523,6 +625,8 @@ impl Link for MoosLink {
     }
 
     fn decided(&mut self, _snapshot: &SensorSnapshot, d: &Decision) {
+        // Counted whether or not they can go out now, so labels stay unique.
+        let drawn = self.views.of(d);
         if !self.connected() {
             return;
         }
@@ -550,6 +654,12 @@ impl Link for MoosLink {
             if let Some((key, value)) = posting
                 && self.outbox.len() < 1000
             {
+                let m = self.post(key, PostValue::Text(value));
+                self.outbox.push(m);
+            }
+        }
+        for (key, value) in drawn {
+            if self.outbox.len() < 1000 {
                 let m = self.post(key, PostValue::Text(value));
                 self.outbox.push(m);
             }

@@ -79,6 +79,8 @@ impl NavState {
             "NAV_SPEED" => self.speed = Some(within(-100.0, 100.0)?),
             "NAV_DEPTH" => self.depth = Some(within(-100.0, 12_000.0)?),
             "NAV_ALTITUDE" => self.altitude = Some(within(0.0, 12_000.0)?),
+            // The chemical reading: the line inputs' range.
+            _ if !(-1e6..=1e9).contains(&v) => return Err("out_of_range"),
             _ => events.push(LinkEvent::Chem(v)),
         }
         Ok(())

@@ -50,16 +50,22 @@
 //! consolidation period. The server drops a client silent for longer than its timeout, so the
 //! timing messages are also the heartbeat. Clock skew is estimated from the replies as MOOS does
 //! (`CMOOSCommClient::UpdateMOOSSkew`): half the sum of (server - received) and
-//! (server - sent), smoothed 0.9 / 0.1; times this client posts are its clock plus the skew.
+//! (server - sent), smoothed 0.9 / 0.1, the first reply left out and no estimate at all when the
+//! welcome's `hostname=` is this computer's host name; times this client posts are its clock plus
+//! the skew. The reply's second double (the DB's consolidation period) is the least time between
+//! two outgoing packets (`MOOSAsyncCommClient::MonitorAndLimitWriteSpeed`).
 //!
 //! # Bounds on what arrives
 //!
-//! A packet longer than [`MAX_PACKET`] or shorter than its header, a negative or overlong
-//! string length, a message count the packet cannot hold, a message whose length disagrees with
-//! its fields, a compressed packet, an unknown type or data type, non-UTF-8 names or trailing
-//! bytes make the packet an error: counted by kind, written to the traffic log, never acted on.
-//! Nothing is allocated from a length field before the bytes are there. A length that cannot be
-//! trusted loses the packet boundaries, so the connection is then dropped and made again.
+//! A packet shorter than its header, a negative or overlong string length, a message count the
+//! packet cannot hold, a compressed packet or trailing bytes make the packet an error; inside a
+//! message whose length fits its packet, an unknown type or data type, a non-UTF-8 name or fields
+//! that disagree with the length make that message an error and leave the others
+//! ([`decode_messages`]). Errors are counted by kind, written to the traffic log, never acted on.
+//! A packet longer than [`MAX_PACKET`] (1 MiB; MOOS itself sets no limit) is skipped by the
+//! [`Framer`] as its bytes arrive, never buffered, and the stream goes on after it. Nothing is
+//! allocated from a length field before the bytes are there. A packet length that cannot be a
+//! packet's loses the packet boundaries, so the connection is then dropped and made again.
 
 use std::time::{Duration, SystemTime};
 
@@ -310,7 +316,7 @@ pub enum MoosError {
     /// Bytes after the last message.
     #[error("{0} bytes after the last message")]
     Trailing(usize),
-    /// A packet too large to send.
+    /// A packet too large to send, or received and skipped.
     #[error("a packet of {0} bytes is larger than {MAX_PACKET}")]
     TooLarge(usize),
 }
@@ -395,6 +401,7 @@ fn decode_message(r: &mut Reader<'_>) -> Result<Message, MoosError> {
         .ok()
         .filter(|l| *l >= MIN_MESSAGE && *l <= r.left() + 4);
     let Some(len) = len_ok else {
+        r.at = start;
         return Err(MoosError::BadLength {
             what: "the message length",
             value: i64::from(len),
@@ -404,6 +411,8 @@ fn decode_message(r: &mut Reader<'_>) -> Result<Message, MoosError> {
         b: &r.b[start..start + len],
         at: 4,
     };
+    // The message's bounds are known: whatever is wrong inside it, the packet goes on after it.
+    r.at = start + len;
     let id = m.i32("the id")?;
     let kind = m.u8("the type")?;
     if !kind::ALL.contains(&kind) {
@@ -427,7 +436,6 @@ fn decode_message(r: &mut Reader<'_>) -> Result<Message, MoosError> {
             value: len as i64,
         });
     }
-    r.at = start + len;
     Ok(Message {
         id,
         kind,
@@ -459,8 +467,17 @@ pub fn encode_packet(messages: &[Message]) -> Result<Vec<u8>, MoosError> {
     Ok(out)
 }
 
-/// The messages of one whole packet (`bytes` is exactly the packet).
+/// The messages of one whole packet (`bytes` is exactly the packet); the first bad message
+/// makes the whole packet an error.
 pub fn decode_packet(bytes: &[u8]) -> Result<Vec<Message>, MoosError> {
+    decode_messages(bytes)?.into_iter().collect()
+}
+
+/// The messages of one whole packet, each on its own: a message of an unknown type, with a name
+/// that is not UTF-8 or fields that disagree with its length is an error of its own and the
+/// others stand (as libMOOS reads a packet); an error in the packet's own framing (its length,
+/// its message count, a message length it cannot hold, trailing bytes) is the whole packet's.
+pub fn decode_messages(bytes: &[u8]) -> Result<Vec<Result<Message, MoosError>>, MoosError> {
     let mut r = Reader { b: bytes, at: 0 };
     let len = r.i32("the packet length")?;
     if usize::try_from(len).ok() != Some(bytes.len()) || bytes.len() > MAX_PACKET {
@@ -484,7 +501,13 @@ pub fn decode_packet(bytes: &[u8]) -> Result<Vec<Message>, MoosError> {
     }
     let mut out = Vec::with_capacity(n);
     for _ in 0..n {
-        out.push(decode_message(&mut r)?);
+        let before = r.at;
+        let m = decode_message(&mut r);
+        if r.at == before {
+            // Its length could not be read: the packet cannot be followed past it.
+            return Err(m.err().unwrap_or(MoosError::Trailing(r.left())));
+        }
+        out.push(m);
     }
     if r.left() != 0 {
         return Err(MoosError::Trailing(r.left()));
@@ -492,20 +515,26 @@ pub fn decode_packet(bytes: &[u8]) -> Result<Vec<Message>, MoosError> {
     Ok(out)
 }
 
-/// Cuts a byte stream into packets by their length fields.
+/// Cuts a byte stream into packets by their length fields. A packet longer than
+/// [`MAX_PACKET`] (MOOS sets no limit) is skipped as its bytes arrive, never buffered: it is
+/// reported once as [`MoosError::TooLarge`] and the stream goes on after it.
 #[derive(Debug, Default)]
 pub struct Framer {
     buf: Vec<u8>,
+    // Bytes of a skipped packet still to come.
+    skip: usize,
 }
 
 impl Framer {
     /// Appends received bytes.
     pub fn push(&mut self, bytes: &[u8]) {
-        self.buf.extend_from_slice(bytes);
+        let skipped = self.skip.min(bytes.len());
+        self.skip -= skipped;
+        self.buf.extend_from_slice(&bytes[skipped..]);
     }
 
-    /// The next whole packet, if its bytes are all there; an error if its length field cannot
-    /// be a packet's (the stream cannot be followed past it).
+    /// The next whole packet, if its bytes are all there; an error if it is too large (skipped)
+    /// or if its length field cannot be a packet's (the stream cannot be followed past it).
     pub fn next_packet(&mut self) -> Option<Result<Vec<u8>, MoosError>> {
         if self.buf.len() < 4 {
             return None;
@@ -514,6 +543,12 @@ impl Framer {
         match usize::try_from(len) {
             Ok(l) if (PACKET_HEADER..=MAX_PACKET).contains(&l) => {
                 (self.buf.len() >= l).then(|| Ok(self.buf.drain(..l).collect()))
+            }
+            Ok(l) if l > MAX_PACKET => {
+                let here = self.buf.len().min(l);
+                self.buf.drain(..here);
+                self.skip = l - here;
+                Some(Err(MoosError::TooLarge(l)))
             }
             _ => Some(Err(MoosError::BadLength {
                 what: "the packet length",
@@ -525,6 +560,7 @@ impl Framer {
     /// Forgets what is buffered.
     pub fn clear(&mut self) {
         self.buf.clear();
+        self.skip = 0;
     }
 }
 
@@ -806,6 +842,51 @@ mod tests {
             f.push(&len.to_le_bytes());
             assert!(matches!(f.next_packet(), Some(Err(_))), "{len}");
         }
+    }
+
+    #[test]
+    fn a_packet_too_large_is_skipped_and_the_stream_goes_on() {
+        let big = Message::with_string(kind::NOTIFY, "BIG", &"x".repeat(MAX_PACKET), 1.0);
+        // Framed by hand: the encoder refuses to write it.
+        let mut p = Vec::new();
+        let len = PACKET_HEADER + big.wire_len();
+        p.extend_from_slice(&(len as i32).to_le_bytes());
+        p.extend_from_slice(&1i32.to_le_bytes());
+        p.push(0);
+        big.encode_into(&mut p);
+        let small = encode_packet(&[Message::timing(2.0)]).unwrap_or_default();
+        p.extend_from_slice(&small);
+        let mut f = Framer::default();
+        let mut got = Vec::new();
+        for chunk in p.chunks(4096) {
+            f.push(chunk);
+            while let Some(r) = f.next_packet() {
+                got.push(r.map_err(|e| e.kind()));
+            }
+        }
+        assert_eq!(got, vec![Err("too_large"), Ok(small)]);
+        assert!(f.buf.capacity() < 2 * 4096 + 64, "{}", f.buf.capacity());
+    }
+
+    #[test]
+    fn one_bad_message_in_a_packet_leaves_the_others() {
+        let good = Message::with_double(kind::NOTIFY, "NAV_X", 1.0, 2.0);
+        let mut p = encode_packet(&[good.clone(), good.clone(), good.clone()]).unwrap_or_default();
+        // The first message's type, and the second's key made non-UTF-8.
+        p[PACKET_HEADER + 8] = b'Z';
+        let second = PACKET_HEADER + good.wire_len();
+        let key_at = second + 4 + 4 + 1 + 1 + 3 * 4 + 4;
+        p[key_at] = 0xff;
+        let got: Vec<Result<String, &str>> = decode_messages(&p)
+            .unwrap_or_default()
+            .into_iter()
+            .map(|m| m.map(|m| m.key).map_err(|e| e.kind()))
+            .collect();
+        assert_eq!(
+            got,
+            vec![Err("bad_type"), Err("not_text"), Ok("NAV_X".into())]
+        );
+        assert_eq!(decode_packet(&p).map_err(|e| e.kind()), Err("bad_type"));
     }
 
     /// splitmix64: a deterministic stream for the fuzz pass (no random-number crate onboard).

@@ -2,7 +2,7 @@
 //! the reading in a configured field, checksum required) or the instrument's plain ASCII reading
 //! (one number per line). Readings are timestamped on arrival by the caller.
 
-use crate::protocol::sentence::{ANY, Fields, SentenceError};
+use crate::protocol::sentence::{Fields, READING, SentenceError};
 use serde::{Deserialize, Serialize};
 
 /// How chemical readings arrive.
@@ -53,7 +53,8 @@ impl ChemFormat {
                 let ok = t.len() <= 32
                     && t.bytes()
                         .all(|b| b.is_ascii_digit() || matches!(b, b'.' | b'-' | b'+'));
-                ok.then(|| t.parse::<f64>().ok())
+                let v = ok
+                    .then(|| t.parse::<f64>().ok())
                     .flatten()
                     .filter(|v| v.is_finite())
                     .ok_or(SentenceError::BadField {
@@ -62,7 +63,8 @@ impl ChemFormat {
                         name: "reading",
                         text: t.chars().take(32).collect(),
                         what: "a number",
-                    })
+                    })?;
+                READING.check("chemical", "reading", v)
             }
             ChemFormat::Sentence { id, field } => {
                 let f = Fields::parse(line)?;
@@ -70,7 +72,7 @@ impl ChemFormat {
                     return Err(SentenceError::Unknown(f.id.to_string()));
                 }
                 f.expect_at_least("chemical", *field)?;
-                f.f64("chemical", *field, "reading", ANY)
+                f.f64("chemical", *field, "reading", READING)
             }
         }
     }

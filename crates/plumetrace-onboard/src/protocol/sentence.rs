@@ -423,7 +423,8 @@ impl Range {
         Range { lo, hi, text }
     }
 
-    fn check(self, id: &'static str, name: &'static str, v: f64) -> Result<f64, SentenceError> {
+    /// `v` when it is finite and within the range; otherwise the error naming it.
+    pub fn check(self, id: &'static str, name: &'static str, v: f64) -> Result<f64, SentenceError> {
         if v.is_finite() && v >= self.lo && v <= self.hi {
             Ok(v)
         } else {
@@ -447,6 +448,9 @@ pub const DEPTH: Range = Range::new(-100.0, 12_000.0, "[-100, 12000]");
 pub const SPEED: Range = Range::new(-50.0, 50.0, "[-50, 50]");
 /// A rate: `[-1000, 1000]` per s.
 pub const RATE: Range = Range::new(-1000.0, 1000.0, "[-1000, 1000]");
+/// A chemical reading: `[-1e6, 1e9]` in the sensor's unit (wide enough for any instrument's
+/// scale, slightly negative offsets included; a reading beyond it is a corrupted number).
+pub const READING: Range = Range::new(-1e6, 1e9, "[-1e6, 1e9]");
 /// Anything finite.
 pub const ANY: Range = Range::new(f64::MIN, f64::MAX, "the finite numbers");
 
@@ -488,6 +492,15 @@ impl UtcTime {
     pub fn since(self, earlier: UtcTime) -> f64 {
         let d = (i64::from(self.ms) - i64::from(earlier.ms)).rem_euclid(i64::from(Self::DAY_MS));
         d as f64 / 1000.0
+    }
+
+    /// Milliseconds from `earlier` to `self` the short way round the day: in
+    /// `[-43_200_000, 43_200_000)`, so a time stamped just before `earlier` is behind it, not a
+    /// day ahead.
+    pub fn offset_ms_from(self, earlier: UtcTime) -> i64 {
+        let half = i64::from(Self::DAY_MS / 2);
+        (i64::from(self.ms) - i64::from(earlier.ms) + half).rem_euclid(i64::from(Self::DAY_MS))
+            - half
     }
 
     /// Reads `hhmmss` with an optional fraction (rounded to the millisecond).

@@ -100,8 +100,7 @@ impl<'a> Flight<'a> {
             LinkEvent::Clock(t) => {
                 s.front_time = t;
                 if s.lock_step {
-                    let first = *s.first_time.get_or_insert(t);
-                    s.clock_s = s.clock_s.max(t.since(first));
+                    s.tick(t);
                     // Checked at every tick of the front seat's clock, so a pause starts
                     // at the same mission time whatever the batching of lines.
                     if s.last_nav_s.is_some_and(|n| s.clock_s - n > l.stale_nav_s) {
@@ -123,7 +122,10 @@ impl<'a> Flight<'a> {
             }
             LinkEvent::Accepting(a) => {
                 s.accepting = a;
-                if !a {
+                // The front seat's last tick at the time limit: the run's end sends the final
+                // stop, once.
+                let ending = s.lock_step && s.clock_s >= onboard.file.run.time_limit_s;
+                if !a && !ending {
                     s.pause(link, "the front seat does not accept commands".into());
                 }
             }

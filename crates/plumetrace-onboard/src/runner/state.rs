@@ -17,7 +17,9 @@ fn utc_now() -> UtcTime {
 pub(super) struct State {
     pub(super) lock_step: bool,
     pub(super) started: Instant,
-    pub(super) first_time: Option<UtcTime>,
+    // The latest front-seat time the clock advanced to, and the milliseconds since the first.
+    pub(super) last_time: Option<UtcTime>,
+    pub(super) front_elapsed_ms: i64,
     pub(super) front_time: UtcTime,
     pub(super) clock_s: f64,
     pub(super) last_nav_s: Option<f64>,
@@ -33,7 +35,8 @@ impl State {
         State {
             lock_step,
             started: Instant::now(),
-            first_time: None,
+            last_time: None,
+            front_elapsed_ms: 0,
             front_time: UtcTime::default(),
             clock_s: 0.0,
             last_nav_s: None,
@@ -75,6 +78,22 @@ impl State {
         }
     }
 
+    /// Advances the lock-step clock to the front seat's time `t`: by the time since the latest
+    /// one, the short way round the day (a midnight between them counts). A time behind the
+    /// latest (a record stamped late, out of order) leaves the clock where it is.
+    pub(super) fn tick(&mut self, t: UtcTime) {
+        let Some(last) = self.last_time else {
+            self.last_time = Some(t);
+            return;
+        };
+        let d = t.offset_ms_from(last);
+        if d > 0 {
+            self.front_elapsed_ms += d;
+            self.last_time = Some(t);
+            self.clock_s = self.clock_s.max(self.front_elapsed_ms as f64 / 1000.0);
+        }
+    }
+
     /// Pauses the planner (once) and sends the safe command.
     pub(super) fn pause(&mut self, link: &mut dyn Link, reason: String) {
         if self.paused.is_some() {
@@ -101,5 +120,26 @@ impl State {
                 p.end_s = Some(t);
             }
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_record_stamped_before_the_first_does_not_move_the_clock_a_day() {
+        let mut s = State::new(true);
+        let at = |h: f64| UtcTime::from_seconds(h);
+        for t in [43_200.0, 43_199.0, 43_200.5, 43_201.0] {
+            s.tick(at(t));
+        }
+        assert!((s.clock_s - 1.0).abs() < 1e-9, "{}", s.clock_s);
+        // Midnight between two records.
+        let mut s = State::new(true);
+        for t in [86_399.5, 0.5, 1.0] {
+            s.tick(at(t));
+        }
+        assert!((s.clock_s - 1.5).abs() < 1e-9, "{}", s.clock_s);
     }
 }

@@ -4,7 +4,7 @@
 //! sharing the line routed to their own readers.
 
 use super::conn::{Conn, Endpoint, read_tcp};
-use super::lines::LineBuffer;
+use super::lines::{LineBuffer, Piece};
 use crate::link::{Link, LinkEvent, LinkTiming, Outgoing};
 use crate::protocol::chem::ChemFormat;
 use crate::protocol::current::FlowFormat;
@@ -55,7 +55,7 @@ impl LineLink {
             backoff: timing.reconnect_min,
             timing,
             conn: None,
-            lines: LineBuffer::default(),
+            lines: LineBuffer::with_limit(2 * MAX_LINE),
             last_byte: now,
             next_try: now,
             counts: LineCounts::default(),
@@ -200,16 +200,16 @@ impl Link for LineLink {
                         self.log('#', "the line speaks again");
                     }
                     self.lines.push(&chunk[..n]);
-                    while let Some(line) = self.lines.next_line() {
-                        if !line.trim().is_empty() {
-                            self.take_line(&line, &mut events);
+                    while let Some(piece) = self.lines.next_piece() {
+                        match piece {
+                            Piece::Line(line) if line.trim().is_empty() => {}
+                            Piece::Line(line) => self.take_line(&line, &mut events),
+                            Piece::TooLong(n) => {
+                                let r: Result<(), _> = Err(SentenceError::TooLong(n));
+                                self.counts.count(&r);
+                                self.log('!', &format!("a line of over {n} bytes was dropped"));
+                            }
                         }
-                    }
-                    if self.lines.len() > 2 * MAX_LINE {
-                        let r: Result<(), _> = Err(SentenceError::TooLong(self.lines.len()));
-                        self.counts.count(&r);
-                        self.log('!', "an endless line was dropped");
-                        self.lines.clear();
                     }
                 }
                 Err(e) => {
@@ -283,5 +283,87 @@ impl Link for LineLink {
             }
         }
         self.conn = None;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::protocol::sentence::frame;
+    use crate::protocol::session::{Bluefin, BluefinSettings};
+    use std::net::TcpListener;
+
+    /// Everything a link reports until the other side closes.
+    fn events_of(
+        server: impl FnOnce(std::net::TcpStream) + Send + 'static,
+    ) -> (Vec<LinkEvent>, LineCounts) {
+        let listener = TcpListener::bind("127.0.0.1:0").unwrap_or_else(|e| panic!("{e}"));
+        let addr = listener.local_addr().unwrap_or_else(|e| panic!("{e}"));
+        let t = std::thread::spawn(move || {
+            if let Ok((s, _)) = listener.accept() {
+                server(s);
+            }
+        });
+        let secs = Duration::from_secs_f64;
+        let protocol = Bluefin::new(BluefinSettings {
+            ack_timeout: secs(5.0),
+            ack_tries: 3,
+            status_period: secs(1.0),
+            safe_stop: true,
+        });
+        let timing = LinkTiming {
+            silence_timeout: secs(10.0),
+            reconnect_min: secs(60.0),
+            reconnect_max: secs(60.0),
+        };
+        let mut link = LineLink::new(
+            Endpoint::Tcp(addr.to_string()),
+            Box::new(protocol),
+            None,
+            timing,
+            None,
+        );
+        let mut events = Vec::new();
+        let deadline = Instant::now() + Duration::from_secs(20);
+        while Instant::now() < deadline {
+            let got = link.poll(Duration::from_millis(50));
+            let lost = got.iter().any(|e| matches!(e, LinkEvent::Lost(_)));
+            events.extend(got);
+            if lost {
+                break;
+            }
+        }
+        let _ = t.join();
+        (events, link.counts().clone())
+    }
+
+    #[test]
+    fn an_over_long_line_is_dropped_whole_and_counted_once() {
+        let (events, counts) = events_of(|mut s| {
+            let pause = || std::thread::sleep(Duration::from_millis(100));
+            // 2 kB with no end of line, whose tail is a valid sentence: not a line of its own.
+            let _ = s.write_all(&[b'X'; 1100]);
+            pause();
+            let _ = s.write_all(frame("BFCTL,120000.000,0").as_bytes());
+            pause();
+            // 100 kB in one line, in pieces.
+            for _ in 0..25 {
+                let _ = s.write_all(&[b'Y'; 4000]);
+                pause();
+            }
+            let _ = s.write_all(b"\r\n");
+            let _ = s.write_all(frame("BFCTL,120001.000,1").as_bytes());
+            pause();
+        });
+        let accepting: Vec<bool> = events
+            .iter()
+            .filter_map(|e| match e {
+                LinkEvent::Accepting(a) => Some(*a),
+                _ => None,
+            })
+            .collect();
+        assert_eq!(accepting, [true], "{events:?}");
+        assert_eq!(counts.rejected.get("too_long"), Some(&2), "{counts:?}");
+        assert_eq!(counts.accepted, 1, "{counts:?}");
     }
 }

@@ -1,0 +1,186 @@
+//! What pMarineViewer draws of the planner: its op-area and subregions as `VIEW_POLYGON`, its
+//! source estimate and declarations as `VIEW_MARKER`, the points where it lost the plume as
+//! `VIEW_POINT`, in the string formats of MOOS-IvP's geometry library (`x=..,y=..,label=..`
+//! pairs; a posting with a label already drawn replaces that shape).
+//!
+//! Labels: `cpt_op_area`, `cpt_subregion_K` (K from 0), `cpt_estimate` (one marker, moved as
+//! the estimate moves by more than 0.5 m), `cpt_lost_N` and `cpt_declared_N` (N from 1: every
+//! one stays on the map).
+
+use plumetrace_core::{Decision, PlannerEvent, Telemetry, Vec2};
+
+/// How far the estimate moves before its marker is posted again, m.
+const ESTIMATE_STEP_M: f64 = 0.5;
+
+/// A polygon as `VIEW_POLYGON` takes it.
+pub fn polygon(points: &[[f64; 2]], label: &str, color: &str) -> String {
+    let pts: Vec<String> = points
+        .iter()
+        .map(|p| format!("{:.2},{:.2}", p[0], p[1]))
+        .collect();
+    format!(
+        "pts={{{}}},label={label},edge_color={color},vertex_color={color},vertex_size=2,edge_size=1",
+        pts.join(":")
+    )
+}
+
+/// A marker as `VIEW_MARKER` takes it.
+pub fn marker(kind: &str, p: Vec2, label: &str, color: &str, width: f64) -> String {
+    format!(
+        "type={kind},x={:.2},y={:.2},label={label},color={color},width={width}",
+        p.x, p.y
+    )
+}
+
+/// A point as `VIEW_POINT` takes it.
+pub fn point(p: Vec2, label: &str, color: &str, size: u32) -> String {
+    format!(
+        "x={:.2},y={:.2},label={label},vertex_color={color},vertex_size={size}",
+        p.x, p.y
+    )
+}
+
+/// The mission's geometry: the op-area and each subregion.
+pub fn geometry(op_area: &[[f64; 2]], subregions: &[Vec<[f64; 2]>]) -> Vec<(&'static str, String)> {
+    let mut out = vec![("VIEW_POLYGON", polygon(op_area, "cpt_op_area", "yellow"))];
+    for (k, r) in subregions.iter().enumerate() {
+        out.push((
+            "VIEW_POLYGON",
+            polygon(r, &format!("cpt_subregion_{k}"), "gray"),
+        ));
+    }
+    out
+}
+
+/// The drawings a run's decisions call for, with what has been drawn so far.
+#[derive(Debug, Default)]
+pub struct Views {
+    estimate: Option<Vec2>,
+    lost: u32,
+    declared: u32,
+}
+
+impl Views {
+    /// The postings decision `d` calls for: a new lost point or declaration, an estimate moved
+    /// by more than 0.5 m since it was last drawn.
+    pub fn of(&mut self, d: &Decision) -> Vec<(&'static str, String)> {
+        let mut out = Vec::new();
+        for e in &d.events {
+            match e {
+                PlannerEvent::LostPoint { pos_m } => {
+                    self.lost += 1;
+                    let label = format!("cpt_lost_{}", self.lost);
+                    out.push(("VIEW_POINT", point(*pos_m, &label, "red", 4)));
+                }
+                PlannerEvent::Declared { pos_m, .. } => {
+                    self.declared += 1;
+                    let label = format!("cpt_declared_{}", self.declared);
+                    out.push((
+                        "VIEW_MARKER",
+                        marker("circle", *pos_m, &label, "green", 6.0),
+                    ));
+                }
+                _ => {}
+            }
+        }
+        for t in &d.telemetry {
+            if let Telemetry::SourceEstimate { pos_m } = t
+                && pos_m.x.is_finite()
+                && pos_m.y.is_finite()
+                && self
+                    .estimate
+                    .is_none_or(|e| (e - *pos_m).norm() > ESTIMATE_STEP_M)
+            {
+                self.estimate = Some(*pos_m);
+                out.push((
+                    "VIEW_MARKER",
+                    marker("diamond", *pos_m, "cpt_estimate", "orange", 4.0),
+                ));
+            }
+        }
+        out
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use plumetrace_core::{Command, DeclarationKind, Heading, PlanStatus, VerticalCommand};
+
+    fn decision(events: Vec<PlannerEvent>, estimate: Option<Vec2>) -> Decision {
+        let mut d = Decision::new(
+            Command {
+                heading: Heading::from_deg(0.0),
+                speed_mps: 1.0,
+                vertical: VerticalCommand::Depth(2.0),
+            },
+            PlanStatus::Running,
+        );
+        d.events = events;
+        d.telemetry = estimate
+            .map(|pos_m| Telemetry::SourceEstimate { pos_m })
+            .into_iter()
+            .collect();
+        d
+    }
+
+    #[test]
+    fn the_planner_is_drawn_in_pmarineviewer_strings() {
+        let g = geometry(
+            &[[60.0, -80.0], [460.0, -80.0], [460.0, 80.0]],
+            &[vec![[0.0, 0.0], [1.0, 0.0], [1.0, 1.0]]],
+        );
+        assert_eq!(
+            g[0],
+            (
+                "VIEW_POLYGON",
+                "pts={60.00,-80.00:460.00,-80.00:460.00,80.00},label=cpt_op_area,edge_color=yellow,vertex_color=yellow,vertex_size=2,edge_size=1".to_string()
+            )
+        );
+        assert!(g[1].1.contains("label=cpt_subregion_0"), "{g:?}");
+        let mut v = Views::default();
+        let lost = PlannerEvent::LostPoint {
+            pos_m: Vec2::new(100.0, -2.5),
+        };
+        let declared = PlannerEvent::Declared {
+            pos_m: Vec2::new(120.25, 3.0),
+            rule: DeclarationKind::new("along_flow"),
+        };
+        let got = v.of(&decision(vec![lost.clone()], Some(Vec2::new(130.0, 1.0))));
+        assert_eq!(
+            got,
+            vec![
+                (
+                    "VIEW_POINT",
+                    "x=100.00,y=-2.50,label=cpt_lost_1,vertex_color=red,vertex_size=4".to_string()
+                ),
+                (
+                    "VIEW_MARKER",
+                    "type=diamond,x=130.00,y=1.00,label=cpt_estimate,color=orange,width=4"
+                        .to_string()
+                ),
+            ]
+        );
+        // An estimate that moved 0.3 m is not posted again; a second lost point has its own
+        // label; the declaration is a marker of its own.
+        let got = v.of(&decision(vec![lost, declared], Some(Vec2::new(130.3, 1.0))));
+        assert_eq!(
+            got,
+            vec![
+                (
+                    "VIEW_POINT",
+                    "x=100.00,y=-2.50,label=cpt_lost_2,vertex_color=red,vertex_size=4".to_string()
+                ),
+                (
+                    "VIEW_MARKER",
+                    "type=circle,x=120.25,y=3.00,label=cpt_declared_1,color=green,width=6"
+                        .to_string()
+                ),
+            ]
+        );
+        assert_eq!(
+            v.of(&decision(vec![], Some(Vec2::new(131.0, 1.0)))).len(),
+            1
+        );
+    }
+}
