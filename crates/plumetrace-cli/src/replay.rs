@@ -21,9 +21,33 @@ pub struct ReplayArgs {
     #[arg(long, requires = "planner_file", allow_hyphen_values = true, value_parser = crate::args::vehicle)]
     pub vehicle: Option<u32>,
     /// Also write a replay page (HTML) of the replayed mission here: the logged tracks with the
-    /// replayed planners' behaviours and events.
+    /// replayed planners' behaviours and events (and the true sources, when the log sits in a
+    /// run's output directory beside its `summary.json`).
     #[arg(long)]
     pub page: Option<PathBuf>,
+}
+
+/// The true sources of the run whose output directory holds `log`, read from the `summary.json`
+/// beside it; none when there is no such file (a vehicle's log carries no truth) or it names
+/// no sources.
+fn sources_beside(log: &std::path::Path) -> Vec<[f64; 2]> {
+    let Some(text) = log
+        .parent()
+        .and_then(|d| std::fs::read_to_string(d.join("summary.json")).ok())
+    else {
+        return Vec::new();
+    };
+    let Ok(summary) = serde_json::from_str::<serde_json::Value>(&text) else {
+        return Vec::new();
+    };
+    summary["sources"]
+        .as_array()
+        .map(|a| {
+            a.iter()
+                .filter_map(|s| Some([s["x_m"].as_f64()?, s["y_m"].as_f64()?]))
+                .collect()
+        })
+        .unwrap_or_default()
 }
 
 /// The planner table of a `--planner-file`: the file itself (`kind` and keys), or the one
@@ -104,9 +128,9 @@ pub fn run(args: &ReplayArgs) -> Result<bool> {
             "{planner}: {} decisions, {} differ from the log",
             report.decisions, report.differing
         );
-        let html = builder
-            .page(&format!("replay of {}", args.log.display()), &subtitle)
-            .html()?;
+        let mut data = builder.page(&format!("replay of {}", args.log.display()), &subtitle);
+        data.sources = sources_beside(&args.log);
+        let html = data.html()?;
         crate::output::write_atomic(path, html.as_bytes())
             .with_context(|| format!("writing {}", path.display()))?;
     }

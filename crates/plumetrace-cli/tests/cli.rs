@@ -281,6 +281,31 @@ fn mission_run_writes_summary_trajectory_events_and_plot() {
         !replayed.contains(", 0 differ") && replayed.contains("line 2, vehicle 0"),
         "{replayed}"
     );
+    // The replayed page shows the run's true sources (read from the summary.json beside the log);
+    // the same log anywhere else carries no truth, and its page shows none.
+    let page_of = |log: &std::path::Path, page: &std::path::Path| {
+        let out = bin()
+            .args(["replay", log.to_str().unwrap(), "--planner-file"])
+            .arg(&other)
+            .arg("--page")
+            .arg(page)
+            .output()
+            .unwrap();
+        assert_eq!(out.status.code(), Some(3));
+        std::fs::read_to_string(page).unwrap()
+    };
+    let page = page_of(&log, &dir.path().join("replayed.html"));
+    assert!(
+        page.contains("\"sources\":[["),
+        "no true source on the replayed page"
+    );
+    let alone = dir.path().join("alone.jsonl.gz");
+    std::fs::copy(&log, &alone).unwrap();
+    let page = page_of(&alone, &dir.path().join("alone.html"));
+    assert!(
+        page.contains("\"sources\":[]"),
+        "a log without its run has no truth"
+    );
     // A bad planner file is named in the error.
     std::fs::write(&other, "kind = \"amp\"\nspeed = 1.5\n").unwrap();
     let out = bin()
