@@ -560,8 +560,8 @@ fn vehicle_layers(
 
 /// Places each time label on the side of its tick where it hides no marker (true and declared
 /// sources, lost points, reference targets, aborts and incidents: `marks`, each about 9 px
-/// across) and overlaps no earlier label; with no such side, leaves the label out (its tick
-/// stays).
+/// across) and overlaps no earlier label, preferring a side that no track crosses; with no side
+/// free of markers and labels, leaves the label out (its tick stays).
 fn place_time_labels(layers: &mut [VehicleLayer], marks: &[(f64, f64)], m: f64) {
     let mark_half = 9.0 * m;
     // Boxes taken: centre and half sizes.
@@ -569,6 +569,7 @@ fn place_time_labels(layers: &mut [VehicleLayer], marks: &[(f64, f64)], m: f64) 
         .iter()
         .map(|&(x, y)| (x, y, mark_half, mark_half))
         .collect();
+    let tracks = track_points(layers, 2.0 * m);
     for l in layers {
         for t in &mut l.times {
             let half_w = (text_px(&t.label, TIME_FONT_PX) / 2.0 + 2.0) * m;
@@ -581,11 +582,15 @@ fn place_time_labels(layers: &mut [VehicleLayer], marks: &[(f64, f64)], m: f64) 
                 t.label_at,
                 (2.0 * mid.0 - t.label_at.0, 2.0 * mid.1 - t.label_at.1),
             ];
-            let free = sides.into_iter().find(|&(cx, cy)| {
-                !boxes
-                    .iter()
-                    .any(|&(x, y, w, h)| (cx - x).abs() < half_w + w && (cy - y).abs() < half_h + h)
-            });
+            let inside = |(cx, cy): (f64, f64), (x, y): (f64, f64), w: f64, h: f64| {
+                (cx - x).abs() < half_w + w && (cy - y).abs() < half_h + h
+            };
+            let clear = |c: (f64, f64)| !boxes.iter().any(|&(x, y, w, h)| inside(c, (x, y), w, h));
+            let off_tracks = |c: (f64, f64)| !tracks.iter().any(|&p| inside(c, p, 0.0, 0.0));
+            let free = sides
+                .into_iter()
+                .find(|&c| clear(c) && off_tracks(c))
+                .or_else(|| sides.into_iter().find(|&c| clear(c)));
             match free {
                 Some(at) => {
                     t.label_at = at;
@@ -595,6 +600,32 @@ fn place_time_labels(layers: &mut [VehicleLayer], marks: &[(f64, f64)], m: f64) 
             }
         }
     }
+}
+
+/// Points along every drawn track (true and estimated), no more than `step` apart, so a label
+/// box that a track crosses holds at least one of them.
+fn track_points(layers: &[VehicleLayer], step: f64) -> Vec<(f64, f64)> {
+    let mut out = Vec::new();
+    let mut along = |line: &[(f64, f64)]| {
+        for w in line.windows(2) {
+            let (a, b) = (w[0], w[1]);
+            let n = ((b.0 - a.0).hypot(b.1 - a.1) / step)
+                .ceil()
+                .clamp(1.0, 10_000.0) as usize;
+            out.extend((0..n).map(|i| {
+                let f = i as f64 / n as f64;
+                (a.0 + (b.0 - a.0) * f, a.1 + (b.1 - a.1) * f)
+            }));
+        }
+        out.extend(line.last().copied());
+    };
+    for l in layers {
+        along(&l.truth);
+        for (_, p) in &l.runs {
+            along(p);
+        }
+    }
+    out
 }
 
 /// Every point drawn on the map that the legend, the key or a marker's label could hide.
@@ -860,6 +891,43 @@ mod tests {
         let svg = mission_figure(&run, "marks").unwrap();
         let over = crate::inspect::texts_over_marks(&svg);
         assert!(over.iter().all(|t| !t.ends_with(" min")), "{over:?}");
+    }
+
+    #[test]
+    fn a_time_label_moves_off_a_track_through_its_place() {
+        let run = demo(240.0);
+        let lay = layout(&run);
+        let m = lay.m_per_px;
+        let mut layers = lay.layers.clone();
+        let first = layers[0].times[0].clone();
+        assert!(!first.label.is_empty());
+        let at = first.label_at;
+        let mid = (
+            (first.tick[0].0 + first.tick[1].0) / 2.0,
+            (first.tick[0].1 + first.tick[1].1) / 2.0,
+        );
+        let other = (2.0 * mid.0 - at.0, 2.0 * mid.1 - at.1);
+        // Only a short track straight through the label's place: the label goes to the other
+        // side of its tick.
+        for l in &mut layers {
+            l.truth.clear();
+            l.runs.clear();
+        }
+        let mut crossing = layers[0].clone();
+        crossing.times.clear();
+        crossing.truth = vec![(at.0, at.1 - 3.0 * m), (at.0, at.1 + 3.0 * m)];
+        layers.push(crossing);
+        place_time_labels(&mut layers, &[], m);
+        let t = &layers[0].times[0];
+        assert_eq!(t.label_at, other, "the label moves to the side no track crosses");
+        // Crossed on both sides, it keeps its first place rather than vanish.
+        let mut both = layers.clone();
+        both[0].times[0].label_at = at;
+        both.last_mut().unwrap().truth = vec![at, other];
+        place_time_labels(&mut both, &[], m);
+        assert_eq!(both[0].times[0].label_at, at);
+        assert_eq!(both[0].times[0].label, first.label);
+        assert_eq!(t.label, first.label);
     }
 
     #[test]
