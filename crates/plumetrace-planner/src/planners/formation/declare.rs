@@ -24,9 +24,10 @@
 //!
 //! Its confidence, reported with the declaration (the leader's `formation` telemetry), is the
 //! contrast of the drop times the share of members that saw the plume, `(1 - q / p) n / 3`: `p`
-//! the strongest member's peak, `q` the largest reading any member took up-flow of the edge, `n`
-//! the members whose peak reached `min_peak`. A declaration from one member's readings with the
-//! plume still faintly read ahead scores low.
+//! the strongest member's peak, `q` the largest reading any member took over the confirming
+//! stretch (up-flow of the last trace), `n` the members whose peak reached `min_peak`. A
+//! declaration from one member's readings, or with the plume still faintly read ahead, scores
+//! low.
 
 use plumetrace_core::Vec2;
 use std::collections::BTreeMap;
@@ -132,7 +133,7 @@ impl Profile {
         let ahead = r.extrapolate * (own_edge - top).max(0) as f64;
         let along = (own_edge as f64 + 0.5 + ahead) * r.bin_m;
         let q = (0..3)
-            .flat_map(|k| self.bins[k].range(edge + 1..).map(|(_, &c)| c))
+            .flat_map(|k| self.bins[k].range(trace + 1..).map(|(_, &c)| c))
             .fold(0.0_f64, f64::max);
         let seen = self.peaks.iter().filter(|&&x| x >= r.min_peak).count();
         let confidence = ((1.0 - q / p).clamp(0.0, 1.0) * seen as f64 / 3.0).clamp(0.0, 1.0);
@@ -152,7 +153,7 @@ pub(super) fn on_centre_line(mid: Vec2, up: Vec2, along: f64) -> Vec2 {
 mod tests {
     use super::*;
 
-    fn rule() -> Rule {
+    fn rule(extrapolate: f64) -> Rule {
         Rule {
             bin_m: 1.0,
             significant_fraction: 0.5,
@@ -160,18 +161,25 @@ mod tests {
             min_peak: 0.01,
             min_strong_m: 3.0,
             confirm_m: 6.0,
-            extrapolate: 0.0,
+            extrapolate,
         }
     }
 
-    /// A team going up-flow at 0.25 m/s over a plume whose profile is `c(along)`, the follower
-    /// reading it; the along-flow coordinate where the rule declares, if it does.
-    fn fly(c: impl Fn(f64) -> f64) -> Option<Confirmed> {
+    /// A member's profile `exp(-a / x) / x`, `x` down-flow of an outlet at 0 (`along` is up-flow).
+    fn outlet(along: f64) -> f64 {
+        let x = -along;
+        if x > 0.0 { (-5.0 / x).exp() / x } else { 0.0 }
+    }
+
+    /// A team going up-flow over a plume whose profile is `c(along)` (the follower reading it,
+    /// a leader half of it); the declaration, if the rule makes one.
+    fn fly(extrapolate: f64, c: impl Fn(f64) -> f64) -> Option<Confirmed> {
         let mut p = Profile::default();
-        for k in 0..2000 {
+        for k in 0..5000 {
             let along = -100.0 + 0.025 * k as f64;
             let r = c(along);
-            if let Some(d) = p.update(&rule(), [Some((r * 0.1, along)), None, Some((r, along))], along) {
+            let members = [Some((r * 0.5, along)), None, Some((r, along))];
+            if let Some(d) = p.update(&rule(extrapolate), members, along) {
                 return Some(d);
             }
         }
@@ -179,23 +187,25 @@ mod tests {
     }
 
     #[test]
-    fn declares_past_the_end_of_a_steady_plume_and_not_before() {
-        // An outlet at 0: 1/x down-flow, nothing up-flow.
-        let d = fly(|a| if a < -0.5 { 1.0 / -a } else { 0.0 }).expect("declares");
-        assert!((-3.0..=0.5).contains(&d.along_m), "{d:?}");
-        assert!(d.confidence > 0.6, "{d:?}");
+    fn declares_past_the_end_of_a_steady_plume_at_the_outlet_extrapolated() {
+        // At the half-peak edge (x = 0.37 a = 1.85 m) without the extrapolation, on the outlet
+        // with it.
+        let edge = fly(0.0, outlet).expect("declares");
+        assert!((-2.5..=-1.0).contains(&edge.along_m), "{edge:?}");
+        let d = fly(0.59, outlet).expect("declares");
+        assert!(d.along_m.abs() < 1.0, "{d:?}");
+        // Two of the three members read: at most 2/3.
+        assert!(d.confidence > 0.6 && d.confidence <= 2.0 / 3.0, "{d:?}");
     }
 
     #[test]
     fn a_lull_shorter_than_the_confirmation_distance_does_not_declare() {
         // The plume fades for 4 m (the team off its side) and comes back stronger.
-        let d = fly(|a| {
+        let d = fly(0.0, |a| {
             if (-30.0..-26.0).contains(&a) {
                 0.0
-            } else if a < -0.5 {
-                1.0 / -a
             } else {
-                0.0
+                outlet(a)
             }
         })
         .expect("declares");
@@ -204,6 +214,7 @@ mod tests {
 
     #[test]
     fn a_single_spike_is_not_a_plume() {
-        assert_eq!(fly(|a| if (-50.0..-49.5).contains(&a) { 1.0 } else { 0.0 }), None);
+        let spike = |a: f64| if (-50.0..-49.5).contains(&a) { 1.0 } else { 0.0 };
+        assert_eq!(fly(0.0, spike), None);
     }
 }
