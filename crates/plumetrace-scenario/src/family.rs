@@ -1018,7 +1018,11 @@ impl Site {
         for (k, v) in Site::COLUMNS.iter().zip(self.values()) {
             out.push_str(&format!("#   {} = {v}\n", k.trim_start_matches("site_")));
         }
-        for (k, v) in self.team.iter().flat_map(crate::family_team::TeamSite::values) {
+        for (k, v) in self
+            .team
+            .iter()
+            .flat_map(crate::family_team::TeamSite::values)
+        {
             out.push_str(&format!("#   {k} = {v}\n"));
         }
         out.push_str(&toml::to_string(&table).unwrap_or_default());

@@ -241,7 +241,11 @@ fn roles(base: &toml::Table, base_origin: &Origin, path: &Path) -> Result<Roles,
         .and_then(toml::Value::as_array)
         .cloned()
         .unwrap_or_default();
-    let kind = |t: &toml::Table| t.get("kind").and_then(toml::Value::as_str).map(String::from);
+    let kind = |t: &toml::Table| {
+        t.get("kind")
+            .and_then(toml::Value::as_str)
+            .map(String::from)
+    };
     let follower = vehicles.iter().enumerate().find_map(|(k, v)| {
         let (name, t) = planner_of(base, v)?;
         (kind(&t).as_deref() == Some("formation_follower")).then_some((k, name, t))
@@ -332,14 +336,24 @@ pub(crate) fn check(
         1e-9,
         1e3,
     )?;
-    range("start_along_fraction", Some(t.start_along_fraction), 0.0, 1.0)?;
+    range(
+        "start_along_fraction",
+        Some(t.start_along_fraction),
+        0.0,
+        1.0,
+    )?;
     range(
         "start_along_min_m",
         Some([t.start_along_min_m; 2]),
         0.0,
         1e5,
     )?;
-    range("start_cross_sigmas", Some([t.start_cross_sigmas; 2]), 0.0, 10.0)?;
+    range(
+        "start_cross_sigmas",
+        Some([t.start_cross_sigmas; 2]),
+        0.0,
+        10.0,
+    )?;
     range("consumer_sigma_m", Some(t.consumer_sigma_m), 0.0, 100.0)?;
     range("acoustic_loss", t.acoustic_loss, 0.0, 1.0)?;
     range("ranging_noise_sd_s", t.ranging_noise_sd_s, 0.0, 1.0)?;
@@ -438,13 +452,19 @@ pub(crate) fn draw(
     let ky = float_of(base, "plume", "horizontal_diffusivity_m2ps").unwrap_or(0.012);
     let kz = float_of(base, "plume", "vertical_diffusivity_m2ps").unwrap_or(0.0004);
     let s = medium.unwrap_or(35.0);
-    let reach = s * q / (FRESH_KG_M3 * std::f64::consts::TAU * (ky * kz).sqrt())
-        / t.reach_freshness_ppt;
-    let mut along = (t.start_along_min_m.max(reach * uniform(&mut rng, t.start_along_fraction)))
-        .min(reach.max(t.start_along_min_m));
+    let reach =
+        s * q / (FRESH_KG_M3 * std::f64::consts::TAU * (ky * kz).sqrt()) / t.reach_freshness_ppt;
+    let mut along = (t
+        .start_along_min_m
+        .max(reach * uniform(&mut rng, t.start_along_fraction)))
+    .min(reach.max(t.start_along_min_m));
     let sigma = |x: f64| (2.0 * ky * x / site.flow_speed_mps).sqrt();
     let k = t.start_cross_sigmas;
-    let cross_unit = if k > 0.0 { rng.random_range(-k..=k) } else { 0.0 };
+    let cross_unit = if k > 0.0 {
+        rng.random_range(-k..=k)
+    } else {
+        0.0
+    };
     let place = |along: f64| {
         let c = outlet + down * along + left * (cross_unit * sigma(along));
         (
@@ -631,8 +651,14 @@ pub(crate) fn apply(
     let m = f.domain_margin_m;
     let xs = site.op_area.iter().map(|p| p[0]);
     let ys = site.op_area.iter().map(|p| p[1]);
-    let (x0, x1) = (xs.clone().fold(f64::MAX, f64::min), xs.fold(f64::MIN, f64::max));
-    let (y0, y1) = (ys.clone().fold(f64::MAX, f64::min), ys.fold(f64::MIN, f64::max));
+    let (x0, x1) = (
+        xs.clone().fold(f64::MAX, f64::min),
+        xs.fold(f64::MIN, f64::max),
+    );
+    let (y0, y1) = (
+        ys.clone().fold(f64::MAX, f64::min),
+        ys.fold(f64::MIN, f64::max),
+    );
     if let Some(domain) = table_at(t, "domain") {
         for (k, v) in [
             ("x_min_m", x0 - m),
@@ -644,7 +670,10 @@ pub(crate) fn apply(
         }
     }
     // A steady plume needs no spin-up.
-    if base.get("mission").and_then(|m| m.get("spinup_s")).is_none()
+    if base
+        .get("mission")
+        .and_then(|m| m.get("spinup_s"))
+        .is_none()
         && let Some(mission) = table_at(t, "mission")
     {
         mission.remove("spinup_s");
@@ -788,7 +817,10 @@ mod tests {
                 "<= 1",
             ),
             (
-                FORMATION.replace("gps = [\"rtk\", \"consumer\"]", "gps = [\"rtk\", \"phone\"]"),
+                FORMATION.replace(
+                    "gps = [\"rtk\", \"consumer\"]",
+                    "gps = [\"rtk\", \"phone\"]",
+                ),
                 "team.gps",
                 "unknown variant",
             ),

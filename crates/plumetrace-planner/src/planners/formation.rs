@@ -669,8 +669,11 @@ impl FormationLeader {
         }
         let since = *d.quiet_since_s.get_or_insert(t);
         let (along, point) = d.strong?;
-        (t - since >= self.p.quiet_s && mid.dot(&up) - along >= self.p.past_m)
-            .then_some((point, PASSED_PEAK, None))
+        (t - since >= self.p.quiet_s && mid.dot(&up) - along >= self.p.past_m).then_some((
+            point,
+            PASSED_PEAK,
+            None,
+        ))
     }
 }
 

@@ -69,7 +69,9 @@ pub struct BuildContext {
     /// Its kind.
     pub vehicle_kind: VehicleKind,
     /// The names of the mission's vehicles, by index (empty where the planner flies alone, as on
-    /// a vehicle link): planners that name other vehicles check them against it.
+    /// a vehicle link): planners that name other vehicles check them against it. Not written to
+    /// snapshot logs (a replay builds without the check).
+    #[serde(skip)]
     pub team: Vec<String>,
 }
 

@@ -122,7 +122,10 @@ impl Profile {
         let bins = &self.bins[best];
         let top = bins
             .iter()
-            .fold((edge, f64::MIN), |a, (&b, &c)| if c > a.1 { (b, c) } else { a })
+            .fold(
+                (edge, f64::MIN),
+                |a, (&b, &c)| if c > a.1 { (b, c) } else { a },
+            )
             .0;
         let own_edge = bins
             .iter()
@@ -214,7 +217,13 @@ mod tests {
 
     #[test]
     fn a_single_spike_is_not_a_plume() {
-        let spike = |a: f64| if (-50.0..-49.5).contains(&a) { 1.0 } else { 0.0 };
+        let spike = |a: f64| {
+            if (-50.0..-49.5).contains(&a) {
+                1.0
+            } else {
+                0.0
+            }
+        };
         assert_eq!(fly(0.0, spike), None);
     }
 }
