@@ -75,10 +75,10 @@ fn a_follower_naming_a_leader_that_does_not_exist_is_refused_with_the_vehicles_t
     let origin = Origin::File("team.toml".into());
     let cfg = plumetrace_scenario::parse(&text, &origin).unwrap();
     let built = build(&cfg, &origin, None).unwrap();
-    let e = plumetrace_mission::MissionSetup::new(built)
-        .err()
-        .expect("refused")
-        .to_string();
+    let Err(e) = plumetrace_mission::MissionSetup::new(built) else {
+        panic!("accepted");
+    };
+    let e = e.to_string();
     for part in [
         "team.toml",
         "planners.follower.left_leader",

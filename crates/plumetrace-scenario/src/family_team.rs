@@ -376,7 +376,8 @@ pub(crate) fn check(
             path,
             "team.outlets",
             format!(
-                "{base_origin} has a gaussian plume, which takes exactly one source: use                  outlets = [1], or a base whose plume model takes several"
+                "{base_origin} has a gaussian plume, which takes exactly one source: use \
+                 outlets = [1], or a base whose plume model takes several"
             ),
         ));
     }
