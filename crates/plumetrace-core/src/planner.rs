@@ -217,6 +217,9 @@ pub enum Telemetry {
         setpoint_m: Option<f64>,
         /// The member's filtered chemical reading.
         reading: f64,
+        /// The confidence of the declaration just made (a leader's confirmed rule), 0 to 1.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        declaration_confidence: Option<f64>,
     },
     /// The state of the planner's source-likelihood map.
     SourceMap {

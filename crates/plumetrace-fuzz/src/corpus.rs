@@ -76,6 +76,14 @@ pub const CAMPAIGNS: &[(&str, &str)] = &[
         include_str!("../../../examples/campaigns/formation-soares-filaments.toml"),
     ),
     (
+        "formation-family",
+        include_str!("../../../examples/campaigns/formation-family.toml"),
+    ),
+    (
+        "formation-family-tuning",
+        include_str!("../../../examples/campaigns/formation-family-tuning.toml"),
+    ),
+    (
         "map-declaration-coastal",
         include_str!("../../../examples/campaigns/map-declaration-coastal.toml"),
     ),
@@ -138,6 +146,10 @@ pub const FAMILIES: &[(&str, &str)] = &[
     (
         "faults",
         include_str!("../../../examples/families/faults.family.toml"),
+    ),
+    (
+        "formation",
+        include_str!("../../../examples/families/formation.family.toml"),
     ),
 ];
 

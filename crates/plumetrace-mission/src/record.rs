@@ -622,6 +622,7 @@ mod tests {
                 ranges_to: Some([VehicleId(1), VehicleId(2)]),
                 setpoint_m: Some(1.5),
                 reading: 0.5,
+                declaration_confidence: None,
             },
             Telemetry::SourceMap {
                 entropy_bits: 3.0,

@@ -153,6 +153,7 @@ impl MissionSetup {
                 geometry: geometry.clone(),
                 vehicle: v.vehicle.id,
                 vehicle_kind: v.vehicle.params.kind,
+                team: sc.vehicles.iter().map(|v| v.name.clone()).collect(),
             };
             // Build once here so that `check` catches what building would reject.
             config.build(&context, &r.key).map_err(&invalid)?;

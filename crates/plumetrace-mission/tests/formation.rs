@@ -65,3 +65,26 @@ fn with_a_fifth_of_the_acoustic_packets_lost_the_losses_are_counted_and_the_team
     assert_eq!(r.summary.outcome, Outcome::Declared);
     assert!(team.range_error_median_m.unwrap() < 1.0);
 }
+
+#[test]
+fn a_follower_naming_a_leader_that_does_not_exist_is_refused_with_the_vehicles_there_are() {
+    let preset = plumetrace_scenario::find_preset("soares-freshwater").unwrap();
+    let text = preset
+        .toml
+        .replace("left_leader = 2", "left_leader = 10000");
+    let origin = Origin::File("team.toml".into());
+    let cfg = plumetrace_scenario::parse(&text, &origin).unwrap();
+    let built = build(&cfg, &origin, None).unwrap();
+    let Err(e) = plumetrace_mission::MissionSetup::new(built) else {
+        panic!("accepted");
+    };
+    let e = e.to_string();
+    for part in [
+        "team.toml",
+        "planners.follower.left_leader",
+        "vehicle 10000 does not exist",
+        "3 vehicles, 0 (follower), 1 (leader-right), 2 (leader-left)",
+    ] {
+        assert!(e.contains(part), "{part}: {e}");
+    }
+}

@@ -515,6 +515,7 @@ impl Onboard {
             geometry,
             vehicle: plumetrace_core::VehicleId(0),
             vehicle_kind: m.vehicle_kind,
+            team: Vec::new(),
         };
         Ok(Onboard {
             file,

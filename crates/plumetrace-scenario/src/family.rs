@@ -79,6 +79,9 @@ pub struct FamilyFile {
     /// Sensor faults (default: none).
     #[serde(default)]
     pub faults: Option<FaultDraw>,
+    /// A formation team's draws (see [`crate::family_team`]).
+    #[serde(default)]
+    pub team: Option<crate::family_team::TeamDraw>,
 }
 
 fn default_margin() -> f64 {
@@ -268,6 +271,8 @@ pub struct Site {
     pub flow_fault_s: Option<[f64; 2]>,
     /// Spin-up time, s.
     pub spinup_s: f64,
+    /// A formation team's draws, if the family has `[team]`.
+    pub team: Option<crate::family_team::TeamSite>,
 }
 
 /// A loaded, checked family.
@@ -420,6 +425,7 @@ impl Family {
                 format!("{base_origin} is not a mission: it needs [mission] and [[vehicles]]"),
             ));
         }
+        crate::family_team::check(&file, &base, &base_origin, path)?;
         Ok(Family {
             file,
             path: path.to_path_buf(),
@@ -431,7 +437,11 @@ impl Family {
 
     /// The site of `seed`.
     pub fn draw(&self, seed: u64) -> Site {
-        draw(&self.file, seed)
+        let mut site = draw(&self.file, seed);
+        if let Some(t) = &self.file.team {
+            site.team = crate::family_team::draw(t, &self.base, &self.base_origin, &site, seed);
+        }
+        site
     }
 
     /// The scenario table of the site of `seed`.
@@ -755,6 +765,7 @@ fn draw(f: &FamilyFile, seed: u64) -> Site {
         fix_sigma_m: fix_sigma,
         flow_fault_s: fault,
         spinup_s,
+        team: None,
     }
 }
 
@@ -909,8 +920,25 @@ impl Site {
                 s.insert("mass_rate_per_s".into(), float(round(q, 4)));
             }
         }
-        // Vehicle.
-        if let Some(v) = first_of(&mut t, "vehicles") {
+        // Vehicle (a base of several keeps them all: the team moves as one, or as `[team]` draws).
+        let several = t
+            .get("vehicles")
+            .and_then(toml::Value::as_array)
+            .is_some_and(|a| a.len() > 1);
+        if several && self.team.is_none() {
+            crate::family_team::move_team(self, &mut t);
+        }
+        let first = if several {
+            t.get_mut("vehicles")
+                .and_then(toml::Value::as_array_mut)
+                .and_then(|a| a.first_mut())
+                .and_then(toml::Value::as_table_mut)
+        } else {
+            first_of(&mut t, "vehicles")
+        };
+        if self.team.is_none()
+            && let Some(v) = first
+        {
             v.insert("x_m".into(), float(round(self.start_pos[0], 2)));
             v.insert("y_m".into(), float(round(self.start_pos[1], 2)));
             v.insert(
@@ -968,6 +996,9 @@ impl Site {
             sim.insert("duration_s".into(), float(l));
         }
         t.remove("output");
+        if let Some(team) = &self.team {
+            crate::family_team::apply(team, f, self, base, &mut t);
+        }
         t
     }
 
@@ -986,6 +1017,13 @@ impl Site {
         );
         for (k, v) in Site::COLUMNS.iter().zip(self.values()) {
             out.push_str(&format!("#   {} = {v}\n", k.trim_start_matches("site_")));
+        }
+        for (k, v) in self
+            .team
+            .iter()
+            .flat_map(crate::family_team::TeamSite::values)
+        {
+            out.push_str(&format!("#   {k} = {v}\n"));
         }
         out.push_str(&toml::to_string(&table).unwrap_or_default());
         out

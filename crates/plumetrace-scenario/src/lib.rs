@@ -10,6 +10,7 @@ pub mod build;
 pub mod config;
 pub mod error;
 pub mod family;
+pub mod family_team;
 pub mod limits;
 pub mod locate;
 pub mod overrides;

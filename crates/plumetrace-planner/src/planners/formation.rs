@@ -79,6 +79,8 @@ use plumetrace_guidance::{Autopilot, AutopilotParams, OpArea, Steer};
 use serde::{Deserialize, Serialize};
 use std::collections::VecDeque;
 
+mod declare;
+
 /// Time between the telemetry records of a formation member, s.
 const TELEMETRY_PERIOD_S: f64 = 1.0;
 
@@ -110,10 +112,28 @@ impl Choice for ReadingModel {
     const ALL: &'static [Self] = &[ReadingModel::Freshness, ReadingModel::Concentration];
 }
 
+/// The leaders' declaration rule.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum DeclarationRule {
+    /// Every reading faded for `quiet_s` and the midpoint `past_m` up-flow of the strong point.
+    PassedPeak,
+    /// The along-flow profile the team sensed: the plume's end confirmed over `confirm_m`.
+    Confirmed,
+}
+
+impl Choice for DeclarationRule {
+    const ALL: &'static [Self] = &[DeclarationRule::PassedPeak, DeclarationRule::Confirmed];
+}
+
 /// The formation's rule in events: the team moved up-flow past its strongest readings and every
 /// member's reading faded; declared at the most up-flow strong reading, on the formation's centre
 /// line.
 pub const PASSED_PEAK: DeclarationKind = DeclarationKind::new("formation_passed_peak");
+
+/// The confirmed rule in events: the team's along-flow profile ended, confirmed over a distance;
+/// declared at the most up-flow strong reading, on the formation's centre line.
+pub const CONFIRMED: DeclarationKind = DeclarationKind::new("formation_confirmed");
 
 plumetrace_core::params! {
     /// Parameters of a formation leader (surface craft with GPS).
@@ -166,6 +186,16 @@ plumetrace_core::params! {
         stale_s: f64 = 10.0, "s", Bounds::positive(3600.0);
         /// Declare a source and finish (the rule in the module docs).
         declare: bool = true, "", Bounds::Any;
+        /// Which rule declares: `confirmed` (the along-flow profile) or `passed_peak` (a lull in time).
+        declaration_rule: DeclarationRule = DeclarationRule::Confirmed, "", Bounds::Any;
+        /// Bin width of the along-flow profile (`confirmed`).
+        bin_m: f64 = 1.0, "m", Bounds::closed(0.1, 100.0);
+        /// Least along-flow span of the strong readings (`confirmed`).
+        min_strong_m: f64 = 3.0, "m", Bounds::non_negative(1000.0);
+        /// How far up-flow of the last trace of plume the midpoint must go (`confirmed`).
+        confirm_m: f64 = 10.0, "m", Bounds::non_negative(1000.0);
+        /// Declare this fraction of the strongest member's peak-to-edge distance up-flow of its edge (`confirmed`; 0: at the edge).
+        extrapolate: f64 = 0.59, "", Bounds::closed(0.0, 5.0);
         /// A reading of at least this fraction of its member's peak marks a strong point.
         significant_fraction: f64 = 0.5, "", Bounds::closed(0.0, 1.0);
         /// Readings below this fraction of their member's peak count as faded.
@@ -176,6 +206,8 @@ plumetrace_core::params! {
         past_m: f64 = 2.0, "m", Bounds::non_negative(1000.0);
         /// Least peak that counts as plume (readings below it are noise).
         min_peak: f64 = 0.01, "unit", Bounds::non_negative(1e6);
+        /// When every reading has faded after the plume was seen, centre at full speed towards the side that read it last.
+        reacquire: bool = false, "", Bounds::Any;
         /// Compensate courses for the measured flow (crab angle).
         flow_compensation: bool = false, "", Bounds::Any;
     }
@@ -231,10 +263,16 @@ impl PlannerParams for FormationLeaderParams {
     const KIND: &'static str = "formation_leader";
     const SUMMARY: &'static str = "Formation leader (seed 004): Laplacian formation feedback on GPS positions by radio, up-flow urge, plume centring and cross-flow scaling; answers the follower's ranging requests; declares when the team has passed its strongest readings";
     const BEHAVIOURS: &'static [BehaviourKind] = &[];
-    const RULES: &'static [RuleDoc] = &[RuleDoc {
-        rule: PASSED_PEAK,
-        doc: "the team moved past_m up-flow of its strongest readings and every member's reading stayed below quiet_fraction of its peak for quiet_s: the most up-flow strong reading, on the formation's centre line",
-    }];
+    const RULES: &'static [RuleDoc] = &[
+        RuleDoc {
+            rule: CONFIRMED,
+            doc: "the strong readings span min_strong_m along the flow, the team went confirm_m up-flow of the last reading above quiet_fraction of its member's peak, and every reading faded: the most up-flow strong reading, on the formation's centre line (with a confidence in the leader's telemetry)",
+        },
+        RuleDoc {
+            rule: PASSED_PEAK,
+            doc: "the team moved past_m up-flow of its strongest readings and every member's reading stayed below quiet_fraction of its peak for quiet_s: the most up-flow strong reading, on the formation's centre line",
+        },
+    ];
 
     fn validate(&self, prefix: &str) -> Result<(), ParamError> {
         self.check_bounds(prefix)?;
@@ -307,6 +345,22 @@ impl PlannerParams for FormationFollowerParams {
                 return Err(ParamError {
                     key: key.into(),
                     message: format!("{id} is the follower itself"),
+                });
+            }
+            if !ctx.team.is_empty() && id as usize >= ctx.team.len() {
+                let named: Vec<String> = ctx
+                    .team
+                    .iter()
+                    .enumerate()
+                    .map(|(k, n)| format!("{k} ({n})"))
+                    .collect();
+                return Err(ParamError {
+                    key: key.into(),
+                    message: format!(
+                        "vehicle {id} does not exist: the scenario has {} vehicles, {}",
+                        ctx.team.len(),
+                        named.join(", ")
+                    ),
                 });
             }
         }
@@ -425,6 +479,9 @@ pub struct FormationLeader {
     next_radio_s: f64,
     next_telemetry_s: f64,
     declarer: Declarer,
+    profile: declare::Profile,
+    /// The side that last read more, +1 left, -1 right (0: none yet).
+    last_side: f64,
     declared: bool,
 }
 
@@ -454,6 +511,8 @@ impl FormationLeader {
                 strong: None,
                 quiet_since_s: None,
             },
+            profile: declare::Profile::default(),
+            last_side: 0.0,
             declared: false,
             p,
         }
@@ -555,7 +614,8 @@ impl FormationLeader {
         }
     }
 
-    /// Updates the declaration bookkeeping; the declared point when the rule fires.
+    /// Updates the declaration bookkeeping; the declared point, its rule and its confidence (the
+    /// confirmed rule's) when the rule fires.
     fn check_declaration(
         &mut self,
         t: f64,
@@ -563,7 +623,7 @@ impl FormationLeader {
         own: Option<f64>,
         partner: Option<PartnerState>,
         follower: Option<f64>,
-    ) -> Option<Vec2> {
+    ) -> Option<(Vec2, DeclarationKind, Option<f64>)> {
         let up = self.upflow.unit();
         let mid = partner.map_or(me_pos - self.bias(self.sign(), self.scale), |q| {
             0.5 * (me_pos + q.pos_m)
@@ -573,6 +633,21 @@ impl FormationLeader {
             partner.map(|q| (q.reading, q.pos_m)),
             follower.map(|c| (c, self.follower_station(mid))),
         ];
+        if self.p.declaration_rule == DeclarationRule::Confirmed {
+            let rule = declare::Rule {
+                bin_m: self.p.bin_m,
+                significant_fraction: self.p.significant_fraction,
+                quiet_fraction: self.p.quiet_fraction,
+                min_peak: self.p.min_peak,
+                min_strong_m: self.p.min_strong_m,
+                confirm_m: self.p.confirm_m,
+                extrapolate: self.p.extrapolate,
+            };
+            let along = members.map(|m| m.map(|(c, p)| (c, p.dot(&up))));
+            let d = self.profile.update(&rule, along, mid.dot(&up))?;
+            let at = declare::on_centre_line(mid, up, d.along_m);
+            return Some((at, CONFIRMED, Some(d.confidence)));
+        }
         let d = &mut self.declarer;
         let mut faded = true;
         for (k, m) in members.iter().enumerate() {
@@ -594,7 +669,11 @@ impl FormationLeader {
         }
         let since = *d.quiet_since_s.get_or_insert(t);
         let (along, point) = d.strong?;
-        (t - since >= self.p.quiet_s && mid.dot(&up) - along >= self.p.past_m).then_some(point)
+        (t - since >= self.p.quiet_s && mid.dot(&up) - along >= self.p.past_m).then_some((
+            point,
+            PASSED_PEAK,
+            None,
+        ))
     }
 }
 
@@ -634,9 +713,18 @@ impl Planner for FormationLeader {
         let up = self.upflow.unit();
         let left = self.left();
         let u_w = up * (self.p.urge_mps + self.p.current_speed_mps / self.p.k_w);
+        if (c_left - c_right).abs() >= self.p.min_peak {
+            self.last_side = (c_left - c_right).signum();
+        }
+        let faded = c_left.max(c_right).max(follower.unwrap_or(0.0)) < self.p.min_peak;
+        let centre = if self.p.reacquire && faded && self.last_side != 0.0 {
+            self.p.uc_max * self.last_side
+        } else {
+            centring(c_left, c_right, self.p.uc_max, self.p.k_l)
+        };
         let (u_c, u_f) = match partner {
             Some(q) => (
-                left * centring(c_left, c_right, self.p.uc_max, self.p.k_l),
+                left * centre,
                 laplacian_feedback(
                     me_pos,
                     self.bias(self.sign(), self.scale),
@@ -666,7 +754,7 @@ impl Planner for FormationLeader {
         }
         let mut events = Vec::new();
         let mut status = PlanStatus::Running;
-        let telemetry = if t + 1e-9 >= self.next_telemetry_s {
+        let mut telemetry = if t + 1e-9 >= self.next_telemetry_s {
             self.next_telemetry_s = t + TELEMETRY_PERIOD_S;
             vec![Telemetry::Formation {
                 scale_cw: Some(self.scale),
@@ -674,19 +762,28 @@ impl Planner for FormationLeader {
                 ranges_to: None,
                 setpoint_m: None,
                 reading: c_own,
+                declaration_confidence: None,
             }]
         } else {
             Vec::new()
         };
         if self.p.declare
             && !self.declared
-            && let Some(pos_m) = self.check_declaration(t, me_pos, own, partner, follower)
+            && let Some((pos_m, rule, confidence)) =
+                self.check_declaration(t, me_pos, own, partner, follower)
         {
             self.declared = true;
-            events.push(PlannerEvent::Declared {
-                pos_m,
-                rule: PASSED_PEAK,
-            });
+            events.push(PlannerEvent::Declared { pos_m, rule });
+            if confidence.is_some() {
+                telemetry.push(Telemetry::Formation {
+                    scale_cw: Some(self.scale),
+                    ranges_m: None,
+                    ranges_to: None,
+                    setpoint_m: None,
+                    reading: c_own,
+                    declaration_confidence: confidence,
+                });
+            }
             status = PlanStatus::Finished;
         }
         let flow = s.flow.map_or(Vec2::zeros(), |f| f.velocity_mps);
@@ -936,6 +1033,7 @@ impl Planner for FormationFollower {
                     ]),
                     setpoint_m: Some(d_f),
                     reading,
+                    declaration_confidence: None,
                 }]
             } else {
                 Vec::new()

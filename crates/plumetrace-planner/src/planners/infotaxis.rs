@@ -311,6 +311,7 @@ mod tests {
             },
             vehicle: VehicleId(0),
             vehicle_kind: VehicleKind::Auv,
+            team: Vec::new(),
         }
     }
 

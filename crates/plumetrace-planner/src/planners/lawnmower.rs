@@ -435,6 +435,7 @@ mod tests {
             },
             vehicle: VehicleId(0),
             vehicle_kind: plumetrace_core::VehicleKind::Auv,
+            team: Vec::new(),
         };
         let p = LawnmowerParams {
             edge_margin_m: 150.0,

@@ -68,6 +68,11 @@ pub struct BuildContext {
     pub vehicle: VehicleId,
     /// Its kind.
     pub vehicle_kind: VehicleKind,
+    /// The names of the mission's vehicles, by index (empty where the planner flies alone, as on
+    /// a vehicle link): planners that name other vehicles check them against it. Not written to
+    /// snapshot logs (a replay builds without the check).
+    #[serde(skip)]
+    pub team: Vec<String>,
 }
 
 /// The parameters of one planner, and how to make the planner from them.
