@@ -919,7 +919,10 @@ mod tests {
         layers.push(crossing);
         place_time_labels(&mut layers, &[], m);
         let t = &layers[0].times[0];
-        assert_eq!(t.label_at, other, "the label moves to the side no track crosses");
+        assert_eq!(
+            t.label_at, other,
+            "the label moves to the side no track crosses"
+        );
         // Crossed on both sides, it keeps its first place rather than vanish.
         let mut both = layers.clone();
         both[0].times[0].label_at = at;
