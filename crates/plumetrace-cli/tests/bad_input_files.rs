@@ -1,0 +1,107 @@
+//! Bad input that names files: names that become file names are checked where the scenario is
+//! read, writers stay inside their output directory whatever the name, and a run that cannot go
+//! ahead leaves an earlier run's files as they were.
+
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
+use std::path::Path;
+
+mod common;
+use common::{bin, demo};
+
+/// Every file under `dir`, relative to it, sorted.
+fn tree(dir: &Path) -> Vec<String> {
+    let mut out = Vec::new();
+    let mut stack = vec![dir.to_path_buf()];
+    while let Some(d) = stack.pop() {
+        for e in std::fs::read_dir(&d).unwrap().flatten() {
+            let p = e.path();
+            if p.is_dir() {
+                stack.push(p.clone());
+            }
+            out.push(p.strip_prefix(dir).unwrap().display().to_string());
+        }
+    }
+    out.sort();
+    out
+}
+
+/// Runs `plumetrace ARGS`, expects status 1, and returns standard error.
+fn fails(args: &[&str]) -> String {
+    let out = bin().args(args).output().unwrap();
+    assert_eq!(
+        out.status.code(),
+        Some(1),
+        "plumetrace {args:?}: {}",
+        String::from_utf8_lossy(&out.stdout)
+    );
+    String::from_utf8_lossy(&out.stderr).into_owned()
+}
+
+#[test]
+fn hostile_vehicle_names_are_refused_and_nothing_is_written_outside_out() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let long = "x".repeat(300);
+    let names = [
+        "../alog-escaped",
+        "../../alog-escaped",
+        "/tmp/alog-escaped-absolute",
+        "a/b",
+        "..",
+        ".hidden",
+        "a\\u0000b",
+        "bell\\u0007",
+        long.as_str(),
+        "",
+    ];
+    for (i, name) in names.iter().enumerate() {
+        let text = demo().replacen("name = \"auv\"", &format!("name = \"{name}\""), 1);
+        let file = d.join(format!("s{i}.toml"));
+        std::fs::write(&file, &text).unwrap();
+        let out = d.join("o").join("a").join("b");
+        let before = tree(d);
+        if name.is_empty() {
+            // an empty name is the default (`vehicles[0]`); `check` accepts it
+            continue;
+        }
+        let e = fails(&["check", file.to_str().unwrap()]);
+        let line = text.lines().position(|l| l.starts_with("name = \"")).unwrap();
+        let line = text.lines().skip(line + 1).position(|l| l.starts_with("name = ")).unwrap()
+            + line
+            + 2;
+        assert!(
+            e.contains(&format!("s{i}.toml:{line}: vehicles[0].name:")),
+            "{name}: {e}"
+        );
+        let e = fails(&[
+            "run",
+            file.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+            "--alog",
+        ]);
+        assert!(e.contains("vehicles[0].name"), "{name}: {e}");
+        let after: Vec<String> = tree(d)
+            .into_iter()
+            .filter(|p| !p.starts_with("o"))
+            .collect();
+        assert_eq!(after, before, "{name}: files appeared outside --out");
+        assert!(!Path::new("/tmp/alog-escaped-absolute.alog").exists());
+        let _ = std::fs::remove_dir_all(d.join("o"));
+    }
+}
+
+#[test]
+fn two_vehicles_with_one_name_are_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let file = dir.path().join("twins.toml");
+    let twin = "[[vehicles]]\nkind = \"auv\"\nname = \"auv\"\nx_m = 470.0\ny_m = 60.0\nheading_deg = 270.0\n\n[mission]";
+    std::fs::write(&file, demo().replacen("[mission]", twin, 1)).unwrap();
+    let e = fails(&["check", file.to_str().unwrap()]);
+    assert!(
+        e.contains("twins.toml:")
+            && e.contains("vehicles[1].name: \"auv\" is also vehicles[0]'s name"),
+        "{e}"
+    );
+}
