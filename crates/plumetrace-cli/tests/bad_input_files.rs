@@ -66,8 +66,15 @@ fn hostile_vehicle_names_are_refused_and_nothing_is_written_outside_out() {
             continue;
         }
         let e = fails(&["check", file.to_str().unwrap()]);
-        let line = text.lines().position(|l| l.starts_with("name = \"")).unwrap();
-        let line = text.lines().skip(line + 1).position(|l| l.starts_with("name = ")).unwrap()
+        let line = text
+            .lines()
+            .position(|l| l.starts_with("name = \""))
+            .unwrap();
+        let line = text
+            .lines()
+            .skip(line + 1)
+            .position(|l| l.starts_with("name = "))
+            .unwrap()
             + line
             + 2;
         assert!(

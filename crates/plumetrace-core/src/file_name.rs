@@ -68,7 +68,14 @@ mod tests {
 
     #[test]
     fn names_are_checked_against_the_safe_set() {
-        for good in ["remus", "leader-left", "a", "auv_2", "v1.2", &"x".repeat(64)] {
+        for good in [
+            "remus",
+            "leader-left",
+            "a",
+            "auv_2",
+            "v1.2",
+            &"x".repeat(64),
+        ] {
             assert_eq!(check_name(good), Ok(()), "{good}");
         }
         let cases: &[(&str, UnsafeName)] = &[
@@ -94,8 +101,21 @@ mod tests {
     fn joins_stay_inside_the_directory() {
         let dir = Path::new("out");
         assert_eq!(join_inside(dir, "a.alog"), Ok(dir.join("a.alog")));
-        assert_eq!(join_inside(dir, "vehicles[0].alog"), Ok(dir.join("vehicles[0].alog")));
-        for bad in ["", "..", ".", "../a.alog", "/a.alog", "a/b.alog", "a/", "./a", "a\0b"] {
+        assert_eq!(
+            join_inside(dir, "vehicles[0].alog"),
+            Ok(dir.join("vehicles[0].alog"))
+        );
+        for bad in [
+            "",
+            "..",
+            ".",
+            "../a.alog",
+            "/a.alog",
+            "a/b.alog",
+            "a/",
+            "./a",
+            "a\0b",
+        ] {
             assert!(join_inside(dir, bad).is_err(), "{bad:?}");
         }
     }

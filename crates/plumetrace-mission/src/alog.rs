@@ -98,7 +98,8 @@ impl AlogObserver {
             };
             let file = File::create(&partial).map_err(io)?;
             // pushed before the header is written, so that a failure removes the file
-            let writer = AlogWriter::new(BufWriter::new(file), &path.display().to_string(), 0.0, name);
+            let writer =
+                AlogWriter::new(BufWriter::new(file), &path.display().to_string(), 0.0, name);
             match writer {
                 Ok(writer) => obs.writers.push(Some(AlogFile {
                     path,
@@ -165,5 +166,43 @@ impl Observer for AlogObserver {
             }
         }
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    #![allow(clippy::unwrap_used)]
+    use super::*;
+
+    #[test]
+    fn names_that_would_leave_the_directory_or_share_a_log_are_refused_before_writing() {
+        let root =
+            std::env::temp_dir().join(format!("plumetrace-alog-names-{}", std::process::id()));
+        let dir = root.join("out");
+        std::fs::create_dir_all(&dir).unwrap();
+        for bad in ["../up", "/abs", "a/b", "../..", "a\0b"] {
+            let names = vec!["ok".to_string(), bad.to_string()];
+            let e = AlogObserver::create(&dir, &names, &[true, true])
+                .err()
+                .unwrap();
+            assert!(e.to_string().starts_with("vehicle 1 ("), "{bad:?}: {e}");
+        }
+        let twins = vec!["auv".to_string(), "auv".to_string()];
+        let e = AlogObserver::create(&dir, &twins, &[true, true])
+            .err()
+            .unwrap();
+        assert_eq!(
+            e.to_string(),
+            "vehicles 0 and 1 are both named \"auv\"; each needs its own .alog"
+        );
+        assert!(AlogObserver::create(&dir, &twins, &[true, false]).is_ok());
+        let listed = |d: &Path| std::fs::read_dir(d).unwrap().count();
+        assert_eq!(
+            listed(&dir),
+            0,
+            "nothing written, partial logs removed on drop"
+        );
+        assert_eq!(listed(&root), 1, "nothing beside the directory");
+        let _ = std::fs::remove_dir_all(&root);
     }
 }
