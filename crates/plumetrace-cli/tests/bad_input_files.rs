@@ -112,3 +112,118 @@ fn two_vehicles_with_one_name_are_refused() {
         "{e}"
     );
 }
+
+/// An onboard file for a Bluefin front seat on a port nobody listens on.
+const ONBOARD: &str = r#"name = "t"
+[mission]
+op_area = [[60.0, -80.0], [460.0, -80.0], [460.0, 80.0], [60.0, 80.0]]
+prior_flow_toward_deg = 90.0
+[planner]
+kind = "amp"
+[link]
+protocol = "bluefin"
+address = "127.0.0.1:9"
+origin = { lat_deg = 36.18, lon_deg = -75.75 }
+give_up_s = 0.5
+[run]
+mode = "lock_step"
+"#;
+
+#[test]
+fn an_onboard_file_that_cannot_fly_leaves_the_previous_flight_whole() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let out = d.join("flight");
+    std::fs::create_dir_all(&out).unwrap();
+    let earlier = [
+        ("link.log", "earlier traffic\n".repeat(1000)),
+        ("run.alog", "earlier alog\n".to_string()),
+        ("onboard.json", "{}".to_string()),
+    ];
+    for (name, text) in &earlier {
+        std::fs::write(out.join(name), text).unwrap();
+    }
+    let cases = [
+        (
+            "kind = \"amp\"",
+            "kind = \"lawnmower\"\nedge_margin_m = 1000.0",
+            "bad.toml:7: planner.edge_margin_m: no survey lane fits",
+        ),
+        (
+            "kind = \"amp\"",
+            "kind = \"amp\"\nspeed_mps = 10.0",
+            "bad.toml:7: planner.speed_mps: 10 m/s is above the vehicle's limit link.limits.max_speed_mps (2.5 m/s)",
+        ),
+        (
+            "[460.0, 80.0], [60.0, 80.0]]",
+            "[460.0, 80.0, 3.0], [60.0, 80.0]]",
+            "vertex 2 has 3 coordinates",
+        ),
+    ];
+    for (from, to, want) in cases {
+        let file = d.join("bad.toml");
+        std::fs::write(&file, ONBOARD.replacen(from, to, 1)).unwrap();
+        for check in [true, false] {
+            let mut args = vec![
+                "onboard",
+                file.to_str().unwrap(),
+                "--out",
+                out.to_str().unwrap(),
+            ];
+            if check {
+                args.push("--check");
+            }
+            let e = fails(&args);
+            assert!(e.contains(want), "{to}: {e}");
+        }
+        for (name, text) in &earlier {
+            assert_eq!(
+                &std::fs::read_to_string(out.join(name)).unwrap(),
+                text,
+                "{name}"
+            );
+        }
+        assert_eq!(std::fs::read_dir(&out).unwrap().count(), 3, "no new files");
+    }
+}
+
+#[test]
+fn onboard_check_connects_to_nothing_and_writes_nothing() {
+    let dir = tempfile::tempdir().unwrap();
+    let file = dir.path().join("ok.toml");
+    std::fs::write(&file, ONBOARD).unwrap();
+    let out = dir.path().join("never");
+    let started = std::time::Instant::now();
+    let o = common::run_ok(&[
+        "onboard",
+        file.to_str().unwrap(),
+        "--check",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(started.elapsed().as_secs_f64() < 5.0);
+    let said = String::from_utf8_lossy(&o.stdout);
+    assert!(said.contains("ok.toml: ok: planner amp"), "{said}");
+    assert!(!out.exists());
+}
+
+#[test]
+fn family_out_at_a_file_says_so_and_writes_nothing() {
+    let dir = tempfile::tempdir().unwrap();
+    let file = dir.path().join("plain");
+    std::fs::write(&file, "x").unwrap();
+    let fam = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../examples/families/coastal.family.toml"
+    );
+    let e = fails(&[
+        "family",
+        fam,
+        "--sample",
+        "2",
+        "--out",
+        file.to_str().unwrap(),
+    ]);
+    assert!(e.contains("plain: is a file, not a directory"), "{e}");
+    assert_eq!(std::fs::read_to_string(&file).unwrap(), "x");
+}

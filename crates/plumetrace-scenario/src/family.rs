@@ -290,9 +290,15 @@ pub const FAMILY_LIMITS: &[(&str, f64, f64, &str)] = &[
     ("time_limit_s", 1.0, 1e6, "about 11 days at most"),
     (
         "domain_margin_m",
-        0.0,
+        1.0,
         10_000.0,
-        "room for the plume and the cage",
+        "room for the plume and the cage (at least 1 m: the domain is written to 0.1 m, the op-area to 0.01 m)",
+    ),
+    (
+        "vertical_mixing_length_m",
+        0.0,
+        200.0,
+        "times a current of up to 5 m/s, within the scenario's vertical diffusivity bound (1000 m^2/s)",
     ),
     ("prior_flow_error_deg[]", -180.0, 180.0, "an angle"),
     ("flow.toward_deg[]", -720.0, 720.0, "compass degrees"),
@@ -474,6 +480,10 @@ fn check(f: &FamilyFile, path: &Path) -> Result<(), ScenarioError> {
         }
         Ok(())
     };
+    // The name becomes every site's name and the campaign's scenario label (and file names
+    // made of it), so it keeps to the safe set of names that become file names.
+    plumetrace_core::file_name::check_name(&f.name)
+        .map_err(|e| invalid(path, "name", format!("{:?} {e}", f.name)))?;
     if let Some(t) = f.time_limit_s {
         num("time_limit_s", t)?;
     }
@@ -1078,6 +1088,30 @@ mod tests {
                 COASTAL.replace("shapes = [\"rectangle\", \"convex\"]", "shapes = []"),
                 "area.shapes",
                 "at least one",
+            ),
+            // each of these passed, and every site then failed, blaming the base
+            (
+                COASTAL.replace("domain_margin_m = 150.0", "domain_margin_m = 0.0"),
+                "domain_margin_m",
+                ">= 1",
+            ),
+            (
+                COASTAL.replace(
+                    "vertical_mixing_length_m = 0.038",
+                    "vertical_mixing_length_m = -0.038",
+                ),
+                "vertical_mixing_length_m",
+                ">= 0",
+            ),
+            (
+                COASTAL.replace("name = \"coastal\"", "name = \"coast\\u0007al\""),
+                "name",
+                "holds '\\u{7}'",
+            ),
+            (
+                COASTAL.replace("name = \"coastal\"", "name = \"../coastal\""),
+                "name",
+                "starts with '.'",
             ),
         ];
         for (text, key, what) in cases {
