@@ -305,7 +305,11 @@ pub const LIMITS: &[Limit] = &[
         1e4,
         "kelp patches are metres to hundreds of metres apart",
     ),
-    num("kelp[].seed", 0.0, 1.8446744073709552e19, "a 64-bit seed"),
+    Limit {
+        key: "kelp[].seed",
+        bound: Bound::Any,
+        why: "any whole number 0..2^64, as the run seed (beyond 2^63 - 1 a string of digits)",
+    },
     num(
         "output.nx",
         2.0,

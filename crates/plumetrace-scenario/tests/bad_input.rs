@@ -709,3 +709,24 @@ fn the_success_radius_is_a_mission_key_with_a_default() {
         "{e}"
     );
 }
+
+#[test]
+fn kelp_seeds_take_every_64_bit_value_as_the_run_seed_does() {
+    let kelp = find_preset("li-zhang-kelp").unwrap().toml;
+    for v in [
+        "9223372036854775808",
+        "\"9223372036854775808\"",
+        "18446744073709551615",
+        "\"18446744073709551615\"",
+    ] {
+        let text = kelp.replacen(
+            "name = \"kelp\"",
+            &format!("name = \"kelp\"\nseed = {v}"),
+            1,
+        );
+        assert_ne!(text, kelp);
+        assert_eq!(error_of(&text), "accepted", "seed = {v}");
+    }
+    let text = kelp.replacen("name = \"kelp\"", "name = \"kelp\"\nseed = -1", 1);
+    assert!(error_of(&text).contains("kelp[0].seed: expected a whole number"));
+}
