@@ -593,6 +593,11 @@ pub const LIMITS: &[Limit] = &[
     count("planners", 100, "planners are per vehicle"),
 ];
 
+/// The most flow grid-node updates a run may take (sub-steps times nodes, spin-up included):
+/// about an hour of computing at a few hundred million node updates a second. Counting sub-steps
+/// alone let a fine grid with a short stable step run for days within [`MAX_STEPS`].
+pub const MAX_FLOW_NODE_STEPS: f64 = 1e12;
+
 /// The most steps of a run (plume run or mission), the spin-up apart: about a day of computing.
 pub const MAX_STEPS: f64 = 1e8;
 /// The most steps of a spin-up.

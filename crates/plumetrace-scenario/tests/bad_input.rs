@@ -730,3 +730,31 @@ fn kelp_seeds_take_every_64_bit_value_as_the_run_seed_does() {
     let text = kelp.replacen("name = \"kelp\"", "name = \"kelp\"\nseed = -1", 1);
     assert!(error_of(&text).contains("kelp[0].seed: expected a whole number"));
 }
+
+#[test]
+fn flow_sub_steps_count_in_the_step_budget_with_their_grid() {
+    // A 0.1 s plume run on a fine grid whose stable step needs about 250,000 sub-steps per step
+    // is within the budget; a 10 s one would take about 2.5e13 node updates and ran for days.
+    let fine = |duration: &str| {
+        demo_with(|t| {
+            t.replacen("duration_s = 600.0", &format!("duration_s = {duration}"), 1)
+                .replacen("nx = 21", "nx = 1000", 1)
+                .replacen("ny = 11", "ny = 1000", 1)
+                .replacen(
+                    "noise_gain = 0.3",
+                    "noise_gain = 0.3\ndiffusivity_x_m2ps = 10000.0\ndiffusivity_y_m2ps = 10000.0",
+                    1,
+                )
+                .replacen("average_start_s = 300.0", "average_start_s = 0.0", 1)
+        })
+    };
+    assert_eq!(error_of(&fine("0.1")), "accepted");
+    let e = error_of(&fine("10.0"));
+    assert!(
+        e.contains("scenario.toml: flow.farrell:")
+            && e.contains(
+                "flow steps of 1000000 grid nodes each, 2.495e13 node updates; at most 1e12"
+            ),
+        "{e}"
+    );
+}
