@@ -227,3 +227,20 @@ fn family_out_at_a_file_says_so_and_writes_nothing() {
     assert!(e.contains("plain: is a file, not a directory"), "{e}");
     assert_eq!(std::fs::read_to_string(&file).unwrap(), "x");
 }
+
+#[test]
+fn a_start_inside_an_obstacle_is_refused_by_check() {
+    let dir = tempfile::tempdir().unwrap();
+    let file = dir.path().join("walled.toml");
+    let wall = "[[obstacles]]\nname = \"pier\"\nvertices = [[460.0, -70.0], [480.0, -70.0], [480.0, -50.0], [460.0, -50.0]]\n\n[[vehicles]]";
+    let text = demo().replacen("[[vehicles]]", wall, 1);
+    std::fs::write(&file, &text).unwrap();
+    let e = fails(&["check", file.to_str().unwrap()]);
+    let line = text.lines().position(|l| l == "x_m = 470.0").unwrap() + 1;
+    assert!(
+        e.contains(&format!(
+            "walled.toml:{line}: vehicles[0].x_m: start (470, -60) is inside obstacles[0] ('pier')"
+        )),
+        "{e}"
+    );
+}
