@@ -244,3 +244,27 @@ fn a_start_inside_an_obstacle_is_refused_by_check() {
         "{e}"
     );
 }
+
+#[test]
+fn a_plume_run_whose_flow_diverges_names_the_file_and_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let file = dir.path().join("wild.toml");
+    let text = plumetrace_scenario::find_preset("plume-demo")
+        .unwrap()
+        .toml
+        .replacen("noise_gain = 0.3", "noise_gain = 100.0", 1);
+    std::fs::write(&file, &text).unwrap();
+    let out = dir.path().join("o");
+    let e = fails(&[
+        "run",
+        file.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    let line = text.lines().position(|l| l == "[flow.farrell]").unwrap() + 1;
+    assert!(
+        e.contains(&format!("wild.toml:{line}: step "))
+            && e.contains("flow.farrell: the field diverged"),
+        "{e}"
+    );
+}

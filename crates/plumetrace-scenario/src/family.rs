@@ -315,7 +315,12 @@ pub const FAMILY_LIMITS: &[(&str, f64, f64, &str)] = &[
         1e7,
         "a period of minutes to months",
     ),
-    ("flow.meander_gain[]", 0.0, 100.0, "the Farrell noise gain"),
+    (
+        "flow.meander_gain[]",
+        0.0,
+        1.0,
+        "the Farrell noise gain; above 1 the meander reaches metres per second and the grid can diverge (plume-demo's does at 5 within two minutes)",
+    ),
     (
         "area.length_m[]",
         10.0,
@@ -426,13 +431,15 @@ impl Family {
                 format!("{base_origin} is not a mission: it needs [mission] and [[vehicles]]"),
             ));
         }
-        Ok(Family {
+        let family = Family {
             file,
             path: path.to_path_buf(),
             text: text.to_string(),
             base_origin,
             base,
-        })
+        };
+        check_extremes(&family)?;
+        Ok(family)
     }
 
     /// The site of `seed`.
@@ -537,6 +544,62 @@ fn check(f: &FamilyFile, path: &Path) -> Result<(), ScenarioError> {
     if let Some(x) = &f.faults {
         num("faults.flow_sensor_probability", x.flow_sensor_probability)?;
         range("faults.duration_s", Some(x.duration_s))?;
+    }
+    Ok(())
+}
+
+/// Builds sites at the ends of the ranges that decide whether a site can be built at all (the
+/// current's speed, the op-area's extents and the tide's swing set the domain, the spin-up and
+/// so the flow's steps), a few draws each, so that a family whose sites would be refused at run
+/// time (a long time limit over tiny op-areas exceeding the step budget of the base's flow grid,
+/// say) is refused here, at the family file.
+fn check_extremes(family: &Family) -> Result<(), ScenarioError> {
+    let f = &family.file;
+    let ends = |r: Range, high: bool| if high { [r[1], r[1]] } else { [r[0], r[0]] };
+    for corner in 0..16_u32 {
+        let mut g = f.clone();
+        g.flow.speed_mps = ends(f.flow.speed_mps, corner & 1 != 0);
+        g.area.length_m = ends(f.area.length_m, corner & 2 != 0);
+        g.area.width_m = ends(f.area.width_m, corner & 4 != 0);
+        g.flow.tidal_swing_deg = f.flow.tidal_swing_deg.map(|r| ends(r, true));
+        // Axis-aligned op-areas make the narrowest domains (the finest flow grid), and a
+        // convex op-area's domain can be half a rectangle's across, which takes up to four
+        // times the flow's sub-steps: the probe flies four times the time limit.
+        g.flow.toward_deg = [0.0, 0.0];
+        g.area.axis_to_flow_deg = Some(if corner & 8 != 0 {
+            [90.0, 90.0]
+        } else {
+            [0.0, 0.0]
+        });
+        let limit = f.time_limit_s.or_else(|| {
+            family
+                .base
+                .get("mission")
+                .and_then(|m| m.get("time_limit_s"))
+                .and_then(toml::Value::as_float)
+        });
+        g.time_limit_s = Some(4.0 * limit.unwrap_or(7200.0));
+        for seed in 0..3 {
+            let site = draw(&g, seed);
+            let text = site.to_toml(&g, &family.base, seed, &g.name);
+            let origin = Origin::File(family.path.clone());
+            let built = crate::parse(&text, &origin)
+                .and_then(|cfg| crate::build(&cfg, &origin, None).map(|_| ()));
+            if let Err(e) = built {
+                let e = e.to_string();
+                let what = e.strip_prefix(&format!("{origin}: ")).unwrap_or(&e);
+                return Err(invalid(
+                    &family.path,
+                    "area",
+                    format!(
+                        "a site at the ends of the ranges (flow.speed_mps {}, area.length_m {}, \
+                         area.width_m {}) cannot be built: {what}; narrow the ranges or change \
+                         time_limit_s or the base",
+                        g.flow.speed_mps[0], g.area.length_m[0], g.area.width_m[0]
+                    ),
+                ));
+            }
+        }
     }
     Ok(())
 }
@@ -1107,6 +1170,11 @@ mod tests {
                 COASTAL.replace("name = \"coastal\"", "name = \"coast\\u0007al\""),
                 "name",
                 "holds '\\u{7}'",
+            ),
+            (
+                COASTAL.replace("[area]", "meander_gain = [0.1, 100.0]\n\n[area]"),
+                "flow.meander_gain",
+                "<= 1",
             ),
             (
                 COASTAL.replace("name = \"coastal\"", "name = \"../coastal\""),
