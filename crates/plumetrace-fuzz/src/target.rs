@@ -276,7 +276,21 @@ fn scenario(input: &Input, path: &Path, deadline: Instant) -> Result<String, Sto
     let built = plumetrace_scenario::build(&cfg, &origin, None).map_err(rejected)?;
     check_deadline(deadline, || "building the scenario".into())?;
     if built.mission.is_none() {
-        return plume_run(built, deadline);
+        // As `plumetrace run` places a run-time error: the file, and the line of the flow's
+        // table when the flow diverged.
+        let text = String::from_utf8_lossy(&input.bytes).into_owned();
+        return plume_run(built, deadline).map_err(|stop| match stop {
+            Stop::Rejected(m) => {
+                let line = m
+                    .contains("flow.farrell: the field diverged")
+                    .then(|| plumetrace_scenario::locate::line_of(&text, "flow.farrell"))
+                    .flatten()
+                    .map(|l| format!(":{l}"))
+                    .unwrap_or_default();
+                Stop::Rejected(format!("{}{line}: {m}", path.display()))
+            }
+            other => other,
+        });
     }
     MissionSetup::new(built).map_err(rejected)?;
     check_deadline(deadline, || "checking the mission".into())?;

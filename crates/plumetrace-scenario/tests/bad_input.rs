@@ -758,3 +758,17 @@ fn flow_sub_steps_count_in_the_step_budget_with_their_grid() {
         "{e}"
     );
 }
+
+#[test]
+fn a_key_that_is_not_bare_is_quoted_in_the_error_path() {
+    let demo = find_preset("demo").unwrap().toml;
+    let text = format!("{demo}\n[planners]\n\"\" = \"x\"\n");
+    let e = error_of(&text);
+    assert!(
+        e.contains("scenario.toml:67: planners.\"\": invalid type"),
+        "{e}"
+    );
+    let text = format!("{demo}\n[planners]\n\"a b\" = 1\n");
+    let e = error_of(&text);
+    assert!(e.contains("planners.\"a b\": invalid type"), "{e}");
+}
