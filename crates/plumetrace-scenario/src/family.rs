@@ -399,7 +399,7 @@ impl Family {
                 e.into_inner().to_string(),
             )
         })?;
-        check(&file, path)?;
+        check(&file, path).map_err(|e| e.located(text))?;
         let (base_origin, base_text) = if file.base.ends_with(".toml") {
             let p = path
                 .parent()
@@ -438,7 +438,7 @@ impl Family {
             base_origin,
             base,
         };
-        check_extremes(&family)?;
+        check_extremes(&family).map_err(|e| e.located(text))?;
         Ok(family)
     }
 
@@ -1187,5 +1187,17 @@ mod tests {
             assert!(e.contains(key) && e.contains(what), "{key}: {e}");
             assert!(e.contains("f.family.toml"), "{e}");
         }
+        // with the line of the key
+        let text = COASTAL.replace("domain_margin_m = 150.0", "domain_margin_m = 0.0");
+        let line = text
+            .lines()
+            .position(|l| l.starts_with("domain_margin_m"))
+            .unwrap_or(0)
+            + 1;
+        let e = Family::parse(&text, p).map(|_| ()).unwrap_err().to_string();
+        assert!(
+            e.starts_with(&format!("f.family.toml:{line}: domain_margin_m:")),
+            "{e}"
+        );
     }
 }
