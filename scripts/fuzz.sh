@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Fuzzes plumetrace's scenario and campaign files with the plumetrace-fuzz harness
+# Fuzzes plumetrace's scenario, campaign, family and onboard files with the plumetrace-fuzz harness
 # (crates/plumetrace-fuzz): mutated presets and example campaigns are checked as `plumetrace
 # check` does, accepted scenarios are run briefly, campaigns are resolved and checked, and every
 # input is classified (accepted, rejected_located, or a finding: rejected_unlocated, panic,

@@ -87,6 +87,25 @@ impl Place {
         }
     }
 
+    /// A run-time error of the scenario from `origin` (a plume run's diverging flow, say), named
+    /// with the file, and the line of `[flow.farrell]` when the flow diverged.
+    pub fn at_origin(
+        &self,
+        origin: &plumetrace_scenario::Origin,
+        e: anyhow::Error,
+    ) -> anyhow::Error {
+        let diverged = e.chain().any(|c| {
+            matches!(
+                c.downcast_ref::<plumetrace_env::EnvError>(),
+                Some(plumetrace_env::EnvError::Diverged { .. })
+            )
+        });
+        match diverged.then(|| self.line("flow.farrell")).flatten() {
+            Some(line) => anyhow!("{origin}:{line}: {e:#}"),
+            None => anyhow!("{origin}: {e:#}"),
+        }
+    }
+
     /// Prints the scenario's warnings (keys with no effect in this kind of run) on stderr.
     pub fn warn(&self, built: &BuiltScenario) {
         // A time limit changed from the command line leaves the file's duration behind: not news.

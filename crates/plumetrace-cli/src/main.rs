@@ -38,7 +38,7 @@ mod progress;
 mod replay;
 mod run;
 
-use anyhow::Result;
+use anyhow::{Context, Result};
 use clap::{Parser, Subcommand};
 use std::fmt::Write as _;
 use std::path::PathBuf;
@@ -201,14 +201,27 @@ struct FamilyArgs {
 /// file (with the drawn values in its opening comment), checked by the same build as `run`.
 fn family(a: &FamilyArgs) -> Result<()> {
     let f = plumetrace_scenario::Family::load(&a.file)?;
-    if a.out.exists() && std::fs::read_dir(&a.out)?.next().is_some() {
+    if a.out.exists() && !a.out.is_dir() {
+        anyhow::bail!(
+            "{}: is a file, not a directory; give a new or empty --out directory",
+            a.out.display()
+        );
+    }
+    if a.out.exists()
+        && std::fs::read_dir(&a.out)
+            .with_context(|| format!("reading {}", a.out.display()))?
+            .next()
+            .is_some()
+    {
         anyhow::bail!(
             "{}: holds files already; give a new or empty --out directory",
             a.out.display()
         );
     }
-    std::fs::create_dir_all(&a.out)?;
+    // Every site is drawn and checked before the first is written, so a site that cannot be
+    // built leaves no partial set behind.
     let width = (a.sample.max(1) - 1).to_string().len().max(3);
+    let mut sites = Vec::new();
     for k in 0..a.sample {
         let seed = plumetrace_env::derive_seed(a.seed, k);
         let site = f.draw(seed);
@@ -218,7 +231,11 @@ fn family(a: &FamilyArgs) -> Result<()> {
         let origin = plumetrace_scenario::Origin::File(path.clone());
         let cfg = plumetrace_scenario::parse(&text, &origin)?;
         plumetrace_scenario::build(&cfg, &origin, None)?;
-        plumetrace_mission::output::write_atomic(&path, text.as_bytes())?;
+        sites.push((path, text));
+    }
+    std::fs::create_dir_all(&a.out).with_context(|| format!("creating {}", a.out.display()))?;
+    for (path, text) in &sites {
+        crate::output::write_atomic(path, text.as_bytes())?;
     }
     crate::outln!(
         "{}: wrote {} sites of '{}' (seed {}) to {}",

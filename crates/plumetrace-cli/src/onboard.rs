@@ -10,7 +10,7 @@ use plumetrace_log::snapshot::{Header, SnapshotLogFile};
 use plumetrace_onboard::config::Onboard;
 use plumetrace_onboard::runner::{self, RunReport};
 use serde::Serialize;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 /// Arguments of `plumetrace onboard`.
 #[derive(Debug, clap::Args)]
@@ -21,6 +21,10 @@ pub struct OnboardArgs {
     /// `chem.log` (a separate chemical input's), `run.alog` (MOOS), `onboard.json` (the report).
     #[arg(long, default_value = "onboard-out")]
     pub out: PathBuf,
+    /// Only check the file (planner built against its mission, limits, link settings) and say
+    /// what it would fly; connects to nothing and writes nothing.
+    #[arg(long)]
+    pub check: bool,
 }
 
 #[derive(Serialize)]
@@ -64,19 +68,81 @@ impl From<&RunReport> for ReportFile {
     }
 }
 
-/// Reads an onboard file, naming it in errors.
+/// Reads an onboard file, naming it (and the line of the key, where it is written) in errors.
 pub fn load(path: &std::path::Path) -> Result<Onboard> {
     let text = plumetrace_env::input::read_text(path, plumetrace_env::input::MAX_TEXT_BYTES)
         .map_err(anyhow::Error::msg)
         .with_context(|| format!("reading {}", path.display()))?;
-    Onboard::from_toml(&text).with_context(|| format!("{}", path.display()))
+    Onboard::from_toml(&text).map_err(|e| {
+        let line = plumetrace_scenario::locate::line_of(&text, &e.key)
+            .map(|l| format!(":{l}"))
+            .unwrap_or_default();
+        anyhow::anyhow!("{}{line}: {e}", path.display())
+    })
 }
 
-/// Runs the onboard process.
+/// Output files written under a temporary name beside their own and renamed together once the
+/// flight is over, so that an earlier flight's files stay whole until a new one has flown; the
+/// temporary files of a flight that never started are removed.
+struct Pending {
+    files: Vec<(PathBuf, PathBuf)>,
+}
+
+impl Pending {
+    /// Creates `dir/name` under its temporary name.
+    fn create(&mut self, dir: &Path, name: &str) -> Result<(std::fs::File, PathBuf)> {
+        let path = plumetrace_core::file_name::join_inside(dir, name)
+            .with_context(|| format!("writing into {}", dir.display()))?;
+        let partial = path.with_extension(format!(
+            "{}.{}.partial",
+            path.extension().and_then(|e| e.to_str()).unwrap_or("out"),
+            std::process::id()
+        ));
+        let f = std::fs::File::create(&partial)
+            .with_context(|| format!("creating {}", partial.display()))?;
+        self.files.push((partial, path.clone()));
+        Ok((f, path))
+    }
+
+    /// Moves every file into place.
+    fn commit(mut self) -> Result<()> {
+        for (partial, path) in std::mem::take(&mut self.files) {
+            std::fs::rename(&partial, &path)
+                .with_context(|| format!("writing {}", path.display()))?;
+        }
+        Ok(())
+    }
+}
+
+impl Drop for Pending {
+    fn drop(&mut self) {
+        for (partial, _) in &self.files {
+            let _ = std::fs::remove_file(partial);
+        }
+    }
+}
+
+/// Runs the onboard process (or with `--check`, only checks its file).
 pub fn run(args: &OnboardArgs) -> Result<()> {
     let onboard = load(&args.file)?;
+    if args.check {
+        let l = &onboard.file.link;
+        crate::outln!(
+            "{}: ok: planner {} over {}, commands at most {} m/s; connected to nothing",
+            args.file.display(),
+            onboard.planner.kind().name(),
+            format!("{:?}", l.protocol).to_lowercase(),
+            l.limits.max_speed_mps
+        );
+        return Ok(());
+    }
     std::fs::create_dir_all(&args.out)
         .with_context(|| format!("creating {}", args.out.display()))?;
+    fly(&onboard, args)
+}
+
+/// Connects and flies; writes every output under a temporary name ([`Pending`]).
+fn fly(onboard: &Onboard, args: &OnboardArgs) -> Result<()> {
     let header = Header::new(
         &onboard.file.name,
         0,
@@ -86,34 +152,27 @@ pub fn run(args: &OnboardArgs) -> Result<()> {
     let log_path = args.out.join(crate::mission::SNAPSHOT_LOG);
     let mut log = SnapshotLogFile::create(&log_path, &header)
         .with_context(|| format!("creating {}", log_path.display()))?;
-    let traffic_path = args.out.join("link.log");
-    let traffic = std::fs::File::create(&traffic_path)
-        .with_context(|| format!("creating {}", traffic_path.display()))?;
-    let mut link = runner::link_for(&onboard, Some(Box::new(std::io::BufWriter::new(traffic))))
+    let mut pending = Pending { files: Vec::new() };
+    let (traffic, _) = pending.create(&args.out, "link.log")?;
+    let mut link = runner::link_for(onboard, Some(Box::new(std::io::BufWriter::new(traffic))))
         .with_context(|| format!("{}", args.file.display()))?;
     let chem_traffic = match &onboard.file.chemical {
         c if c.address.is_some() || c.device.is_some() => {
-            let p = args.out.join("chem.log");
-            let f =
-                std::fs::File::create(&p).with_context(|| format!("creating {}", p.display()))?;
+            let (f, _) = pending.create(&args.out, "chem.log")?;
             Some(Box::new(std::io::BufWriter::new(f)) as Box<dyn std::io::Write + Send>)
         }
         _ => None,
     };
-    let mut chem = runner::chem_link_for(&onboard, chem_traffic);
+    let mut chem = runner::chem_link_for(onboard, chem_traffic);
     let flow_traffic = match &onboard.file.flow {
         Some(f) if f.address.is_some() || f.device.is_some() => {
-            let p = args.out.join("flow.log");
-            let f =
-                std::fs::File::create(&p).with_context(|| format!("creating {}", p.display()))?;
+            let (f, _) = pending.create(&args.out, "flow.log")?;
             Some(Box::new(std::io::BufWriter::new(f)) as Box<dyn std::io::Write + Send>)
         }
         _ => None,
     };
-    let mut flow = runner::flow_link_for(&onboard, flow_traffic);
-    let alog_path = args.out.join("run.alog");
-    let alog_file = std::fs::File::create(&alog_path)
-        .with_context(|| format!("creating {}", alog_path.display()))?;
+    let mut flow = runner::flow_link_for(onboard, flow_traffic);
+    let (alog_file, alog_path) = pending.create(&args.out, "run.alog")?;
     let start_unix = std::time::SystemTime::now()
         .duration_since(std::time::UNIX_EPOCH)
         .map_or(0.0, |d| d.as_secs_f64());
@@ -127,7 +186,7 @@ pub fn run(args: &OnboardArgs) -> Result<()> {
     let mut inputs: Vec<&mut dyn plumetrace_onboard::link::Link> = Vec::new();
     inputs.extend(chem.as_mut().map(|c| c as _));
     inputs.extend(flow.as_mut().map(|c| c as _));
-    let report = runner::run_with_inputs(&onboard, &mut *link, &mut inputs, &mut |s, d| {
+    let report = runner::run_with_inputs(onboard, &mut *link, &mut inputs, &mut |s, d| {
         if log_error.is_none() {
             let written = log
                 .write(0, s, d)
@@ -137,14 +196,19 @@ pub fn run(args: &OnboardArgs) -> Result<()> {
                 log_error = Some(e);
             }
         }
-    })?;
+    })
+    .with_context(|| format!("{}", args.file.display()))?;
     drop(link);
+    drop(chem);
+    drop(flow);
     if let Some(e) = log_error {
         anyhow::bail!("writing {}: {e}", log_path.display());
     }
     log.finish()?;
     alog.finish()
+        .and_then(|w| w.into_inner().map_err(|e| e.into_error()))
         .with_context(|| format!("writing {}", alog_path.display()))?;
+    pending.commit()?;
     let file = ReportFile::from(&report);
     let json = serde_json::to_string_pretty(&file)?;
     write_atomic(&args.out.join("onboard.json"), json.as_bytes())?;

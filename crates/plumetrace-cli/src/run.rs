@@ -61,7 +61,8 @@ pub fn run(args: &RunArgs) -> Result<()> {
         crate::mission::run(sc, &args.out, args.stats, !args.no_snapshot_log, args.alog)
             .map_err(|e| place.locate(e))
     } else {
-        run_plume(sc, args)
+        let origin = sc.origin.clone();
+        run_plume(sc, args).map_err(|e| place.at_origin(&origin, e))
     }
 }
 

@@ -173,6 +173,7 @@ const RULES: &[(&str, Side, &[&str])] = &[
             "plumetrace-mission",
             "plumetrace-report",
             "plumetrace-campaign",
+            "plumetrace-onboard",
         ],
     ),
 ];

@@ -14,6 +14,7 @@
 
 pub mod angle;
 pub mod any_f64;
+pub mod file_name;
 pub mod finite;
 pub mod flow_gate;
 pub mod frame;

@@ -31,6 +31,11 @@ impl SoftObstacle {
             polygon: Polygon::new(LineString::from(ring), vec![]),
         })
     }
+
+    /// Whether `p` is inside it (as [`ObstacleSet::contains`] counts a collision).
+    pub fn contains(&self, p: Vec2) -> bool {
+        self.polygon.contains(&Point::new(p.x, p.y))
+    }
 }
 
 /// All obstacles of a world.

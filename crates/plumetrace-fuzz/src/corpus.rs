@@ -12,6 +12,8 @@ pub enum Target {
     Campaign,
     /// A scenario family, parsed; a few of its sites are drawn and checked as `check` does.
     Family,
+    /// An onboard file, checked as `plumetrace onboard FILE --check` does (nothing connected).
+    Onboard,
 }
 
 impl Target {
@@ -21,6 +23,7 @@ impl Target {
             Target::Scenario => "fuzz.toml",
             Target::Campaign => "fuzz-campaign.toml",
             Target::Family => "fuzz.family.toml",
+            Target::Onboard => "fuzz.onboard.toml",
         }
     }
 
@@ -30,6 +33,7 @@ impl Target {
             Target::Scenario => "scenario",
             Target::Campaign => "campaign",
             Target::Family => "family",
+            Target::Onboard => "onboard",
         }
     }
 }
@@ -153,7 +157,79 @@ pub const FAMILIES: &[(&str, &str)] = &[
     ),
 ];
 
-/// Every seed: the presets in registry order, then the campaigns, then the families.
+/// Onboard files: a Bluefin link flying the AMP in lock-step, an Iver link flying the moth with
+/// a separate chemical input and a current meter, and a lawnmower with subregions and limits.
+pub const ONBOARDS: &[(&str, &str)] = &[
+    (
+        "bluefin-amp",
+        r#"name = "demo on a vehicle"
+[mission]
+op_area = [[60.0, -80.0], [460.0, -80.0], [460.0, 80.0], [60.0, 80.0]]
+prior_flow_toward_deg = 90.0
+[planner]
+kind = "amp"
+speed_mps = 1.5
+mapping_lines = 3
+[link]
+protocol = "bluefin"
+address = "127.0.0.1:29500"
+origin = { lat_deg = 36.18, lon_deg = -75.75 }
+[chemical]
+format = "sentence"
+id = "PTCHM"
+field = 2
+[run]
+mode = "lock_step"
+"#,
+    ),
+    (
+        "iver-moth",
+        r#"name = "iver"
+[mission]
+op_area = [[0.0, 0.0], [300.0, 0.0], [300.0, 200.0], [0.0, 200.0]]
+vehicle_kind = "auv"
+[planner]
+kind = "moth"
+[link]
+protocol = "iver"
+device = "/dev/ttyUSB0"
+remote_helm_major = 5
+baud = 57600
+origin = { lat_deg = 44.0, lon_deg = -68.0 }
+limits = { max_speed_mps = 2.0, max_depth_m = 50.0, min_altitude_m = 2.0, max_altitude_m = 20.0 }
+[chemical]
+format = "plain"
+address = "127.0.0.1:29501"
+[flow]
+address = "127.0.0.1:29502"
+layer = 3
+[run]
+mode = "real_time"
+time_limit_s = 3600.0
+"#,
+    ),
+    (
+        "bluefin-lawnmower",
+        r#"name = "survey"
+[mission]
+op_area = [[0.0, 0.0], [400.0, 0.0], [400.0, 300.0], [0.0, 300.0]]
+subregions = [[[0.0, 0.0], [200.0, 0.0], [200.0, 300.0], [0.0, 300.0]]]
+prior_flow_toward_deg = 45.0
+[planner]
+kind = "lawnmower"
+lane_spacing_m = 20.0
+[link]
+protocol = "bluefin"
+address = "10.0.0.2:29500"
+origin = { lat_deg = -33.9, lon_deg = 151.2 }
+stale_nav_s = 10.0
+ack_tries = 5
+"#,
+    ),
+];
+
+/// Every seed: the presets in registry order, then the campaigns, the families and the onboard
+/// files.
 pub fn seeds() -> Vec<Seed> {
     PRESETS
         .iter()
@@ -170,6 +246,11 @@ pub fn seeds() -> Vec<Seed> {
         .chain(FAMILIES.iter().map(|(name, text)| Seed {
             name,
             target: Target::Family,
+            text,
+        }))
+        .chain(ONBOARDS.iter().map(|(name, text)| Seed {
+            name,
+            target: Target::Onboard,
             text,
         }))
         .collect()
@@ -235,7 +316,16 @@ mod tests {
     #[test]
     fn every_seed_is_toml_and_side_files_exist() {
         let all = seeds();
-        assert_eq!(all.len(), PRESETS.len() + CAMPAIGNS.len() + FAMILIES.len());
+        assert_eq!(
+            all.len(),
+            PRESETS.len() + CAMPAIGNS.len() + FAMILIES.len() + ONBOARDS.len()
+        );
+        for (name, text) in ONBOARDS {
+            assert!(
+                plumetrace_onboard::config::Onboard::from_toml(text).is_ok(),
+                "{name}"
+            );
+        }
         for s in &all {
             assert!(s.text.parse::<toml::Table>().is_ok(), "{}", s.name);
         }

@@ -71,12 +71,15 @@ pub fn generate(seed: u64, index: u64) -> Input {
         .filter(|s| s.target == Target::Campaign)
         .collect();
     let families: Vec<&Seed> = all.iter().filter(|s| s.target == Target::Family).collect();
-    // About 60 % scenarios, 30 % campaigns, 10 % families.
+    let onboards: Vec<&Seed> = all.iter().filter(|s| s.target == Target::Onboard).collect();
+    // About 50 % scenarios, 30 % campaigns, 10 % families, 10 % onboard files.
     let r: f64 = rng.random();
     let pool = if r < 0.3 && !campaigns.is_empty() {
         &campaigns
     } else if r < 0.4 && !families.is_empty() {
         &families
+    } else if r < 0.5 && !onboards.is_empty() {
+        &onboards
     } else {
         &scenarios
     };
@@ -206,7 +209,7 @@ mod tests {
             assert!(!input.mutations.is_empty());
             targets.insert(input.target);
             seen.extend(input.mutations.iter().map(|m| m.kind));
-            if seen.len() == Kind::ALL.len() && targets.len() == 3 {
+            if seen.len() == Kind::ALL.len() && targets.len() == 4 {
                 break;
             }
         }
@@ -216,6 +219,10 @@ mod tests {
             .map(|k| k.name())
             .collect();
         assert!(missing.is_empty(), "never produced: {missing:?}");
-        assert_eq!(targets.len(), 3, "scenarios, campaigns and families");
+        assert_eq!(
+            targets.len(),
+            4,
+            "scenarios, campaigns, families and onboard files"
+        );
     }
 }

@@ -1,9 +1,12 @@
-//! `plumetrace-fuzz`: mutated scenario and campaign files against `check`, short runs and
-//! campaign parsing.
+//! `plumetrace-fuzz`: mutated scenario, campaign, family and onboard files against `check`,
+//! short runs (with `--alog`), campaign parsing, family sites and `onboard FILE --check`.
 //!
 //! Every input is made from (pass seed, index) alone: a seed of the corpus (the built-in
-//! presets and the example campaigns) and one to three mutations drawn from a random stream of
-//! its own, so a finding is replayed with `plumetrace-fuzz one --index I --seed S`.
+//! presets, the example campaigns and families, and onboard files) and one to three mutations
+//! drawn from a random stream of its own, so a finding is replayed with
+//! `plumetrace-fuzz one --index I --seed S`. Among the mutations, hostile names (`..`, a
+//! separator, an absolute path, NUL, 300 bytes, another vehicle's): every short run writes its
+//! `.alog` files, and a file outside their directory is a finding.
 //!
 //! - `pass`: the parent; runs a range of inputs in child processes under a memory limit and
 //!   prints a JSON report (exit status 1 when anything was found);

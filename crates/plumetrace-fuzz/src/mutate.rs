@@ -49,6 +49,9 @@ pub enum Kind {
     HugeArray,
     /// A string of up to half a megabyte.
     HugeString,
+    /// A name that becomes a file name (a vehicle's, a family's, an obstacle's) made hostile:
+    /// `..`, a separator, an absolute path, NUL, a control character, 300 bytes, another's.
+    HostileName,
     /// Campaign `seeds`: 0, negative, huge, wrong type.
     CampaignSeeds,
     /// Campaign `sweep`: many values, duplicates, empty, not an array, odd keys.
@@ -75,7 +78,7 @@ pub enum Kind {
 
 impl Kind {
     /// Every kind, in declaration order.
-    pub const ALL: [Kind; 26] = [
+    pub const ALL: [Kind; 27] = [
         Kind::DeleteKey,
         Kind::DeleteTable,
         Kind::DuplicateArrayEntry,
@@ -91,6 +94,7 @@ impl Kind {
         Kind::PolygonFarVertex,
         Kind::HugeArray,
         Kind::HugeString,
+        Kind::HostileName,
         Kind::CampaignSeeds,
         Kind::CampaignSweep,
         Kind::CampaignConfigName,
@@ -122,6 +126,7 @@ impl Kind {
             Kind::PolygonFarVertex => "polygon_far_vertex",
             Kind::HugeArray => "huge_array",
             Kind::HugeString => "huge_string",
+            Kind::HostileName => "hostile_name",
             Kind::CampaignSeeds => "campaign_seeds",
             Kind::CampaignSweep => "campaign_sweep",
             Kind::CampaignConfigName => "campaign_config_name",
@@ -662,6 +667,7 @@ pub fn apply_tree(
         | Kind::PolygonFarVertex => polygon(kind, root, target, rng),
         Kind::HugeArray => huge_array(root, rng),
         Kind::HugeString => huge_string(root, rng),
+        Kind::HostileName => hostile_name(root, rng),
         Kind::CampaignSeeds
         | Kind::CampaignSweep
         | Kind::CampaignConfigName
@@ -818,6 +824,11 @@ fn polygon_target(
         }
         // A family has no polygon of its own.
         Target::Family => return None,
+        Target::Onboard => {
+            let m = root.get_mut("mission")?.as_table_mut()?;
+            m.insert("op_area".into(), points_value(&square));
+            vec![Seg::Key("mission".into()), Seg::Key("op_area".into())]
+        }
         Target::Scenario => {
             if let Some(Value::Table(m)) = root.get_mut("mission") {
                 m.insert("op_area".into(), points_value(&square));
@@ -995,6 +1006,51 @@ fn huge_array(root: &mut Table, rng: &mut Pcg64Mcg) -> Option<String> {
     };
     let text = format!("{} = {what}", path_text(&p));
     set(root, &p, value).then_some(text)
+}
+
+/// Names that must never reach outside an output directory or break a file written from them.
+const HOSTILE_NAMES: &[&str] = &[
+    "..",
+    "../escaped",
+    "../../escaped",
+    "/tmp/escaped",
+    "a/b",
+    "a\\b",
+    ".hidden",
+    "a\u{0}b",
+    "bell\u{7}",
+    "new\nline",
+    "-dash",
+    "name with spaces",
+    "é",
+    "",
+];
+
+fn hostile_name(root: &mut Table, rng: &mut Pcg64Mcg) -> Option<String> {
+    let c = paths_where(root, &|p, v| {
+        matches!(v, Value::String(_)) && matches!(p.last(), Some(Seg::Key(k)) if k == "name")
+    });
+    let p = pick(rng, &c)?.clone();
+    let name = if below(rng, 8) == 0 {
+        "x".repeat(300)
+    } else if below(rng, 8) == 0 {
+        // another vehicle's (or the first entry's) name: duplicates
+        match get(
+            root,
+            &[
+                Seg::Key("vehicles".into()),
+                Seg::Idx(0),
+                Seg::Key("name".into()),
+            ],
+        ) {
+            Some(Value::String(s)) => s.clone(),
+            _ => "auv".into(),
+        }
+    } else {
+        (*pick(rng, HOSTILE_NAMES)?).to_string()
+    };
+    let what = format!("{} = {name:?}", path_text(&p));
+    set(root, &p, Value::String(name)).then_some(what)
 }
 
 fn huge_string(root: &mut Table, rng: &mut Pcg64Mcg) -> Option<String> {

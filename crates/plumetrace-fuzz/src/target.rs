@@ -124,6 +124,7 @@ impl Workdir {
             Target::Scenario => self.scenario.join(target.file_name()),
             Target::Campaign => self.campaign.join(target.file_name()),
             Target::Family => self.families.join(target.file_name()),
+            Target::Onboard => self.scenario.join(target.file_name()),
         }
     }
 
@@ -193,6 +194,7 @@ pub fn run(input: &Input, wd: &Workdir, timeout_s: f64) -> anyhow::Result<Outcom
         Target::Scenario => scenario(input, &path, deadline),
         Target::Campaign => campaign(input, &path, deadline),
         Target::Family => family(input, &path, deadline),
+        Target::Onboard => onboard(input, &path),
     }));
     let secs = start.elapsed().as_secs_f64();
     let (class, message) = match result {
@@ -241,6 +243,26 @@ fn family(input: &Input, path: &Path, deadline: Instant) -> Result<String, Stop>
     Ok(format!("family: {FAMILY_SITES} sites built"))
 }
 
+/// An onboard file checked as `plumetrace onboard FILE --check` does: every key, the planner
+/// built against the file's mission; nothing is connected. Errors are placed as the command
+/// places them (the file, the key's line, the key).
+fn onboard(input: &Input, path: &Path) -> Result<String, Stop> {
+    let text = std::str::from_utf8(&input.bytes).map_err(|e| {
+        rejected(format!(
+            "{}: not UTF-8 at byte {}",
+            path.display(),
+            e.valid_up_to()
+        ))
+    })?;
+    let o = plumetrace_onboard::config::Onboard::from_toml(text).map_err(|e| {
+        let line = plumetrace_scenario::locate::line_of(text, &e.key)
+            .map(|l| format!(":{l}"))
+            .unwrap_or_default();
+        rejected(format!("{}{line}: {e}", path.display()))
+    })?;
+    Ok(format!("onboard: {} checked", o.planner.kind().name()))
+}
+
 /// Sites drawn and checked per family input.
 const FAMILY_SITES: u64 = 3;
 
@@ -254,7 +276,21 @@ fn scenario(input: &Input, path: &Path, deadline: Instant) -> Result<String, Sto
     let built = plumetrace_scenario::build(&cfg, &origin, None).map_err(rejected)?;
     check_deadline(deadline, || "building the scenario".into())?;
     if built.mission.is_none() {
-        return plume_run(built, deadline);
+        // As `plumetrace run` places a run-time error: the file, and the line of the flow's
+        // table when the flow diverged.
+        let text = String::from_utf8_lossy(&input.bytes).into_owned();
+        return plume_run(built, deadline).map_err(|stop| match stop {
+            Stop::Rejected(m) => {
+                let line = m
+                    .contains("flow.farrell: the field diverged")
+                    .then(|| plumetrace_scenario::locate::line_of(&text, "flow.farrell"))
+                    .flatten()
+                    .map(|l| format!(":{l}"))
+                    .unwrap_or_default();
+                Stop::Rejected(format!("{}{line}: {m}", path.display()))
+            }
+            other => other,
+        });
     }
     MissionSetup::new(built).map_err(rejected)?;
     check_deadline(deadline, || "checking the mission".into())?;
@@ -278,6 +314,7 @@ fn scenario(input: &Input, path: &Path, deadline: Instant) -> Result<String, Sto
         plume_frames_every_s: Some(plumetrace_mission::PLUME_FRAME_EVERY_S),
     };
     let mut mission = Mission::new(setup, options).map_err(|e| in_run(&e))?;
+    let alog_dir = alog_observer(&mut mission, path)?;
     check_deadline(deadline, || "in the spin-up".into())?;
     while mission.step().map_err(|e| in_run(&e))?.is_none() {
         check_deadline(deadline, || {
@@ -289,6 +326,7 @@ fn scenario(input: &Input, path: &Path, deadline: Instant) -> Result<String, Sto
         })?;
     }
     let run = mission.finish().map_err(|e| in_run(&e))?;
+    check_alogs(&alog_dir, path)?;
     check_summary(&run)?;
     check_trajectory(&run)?;
     let t0 = Instant::now();
@@ -308,6 +346,59 @@ fn scenario(input: &Input, path: &Path, deadline: Instant) -> Result<String, Sto
         page.len(),
         t0.elapsed().as_secs_f64()
     ))
+}
+
+/// `--alog` as `run` writes it: a `.alog` per vehicle with a planner, into `alog/` beside the
+/// input (emptied first).
+fn alog_observer(mission: &mut Mission, path: &Path) -> Result<PathBuf, Stop> {
+    let dir = path.with_file_name("alog");
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).map_err(|e| rejected(format!("harness: {e}")))?;
+    let planned: Vec<bool> = mission.planned().iter().map(Option::is_some).collect();
+    let w =
+        plumetrace_mission::alog::AlogObserver::create(&dir, &mission.vehicle_names(), &planned)
+            .map_err(|e| rejected(format!("creating the .alog files: {e}")))?;
+    mission
+        .observe(Box::new(w))
+        .map_err(|e| rejected(format!("short run: {e}")))?;
+    Ok(dir)
+}
+
+/// Every `.alog` is a plain file in `alog/`, and nothing else appeared beside the input's
+/// directory (a vehicle name that escaped it would show there).
+fn check_alogs(dir: &Path, path: &Path) -> Result<(), Stop> {
+    let names = |d: &Path| -> Vec<String> {
+        std::fs::read_dir(d)
+            .map(|r| {
+                r.flatten()
+                    .map(|e| e.file_name().to_string_lossy().into_owned())
+                    .collect()
+            })
+            .unwrap_or_default()
+    };
+    let escaped =
+        |what: String| Stop::Rejected(format!("--alog wrote outside its directory: {what}"));
+    if let Some(bad) = names(dir)
+        .into_iter()
+        .find(|n| !n.ends_with(".alog") || n.contains(".partial"))
+    {
+        return Err(escaped(format!("alog/{bad}")));
+    }
+    let root = path.parent().and_then(Path::parent).unwrap_or(path);
+    if let Some(bad) = names(root)
+        .into_iter()
+        .find(|n| !["scenario", "campaign", "families"].contains(&n.as_str()))
+    {
+        return Err(escaped(bad));
+    }
+    let beside = path.parent().unwrap_or(path);
+    if let Some(bad) = names(beside)
+        .into_iter()
+        .find(|n| n != "alog" && !n.starts_with("fuzz"))
+    {
+        return Err(escaped(bad));
+    }
+    Ok(())
 }
 
 /// Plume only: a few steps, then the output grid.

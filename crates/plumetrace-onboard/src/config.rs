@@ -65,9 +65,10 @@ fn default_name() -> String {
 #[serde(deny_unknown_fields)]
 pub struct MissionFile {
     /// The op-area polygon, local metres `[east, north]`.
+    #[serde(deserialize_with = "points")]
     pub op_area: Vec<[f64; 2]>,
     /// Subregions searched in turn.
-    #[serde(default)]
+    #[serde(default, deserialize_with = "regions")]
     pub subregions: Vec<Vec<[f64; 2]>>,
     /// Flow direction assumed until the first flow measurement, deg (towards); when left out,
     /// 0 and not "given".
@@ -75,6 +76,36 @@ pub struct MissionFile {
     /// The vehicle kind the planner is built for.
     #[serde(default = "default_kind")]
     pub vehicle_kind: VehicleKind,
+}
+
+/// A polygon's vertices, each exactly `[east, north]` (a third coordinate is refused, as a
+/// scenario refuses it, rather than dropped).
+fn points<'de, D: serde::Deserializer<'de>>(d: D) -> Result<Vec<[f64; 2]>, D::Error> {
+    let raw: Vec<Vec<f64>> = Vec::deserialize(d)?;
+    raw.iter()
+        .enumerate()
+        .map(|(k, p)| match p.as_slice() {
+            [x, y] => Ok([*x, *y]),
+            _ => Err(serde::de::Error::custom(format!(
+                "vertex {k} has {} coordinates; give [east, north] in metres",
+                p.len()
+            ))),
+        })
+        .collect()
+}
+
+/// Subregions' vertices, as [`points`].
+fn regions<'de, D: serde::Deserializer<'de>>(d: D) -> Result<Vec<Vec<[f64; 2]>>, D::Error> {
+    let raw: Vec<Vec<Vec<f64>>> = Vec::deserialize(d)?;
+    raw.into_iter()
+        .enumerate()
+        .map(|(r, poly)| {
+            use serde::de::IntoDeserializer;
+            let d: serde::de::value::SeqDeserializer<_, serde::de::value::Error> =
+                poly.into_deserializer();
+            points(d).map_err(|e| serde::de::Error::custom(format!("subregion {r}: {e}")))
+        })
+        .collect()
 }
 
 fn default_kind() -> VehicleKind {
@@ -517,12 +548,42 @@ impl Onboard {
             vehicle_kind: m.vehicle_kind,
             team: Vec::new(),
         };
+        check_planner(&planner, &context, &l.limits)?;
         Ok(Onboard {
             file,
             planner,
             context,
         })
     }
+}
+
+/// What would stop the planner flying once connected: a table the registry reads but cannot
+/// build against this mission (no survey lane fits, say), or a speed above the vehicle's limit,
+/// which the command chokepoint would refuse in every command.
+fn check_planner(
+    planner: &PlannerConfig,
+    context: &BuildContext,
+    limits: &VehicleLimits,
+) -> Result<(), ParamError> {
+    planner.build(context, "planner")?;
+    let table = planner
+        .to_table()
+        .map_err(|e| err("planner", e.to_string()))?;
+    for key in ["speed_mps", "max_speed_mps"] {
+        if let Some(v) = table.get(key).and_then(toml::Value::as_float)
+            && v > limits.max_speed_mps
+        {
+            return Err(err(
+                &format!("planner.{key}"),
+                format!(
+                    "{v} m/s is above the vehicle's limit link.limits.max_speed_mps ({} m/s), \
+                     so every command would be refused; lower it or raise the limit",
+                    limits.max_speed_mps
+                ),
+            ));
+        }
+    }
+    Ok(())
 }
 
 /// The MOOS link's keys.
@@ -784,6 +845,27 @@ origin = { lat_deg = 36.18, lon_deg = -75.75 }
                 "protocol = \"bluefin\"",
                 "protocol = \"iver\"\ndevice = \"/dev/null\"",
                 "link.remote_helm_major",
+            ),
+            // the file's checks passed these, and the flight then failed or sent nothing
+            (
+                "kind = \"amp\"",
+                "kind = \"lawnmower\"\nedge_margin_m = 1000.0",
+                "planner.edge_margin_m",
+            ),
+            (
+                "kind = \"amp\"",
+                "kind = \"amp\"\nspeed_mps = 10.0",
+                "planner.speed_mps",
+            ),
+            (
+                "[460.0, 80.0], [60.0, 80.0]]",
+                "[460.0, 80.0, 3.0], [60.0, 80.0]]",
+                "mission.op_area",
+            ),
+            (
+                "prior_flow_toward_deg = 90.0",
+                "prior_flow_toward_deg = 90.0\nsubregions = [[[60.0, -80.0], [460.0, -80.0], [460.0]]]",
+                "mission.subregions",
             ),
         ];
         for (from, to, key) in cases {

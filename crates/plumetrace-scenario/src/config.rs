@@ -279,7 +279,14 @@ pub struct KelpConfig {
     /// Radius kept free of kelp around every source and every vehicle's start, m (default 10).
     #[serde(default = "ten")]
     pub clear_m: f64,
-    /// Seed of the draw (default: the run seed, so each run has its own field).
+    /// Seed of the draw (default: the run seed, so each run has its own field); any whole
+    /// number 0..2^64, as the run seed ([`seed`]).
+    #[serde(
+        default,
+        deserialize_with = "seed::read_some",
+        serialize_with = "seed::write_some",
+        skip_serializing_if = "Option::is_none"
+    )]
     pub seed: Option<u64>,
 }
 
@@ -676,6 +683,19 @@ pub mod seed {
             }
         }
         d.deserialize_any(Seed)
+    }
+
+    /// Reads a seed that may be left out ([`read`]).
+    pub fn read_some<'de, D: Deserializer<'de>>(d: D) -> Result<Option<u64>, D::Error> {
+        read(d).map(Some)
+    }
+
+    /// Writes a seed that may be left out ([`write`]).
+    pub fn write_some<S: Serializer>(seed: &Option<u64>, s: S) -> Result<S::Ok, S::Error> {
+        match seed {
+            Some(v) => write(v, s),
+            None => s.serialize_none(),
+        }
     }
 
     /// Writes a seed as [`value`] does.

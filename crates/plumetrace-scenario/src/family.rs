@@ -295,9 +295,15 @@ pub const FAMILY_LIMITS: &[(&str, f64, f64, &str)] = &[
     ("time_limit_s", 1.0, 1e6, "about 11 days at most"),
     (
         "domain_margin_m",
-        0.0,
+        1.0,
         10_000.0,
-        "room for the plume and the cage",
+        "room for the plume and the cage (at least 1 m: the domain is written to 0.1 m, the op-area to 0.01 m)",
+    ),
+    (
+        "vertical_mixing_length_m",
+        0.0,
+        200.0,
+        "times a current of up to 5 m/s, within the scenario's vertical diffusivity bound (1000 m^2/s)",
     ),
     ("prior_flow_error_deg[]", -180.0, 180.0, "an angle"),
     ("flow.toward_deg[]", -720.0, 720.0, "compass degrees"),
@@ -314,7 +320,12 @@ pub const FAMILY_LIMITS: &[(&str, f64, f64, &str)] = &[
         1e7,
         "a period of minutes to months",
     ),
-    ("flow.meander_gain[]", 0.0, 100.0, "the Farrell noise gain"),
+    (
+        "flow.meander_gain[]",
+        0.0,
+        1.0,
+        "the Farrell noise gain; above 1 the meander reaches metres per second and the grid can diverge (plume-demo's does at 5 within two minutes)",
+    ),
     (
         "area.length_m[]",
         10.0,
@@ -393,7 +404,7 @@ impl Family {
                 e.into_inner().to_string(),
             )
         })?;
-        check(&file, path)?;
+        check(&file, path).map_err(|e| e.located(text))?;
         let (base_origin, base_text) = if file.base.ends_with(".toml") {
             let p = path
                 .parent()
@@ -426,13 +437,15 @@ impl Family {
             ));
         }
         crate::family_team::check(&file, &base, &base_origin, path)?;
-        Ok(Family {
+        let family = Family {
             file,
             path: path.to_path_buf(),
             text: text.to_string(),
             base_origin,
             base,
-        })
+        };
+        check_extremes(&family).map_err(|e| e.located(text))?;
+        Ok(family)
     }
 
     /// The site of `seed`.
@@ -484,6 +497,10 @@ fn check(f: &FamilyFile, path: &Path) -> Result<(), ScenarioError> {
         }
         Ok(())
     };
+    // The name becomes every site's name and the campaign's scenario label (and file names
+    // made of it), so it keeps to the safe set of names that become file names.
+    plumetrace_core::file_name::check_name(&f.name)
+        .map_err(|e| invalid(path, "name", format!("{:?} {e}", f.name)))?;
     if let Some(t) = f.time_limit_s {
         num("time_limit_s", t)?;
     }
@@ -537,6 +554,66 @@ fn check(f: &FamilyFile, path: &Path) -> Result<(), ScenarioError> {
     if let Some(x) = &f.faults {
         num("faults.flow_sensor_probability", x.flow_sensor_probability)?;
         range("faults.duration_s", Some(x.duration_s))?;
+    }
+    Ok(())
+}
+
+/// Builds sites at the ends of the ranges that decide whether a site can be built at all (the
+/// current's speed, the op-area's extents and the tide's swing set the domain, the spin-up and
+/// so the flow's steps), a few draws each, so that a family whose sites would be refused at run
+/// time (a long time limit over tiny op-areas exceeding the step budget of the base's flow grid,
+/// say) is refused here, at the family file.
+fn check_extremes(family: &Family) -> Result<(), ScenarioError> {
+    let f = &family.file;
+    let ends = |r: Range, high: bool| if high { [r[1], r[1]] } else { [r[0], r[0]] };
+    for corner in 0..16_u32 {
+        let mut g = f.clone();
+        g.flow.speed_mps = ends(f.flow.speed_mps, corner & 1 != 0);
+        g.area.length_m = ends(f.area.length_m, corner & 2 != 0);
+        g.area.width_m = ends(f.area.width_m, corner & 4 != 0);
+        g.flow.tidal_swing_deg = f.flow.tidal_swing_deg.map(|r| ends(r, true));
+        // Axis-aligned op-areas make the narrowest domains (the finest flow grid), and a
+        // convex op-area's domain can be half a rectangle's across, which takes up to four
+        // times the flow's sub-steps: the probe flies four times the time limit.
+        g.flow.toward_deg = [0.0, 0.0];
+        g.area.axis_to_flow_deg = Some(if corner & 8 != 0 {
+            [90.0, 90.0]
+        } else {
+            [0.0, 0.0]
+        });
+        let limit = f.time_limit_s.or_else(|| {
+            family
+                .base
+                .get("mission")
+                .and_then(|m| m.get("time_limit_s"))
+                .and_then(toml::Value::as_float)
+        });
+        g.time_limit_s = Some(4.0 * limit.unwrap_or(7200.0));
+        for seed in 0..3 {
+            let mut site = draw(&g, seed);
+            if let Some(t) = &g.team {
+                site.team =
+                    crate::family_team::draw(t, &family.base, &family.base_origin, &site, seed);
+            }
+            let text = site.to_toml(&g, &family.base, seed, &g.name);
+            let origin = Origin::File(family.path.clone());
+            let built = crate::parse(&text, &origin)
+                .and_then(|cfg| crate::build(&cfg, &origin, None).map(|_| ()));
+            if let Err(e) = built {
+                let e = e.to_string();
+                let what = e.strip_prefix(&format!("{origin}: ")).unwrap_or(&e);
+                return Err(invalid(
+                    &family.path,
+                    "area",
+                    format!(
+                        "a site at the ends of the ranges (flow.speed_mps {}, area.length_m {}, \
+                         area.width_m {}) cannot be built: {what}; narrow the ranges or change \
+                         time_limit_s or the base",
+                        g.flow.speed_mps[0], g.area.length_m[0], g.area.width_m[0]
+                    ),
+                ));
+            }
+        }
     }
     Ok(())
 }
@@ -1117,11 +1194,52 @@ mod tests {
                 "area.shapes",
                 "at least one",
             ),
+            // each of these passed, and every site then failed, blaming the base
+            (
+                COASTAL.replace("domain_margin_m = 150.0", "domain_margin_m = 0.0"),
+                "domain_margin_m",
+                ">= 1",
+            ),
+            (
+                COASTAL.replace(
+                    "vertical_mixing_length_m = 0.038",
+                    "vertical_mixing_length_m = -0.038",
+                ),
+                "vertical_mixing_length_m",
+                ">= 0",
+            ),
+            (
+                COASTAL.replace("name = \"coastal\"", "name = \"coast\\u0007al\""),
+                "name",
+                "holds '\\u{7}'",
+            ),
+            (
+                COASTAL.replace("[area]", "meander_gain = [0.1, 100.0]\n\n[area]"),
+                "flow.meander_gain",
+                "<= 1",
+            ),
+            (
+                COASTAL.replace("name = \"coastal\"", "name = \"../coastal\""),
+                "name",
+                "starts with '.'",
+            ),
         ];
         for (text, key, what) in cases {
             let e = Family::parse(&text, p).map(|_| ()).unwrap_err().to_string();
             assert!(e.contains(key) && e.contains(what), "{key}: {e}");
             assert!(e.contains("f.family.toml"), "{e}");
         }
+        // with the line of the key
+        let text = COASTAL.replace("domain_margin_m = 150.0", "domain_margin_m = 0.0");
+        let line = text
+            .lines()
+            .position(|l| l.starts_with("domain_margin_m"))
+            .unwrap_or(0)
+            + 1;
+        let e = Family::parse(&text, p).map(|_| ()).unwrap_err().to_string();
+        assert!(
+            e.starts_with(&format!("f.family.toml:{line}: domain_margin_m:")),
+            "{e}"
+        );
     }
 }

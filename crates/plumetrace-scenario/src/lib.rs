@@ -74,6 +74,29 @@ pub fn from_table(table: toml::Table, origin: &Origin) -> Result<ScenarioConfig,
     deserialize(toml::Value::Table(table), origin)
 }
 
+/// serde's path as a key path, a key that is not a bare TOML key quoted (`planners."a b"`,
+/// `planners.""`), as [`locate::line_of`] reads it.
+fn key_path(path: &serde_path_to_error::Path) -> String {
+    use serde_path_to_error::Segment;
+    let mut out = String::new();
+    for seg in path.iter() {
+        let key = match seg {
+            Segment::Seq { index } => {
+                out.push_str(&format!("[{index}]"));
+                continue;
+            }
+            Segment::Map { key } => plumetrace_core::params::quoted_key(key),
+            Segment::Enum { variant } => plumetrace_core::params::quoted_key(variant),
+            Segment::Unknown => "?".to_string(),
+        };
+        if !out.is_empty() {
+            out.push('.');
+        }
+        out.push_str(&key);
+    }
+    if out.is_empty() { ".".to_string() } else { out }
+}
+
 /// Deserializes the scenario, turning serde's error into one that names the key path (and the
 /// nearest known key or name, for an unknown one).
 fn deserialize<'de, D: serde::Deserializer<'de, Error = toml::de::Error>>(
@@ -81,7 +104,7 @@ fn deserialize<'de, D: serde::Deserializer<'de, Error = toml::de::Error>>(
     origin: &Origin,
 ) -> Result<ScenarioConfig, ScenarioError> {
     serde_path_to_error::deserialize(de).map_err(|e| {
-        let path = e.path().to_string();
+        let path = key_path(e.path());
         let inner = e.into_inner();
         // With a key path, the message alone (the line is added from the path); without one,
         // the parser's whole report, which shows where.

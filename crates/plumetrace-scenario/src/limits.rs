@@ -305,7 +305,11 @@ pub const LIMITS: &[Limit] = &[
         1e4,
         "kelp patches are metres to hundreds of metres apart",
     ),
-    num("kelp[].seed", 0.0, 1.8446744073709552e19, "a 64-bit seed"),
+    Limit {
+        key: "kelp[].seed",
+        bound: Bound::Any,
+        why: "any whole number 0..2^64, as the run seed (beyond 2^63 - 1 a string of digits)",
+    },
     num(
         "output.nx",
         2.0,
@@ -588,6 +592,11 @@ pub const LIMITS: &[Limit] = &[
     pos("comms.ranging.sound_speed_mps", 1e9, "finite"),
     count("planners", 100, "planners are per vehicle"),
 ];
+
+/// The most flow grid-node updates a run may take (sub-steps times nodes, spin-up included):
+/// about an hour of computing at a few hundred million node updates a second. Counting sub-steps
+/// alone let a fine grid with a short stable step run for days within [`MAX_STEPS`].
+pub const MAX_FLOW_NODE_STEPS: f64 = 1e12;
 
 /// The most steps of a run (plume run or mission), the spin-up apart: about a day of computing.
 pub const MAX_STEPS: f64 = 1e8;

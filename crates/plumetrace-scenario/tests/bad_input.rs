@@ -709,3 +709,66 @@ fn the_success_radius_is_a_mission_key_with_a_default() {
         "{e}"
     );
 }
+
+#[test]
+fn kelp_seeds_take_every_64_bit_value_as_the_run_seed_does() {
+    let kelp = find_preset("li-zhang-kelp").unwrap().toml;
+    for v in [
+        "9223372036854775808",
+        "\"9223372036854775808\"",
+        "18446744073709551615",
+        "\"18446744073709551615\"",
+    ] {
+        let text = kelp.replacen(
+            "name = \"kelp\"",
+            &format!("name = \"kelp\"\nseed = {v}"),
+            1,
+        );
+        assert_ne!(text, kelp);
+        assert_eq!(error_of(&text), "accepted", "seed = {v}");
+    }
+    let text = kelp.replacen("name = \"kelp\"", "name = \"kelp\"\nseed = -1", 1);
+    assert!(error_of(&text).contains("kelp[0].seed: expected a whole number"));
+}
+
+#[test]
+fn flow_sub_steps_count_in_the_step_budget_with_their_grid() {
+    // A 0.1 s plume run on a fine grid whose stable step needs about 250,000 sub-steps per step
+    // is within the budget; a 10 s one would take about 2.5e13 node updates and ran for days.
+    let fine = |duration: &str| {
+        demo_with(|t| {
+            t.replacen("duration_s = 600.0", &format!("duration_s = {duration}"), 1)
+                .replacen("nx = 21", "nx = 1000", 1)
+                .replacen("ny = 11", "ny = 1000", 1)
+                .replacen(
+                    "noise_gain = 0.3",
+                    "noise_gain = 0.3\ndiffusivity_x_m2ps = 10000.0\ndiffusivity_y_m2ps = 10000.0",
+                    1,
+                )
+                .replacen("average_start_s = 300.0", "average_start_s = 0.0", 1)
+        })
+    };
+    assert_eq!(error_of(&fine("0.1")), "accepted");
+    let e = error_of(&fine("10.0"));
+    assert!(
+        e.contains("scenario.toml: flow.farrell:")
+            && e.contains(
+                "flow steps of 1000000 grid nodes each, 2.495e13 node updates; at most 1e12"
+            ),
+        "{e}"
+    );
+}
+
+#[test]
+fn a_key_that_is_not_bare_is_quoted_in_the_error_path() {
+    let demo = find_preset("demo").unwrap().toml;
+    let text = format!("{demo}\n[planners]\n\"\" = \"x\"\n");
+    let e = error_of(&text);
+    assert!(
+        e.contains("scenario.toml:67: planners.\"\": invalid type"),
+        "{e}"
+    );
+    let text = format!("{demo}\n[planners]\n\"a b\" = 1\n");
+    let e = error_of(&text);
+    assert!(e.contains("planners.\"a b\": invalid type"), "{e}");
+}

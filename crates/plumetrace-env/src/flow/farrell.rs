@@ -797,6 +797,9 @@ impl FlowField for FarrellFlow {
     fn max_stable_dt_s(&self) -> Option<f64> {
         Some(self.max_stable_dt_s)
     }
+    fn nodes(&self) -> usize {
+        self.params.nx * self.params.ny
+    }
     fn own_step_s(&self) -> Option<f64> {
         (self.params.step_s > 0.0).then_some(self.params.step_s)
     }

@@ -54,6 +54,12 @@ pub trait FlowField: Send + Sync + std::fmt::Debug {
         None
     }
 
+    /// The grid nodes one step of the model updates (1 for a field without a grid): the cost of
+    /// a step, which a run's budget counts with its sub-steps.
+    fn nodes(&self) -> usize {
+        1
+    }
+
     /// The step the model asks to be advanced with when the plume steps more finely, s (`None`:
     /// with every plume step); see [`crate::environment::flow_schedule`].
     fn own_step_s(&self) -> Option<f64> {
@@ -108,6 +114,9 @@ impl FlowField for FlowModel {
     }
     fn max_stable_dt_s(&self) -> Option<f64> {
         self.inner().max_stable_dt_s()
+    }
+    fn nodes(&self) -> usize {
+        self.inner().nodes()
     }
     fn own_step_s(&self) -> Option<f64> {
         self.inner().own_step_s()

@@ -228,6 +228,7 @@ fn build_sections(
     let plume = plume::plume(cfg, domain, &base_dir)?;
     let obstacles = obstacles::obstacles(cfg, seed)?;
     let vehicles = vehicles::vehicles(cfg, &domain)?;
+    obstacles::starts_clear(cfg, &obstacles)?;
     let comms = comms::comms(&cfg.comms)?;
     let mut env = Environment::new(
         domain,

@@ -62,3 +62,30 @@ fn kelp_field(
     plumetrace_env::kelp_field(&params, &keep_clear, &name, &mut rng)
         .map_err(|e| Invalid::env(&key, e))
 }
+
+/// Refuses a vehicle that starts inside an `[[obstacles]]` polygon: its mission would end
+/// "collided" at the first step. (A kelp field keeps `clear_m` around every start.)
+pub(super) fn starts_clear(
+    cfg: &ScenarioConfig,
+    obstacles: &[SoftObstacle],
+) -> Result<(), Invalid> {
+    for (k, v) in cfg.vehicles.iter().enumerate() {
+        let p = Vec2::new(v.x_m, v.y_m);
+        if let Some((j, o)) = obstacles.iter().enumerate().find(|(_, o)| o.contains(p)) {
+            let which = if j < cfg.obstacles.len() {
+                format!("obstacles[{j}]")
+            } else {
+                "a kelp patch".to_string()
+            };
+            return Err(Invalid::new(
+                format!("vehicles[{k}].x_m"),
+                format!(
+                    "start ({}, {}) is inside {which} ('{}'): the mission would end collided at \
+                     once; move the start or the obstacle",
+                    v.x_m, v.y_m, o.name
+                ),
+            ));
+        }
+    }
+    Ok(())
+}

@@ -3,7 +3,7 @@
 
 use super::Invalid;
 use crate::config::ScenarioConfig;
-use crate::limits::MAX_STEPS;
+use crate::limits::{MAX_FLOW_NODE_STEPS, MAX_STEPS};
 
 /// The run's clock.
 #[derive(Debug, Clone, Copy)]
@@ -70,20 +70,35 @@ impl Timing {
     }
 }
 
-/// Refuses `flow_steps` flow steps of `what` beyond [`MAX_STEPS`], naming the flow grid whose
-/// stable step makes them.
+/// Refuses `flow_steps` flow steps of `what` beyond [`MAX_STEPS`], or more node updates (steps
+/// times the grid's nodes) than [`MAX_FLOW_NODE_STEPS`], naming the flow grid whose stable step
+/// makes them.
 pub(super) fn check_flow_steps(
     flow: &dyn plumetrace_env::FlowField,
     flow_steps: f64,
     what: &str,
 ) -> Result<(), Invalid> {
+    let limit = flow.max_stable_dt_s().unwrap_or(f64::INFINITY);
     if flow_steps > MAX_STEPS {
         return Err(Invalid::new(
             "flow.farrell",
             format!(
-                "the flow grid's stable step is {:.4e} s, so {what} would take {flow_steps:.3e} \
-                 flow steps; at most {MAX_STEPS:.0e}: use a coarser grid or larger diffusivities",
-                flow.max_stable_dt_s().unwrap_or(f64::INFINITY),
+                "the flow grid's stable step is {limit:.4e} s, so {what} would take \
+                 {flow_steps:.3e} flow steps; at most {MAX_STEPS:.0e}: use a coarser grid or \
+                 larger diffusivities"
+            ),
+        ));
+    }
+    let nodes = flow.nodes() as f64;
+    let work = flow_steps * nodes;
+    if work > MAX_FLOW_NODE_STEPS {
+        return Err(Invalid::new(
+            "flow.farrell",
+            format!(
+                "the flow grid's stable step is {limit:.4e} s, so {what} would take \
+                 {flow_steps:.3e} flow steps of {nodes} grid nodes each, {work:.3e} node updates; \
+                 at most {MAX_FLOW_NODE_STEPS:.0e} (about an hour of computing): use a coarser \
+                 grid, smaller diffusivities or a shorter run"
             ),
         ));
     }

@@ -14,6 +14,7 @@ pub(super) fn vehicles(cfg: &ScenarioConfig, domain: &Rect) -> Result<Vec<Vehicl
     let legacy = cfg.planner.as_ref().map(legacy_planner).transpose()?;
     let mut vehicles = Vec::new();
     for (k, v) in cfg.vehicles.iter().enumerate() {
+        check_name(cfg, k)?;
         let mut setup = vehicle_setup(v, k, domain, cfg.domain.depth_m)?;
         setup.planner = match &v.planner {
             Some(name) => Some(named_planner(cfg, k, name)?),
@@ -45,6 +46,26 @@ pub(super) fn vehicles(cfg: &ScenarioConfig, domain: &Rect) -> Result<Vec<Vehicl
         ));
     }
     Ok(vehicles)
+}
+
+/// Vehicle `k`'s `name`, which becomes a file name (`NAME.alog`) and a label: the safe set of
+/// [`plumetrace_core::file_name::check_name`], and no other vehicle's. An omitted name stays
+/// `vehicles[K]`.
+fn check_name(cfg: &ScenarioConfig, k: usize) -> Result<(), Invalid> {
+    let name = &cfg.vehicles[k].name;
+    if name.is_empty() {
+        return Ok(());
+    }
+    let key = format!("vehicles[{k}].name");
+    plumetrace_core::file_name::check_name(name)
+        .map_err(|e| Invalid::new(&key, format!("{name:?} {e}")))?;
+    if let Some(j) = cfg.vehicles[..k].iter().position(|v| &v.name == name) {
+        return Err(Invalid::new(
+            key,
+            format!("{name:?} is also vehicles[{j}]'s name; give each vehicle its own"),
+        ));
+    }
+    Ok(())
 }
 
 /// The `[planner]` table (flown by every AUV that names no planner); its kind may be given by
