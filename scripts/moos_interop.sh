@@ -125,9 +125,8 @@ start_db() {
     (cd "$WORK" && exec MOOSDB interop.moos --moos_port="$PORT" --audit_port="$AUDIT_PORT" \
         --moos_suicide_disable --moos_no_colour) >> "$WORK/moosdb.log" 2>&1 &
     DB_PID=$!
-    local i
     # Ready when it accepts a connection (the probe shows in its log as a failed handshake).
-    for i in $(seq 100); do
+    for _ in $(seq 100); do
         if python3 -c "import socket, sys; socket.create_connection(('127.0.0.1', $PORT), 0.2).close()" 2>/dev/null; then
             return 0
         fi
@@ -216,20 +215,23 @@ REJECTED="$(report lines_rejected)"
 check "traffic" "$(ok python3 -c "import json, sys; r = json.load(open(sys.argv[1]))['lines_rejected']; sys.exit(any(k != 'stale' for k in r))" "$REPORT" 2>/dev/null)" \
     "$(report lines_accepted) messages taken, rejected by kind: $REJECTED (only stored values older than stale_nav_s may be)"
 
-N="$(count DESIRED_HEADING)"
-check "DESIRED_HEADING" "$(ok eval 'test "$N" -ge 50 && in_range DESIRED_HEADING 0 359.999999')" "$N postings, each in [0, 360) deg"
-N="$(count DESIRED_SPEED)"
-check "DESIRED_SPEED" "$(ok eval 'test "$N" -ge 50 && in_range DESIRED_SPEED 0 2.5')" "$N postings, each in [0, 2.5] m/s"
-N="$(count DESIRED_DEPTH)"
-check "DESIRED_DEPTH" "$(ok eval 'test "$N" -ge 50 && in_range DESIRED_DEPTH 0 100')" "$N postings, each in [0, 100] m"
+# set_points KEY LO HI: at least 50 postings, each in [LO, HI].
+set_points() { [ "$(count "$1")" -ge 50 ] && in_range "$1" "$2" "$3"; }
+check "DESIRED_HEADING" "$(ok set_points DESIRED_HEADING 0 359.999999)" \
+    "$(count DESIRED_HEADING) postings, each in [0, 360) deg"
+check "DESIRED_SPEED" "$(ok set_points DESIRED_SPEED 0 2.5)" \
+    "$(count DESIRED_SPEED) postings, each in [0, 2.5] m/s"
+check "DESIRED_DEPTH" "$(ok set_points DESIRED_DEPTH 0 100)" \
+    "$(count DESIRED_DEPTH) postings, each in [0, 100] m"
 
 # The manual override: CPT_PAUSED true with a stop, then false when it is lifted.
-PAUSED="$(postings CPT_PAUSED | tr '\n' ' ')"
+PAUSED="$(postings CPT_PAUSED | tr '\n' ' ' | sed 's/ $//')"
 # The stop goes out with the pause, in the same packet just before it.
 STOP_WHILE_PAUSED="$(awk -F'\t' '$4 != "pPlumetrace" { next }
     $3 == "CPT_PAUSED" && $5 == "true" && prev == "DESIRED_SPEED=0" { n++ }
     { prev = $3 "=" ($3 == "DESIRED_SPEED" ? $5 + 0 : $5) } END { print n + 0 }' "$TSV")"
-check "CPT_PAUSED" "$(ok eval 'postings CPT_PAUSED | tr "\n" " " | grep -q "true .*false" && test "$STOP_WHILE_PAUSED" -ge 1')" \
+paused_then_resumed() { echo "$PAUSED" | grep -q "true .*false" && [ "$STOP_WHILE_PAUSED" -ge 1 ]; }
+check "CPT_PAUSED" "$(ok paused_then_resumed)" \
     "values in order: ${PAUSED:-none}; pauses sent with DESIRED_SPEED = 0: $STOP_WHILE_PAUSED"
 LAST_STATUS="$(postings CPT_STATUS | tail -n 1)"
 check "CPT_STATUS" "$(ok test "$LAST_STATUS" = ended)" "last value: ${LAST_STATUS:-none}"

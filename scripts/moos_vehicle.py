@@ -91,7 +91,7 @@ def decode_packet(p):
 
 
 class Vehicle:
-    def __init__(self, args):
+    def __init__(self, args, log):
         self.args = args
         self.x, self.y = args.start_x, args.start_y
         self.heading, self.speed = 90.0, 1.0
@@ -103,7 +103,7 @@ class Vehicle:
         self.next_id = 0
         self.last_timing = 0.0
         self.started = time.time()
-        self.log = open(args.log, "w", buffering=1)
+        self.log = log
 
     def now(self):
         return time.time() - self.started
@@ -145,7 +145,9 @@ class Vehicle:
         self.sock = None
 
     def msg(self, kind, key, double=-1.0, string=None):
-        m = message(kind, key, time.time(), double, string, self.args.name, self.next_id)
+        m = message(
+            kind, key, time.time(), double, string, self.args.name, self.next_id
+        )
         self.next_id += 1
         return m
 
@@ -219,7 +221,10 @@ class Vehicle:
         a = self.args
         override = []
         if a.override_at is not None:
-            override = [(a.override_at, "true"), (a.override_at + a.override_for, "false")]
+            override = [
+                (a.override_at, "true"),
+                (a.override_at + a.override_for, "false"),
+            ]
         last = self.now()
         next_try = 0.0
         while self.now() < a.duration:
@@ -239,7 +244,9 @@ class Vehicle:
                 self.msg(b"N", a.chem_variable, self.reading()),
             ]
             while override and t >= override[0][0] and self.sock is not None:
-                posts.append(self.msg(b"N", "MOOS_MANUAL_OVERRIDE", string=override[0][1]))
+                posts.append(
+                    self.msg(b"N", "MOOS_MANUAL_OVERRIDE", string=override[0][1])
+                )
                 self.note(f"MOOS_MANUAL_OVERRIDE = {override[0][1]}")
                 override.pop(0)
             self.send(posts)
@@ -265,11 +272,14 @@ def main():
     p.add_argument("--start-y", type=float, default=0.0)
     p.add_argument("--source-x", type=float, default=100.0)
     p.add_argument("--source-y", type=float, default=0.0)
-    p.add_argument("--override-at", type=float, help="post MOOS_MANUAL_OVERRIDE = true then")
+    p.add_argument(
+        "--override-at", type=float, help="post MOOS_MANUAL_OVERRIDE = true then"
+    )
     p.add_argument("--override-for", type=float, default=3.0)
     args = p.parse_args()
     signal.signal(signal.SIGTERM, lambda *_: sys.exit(0))
-    Vehicle(args).run()
+    with open(args.log, "w", buffering=1) as log:
+        Vehicle(args, log).run()
 
 
 if __name__ == "__main__":
