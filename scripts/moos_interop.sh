@@ -159,7 +159,7 @@ wait_onboard() {
 wait_onboard "$DB_DOWN_AT"
 if kill -0 "$ONBOARD_PID" 2>/dev/null; then
     echo "moos_interop: stopping the MOOSDB for ${DB_DOWN_FOR} s"
-    kill "$DB_PID"
+    kill "$DB_PID" 2>/dev/null || true
     wait "$DB_PID" 2>/dev/null || true
     sleep "$DB_DOWN_FOR" &
     wait $!
@@ -167,6 +167,12 @@ if kill -0 "$ONBOARD_PID" 2>/dev/null; then
     echo "moos_interop: the MOOSDB is back"
 fi
 
+# It ends at its time limit; one that has not ended well after it is stopped (and fails).
+wait_onboard $((TIME_LIMIT + 30))
+if kill -0 "$ONBOARD_PID" 2>/dev/null; then
+    echo "moos_interop: the onboard process had not ended well after its time limit: stopping it"
+    kill "$ONBOARD_PID" 2>/dev/null || true
+fi
 ONBOARD_RC=0
 wait "$ONBOARD_PID" || ONBOARD_RC=$?
 ONBOARD_PID=""
