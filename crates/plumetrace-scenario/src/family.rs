@@ -367,7 +367,7 @@ pub const FAMILY_LIMITS: &[(&str, f64, f64, &str)] = &[
     ),
 ];
 
-fn invalid(file: &Path, key: &str, message: String) -> ScenarioError {
+pub(crate) fn invalid(file: &Path, key: &str, message: String) -> ScenarioError {
     ScenarioError::Parse {
         origin: file.display().to_string(),
         line: None,
@@ -618,7 +618,7 @@ fn check_extremes(family: &Family) -> Result<(), ScenarioError> {
     Ok(())
 }
 
-fn uniform(rng: &mut impl Rng, r: Range) -> f64 {
+pub(crate) fn uniform(rng: &mut impl Rng, r: Range) -> f64 {
     if r[1] > r[0] {
         rng.random_range(r[0]..=r[1])
     } else {
@@ -627,7 +627,7 @@ fn uniform(rng: &mut impl Rng, r: Range) -> f64 {
 }
 
 /// A unit vector along compass `deg`.
-fn unit(deg: f64) -> Vec2 {
+pub(crate) fn unit(deg: f64) -> Vec2 {
     let a = deg.to_radians();
     Vec2::new(a.sin(), a.cos())
 }
@@ -847,7 +847,7 @@ fn draw(f: &FamilyFile, seed: u64) -> Site {
 }
 
 /// `t[key]` as a table, made (or replacing a value of another type) if needed.
-fn table_at<'a>(t: &'a mut toml::Table, key: &str) -> Option<&'a mut toml::Table> {
+pub(crate) fn table_at<'a>(t: &'a mut toml::Table, key: &str) -> Option<&'a mut toml::Table> {
     if !t.get(key).is_some_and(toml::Value::is_table) {
         t.insert(key.to_string(), toml::Value::Table(toml::Table::new()));
     }
@@ -865,11 +865,11 @@ fn first_of<'a>(t: &'a mut toml::Table, key: &str) -> Option<&'a mut toml::Table
     }
 }
 
-fn float(v: f64) -> toml::Value {
+pub(crate) fn float(v: f64) -> toml::Value {
     toml::Value::Float(v)
 }
 
-fn round(v: f64, digits: i32) -> f64 {
+pub(crate) fn round(v: f64, digits: i32) -> f64 {
     let k = 10f64.powi(digits);
     (v * k).round() / k
 }

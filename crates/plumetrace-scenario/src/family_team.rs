@@ -30,7 +30,7 @@
 //!   and with probability `deaf_probability` a deaf window of the follower's modem (`deaf_s`
 //!   long, starting in `deaf_start_s`).
 
-use crate::family::{FamilyFile, Range, Site};
+use crate::family::{FamilyFile, Range, Site, float, invalid, round, table_at, uniform, unit};
 use crate::{Origin, ScenarioError};
 use plumetrace_core::Vec2;
 use plumetrace_env::{StreamId, stream_rng};
@@ -218,15 +218,6 @@ struct Roles {
     leader_planners: Vec<String>,
 }
 
-fn invalid(file: &Path, key: &str, message: String) -> ScenarioError {
-    ScenarioError::Parse {
-        origin: file.display().to_string(),
-        line: None,
-        path: key.to_string(),
-        message,
-    }
-}
-
 /// The planner table a vehicle of `base` flies, with its name.
 fn planner_of(base: &toml::Table, v: &toml::Value) -> Option<(String, toml::Table)> {
     let name = v.get("planner")?.as_str()?;
@@ -391,20 +382,6 @@ pub(crate) fn check(
     Ok(())
 }
 
-fn uniform(rng: &mut impl Rng, r: Range) -> f64 {
-    if r[1] > r[0] {
-        rng.random_range(r[0]..=r[1])
-    } else {
-        r[0]
-    }
-}
-
-/// A unit vector along compass `deg`.
-fn unit(deg: f64) -> Vec2 {
-    let a = deg.to_radians();
-    Vec2::new(a.sin(), a.cos())
-}
-
 fn float_of(t: &toml::Table, section: &str, key: &str) -> Option<f64> {
     let v = t.get(section)?.get(key)?;
     v.as_float().or_else(|| v.as_integer().map(|i| i as f64))
@@ -528,23 +505,6 @@ pub(crate) fn draw(
         ranging_noise_sd_s,
         deaf_s: deaf_on.then_some([deaf_at, deaf_at + deaf_len]),
     })
-}
-
-fn float(v: f64) -> toml::Value {
-    toml::Value::Float(v)
-}
-
-fn round(v: f64, digits: i32) -> f64 {
-    let k = 10f64.powi(digits);
-    (v * k).round() / k
-}
-
-/// `t[key]` as a table, made (or replacing a value of another type) if needed.
-fn table_at<'a>(t: &'a mut toml::Table, key: &str) -> Option<&'a mut toml::Table> {
-    if !t.get(key).is_some_and(toml::Value::is_table) {
-        t.insert(key.to_string(), toml::Value::Table(toml::Table::new()));
-    }
-    t.get_mut(key).and_then(toml::Value::as_table_mut)
 }
 
 /// Vehicle `k` of `t` as a table.
