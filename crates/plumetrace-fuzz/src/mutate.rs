@@ -49,6 +49,9 @@ pub enum Kind {
     HugeArray,
     /// A string of up to half a megabyte.
     HugeString,
+    /// A planner key set at one end of its documented bounds, or just past it (the registry's
+    /// bounds for the table's `kind`: an open end itself, `min - 1` and `max + 1` for counts).
+    PlannerKeyAtBound,
     /// A name that becomes a file name (a vehicle's, a family's, an obstacle's) made hostile:
     /// `..`, a separator, an absolute path, NUL, a control character, 300 bytes, another's.
     HostileName,
@@ -78,7 +81,7 @@ pub enum Kind {
 
 impl Kind {
     /// Every kind, in declaration order.
-    pub const ALL: [Kind; 27] = [
+    pub const ALL: [Kind; 28] = [
         Kind::DeleteKey,
         Kind::DeleteTable,
         Kind::DuplicateArrayEntry,
@@ -94,6 +97,7 @@ impl Kind {
         Kind::PolygonFarVertex,
         Kind::HugeArray,
         Kind::HugeString,
+        Kind::PlannerKeyAtBound,
         Kind::HostileName,
         Kind::CampaignSeeds,
         Kind::CampaignSweep,
@@ -126,6 +130,7 @@ impl Kind {
             Kind::PolygonFarVertex => "polygon_far_vertex",
             Kind::HugeArray => "huge_array",
             Kind::HugeString => "huge_string",
+            Kind::PlannerKeyAtBound => "planner_key_at_bound",
             Kind::HostileName => "hostile_name",
             Kind::CampaignSeeds => "campaign_seeds",
             Kind::CampaignSweep => "campaign_sweep",
@@ -667,6 +672,7 @@ pub fn apply_tree(
         | Kind::PolygonFarVertex => polygon(kind, root, target, rng),
         Kind::HugeArray => huge_array(root, rng),
         Kind::HugeString => huge_string(root, rng),
+        Kind::PlannerKeyAtBound => planner_key_at_bound(root, rng),
         Kind::HostileName => hostile_name(root, rng),
         Kind::CampaignSeeds
         | Kind::CampaignSweep
@@ -1025,6 +1031,95 @@ const HOSTILE_NAMES: &[&str] = &[
     "é",
     "",
 ];
+
+/// A key's documented bounds, read back from the registry's words for them
+/// (`">= 0 and <= 100"`, `"> 0 and < 1"`, `"3..=72"`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum KeyBounds {
+    /// A real number: (min, min open, max, max open).
+    Real(f64, bool, f64, bool),
+    /// A whole number in `min..=max`.
+    Whole(u64, u64),
+}
+
+fn key_bounds(words: &str) -> Option<KeyBounds> {
+    if let Some((a, b)) = words.split_once("..=") {
+        return Some(KeyBounds::Whole(
+            a.trim().parse().ok()?,
+            b.trim().parse().ok()?,
+        ));
+    }
+    let (low, high) = words.split_once(" and ")?;
+    let (min_open, min) = match low.trim().strip_prefix(">=") {
+        Some(v) => (false, v),
+        None => (true, low.trim().strip_prefix('>')?),
+    };
+    let (max_open, max) = match high.trim().strip_prefix("<=") {
+        Some(v) => (false, v),
+        None => (true, high.trim().strip_prefix('<')?),
+    };
+    Some(KeyBounds::Real(
+        min.trim().parse().ok()?,
+        min_open,
+        max.trim().parse().ok()?,
+        max_open,
+    ))
+}
+
+/// Sets a key of a planner table (any table with a registered `kind`) to one end of its
+/// bounds or just past it.
+fn planner_key_at_bound(root: &mut Table, rng: &mut Pcg64Mcg) -> Option<String> {
+    let kinds: Vec<&str> = plumetrace_planner::PLANNERS
+        .iter()
+        .map(|p| p.kind.name())
+        .collect();
+    let c = paths_where(root, &|_, v| {
+        v.as_table()
+            .and_then(|t| t.get("kind"))
+            .and_then(Value::as_str)
+            .is_some_and(|k| kinds.contains(&k))
+    });
+    let p = pick(rng, &c)?.clone();
+    let kind = get(root, &p)?.get("kind")?.as_str()?.to_string();
+    let entry = plumetrace_planner::PLANNERS
+        .iter()
+        .find(|e| e.kind.name() == kind)?;
+    let keys: Vec<(&'static str, KeyBounds)> =
+        <plumetrace_planner::CommonParams as plumetrace_core::params::Params>::keys()
+            .into_iter()
+            .chain((entry.keys)())
+            .filter_map(|k| Some((k.name, key_bounds(&k.bounds)?)))
+            .collect();
+    let &(key, bounds) = pick(rng, &keys)?;
+    let (value, at) = match (bounds, below(rng, 4)) {
+        (KeyBounds::Whole(min, _), 0) => (
+            Value::Integer(min.min(i64::MAX as u64) as i64),
+            "at its minimum",
+        ),
+        (KeyBounds::Whole(_, max), 1) => (
+            Value::Integer(max.min(i64::MAX as u64) as i64),
+            "at its maximum",
+        ),
+        (KeyBounds::Whole(min, _), 2) => (Value::Integer(min as i64 - 1), "just below its minimum"),
+        (KeyBounds::Whole(_, max), _) => (
+            Value::Integer((max.min(i64::MAX as u64 - 1) + 1) as i64),
+            "just above its maximum",
+        ),
+        (KeyBounds::Real(min, _, _, _), 0) => (float(min), "at its lower end"),
+        (KeyBounds::Real(_, _, max, _), 1) => (float(max), "at its upper end"),
+        (KeyBounds::Real(min, _, _, _), 2) => (
+            float(min - (min.abs() * 1e-9).max(1e-9)),
+            "just below its lower end",
+        ),
+        (KeyBounds::Real(_, _, max, _), _) => (
+            float(max + (max.abs() * 1e-9).max(1e-9)),
+            "just above its upper end",
+        ),
+    };
+    let what = format!("{}.{key} = {} ({at})", path_text(&p), show(&value));
+    table_mut(root, &p)?.insert(key.to_string(), value);
+    Some(what)
+}
 
 fn hostile_name(root: &mut Table, rng: &mut Pcg64Mcg) -> Option<String> {
     let c = paths_where(root, &|p, v| {
@@ -1531,6 +1626,35 @@ mod tests {
             assert!(what.is_some(), "{kind:?}");
             let text = toml::to_string(&t).unwrap_or_default();
             assert!(!text.is_empty() && text.len() < MAX_INPUT_BYTES, "{kind:?}");
+        }
+    }
+
+    #[test]
+    fn the_registrys_bound_words_are_read_back() {
+        assert_eq!(
+            key_bounds(">= 0 and <= 100"),
+            Some(KeyBounds::Real(0.0, false, 100.0, false))
+        );
+        assert_eq!(
+            key_bounds("> 0 and < 1"),
+            Some(KeyBounds::Real(0.0, true, 1.0, true))
+        );
+        assert_eq!(key_bounds("3..=72"), Some(KeyBounds::Whole(3, 72)));
+        assert_eq!(key_bounds(""), None);
+        // Every bounded key of every planner is understood.
+        for e in plumetrace_planner::PLANNERS {
+            for k in <plumetrace_planner::CommonParams as plumetrace_core::params::Params>::keys()
+                .into_iter()
+                .chain((e.keys)())
+            {
+                assert!(
+                    k.bounds.is_empty() || key_bounds(&k.bounds).is_some(),
+                    "{}.{}: {:?}",
+                    e.kind.name(),
+                    k.name,
+                    k.bounds
+                );
+            }
         }
     }
 
