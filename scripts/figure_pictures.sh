@@ -15,15 +15,9 @@ if [ -z "$bin" ]; then
     cargo build --release --bin plumetrace
     bin="target/release/plumetrace"
 fi
-browser="${PLUMETRACE_BROWSER:-$(command -v chromium-headless-shell || command -v chromium || true)}"
-if [ -z "$browser" ]; then
-    echo "figure_pictures.sh: no headless Chromium: install chromium-headless-shell or set PLUMETRACE_BROWSER" >&2
-    exit 1
-fi
-if [ ! -x "$browser" ]; then
-    echo "figure_pictures.sh: the browser $browser is not an executable file (PLUMETRACE_BROWSER?)" >&2
-    exit 1
-fi
+# shellcheck source=scripts/browser.sh
+. "$root/scripts/browser.sh"
+find_browser figure_pictures.sh
 out="target/figure-pictures"
 rm -rf "$out"
 mkdir -p "$out" docs/images

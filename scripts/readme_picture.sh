@@ -13,11 +13,9 @@ if [ -z "$bin" ]; then
     cargo build --release --bin plumetrace
     bin="target/release/plumetrace"
 fi
-browser="${PLUMETRACE_BROWSER:-$(command -v chromium-headless-shell || command -v chromium || true)}"
-if [ -z "$browser" ]; then
-    echo "readme_picture.sh: no headless Chromium: install chromium-headless-shell or set PLUMETRACE_BROWSER" >&2
-    exit 1
-fi
+# shellcheck source=scripts/browser.sh
+. "$root/scripts/browser.sh"
+find_browser readme_picture.sh
 out="target/readme-picture"
 rm -rf "$out"
 "$bin" run --preset demo --out "$out" --no-snapshot-log >/dev/null

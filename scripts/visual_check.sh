@@ -31,15 +31,9 @@ if [ ! -x "$bin" ]; then
     exit 1
 fi
 bin=$(realpath "$bin")
-browser="${PLUMETRACE_BROWSER:-$(command -v chromium-headless-shell || command -v chromium || true)}"
-if [ -z "$browser" ]; then
-    echo "visual_check.sh: no headless Chromium: install chromium-headless-shell or set PLUMETRACE_BROWSER" >&2
-    exit 1
-fi
-if [ ! -x "$browser" ]; then
-    echo "visual_check.sh: the browser $browser is not an executable file (PLUMETRACE_BROWSER?)" >&2
-    exit 1
-fi
+# shellcheck source=scripts/browser.sh
+. "$root/scripts/browser.sh"
+find_browser visual_check.sh
 rm -rf "$out"
 mkdir -p "$out/png"
 out=$(realpath "$out")
