@@ -123,14 +123,7 @@ fn dispatch(cli: Cli) -> Result<()> {
             if markdown {
                 crate::out!("{}", plumetrace_scenario::limits::markdown());
             } else {
-                let width = plumetrace_scenario::limits::LIMITS
-                    .iter()
-                    .map(|l| l.key.len())
-                    .max()
-                    .unwrap_or(0);
-                for l in plumetrace_scenario::limits::LIMITS {
-                    crate::outln!("{:width$}  {} ({})", l.key, l.bound.describe(), l.why);
-                }
+                crate::out!("{}", plumetrace_scenario::limits::text());
             }
             Ok(())
         }

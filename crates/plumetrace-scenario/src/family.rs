@@ -365,7 +365,97 @@ pub const FAMILY_LIMITS: &[(&str, f64, f64, &str)] = &[
         1e6,
         "a window within the mission",
     ),
+    (
+        "team.outlet_from_end_m[]",
+        0.0,
+        1e5,
+        "inside the basin, from its up-flow end",
+    ),
+    (
+        "team.outlet_cross_m[]",
+        -1e5,
+        1e5,
+        "across the basin from its centre line",
+    ),
+    (
+        "team.second_along_m[]",
+        0.0,
+        1e5,
+        "the second outlet down-flow of the first",
+    ),
+    (
+        "team.second_cross_m[]",
+        -1e5,
+        1e5,
+        "the second outlet across from the first",
+    ),
+    (
+        "team.second_fraction[]",
+        0.0,
+        100.0,
+        "the second outlet's rate as a fraction of the first's",
+    ),
+    (
+        "team.medium_ppt[]",
+        0.1,
+        1000.0,
+        "the medium's salinity (the contrast the team senses), ppt",
+    ),
+    (
+        "team.d_m[]",
+        1.0,
+        1000.0,
+        "the formation's scale: a team of metres to a kilometre",
+    ),
+    (
+        "team.reach_freshness_ppt",
+        1e-9,
+        1e3,
+        "a freshness the plume's centre line reaches, ppt",
+    ),
+    (
+        "team.start_along_fraction[]",
+        0.0,
+        1.0,
+        "a fraction of the plume's reach",
+    ),
+    (
+        "team.start_along_min_m",
+        0.0,
+        1e5,
+        "a distance down-flow of the outlet",
+    ),
+    (
+        "team.start_cross_sigmas",
+        0.0,
+        10.0,
+        "plume widths off the centre line",
+    ),
+    (
+        "team.consumer_sigma_m[]",
+        0.0,
+        100.0,
+        "a GPS's error, from RTK to a poor receiver",
+    ),
+    ("team.acoustic_loss[]", 0.0, 1.0, "a probability"),
+    (
+        "team.ranging_noise_sd_s[]",
+        0.0,
+        1.0,
+        "a second of timing error is no ranging",
+    ),
+    ("team.deaf_probability", 0.0, 1.0, "a probability"),
+    ("team.deaf_s[]", 0.0, 1e6, "a window within the mission"),
+    ("team.deaf_start_s[]", 0.0, 1e6, "a time within the mission"),
 ];
+
+/// The bound of a family key (`[]` for a range's ends) from [`FAMILY_LIMITS`]: low, high and why.
+pub(crate) fn family_bound(key: &str) -> (f64, f64, &'static str) {
+    FAMILY_LIMITS
+        .iter()
+        .find(|l| l.0 == key)
+        .map_or((f64::MIN, f64::MAX, ""), |l| (l.1, l.2, l.3))
+}
 
 pub(crate) fn invalid(file: &Path, key: &str, message: String) -> ScenarioError {
     ScenarioError::Parse {
@@ -465,12 +555,7 @@ impl Family {
 
 /// Checks every bound and rule of a family file; errors name the key.
 fn check(f: &FamilyFile, path: &Path) -> Result<(), ScenarioError> {
-    let bound = |key: &str| {
-        FAMILY_LIMITS
-            .iter()
-            .find(|l| l.0 == key)
-            .map_or((f64::MIN, f64::MAX, ""), |l| (l.1, l.2, l.3))
-    };
+    let bound = family_bound;
     let num = |key: &str, v: f64| -> Result<(), ScenarioError> {
         let (lo, hi, why) = bound(key);
         if v.is_finite() && v >= lo && v <= hi {

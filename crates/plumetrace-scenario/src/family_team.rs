@@ -30,7 +30,10 @@
 //!   and with probability `deaf_probability` a deaf window of the follower's modem (`deaf_s`
 //!   long, starting in `deaf_start_s`).
 
-use crate::family::{FamilyFile, Range, Site, float, invalid, round, table_at, uniform, unit};
+use crate::family::{
+    FAMILY_LIMITS, FamilyFile, Range, Site, family_bound, float, invalid, round, table_at, uniform,
+    unit,
+};
 use crate::{Origin, ScenarioError};
 use plumetrace_core::Vec2;
 use plumetrace_env::{StreamId, stream_rng};
@@ -294,63 +297,50 @@ pub(crate) fn check(
 ) -> Result<(), ScenarioError> {
     let Some(t) = &f.team else { return Ok(()) };
     roles(base, base_origin, path)?;
-    let range = |key: &str, r: Option<Range>, lo: f64, hi: f64| -> Result<(), ScenarioError> {
+    let range = |key: &str, r: Option<Range>| -> Result<(), ScenarioError> {
         let Some([a, b]) = r else { return Ok(()) };
+        let key = format!("team.{key}");
+        let ranged = format!("{key}[]");
+        let (lo, hi, why) = if FAMILY_LIMITS.iter().any(|l| l.0 == ranged) {
+            family_bound(&ranged)
+        } else {
+            family_bound(&key)
+        };
         for v in [a, b] {
             if !(v.is_finite() && v >= lo && v <= hi) {
                 return Err(invalid(
                     path,
-                    &format!("team.{key}"),
-                    format!("must be a finite number >= {lo} and <= {hi}, got {v}"),
+                    &key,
+                    format!("must be a finite number >= {lo} and <= {hi} ({why}), got {v}"),
                 ));
             }
         }
         if a > b {
             return Err(invalid(
                 path,
-                &format!("team.{key}"),
+                &key,
                 format!("[low, high] needs low <= high, got [{a}, {b}]"),
             ));
         }
         Ok(())
     };
-    range("outlet_from_end_m", Some(t.outlet_from_end_m), 0.0, 1e5)?;
-    range("outlet_cross_m", t.outlet_cross_m, -1e5, 1e5)?;
-    range("second_along_m", Some(t.second_along_m), 0.0, 1e5)?;
-    range("second_cross_m", Some(t.second_cross_m), -1e5, 1e5)?;
-    range("second_fraction", Some(t.second_fraction), 0.0, 100.0)?;
-    range("medium_ppt", t.medium_ppt, 0.1, 1000.0)?;
-    range("d_m", t.d_m, 1.0, 1000.0)?;
-    range(
-        "reach_freshness_ppt",
-        Some([t.reach_freshness_ppt; 2]),
-        1e-9,
-        1e3,
-    )?;
-    range(
-        "start_along_fraction",
-        Some(t.start_along_fraction),
-        0.0,
-        1.0,
-    )?;
-    range(
-        "start_along_min_m",
-        Some([t.start_along_min_m; 2]),
-        0.0,
-        1e5,
-    )?;
-    range(
-        "start_cross_sigmas",
-        Some([t.start_cross_sigmas; 2]),
-        0.0,
-        10.0,
-    )?;
-    range("consumer_sigma_m", Some(t.consumer_sigma_m), 0.0, 100.0)?;
-    range("acoustic_loss", t.acoustic_loss, 0.0, 1.0)?;
-    range("ranging_noise_sd_s", t.ranging_noise_sd_s, 0.0, 1.0)?;
-    range("deaf_probability", Some([t.deaf_probability; 2]), 0.0, 1.0)?;
-    range("deaf_s", Some(t.deaf_s), 0.0, 1e6)?;
-    range("deaf_start_s", Some(t.deaf_start_s), 0.0, 1e6)?;
+    range("outlet_from_end_m", Some(t.outlet_from_end_m))?;
+    range("outlet_cross_m", t.outlet_cross_m)?;
+    range("second_along_m", Some(t.second_along_m))?;
+    range("second_cross_m", Some(t.second_cross_m))?;
+    range("second_fraction", Some(t.second_fraction))?;
+    range("medium_ppt", t.medium_ppt)?;
+    range("d_m", t.d_m)?;
+    range("reach_freshness_ppt", Some([t.reach_freshness_ppt; 2]))?;
+    range("start_along_fraction", Some(t.start_along_fraction))?;
+    range("start_along_min_m", Some([t.start_along_min_m; 2]))?;
+    range("start_cross_sigmas", Some([t.start_cross_sigmas; 2]))?;
+    range("consumer_sigma_m", Some(t.consumer_sigma_m))?;
+    range("acoustic_loss", t.acoustic_loss)?;
+    range("ranging_noise_sd_s", t.ranging_noise_sd_s)?;
+    range("deaf_probability", Some([t.deaf_probability; 2]))?;
+    range("deaf_s", Some(t.deaf_s))?;
+    range("deaf_start_s", Some(t.deaf_start_s))?;
     if t.outlets.is_empty() || t.outlets.iter().any(|&n| n == 0 || n > 2) {
         return Err(invalid(
             path,
@@ -756,6 +746,38 @@ mod tests {
             // The leaders keep their 10 m from each other.
             let p = |k: usize| built.vehicles[k].vehicle.state.pos_m;
             assert!(((p(1) - p(2)).norm() - 10.0).abs() < 0.05, "seed {seed}");
+        }
+    }
+
+    #[test]
+    fn every_team_row_bounds_its_key() {
+        let rows: Vec<_> = FAMILY_LIMITS
+            .iter()
+            .filter(|l| l.0.starts_with("team."))
+            .collect();
+        assert!(rows.len() >= 17, "{}", rows.len());
+        for (key, _, hi, why) in rows {
+            let name = key.trim_start_matches("team.");
+            let (name, ranged) = match name.strip_suffix("[]") {
+                Some(n) => (n, true),
+                None => (name, false),
+            };
+            let over = hi * 2.0 + 1.0;
+            let value = if ranged {
+                format!("[{over:?}, {over:?}]")
+            } else {
+                format!("{over:?}")
+            };
+            // Drop any line of the key already in the file, then set it above its bound.
+            let text: String = FORMATION
+                .lines()
+                .filter(|l| !l.trim_start().starts_with(&format!("{name} =")))
+                .map(|l| format!("{l}\n"))
+                .collect::<String>()
+                .replace("[team]\n", &format!("[team]\n{name} = {value}\n"));
+            let e = formation(&text).map(|_| ()).unwrap_err().to_string();
+            let shown = format!("team.{name}");
+            assert!(e.contains(&shown) && e.contains(why), "{key}: {e}");
         }
     }
 

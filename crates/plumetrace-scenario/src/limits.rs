@@ -786,6 +786,35 @@ fn number(v: f64, path: &str, pattern: &str) -> Result<(), LimitError> {
     }
 }
 
+/// The table as aligned text (`plumetrace limits`): key, bound and why, then the family keys'.
+pub fn text() -> String {
+    let family: Vec<(String, String, &str)> = crate::family::FAMILY_LIMITS
+        .iter()
+        .map(|(key, lo, hi, why)| {
+            let bound = format!(">= {} and <= {}", show(*lo), show(*hi));
+            (key.to_string(), bound, *why)
+        })
+        .collect();
+    let width = LIMITS
+        .iter()
+        .map(|l| l.key.len())
+        .chain(family.iter().map(|f| f.0.len()))
+        .max()
+        .unwrap_or(0);
+    let mut out = String::new();
+    for l in LIMITS {
+        let _ = writeln!(out, "{:width$}  {} ({})", l.key, l.bound.describe(), l.why);
+    }
+    out.push_str(
+        "\nScenario families (*.family.toml); a range [low, high] needs low <= high, both within \
+         the bound:\n",
+    );
+    for (key, bound, why) in &family {
+        let _ = writeln!(out, "{key:width$}  {bound} ({why})");
+    }
+    out
+}
+
 /// The table as Markdown (`| key | bound | why |`), then the family keys' table.
 pub fn markdown() -> String {
     let mut out = String::from("| key | bound | why |\n| --- | --- | --- |\n");
