@@ -4,8 +4,8 @@
 # table (exported by the Rust test), min for AND, max accumulation, centroid on the same grids.
 # Only the stateless engine is compared (the side-locking Avoider is not part of it).
 #
-# Installs scikit-fuzzy 0.5.0 with numpy, scipy, networkx and packaging (skfuzzy imports all four;
-# it declares none) into a virtual environment under scripts/.venv-fuzzy, runs the ignored Rust
+# Uses scikit-fuzzy 0.5.0 with numpy, scipy, networkx and packaging (skfuzzy imports all four;
+# it declares none) in the virtual environment scripts/venvs.sh makes (scripts/.venv-fuzzy), runs the ignored Rust
 # test `crosscheck_dump` to evaluate the inputs, then compares; exits non-zero when the largest
 # difference of either output is more than 1 % of its range.
 #
@@ -24,19 +24,13 @@ while [ $# -gt 0 ]; do
         *) echo "unknown argument: $1" >&2; exit 2 ;;
     esac
 done
-venv="$here/.venv-fuzzy"
-if [ ! -x "$venv/bin/python" ]; then
-    python3 -m venv "$venv"
-fi
-# Keep the environment out of git, as Python 3.13's venv does by itself.
-printf '*\n' > "$venv/.gitignore"
-"$venv/bin/pip" install --quiet "scikit-fuzzy==0.5.0" numpy scipy networkx packaging
+venv=$(bash "$here/venvs.sh" fuzzy)
 
 out="${CARGO_TARGET_DIR:-$root/target}/fuzzy-crosscheck"
 mkdir -p "$out"
 "$venv/bin/python" "$here/fuzzy_crosscheck.py" inputs --out "$out/inputs.csv" --n "$n" --seed "$seed"
 FUZZY_INPUTS="$out/inputs.csv" FUZZY_OUTPUTS="$out/outputs.csv" FUZZY_RULES="$out/rules.csv" \
-    cargo test --quiet --manifest-path "$root/Cargo.toml" -p plumetrace-planner \
+    cargo test --quiet --manifest-path "$root/Cargo.toml" --workspace \
     --test fuzzy_avoidance -- --ignored --exact crosscheck_dump
 exec "$venv/bin/python" "$here/fuzzy_crosscheck.py" compare --inputs "$out/inputs.csv" \
     --outputs "$out/outputs.csv" --rules "$out/rules.csv" --tolerance "$tolerance"

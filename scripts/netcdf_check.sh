@@ -4,28 +4,25 @@
 # snapshot.csv: dimensions, CF attributes, probe positions, times, every concentration and the
 # time-averaged map. Exits non-zero on any mismatch.
 #
-# Installs numpy and scipy into a virtual environment under scripts/.venv-netcdf, runs the
+# Uses numpy and scipy in the virtual environment scripts/venvs.sh makes (scripts/.venv-netcdf), runs the
 # plume-demo preset with five probes (in its last table, [output]) unless --run names the output
 # directory of a run already made, and compares.
 #
-# Usage: scripts/netcdf_check.sh [--run DIR]
+# Usage: scripts/netcdf_check.sh [--run DIR] [--bin PLUMETRACE]
+#   --bin   a plumetrace built with the feature (default: `cargo run --features netcdf`)
 set -euo pipefail
 here=$(cd "$(dirname "$0")" && pwd)
 root=$(cd "$here/.." && pwd)
 run=""
+bin=""
 while [ $# -gt 0 ]; do
     case "$1" in
         --run) run=$2; shift 2 ;;
+        --bin) bin=$2; shift 2 ;;
         *) echo "unknown argument: $1" >&2; exit 2 ;;
     esac
 done
-venv="$here/.venv-netcdf"
-if [ ! -x "$venv/bin/python" ]; then
-    python3 -m venv "$venv"
-fi
-# Keep the environment out of git, as Python 3.13's venv does by itself.
-printf '*\n' > "$venv/.gitignore"
-"$venv/bin/pip" install --quiet numpy scipy
+venv=$(bash "$here/venvs.sh" netcdf)
 
 if [ -z "$run" ]; then
     out="${CARGO_TARGET_DIR:-$root/target}/netcdf-check"
@@ -38,8 +35,12 @@ if [ -z "$run" ]; then
         echo 'probe_interval_s = 1.0'
     } > "$out/scenario.toml"
     run="$out/run"
-    cargo run --quiet --manifest-path "$root/Cargo.toml" -p plumetrace-cli --features netcdf -- \
-        run "$out/scenario.toml" --out "$run"
+    if [ -n "$bin" ]; then
+        "$bin" run "$out/scenario.toml" --out "$run"
+    else
+        cargo run --quiet --manifest-path "$root/Cargo.toml" -p plumetrace-cli --features netcdf -- \
+            run "$out/scenario.toml" --out "$run"
+    fi
 fi
 
 exec "$venv/bin/python" - "$run" <<'PY'

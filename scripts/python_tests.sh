@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # The Python package's checks: formatting and lints of its Rust crate, then `pip install` of the
-# package from the repository (maturin builds the wheel) into a fresh virtual environment, its
+# package from the repository (maturin builds the wheel) into the virtual environment
+# scripts/venvs.sh makes, its
 # pytest suite (which compares with the release command line, so it builds that too), and every
 # example of examples/python at a small size.
 #
@@ -10,22 +11,20 @@ here=$(cd "$(dirname "$0")" && pwd)
 root=$(cd "$here/.." && pwd)
 py="$root/crates/plumetrace-py"
 cli_target="${CARGO_TARGET_DIR:-$root/target}"
-venv="$root/target/py-venv"
 
-CARGO_TARGET_DIR="$cli_target" cargo build --release --quiet --manifest-path "$root/Cargo.toml" \
-    -p plumetrace-cli
+# As the README's first command builds it (the same packages selected, so the same build).
+(cd "$root" && CARGO_TARGET_DIR="$cli_target" cargo build --release --quiet --bin plumetrace)
 # The package is its own workspace; sharing the target directory reuses what the two builds
 # have in common.
 export CARGO_TARGET_DIR="$cli_target"
 cargo fmt --manifest-path "$py/Cargo.toml" --check
 cargo clippy --release --manifest-path "$py/Cargo.toml" --all-targets -- -D warnings
 
-rm -rf "$venv"
-python3 -m venv "$venv"
-"$venv/bin/pip" install --quiet "maturin==1.16.0" "gymnasium==1.4.0" "pytest>=7" "pandas" "pyarrow" \
-    "tqdm" "dask[distributed]" "matplotlib"
+# The environment (maturin, Gymnasium, pytest, the optional dependencies) is made once by
+# scripts/venvs.sh; the package itself is installed into it anew every time.
+venv=$(bash "$here/venvs.sh" package)
 start=$SECONDS
-"$venv/bin/pip" install --quiet "$py"
+"$venv/bin/pip" install --quiet --force-reinstall --no-deps "$py"
 echo "pip install of the package: $((SECONDS - start)) s"
 (cd "$py/tests" && PLUMETRACE_BIN="$cli_target/release/plumetrace" "$venv/bin/python" -m pytest -q "$@")
 
