@@ -106,3 +106,102 @@ pub struct LinkTiming {
     /// Longest reconnection delay.
     pub reconnect_max: Duration,
 }
+
+/// The delay before a link's next connection attempt: doubled (up to
+/// [`LinkTiming::reconnect_max`]) after each failed attempt and after each connection that was
+/// lost before it carried a navigation record, and back to [`LinkTiming::reconnect_min`] once a
+/// connection has carried one. So a peer that accepts and then drops every connection (a MOOSDB
+/// re-sending a value the client refuses, a front seat that crashes at each connection) is
+/// retried ever more slowly, not at the shortest delay for ever.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct Backoff {
+    delay: Duration,
+    min: Duration,
+    max: Duration,
+    // Whether the current (or last) connection carried a navigation record.
+    proven: bool,
+}
+
+impl Backoff {
+    /// At the shortest delay.
+    pub(crate) fn new(timing: &LinkTiming) -> Self {
+        Backoff {
+            delay: timing.reconnect_min,
+            min: timing.reconnect_min,
+            max: timing.reconnect_max.max(timing.reconnect_min),
+            proven: false,
+        }
+    }
+
+    /// The delay to wait now, the next one doubled.
+    fn double(&mut self) -> Duration {
+        let d = self.delay;
+        self.delay = (self.delay * 2).min(self.max);
+        d
+    }
+
+    /// A connection attempt failed: the delay before the next.
+    pub(crate) fn failed(&mut self) -> Duration {
+        self.double()
+    }
+
+    /// A connection opened: it has carried nothing yet.
+    pub(crate) fn connected(&mut self) {
+        self.proven = false;
+    }
+
+    /// The connection carried a navigation record: the delay is back to its least.
+    pub(crate) fn carried(&mut self) {
+        if !self.proven {
+            self.proven = true;
+            self.delay = self.min;
+        }
+    }
+
+    /// The connection was lost: the delay before the next attempt (doubling on if it carried
+    /// nothing).
+    pub(crate) fn lost(&mut self) -> Duration {
+        if std::mem::take(&mut self.proven) {
+            self.delay
+        } else {
+            self.double()
+        }
+    }
+
+    /// The delay the next failure would wait.
+    pub(crate) fn current(&self) -> Duration {
+        self.delay
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_connection_that_carries_nothing_does_not_reset_the_delay() {
+        let s = Duration::from_secs_f64;
+        let mut b = Backoff::new(&LinkTiming {
+            silence_timeout: s(10.0),
+            reconnect_min: s(0.5),
+            reconnect_max: s(4.0),
+        });
+        assert_eq!(b.failed(), s(0.5));
+        assert_eq!(b.failed(), s(1.0));
+        // Connections accepted and dropped before any navigation: the delay grows to its most.
+        let mut waits = Vec::new();
+        for _ in 0..4 {
+            b.connected();
+            waits.push(b.lost());
+        }
+        assert_eq!(waits, [s(2.0), s(4.0), s(4.0), s(4.0)]);
+        // One that carried a record: back to the least, and a loss waits only that.
+        b.connected();
+        b.carried();
+        assert_eq!(b.lost(), s(0.5));
+        assert_eq!(b.current(), s(0.5));
+        // The next failure doubles from there.
+        assert_eq!(b.failed(), s(0.5));
+        assert_eq!(b.current(), s(1.0));
+    }
+}

@@ -11,7 +11,7 @@ use super::wire::{
 };
 use crate::config::Onboard;
 use crate::geo::{LocalFrame, OriginError};
-use crate::link::{Link, LinkEvent, LinkTiming, Outgoing};
+use crate::link::{Backoff, Link, LinkEvent, LinkTiming, Outgoing};
 use crate::protocol::sentence::{LineCounts, UtcTime};
 use crate::transport::conn::read_tcp;
 use plumetrace_core::{Decision, PlanStatus, PlannerEvent, SensorSnapshot, variant_name};
@@ -53,7 +53,7 @@ pub struct MoosLink {
     framer: Framer,
     last_byte: Instant,
     next_try: Instant,
-    backoff: Duration,
+    backoff: Backoff,
     counts: LineCounts,
     traffic: Option<Box<dyn Write + Send>>,
     started: Instant,
@@ -89,7 +89,7 @@ impl MoosLink {
     ) -> Self {
         let now = Instant::now();
         MoosLink {
-            backoff: settings.timing.reconnect_min,
+            backoff: Backoff::new(&settings.timing),
             settings,
             frame,
             conn: None,
@@ -187,8 +187,7 @@ impl MoosLink {
         self.phase = Phase::Welcome;
         self.framer.clear();
         self.outbox.clear();
-        self.next_try = Instant::now() + self.backoff;
-        self.backoff = (self.backoff * 2).min(self.settings.timing.reconnect_max);
+        self.next_try = Instant::now() + self.backoff.lost();
     }
 
     fn write_raw(&mut self, bytes: &[u8], events: &mut Vec<LinkEvent>) -> bool {
@@ -271,6 +270,7 @@ impl MoosLink {
         match opened {
             Ok(s) => {
                 self.conn = Some(s);
+                self.backoff.connected();
                 self.phase = Phase::Welcome;
                 self.framer.clear();
                 self.last_byte = now;
@@ -297,11 +297,10 @@ impl MoosLink {
                     '#',
                     &format!(
                         "connecting to {addr} failed: {e}; next try in {:.1} s",
-                        self.backoff.as_secs_f64()
+                        self.backoff.current().as_secs_f64()
                     ),
                 );
-                self.next_try = now + self.backoff;
-                self.backoff = (self.backoff * 2).min(self.settings.timing.reconnect_max);
+                self.next_try = now + self.backoff.failed();
             }
         }
     }
@@ -323,7 +322,6 @@ impl MoosLink {
         self.timing_replies = 0;
         self.community = m.community.clone();
         self.phase = Phase::Ready;
-        self.backoff = self.settings.timing.reconnect_min;
         // `paused` is kept: a `CPT_PAUSED = true` published before the connection was lost is
         // still the community's value, and the next set-point publishes `false`.
         self.log(
@@ -477,6 +475,7 @@ impl MoosLink {
 
     fn assemble(&mut self, events: &mut Vec<LinkEvent>) {
         if let Some(fix) = self.nav.assemble(&self.frame) {
+            self.backoff.carried();
             events.push(LinkEvent::Nav(fix));
         }
     }

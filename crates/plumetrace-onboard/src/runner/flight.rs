@@ -35,7 +35,13 @@ pub(super) struct Flight<'a> {
     last_fix_s: Option<f64>,
     next_decision_s: f64,
     current: Option<CheckedCommand>,
+    // Since when the link has been down (cleared when a connection opens), and what it was
+    // before that connection: a connection lost before it carried a navigation record does not
+    // count as the link having been up, so a peer that accepts and drops every connection still
+    // ends the run after `link.give_up_s`.
     down_since: Option<Instant>,
+    down_before: Option<Instant>,
+    carried: bool,
     period: f64,
 }
 
@@ -57,6 +63,8 @@ impl<'a> Flight<'a> {
             next_decision_s: f64::NEG_INFINITY,
             current: None,
             down_since: Some(Instant::now()),
+            down_before: None,
+            carried: false,
             period,
         })
     }
@@ -89,11 +97,15 @@ impl<'a> Flight<'a> {
         let s = &mut self.s;
         match e {
             LinkEvent::Connected => {
-                self.down_since = None;
+                self.down_before = self.down_since.take();
+                self.carried = false;
                 s.report.connections += 1;
             }
             LinkEvent::Lost(why) => {
-                self.down_since.get_or_insert_with(Instant::now);
+                if self.down_since.is_none() {
+                    let before = self.down_before.filter(|_| !self.carried);
+                    self.down_since = Some(before.unwrap_or_else(Instant::now));
+                }
                 s.pause(link, format!("link lost: {why}"));
             }
             LinkEvent::Quiet(why) => s.pause(link, format!("line silent: {why}")),
@@ -129,7 +141,11 @@ impl<'a> Flight<'a> {
                     s.pause(link, "the front seat does not accept commands".into());
                 }
             }
-            LinkEvent::Nav(f) => fixes.push(f),
+            LinkEvent::Nav(f) => {
+                self.carried = true;
+                self.down_before = None;
+                fixes.push(f);
+            }
             LinkEvent::AckGaveUp => s.report.acks_given_up += 1,
             LinkEvent::Refused(_) => s.report.commands_rejected += 1,
         }

@@ -259,4 +259,51 @@ time_limit_s = 1.6
                 .any(|s| matches!(s.1, Outgoing::Steer(_)) && s.0 >= end)
         );
     }
+
+    #[test]
+    fn a_link_that_connects_and_drops_without_navigation_gives_up() {
+        let text = r#"
+[mission]
+op_area = [[60.0, -80.0], [460.0, -80.0], [460.0, 80.0], [60.0, 80.0]]
+prior_flow_toward_deg = 90.0
+[planner]
+kind = "amp"
+[link]
+protocol = "bluefin"
+address = "127.0.0.1:1"
+origin = { lat_deg = 36.18, lon_deg = -75.75 }
+give_up_s = 0.5
+[run]
+time_limit_s = 5.0
+"#;
+        let onboard = Onboard::from_toml(text).unwrap_or_else(|e| panic!("{e}"));
+        let flapping = |from: f64| {
+            (0..20).flat_map(move |k| {
+                let t = from + 0.1 * k as f64;
+                [
+                    (t, LinkEvent::Connected),
+                    (t + 0.05, LinkEvent::Lost("closed by the peer".into())),
+                ]
+            })
+        };
+        // Up with navigation to 0.2 s, then a connection every 0.1 s that is dropped at once.
+        let mut events = vec![(0.0, LinkEvent::Connected)];
+        events.extend([0.0, 0.1, 0.2].map(nav));
+        events.push((0.25, LinkEvent::Lost("closed by the peer".into())));
+        events.extend(flapping(0.3));
+        let mut link = Script {
+            start: Instant::now(),
+            events,
+            sent: Vec::new(),
+            counts: LineCounts::default(),
+        };
+        let started = Instant::now();
+        let report =
+            run(&onboard, &mut link, None, &mut |_, _| {}).unwrap_or_else(|e| panic!("{e}"));
+        let wall = started.elapsed().as_secs_f64();
+        assert_eq!(report.end, RunEnd::LinkGaveUp, "{report:?}");
+        // Down since 0.25 s; given up 0.5 s later, not at the end of the flapping (2.3 s).
+        assert!((0.7..1.6).contains(&wall), "gave up after {wall} s");
+        assert!(report.connections >= 5, "{}", report.connections);
+    }
 }

@@ -5,7 +5,7 @@
 
 use super::conn::{Conn, Endpoint, read_tcp};
 use super::lines::{LineBuffer, Piece};
-use crate::link::{Link, LinkEvent, LinkTiming, Outgoing};
+use crate::link::{Backoff, Link, LinkEvent, LinkTiming, Outgoing};
 use crate::protocol::chem::ChemFormat;
 use crate::protocol::current::FlowFormat;
 use crate::protocol::sentence::{LineCounts, MAX_LINE, SentenceError, UtcTime};
@@ -24,7 +24,7 @@ pub struct LineLink {
     lines: LineBuffer,
     last_byte: Instant,
     next_try: Instant,
-    backoff: Duration,
+    backoff: Backoff,
     counts: LineCounts,
     clock: UtcTime,
     traffic: Option<Box<dyn Write + Send>>,
@@ -52,7 +52,7 @@ impl LineLink {
             protocol,
             chem,
             flow: None,
-            backoff: timing.reconnect_min,
+            backoff: Backoff::new(&timing),
             timing,
             conn: None,
             lines: LineBuffer::with_limit(2 * MAX_LINE),
@@ -92,7 +92,7 @@ impl LineLink {
             events.push(LinkEvent::Lost(why));
         }
         self.lines.clear();
-        self.next_try = Instant::now() + self.backoff;
+        self.next_try = Instant::now() + self.backoff.lost();
     }
 
     fn send_lines(&mut self, lines: Vec<String>, events: &mut Vec<LinkEvent>) {
@@ -116,7 +116,7 @@ impl LineLink {
         match Conn::open(&self.endpoint) {
             Ok(c) => {
                 self.conn = Some(c);
-                self.backoff = self.timing.reconnect_min;
+                self.backoff.connected();
                 self.last_byte = now;
                 self.log('#', "connected");
                 events.push(LinkEvent::Connected);
@@ -128,11 +128,10 @@ impl LineLink {
                     '#',
                     &format!(
                         "connecting failed: {e}; next try in {:.1} s",
-                        self.backoff.as_secs_f64()
+                        self.backoff.current().as_secs_f64()
                     ),
                 );
-                self.next_try = now + self.backoff;
-                self.backoff = (self.backoff * 2).min(self.timing.reconnect_max);
+                self.next_try = now + self.backoff.failed();
             }
         }
     }
@@ -166,8 +165,10 @@ impl LineLink {
             self.log('!', &e.to_string());
         }
         for e in &events[before..] {
-            if let LinkEvent::Clock(t) = e {
-                self.clock = *t;
+            match e {
+                LinkEvent::Clock(t) => self.clock = *t,
+                LinkEvent::Nav(_) => self.backoff.carried(),
+                _ => {}
             }
         }
     }
