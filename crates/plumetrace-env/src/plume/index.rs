@@ -203,29 +203,25 @@ fn axis_span(c: f64, half: f64, origin: f64, inv_step: f64) -> (usize, usize) {
     (a, b)
 }
 
-/// The squared distance from `c` to the nearest of `coords` (a run of a grid's coordinates,
-/// `origin + k / inv_step` for `k` from its first index), or more only if there is none.
-fn nearest_sq(c: f64, origin: f64, inv_step: f64, coords: &[f64]) -> f64 {
-    let (Some(&first), Some(&last)) = (coords.first(), coords.last()) else {
+/// The squared distance from `c` to the nearest of `coords[lo..hi]` (a grid's coordinates,
+/// `coords[k]` about `origin + k / inv_step`), infinite if there is none.
+fn nearest_sq(c: f64, origin: f64, inv_step: f64, coords: &[f64], lo: usize, hi: usize) -> f64 {
+    if lo >= hi {
         return f64::INFINITY;
-    };
-    if c <= first {
-        return (first - c) * (first - c);
     }
-    if c >= last {
-        return (last - c) * (last - c);
+    let t = (c - origin) * inv_step;
+    // The index at or just below `c`, within one (both neighbours are looked at).
+    let k = if t > 0.0 { t as usize } else { 0 };
+    let k = k.clamp(lo, hi - 1);
+    let (a, b) = (k.saturating_sub(1).max(lo), (k + 2).min(hi));
+    let mut m = f64::INFINITY;
+    for &p in &coords[a..b] {
+        let d = (p - c) * (p - c);
+        if d < m {
+            m = d;
+        }
     }
-    // The grid index at or just below `c` (rounding may put it one off: both neighbours of the
-    // nearest point are looked at).
-    let k0 = ((first - origin) * inv_step).round() as usize;
-    let k = (((c - origin) * inv_step) as usize).saturating_sub(k0);
-    let k = k.min(coords.len() - 1);
-    let lo = k.saturating_sub(1);
-    let hi = (k + 2).min(coords.len());
-    coords[lo..hi]
-        .iter()
-        .map(|&p| (p - c) * (p - c))
-        .fold(f64::INFINITY, f64::min)
+    m
 }
 
 /// Per cell `0..cells`, the points `lo..hi` whose window (`windows`, one per point) holds it;
@@ -345,8 +341,8 @@ impl CellIndex {
                     }
                     // Likewise with the nearest grid row and column: fp addition is monotone,
                     // so every point's d2 is at least this sum.
-                    let dy2 = nearest_sq(e.y, y_origin, axes.inv_dy, &axes.ys[rs0..rs1]);
-                    let dx2 = nearest_sq(e.x, x_origin, axes.inv_dx, &axes.xs[cs0..cs1]);
+                    let dy2 = nearest_sq(e.y, y_origin, axes.inv_dy, &axes.ys, rs0, rs1);
+                    let dx2 = nearest_sq(e.x, x_origin, axes.inv_dx, &axes.xs, cs0, cs1);
                     if dx2 + dy2 + near >= e.lim2 {
                         continue;
                     }
