@@ -31,6 +31,13 @@ seeds=1000
 jobs=2
 while [ $# -gt 0 ]; do
     case "$1" in
+        --before|--before-commit|--after|--pairs|--seeds|--jobs)
+            if [ $# -lt 2 ]; then
+                echo "performance.sh: $1 needs a value (see --help)" >&2
+                exit 2
+            fi ;;
+    esac
+    case "$1" in
         --before) before="$2"; shift 2 ;;
         --before-commit) before_commit="$2"; shift 2 ;;
         --after) after="$2"; shift 2 ;;
@@ -40,6 +47,12 @@ while [ $# -gt 0 ]; do
         -h|--help) sed -n '2,22p' "$0"; exit 0 ;;
         *) echo "performance.sh: unknown argument $1 (see --help)" >&2; exit 2 ;;
     esac
+done
+for n in "$pairs" "$seeds" "$jobs"; do
+    if ! [[ "$n" =~ ^[1-9][0-9]*$ ]]; then
+        echo "performance.sh: --pairs, --seeds and --jobs take a whole number from 1, not '$n'" >&2
+        exit 2
+    fi
 done
 if [ -z "$before" ] || [ -z "$before_commit" ]; then
     echo "performance.sh: --before BIN and --before-commit HASH are needed: a build of the commit to compare against, and that commit (see --help)" >&2
