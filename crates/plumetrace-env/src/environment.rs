@@ -1,6 +1,6 @@
 //! The environment: a flow field and a plume advanced together on a fixed time step.
 
-use crate::field::ConcentrationField;
+use crate::field::{ConcentrationField, GridSpec};
 use crate::flow::{FlowField, FlowModel};
 use crate::obstacle::ObstacleSet;
 use crate::plume::FilamentPlume;
@@ -46,6 +46,12 @@ impl ConcentrationField for Plume {
         match self {
             Plume::Filaments(f) => f.concentrations(points, out),
             Plume::Steady(s) => s.concentrations(points, out),
+        }
+    }
+    fn grid_concentrations(&self, grid: &GridSpec, points: &[Vec3], out: &mut [f64]) {
+        match self {
+            Plume::Filaments(f) => f.grid_concentrations(grid, points, out),
+            Plume::Steady(s) => s.grid_concentrations(grid, points, out),
         }
     }
 }

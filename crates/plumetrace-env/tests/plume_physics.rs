@@ -905,3 +905,60 @@ fn the_grid_s_own_step_leaves_the_filaments_step_alone() {
         );
     }
 }
+
+#[test]
+fn a_grid_query_is_bit_for_bit_the_point_by_point_query() {
+    let domain = rect(0.0, 200.0, -60.0, 60.0);
+    let src = Source {
+        pos_m: Vec3::new(10.0, 0.0, 0.5),
+        mass_rate_per_s: 5.0,
+        filament_rate_hz: 20.0,
+    };
+    for (vertical, z) in [
+        (VerticalBoundary::Reflecting { depth_m: Some(6.0) }, 5.9),
+        (VerticalBoundary::Reflecting { depth_m: None }, 0.2),
+        (VerticalBoundary::Unbounded, 0.5),
+    ] {
+        let params = FilamentParams {
+            vertical,
+            growth_rate_m2ps: 0.02,
+            ..FilamentParams::default()
+        };
+        let mut env = filament_env(domain, pompy_farrell(domain, 0.1), src, params, 0.1, 3);
+        env.spin_up(120.0, 0.2).unwrap();
+        run(&mut env, 5.0);
+        let mut nonzero = 0;
+        // Grids inside the domain, over its edge, beyond it, finer and coarser than the
+        // filaments, a single row (queried point by point) and spacings that are not round.
+        for (x0, x1, y0, y1, nx, ny) in [
+            (0.0, 200.0, -60.0, 60.0, 160, 96),
+            (-30.0, 120.0, -10.0, 75.0, 77, 41),
+            (5.0, 60.0, -8.0, 8.0, 301, 133),
+            (210.0, 400.0, -60.0, 60.0, 20, 20),
+            (0.0, 200.0, 0.0, 1.0, 50, 1),
+            (13.7, 151.3, -47.1, 33.3, 3, 2),
+        ] {
+            let spec = GridSpec {
+                x_min_m: x0,
+                x_max_m: x1,
+                y_min_m: y0,
+                y_max_m: y1,
+                nx,
+                ny,
+                z_m: z,
+            };
+            let pts = spec.points();
+            let mut grid = vec![f64::NAN; pts.len()];
+            env.plume().grid_concentrations(&spec, &pts, &mut grid);
+            for (p, g) in pts.iter().zip(&grid) {
+                let c = env.plume().concentration(*p);
+                assert_eq!(c.to_bits(), g.to_bits(), "{c} vs {g} at {p:?} of {spec:?}");
+                nonzero += usize::from(c > 0.0);
+            }
+        }
+        assert!(
+            nonzero > 100,
+            "{nonzero} points with a concentration at z = {z}"
+        );
+    }
+}

@@ -525,7 +525,10 @@ impl PlumeFrames {
 
     fn sample(&mut self, world: WorldView<'_>) {
         let mut c = vec![0.0; self.points.len()];
-        world.env().plume().concentrations(&self.points, &mut c);
+        world
+            .env()
+            .plume()
+            .grid_concentrations(&self.grid, &self.points, &mut c);
         let flow = world.env().flow();
         self.frames.push(PlumeFrame {
             t_s: world.time_s(),

@@ -904,6 +904,13 @@ impl ConcentrationField for FilamentPlume {
     fn concentration(&self, p: Vec3) -> f64 {
         self.index().concentration(p)
     }
+    fn grid_concentrations(&self, grid: &crate::GridSpec, points: &[Vec3], out: &mut [f64]) {
+        if points.len() == grid.nx * grid.ny && out.len() == points.len() {
+            self.index().grid_concentrations(grid, out);
+        } else {
+            self.concentrations(points, out);
+        }
+    }
 }
 
 #[cfg(test)]

@@ -6,8 +6,9 @@
 //! cell size is raised to bound the number of cells).
 
 use super::filament::{FilamentPlume, VerticalBoundary};
-use crate::Rect;
+use crate::{GridSpec, Rect};
 use plumetrace_core::Vec3;
+use rayon::prelude::*;
 
 /// Most cells an index may have.
 const MAX_CELLS: f64 = 1_048_576.0;
@@ -173,5 +174,231 @@ impl CellIndex {
             }
         }
         c
+    }
+}
+
+/// What a grid query needs of one grid: the points' coordinates and, per cell column and cell
+/// row of the index, the grid columns and rows whose window of cells (the cells
+/// [`CellIndex::concentration`] scans for a point) holds it.
+struct GridAxes {
+    xs: Vec<f64>,
+    ys: Vec<f64>,
+    z: f64,
+    inv_dx: f64,
+    inv_dy: f64,
+    col_span: Vec<(usize, usize)>,
+    row_span: Vec<(usize, usize)>,
+}
+
+/// The indices `lo..hi` along an axis of spacing `1 / inv_step` from `origin` that may lie
+/// within `half` of `c` (a millionth of a spacing to spare, far above the rounding of the
+/// coordinates; the exact test decides).
+fn axis_span(c: f64, half: f64, origin: f64, inv_step: f64) -> (usize, usize) {
+    let slack = 1e-6 + 1e-14 * (c.abs() + half + origin.abs()) * inv_step;
+    let lo = (c - half - origin) * inv_step - slack;
+    let hi = (c + half - origin) * inv_step + slack;
+    // Truncation is the floor of a value that is not negative.
+    let a = if lo > 0.0 { lo as usize } else { 0 };
+    let b = if hi >= 0.0 { hi as usize + 1 } else { 0 };
+    (a, b)
+}
+
+/// The squared distance from `c` to the nearest of `coords[lo..hi]` (a grid's coordinates,
+/// `coords[k]` about `origin + k / inv_step`), infinite if there is none.
+fn nearest_sq(c: f64, origin: f64, inv_step: f64, coords: &[f64], lo: usize, hi: usize) -> f64 {
+    if lo >= hi {
+        return f64::INFINITY;
+    }
+    let t = (c - origin) * inv_step;
+    // The index at or just below `c`, within one (both neighbours are looked at).
+    let k = if t > 0.0 { t as usize } else { 0 };
+    let k = k.clamp(lo, hi - 1);
+    let (a, b) = (k.saturating_sub(1).max(lo), (k + 2).min(hi));
+    let mut m = f64::INFINITY;
+    for &p in &coords[a..b] {
+        let d = (p - c) * (p - c);
+        if d < m {
+            m = d;
+        }
+    }
+    m
+}
+
+/// Per cell `0..cells`, the points `lo..hi` whose window (`windows`, one per point) holds it;
+/// `None` unless every such set is one run of points.
+fn spans(windows: &[Option<(usize, usize)>], cells: usize) -> Option<Vec<(usize, usize)>> {
+    let mut span = vec![(usize::MAX, 0); cells];
+    let mut count = vec![0usize; cells];
+    for (k, w) in windows.iter().enumerate() {
+        let Some((a, b)) = *w else { continue };
+        for c in a..=b.min(cells - 1) {
+            span[c] = (span[c].0.min(k), span[c].1.max(k + 1));
+            count[c] += 1;
+        }
+    }
+    span.iter_mut()
+        .zip(&count)
+        .map(|(s, &n)| {
+            if n == 0 {
+                Some((0, 0))
+            } else {
+                (s.1 - s.0 == n).then_some(*s)
+            }
+        })
+        .collect()
+}
+
+impl CellIndex {
+    /// Concentrations at every point of `grid`, row by row with x fastest (the order of
+    /// [`GridSpec::points`]): bit for bit what [`CellIndex::concentration`] gives at each point.
+    ///
+    /// A point's sum adds its filaments in the index's memory order (cell rows, then cells, then
+    /// the filaments of a cell), which is one order for every point; so the filaments can be
+    /// taken one at a time, each adding its terms to the grid points it reaches, and every point
+    /// still sums the same terms in the same order. Each filament visits only the grid points
+    /// near it instead of every point scanning every filament of its 3 x 3 cells. A grid that is
+    /// not a proper lattice (a single row or column, a spacing that is not finite and positive)
+    /// is queried point by point.
+    pub(crate) fn grid_concentrations(&self, grid: &GridSpec, out: &mut [f64]) {
+        let Some(axes) = self.grid_axes(grid) else {
+            for (o, p) in out.iter_mut().zip(grid.points()) {
+                *o = self.concentration(p);
+            }
+            return;
+        };
+        // One band of rows per thread: a filament is visited once per band its cells reach.
+        let band_rows = grid.ny.div_ceil(rayon::current_num_threads().max(1));
+        out.par_chunks_mut(grid.nx * band_rows)
+            .enumerate()
+            .for_each(|(band, rows)| {
+                rows.fill(0.0);
+                let j0 = band * band_rows;
+                self.scatter_band(&axes, j0, j0 + rows.len() / grid.nx, rows);
+            });
+    }
+
+    /// The grid's axes and spans, or `None` for a grid that is not a proper lattice.
+    fn grid_axes(&self, g: &GridSpec) -> Option<GridAxes> {
+        if g.nx < 2 || g.ny < 2 || self.entries.is_empty() {
+            return None;
+        }
+        let dx = (g.x_max_m - g.x_min_m) / (g.nx - 1) as f64;
+        let dy = (g.y_max_m - g.y_min_m) / (g.ny - 1) as f64;
+        let scale = g.x_min_m.abs() + g.x_max_m.abs() + g.y_min_m.abs() + g.y_max_m.abs() + 1.0;
+        let finite = [g.x_min_m, g.y_min_m, g.z_m, dx, dy]
+            .iter()
+            .all(|v| v.is_finite());
+        if !(finite && dx > 1e-9 * scale && dy > 1e-9 * scale) {
+            return None;
+        }
+        // The same coordinates as `GridSpec::points`, so the same windows and distances.
+        let xs: Vec<f64> = (0..g.nx).map(|i| g.x_min_m + i as f64 * dx).collect();
+        let ys: Vec<f64> = (0..g.ny).map(|j| g.y_min_m + j as f64 * dy).collect();
+        let r = self.search_m;
+        let cols: Vec<_> = xs
+            .iter()
+            .map(|&x| self.cell_range(x - r, x + r, self.x0, self.ncx))
+            .collect();
+        let rows: Vec<_> = ys
+            .iter()
+            .map(|&y| self.cell_range(y - r, y + r, self.y0, self.ncy))
+            .collect();
+        Some(GridAxes {
+            col_span: spans(&cols, self.ncx)?,
+            row_span: spans(&rows, self.ncy)?,
+            xs,
+            ys,
+            z: g.z_m,
+            inv_dx: 1.0 / dx,
+            inv_dy: 1.0 / dy,
+        })
+    }
+
+    /// Adds every filament's terms to the grid rows `j0..j1` (`out`, row by row), filament by
+    /// filament in the index's order.
+    fn scatter_band(&self, axes: &GridAxes, j0: usize, j1: usize, out: &mut [f64]) {
+        let nx = axes.xs.len();
+        let (x_origin, y_origin) = (axes.xs[0], axes.ys[0]);
+        for (cj, &(rs0, rs1)) in axes.row_span.iter().enumerate() {
+            let (rs0, rs1) = (rs0.max(j0), rs1.min(j1));
+            if rs0 >= rs1 {
+                continue;
+            }
+            for (ci, &(cs0, cs1)) in axes.col_span.iter().enumerate() {
+                if cs0 >= cs1 {
+                    continue;
+                }
+                let c = cj * self.ncx + ci;
+                let (a, b) = (self.starts[c] as usize, self.starts[c + 1] as usize);
+                for e in &self.entries[a..b] {
+                    let (all_terms, n) = self.terms(e, axes.z);
+                    let terms = &all_terms[..n];
+                    // d2 = dxy2 + dz2 is at least dz2: a filament none of whose terms is
+                    // within reach at this height adds nothing.
+                    let near = terms.iter().fold(f64::INFINITY, |m, &t| m.min(t));
+                    if near >= e.lim2 {
+                        continue;
+                    }
+                    // Likewise with the nearest grid row and column: fp addition is monotone,
+                    // so every point's d2 is at least this sum.
+                    let dy2 = nearest_sq(e.y, y_origin, axes.inv_dy, &axes.ys, rs0, rs1);
+                    let dx2 = nearest_sq(e.x, x_origin, axes.inv_dx, &axes.xs, cs0, cs1);
+                    if dx2 + dy2 + near >= e.lim2 {
+                        continue;
+                    }
+                    // At least the reach left in the plane (the rounding of the difference
+                    // is below the added billionth).
+                    let half = ((e.lim2 - near).max(0.0) + 1e-9 * e.lim2).sqrt();
+                    let (ra, rb) = axis_span(e.y, half, y_origin, axes.inv_dy);
+                    let (ra, rb) = (ra.max(rs0), rb.min(rs1));
+                    let (ca, cb) = axis_span(e.x, half, x_origin, axes.inv_dx);
+                    let (ca, cb) = (ca.max(cs0), cb.min(cs1));
+                    if ca >= cb {
+                        continue;
+                    }
+                    for j in ra..rb {
+                        let dy = axes.ys[j] - e.y;
+                        let dy2 = dy * dy;
+                        // dx * dx + dy2 is at least dy2, so this skips nothing the sum adds.
+                        if dy2 > e.lim2 {
+                            continue;
+                        }
+                        let row = &mut out[(j - j0) * nx..(j - j0 + 1) * nx];
+                        for (o, &x) in row[ca..cb].iter_mut().zip(&axes.xs[ca..cb]) {
+                            let dx = x - e.x;
+                            let dxy2 = dx * dx + dy2;
+                            if dxy2 > e.lim2 {
+                                continue;
+                            }
+                            for dz2 in terms {
+                                let d2 = dxy2 + dz2;
+                                if d2 < e.lim2 {
+                                    *o += e.amp * (d2 * e.neg_inv_2r2).exp();
+                                }
+                            }
+                        }
+                    }
+                }
+            }
+        }
+    }
+
+    /// The squared vertical distances from height `z` to filament `e` and to its images in the
+    /// seabed and the surface, in the order [`CellIndex::concentration`] adds them, and how many.
+    fn terms(&self, e: &Entry, z: f64) -> ([f64; 3], usize) {
+        let mut t = [0.0; 3];
+        let mut n = 0;
+        for dz in [
+            Some(z - e.z),
+            self.floor.map(|f| z - (2.0 * f - e.z)),
+            self.ceiling.map(|s| z - (2.0 * s - e.z)),
+        ]
+        .into_iter()
+        .flatten()
+        {
+            t[n] = dz * dz;
+            n += 1;
+        }
+        (t, n)
     }
 }
