@@ -5,7 +5,8 @@
 //! the same regular grid (all combinations of its distinct `x_m` and `y_m` values, in any row
 //! order). Velocities are bilinear in space and linear in time; outside the grid the nearest edge
 //! value is used and outside the time span the nearest frame is held. The file format is kept
-//! behind [`GriddedFlow::from_csv`] so that other formats (NetCDF) can produce the same grid.
+//! behind [`GriddedFlow::from_csv`]; [`GriddedFlow::from_netcdf`] (module `cf`) fills the same grid
+//! from an ocean model's CF NetCDF file.
 
 use super::{FlowField, axis_weight};
 use crate::csv_grid::{read_columns, regular_axis};
@@ -16,10 +17,10 @@ use std::path::Path;
 
 /// One time frame: `u` and `v` row-major `ny x nx`.
 #[derive(Debug, Clone)]
-struct Frame {
-    t_s: f64,
-    u: Vec<f64>,
-    v: Vec<f64>,
+pub(super) struct Frame {
+    pub(super) t_s: f64,
+    pub(super) u: Vec<f64>,
+    pub(super) v: Vec<f64>,
 }
 
 /// A regular-grid flow field, possibly time-varying.
@@ -123,7 +124,7 @@ impl GriddedFlow {
         ))
     }
 
-    fn from_frames_unchecked(
+    pub(super) fn from_frames_unchecked(
         x0: f64,
         dx: f64,
         nx: usize,
