@@ -134,6 +134,30 @@ pub const LIMITS: &[Limit] = &[
     num("flow.mean.toward_min_deg", -TURNS, TURNS, ANGLE_WHY),
     num("flow.mean.toward_max_deg", -TURNS, TURNS, ANGLE_WHY),
     pos("flow.mean.period_s", LONG, TIME_WHY),
+    num(
+        "flow.netcdf.depth_m",
+        0.0,
+        DEPTH,
+        "below the surface, at most the deepest ocean",
+    ),
+    num(
+        "flow.netcdf.spacing_m",
+        0.01,
+        COORD,
+        "a centimetre to the widest domain (the grid is capped at 2000 nodes a side anyway)",
+    ),
+    num(
+        "origin.lat_deg",
+        -89.0,
+        89.0,
+        "the poles have no east: the local frame needs a latitude in [-89, 89]",
+    ),
+    num(
+        "origin.lon_deg",
+        -180.0,
+        180.0,
+        "a longitude, east positive",
+    ),
     num("flow.mean.phase_deg", -TURNS, TURNS, ANGLE_WHY),
     num(
         "flow.farrell.nx",

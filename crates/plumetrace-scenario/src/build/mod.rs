@@ -224,7 +224,7 @@ fn build_sections(
     let seed = seed.unwrap_or(cfg.seed);
     let timing = timing::timing(cfg)?;
     let domain = domain::domain(&cfg.domain)?;
-    let flow = flow::flow(&cfg.flow, domain, &base_dir)?;
+    let flow = flow::flow(cfg, domain, &base_dir)?;
     let plume = plume::plume(cfg, domain, &base_dir)?;
     let obstacles = obstacles::obstacles(cfg, seed)?;
     let vehicles = vehicles::vehicles(cfg, &domain)?;
