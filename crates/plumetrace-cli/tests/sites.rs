@@ -219,3 +219,81 @@ fn bad_currents_files_and_keys_are_located() {
     );
     assert!(e.contains("flow.netcdf") && e.contains("not one"), "{e}");
 }
+
+#[test]
+fn the_example_site_flies_in_both_frames() {
+    let dir = tempfile::tempdir().unwrap();
+    let site = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/sites/site.toml");
+    // A shorter mission from a copy beside the example's currents file.
+    let text = std::fs::read_to_string(&site).unwrap().replacen(
+        "time_limit_s = 2400.0",
+        "time_limit_s = 120.0",
+        1,
+    );
+    let copy = site.with_file_name("site-short.test.toml");
+    std::fs::write(&copy, text).unwrap();
+    let out = dir.path().join("run");
+    let done = bin()
+        .args([
+            "run",
+            copy.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+        ])
+        .output()
+        .unwrap();
+    let _ = std::fs::remove_file(&copy);
+    assert!(
+        done.status.success(),
+        "{}",
+        String::from_utf8_lossy(&done.stderr)
+    );
+    let traj = std::fs::read_to_string(out.join("trajectory.csv")).unwrap();
+    let header = traj.lines().next().unwrap();
+    assert!(
+        header.ends_with(",detection,true_lat_deg,true_lon_deg,est_lat_deg,est_lon_deg"),
+        "{header}"
+    );
+    let first: Vec<&str> = traj.lines().nth(1).unwrap().split(',').collect();
+    let lat: f64 = first[12].parse().unwrap();
+    let lon: f64 = first[13].parse().unwrap();
+    // The vehicle starts at 50.34946 N, 4.143387 W and has moved a few centimetres.
+    assert!(
+        (lat - 50.34946).abs() < 2e-6 && (lon + 4.143387).abs() < 2e-6,
+        "{lat} {lon}"
+    );
+    let geo: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("track.geojson")).unwrap()).unwrap();
+    assert_eq!(geo["type"], "FeatureCollection");
+    let kinds: Vec<&str> = geo["features"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|f| f["properties"]["kind"].as_str().unwrap())
+        .collect();
+    assert!(kinds.contains(&"track") && kinds.contains(&"source") && kinds.contains(&"op_area"));
+    let src = geo["features"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|f| f["properties"]["kind"] == "source")
+        .unwrap();
+    let c = &src["geometry"]["coordinates"];
+    assert!((c[0].as_f64().unwrap() + 4.148593).abs() < 1e-7, "{c}");
+    assert!((c[1].as_f64().unwrap() - 50.35).abs() < 1e-7, "{c}");
+}
+
+#[test]
+fn positions_in_degrees_without_an_origin_are_located() {
+    let dir = tempfile::tempdir().unwrap();
+    let text = demo().replacen(
+        "x_m = 100.0\ny_m = 0.0",
+        "lat_deg = 50.35\nlon_deg = -4.15",
+        1,
+    );
+    let e = check_err(dir.path(), "noorigin", &text);
+    assert!(
+        e.contains("noorigin.toml:41: sources[0].lat_deg") && e.contains("add [origin]"),
+        "{e}"
+    );
+}

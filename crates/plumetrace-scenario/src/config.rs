@@ -116,6 +116,9 @@ pub struct FlowConfig {
     pub file: Option<PathBuf>,
     /// How to read CF currents from a NetCDF `file`.
     pub netcdf: Option<NetcdfFlowConfig>,
+    /// "gridded": the strength of a Farrell meander added to the grid (its departure from its
+    /// mean times this; `[flow.farrell]` sets the field; default none).
+    pub meander: Option<f64>,
 }
 
 /// `[flow.netcdf]`: how CF currents are read from a NetCDF file (every key optional).

@@ -70,11 +70,26 @@ pub(super) fn flow(
             } else {
                 GriddedFlow::from_csv(&path)
             };
-            FlowModel::Gridded(Box::new(
-                grid.map_err(|e| Invalid::new("flow.file", e.to_string()))?,
-            ))
+            let mut grid = grid.map_err(|e| Invalid::new("flow.file", e.to_string()))?;
+            if let Some(strength) = f.meander.filter(|s| *s > 0.0) {
+                grid = grid
+                    .with_meander(domain, f.farrell.unwrap_or_default(), strength)
+                    .map_err(|e| match e {
+                        EnvError::InvalidParameter { ref key, .. } if key == "meander" => {
+                            Invalid::env("flow", e)
+                        }
+                        e => Invalid::env("flow.farrell", e),
+                    })?;
+            }
+            FlowModel::Gridded(Box::new(grid))
         }
     };
+    if f.meander.is_some() && f.model != FlowKind::Gridded {
+        return Err(Invalid::new(
+            "flow.meander",
+            "only applies to model = \"gridded\" (the farrell model meanders by itself)",
+        ));
+    }
     if f.file.is_some() && f.model != FlowKind::Gridded {
         return Err(Invalid::new(
             "flow.file",
