@@ -406,11 +406,9 @@ impl NcFile {
         self.numrecs = if numrecs_raw == u32::MAX {
             // Streaming: as many whole records as the file holds.
             let start = rec.iter().map(|v| v.begin).min().unwrap_or(0);
-            if self.recsize == 0 {
-                0
-            } else {
-                ((len as u64).saturating_sub(start) / self.recsize) as usize
-            }
+            ((len as u64).saturating_sub(start))
+                .checked_div(self.recsize)
+                .map_or(0, |n| n.min(MAX_NON_NEG as u64) as usize)
         } else if numrecs_raw as usize > MAX_NON_NEG {
             return Err(ReadError::Header {
                 at: 4,

@@ -594,8 +594,9 @@ fn frames_kept(
         return Err(err(
             path,
             format!(
-                "the currents' frames span {} s to {} s from the mission's start; the mission \
-                 needs 0 s to {end} s (flow.netcdf.start moves the start)",
+                "the currents' frames span {} s to {} s of the run (its time 0 is the start of \
+                 the plume's spin-up, mission.spinup_s before flow.netcdf.start); the run needs \
+                 0 s to {end} s",
                 rel[0],
                 rel[rel.len() - 1]
             ),

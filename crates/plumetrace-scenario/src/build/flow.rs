@@ -99,13 +99,20 @@ pub(super) fn flow(
     Ok(model)
 }
 
-/// Whether a file starts as a NetCDF file does (classic `CDF`, or HDF5 for NetCDF-4, which the
-/// reader then names); anything else, or a file that cannot be opened, is read as CSV.
+/// Whether a file is to be read as NetCDF: it starts as one does (classic `CDF`, or HDF5 for
+/// NetCDF-4, which the reader then names) or is named `.nc`, `.nc4`, `.cdf` or `.netcdf` (so a
+/// damaged one is told it is not NetCDF rather than read as CSV); anything else is read as CSV.
 fn is_netcdf(path: &Path) -> bool {
+    let named = path.extension().and_then(|e| e.to_str()).is_some_and(|e| {
+        ["nc", "nc4", "cdf", "netcdf"]
+            .iter()
+            .any(|n| e.eq_ignore_ascii_case(n))
+    });
     let mut head = [0u8; 4];
-    std::fs::File::open(path)
-        .and_then(|mut f| f.read_exact(&mut head))
-        .is_ok_and(|()| head.starts_with(b"CDF") || head == *b"\x89HDF")
+    named
+        || std::fs::File::open(path)
+            .and_then(|mut f| f.read_exact(&mut head))
+            .is_ok_and(|()| head.starts_with(b"CDF") || head == *b"\x89HDF")
 }
 
 /// How `[flow.netcdf]` and the scenario read CF currents: the site's origin, the date and span
