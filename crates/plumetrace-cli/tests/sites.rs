@@ -218,7 +218,7 @@ fn bad_currents_files_and_keys_are_located() {
         &scenario("notes.nc", "[flow.netcdf]\ndepth_m = 2.0\n"),
     );
     assert!(
-        e.contains("flow.file: notes.nc: not a NetCDF file: it starts with \"a text f\""),
+        e.contains("notes.nc: not a NetCDF file: it starts with \"a text f\""),
         "{e}"
     );
     std::fs::write(d.join("notes.txt"), "a text file\n").unwrap();

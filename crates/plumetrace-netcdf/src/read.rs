@@ -277,7 +277,13 @@ impl NcFile {
                 let head: String = bytes
                     .iter()
                     .take(8)
-                    .map(|&b| if b.is_ascii_graphic() { b as char } else { '.' })
+                    .map(|&b| {
+                        if b.is_ascii_graphic() || b == b' ' {
+                            b as char
+                        } else {
+                            '.'
+                        }
+                    })
                     .collect();
                 return Err(ReadError::NotNetcdf(head));
             }
