@@ -226,6 +226,72 @@ fn length_scale(c: &Var, path: &Path) -> Result<f64, EnvError> {
     }
 }
 
+/// What dimension `d` of `u` is, from its coordinate variable `coord`.
+fn dim_kind(
+    file: &NcFile,
+    u: &Var,
+    d: usize,
+    coord: Option<&Var>,
+    path: &Path,
+) -> Result<Axis, EnvError> {
+    let dim = &file.dims[d];
+    Ok(match coord {
+        Some(c) => {
+            let sn = c.text("standard_name").unwrap_or("");
+            if sn.contains("sigma") || sn.contains("s_coordinate") {
+                return Err(err(
+                    path,
+                    format!(
+                        "dimension {}: variable {} is a terrain-following level \
+                         (standard_name {sn}); sigma and s levels are not read: \
+                         interpolate the file to depth levels first",
+                        dim.name, c.name
+                    ),
+                ));
+            }
+            axis_of(c).ok_or_else(|| {
+                err(
+                    path,
+                    format!(
+                        "dimension {} of variable {}: its coordinate variable has no \
+                         standard_name, units or axis that says time, depth, longitude, \
+                         latitude, x or y",
+                        dim.name, u.name
+                    ),
+                )
+            })?
+        }
+        None if dim.len == 1 => Axis::Single,
+        None => {
+            let curvilinear = u
+                .text("coordinates")
+                .map(|s| {
+                    s.split_whitespace()
+                        .any(|n| file.var(n).is_some_and(|c| c.dims.len() == 2))
+                })
+                .unwrap_or(false);
+            return Err(err(
+                path,
+                if curvilinear {
+                    format!(
+                        "variable {}: its grid is curvilinear (2-D longitude and latitude \
+                         in attribute coordinates = {:?}), which is not read; regrid it to \
+                         a rectilinear grid first (e.g. `cdo remapbil`)",
+                        u.name,
+                        u.text("coordinates").unwrap_or("")
+                    )
+                } else {
+                    format!(
+                        "dimension {} of variable {} has no coordinate variable (a 1-D \
+                         variable of the same name)",
+                        dim.name, u.name
+                    )
+                },
+            ));
+        }
+    })
+}
+
 /// The velocity's axes, from the coordinate variables of its dimensions.
 fn axes(file: &NcFile, u: &Var, path: &Path) -> Result<Axes, EnvError> {
     let mut a = Axes::default();
@@ -235,61 +301,7 @@ fn axes(file: &NcFile, u: &Var, path: &Path) -> Result<Axes, EnvError> {
         let coord = file
             .var(&dim.name)
             .filter(|c| c.dims.len() == 1 && c.dims[0] == d);
-        let kind = match coord {
-            Some(c) => {
-                let sn = c.text("standard_name").unwrap_or("");
-                if sn.contains("sigma") || sn.contains("s_coordinate") {
-                    return Err(err(
-                        path,
-                        format!(
-                            "dimension {}: variable {} is a terrain-following level \
-                             (standard_name {sn}); sigma and s levels are not read: \
-                             interpolate the file to depth levels first",
-                            dim.name, c.name
-                        ),
-                    ));
-                }
-                axis_of(c).ok_or_else(|| {
-                    err(
-                        path,
-                        format!(
-                            "dimension {} of variable {}: its coordinate variable has no \
-                             standard_name, units or axis that says time, depth, longitude, \
-                             latitude, x or y",
-                            dim.name, u.name
-                        ),
-                    )
-                })?
-            }
-            None if dim.len == 1 => Axis::Single,
-            None => {
-                let curvilinear = u
-                    .text("coordinates")
-                    .map(|s| {
-                        s.split_whitespace()
-                            .any(|n| file.var(n).is_some_and(|c| c.dims.len() == 2))
-                    })
-                    .unwrap_or(false);
-                return Err(err(
-                    path,
-                    if curvilinear {
-                        format!(
-                            "variable {}: its grid is curvilinear (2-D longitude and latitude \
-                             in attribute coordinates = {:?}), which is not read; regrid it to \
-                             a rectilinear grid first (e.g. `cdo remapbil`)",
-                            u.name,
-                            u.text("coordinates").unwrap_or("")
-                        )
-                    } else {
-                        format!(
-                            "dimension {} of variable {} has no coordinate variable (a 1-D \
-                             variable of the same name)",
-                            dim.name, u.name
-                        )
-                    },
-                ));
-            }
-        };
+        let kind = dim_kind(file, u, d, coord, path)?;
         if kind != Axis::Single && kinds.contains(&kind) {
             return Err(err(
                 path,
