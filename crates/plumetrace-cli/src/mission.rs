@@ -20,6 +20,7 @@ pub fn run(
     alog: bool,
 ) -> Result<()> {
     let name = sc.name.clone();
+    let site = sc.site;
     let started = Instant::now();
     let setup = MissionSetup::new(sc)?;
     for w in &setup.warnings {
@@ -52,6 +53,9 @@ pub fn run(
     let run = mission.finish()?;
     let wall = started.elapsed().as_secs_f64();
     plumetrace_report::write_mission_outputs(&run, out, &name, wall)?;
+    if let Some(origin) = site {
+        plumetrace_report::geo_outputs::write_geographic_outputs(&run, out, origin, &name)?;
+    }
     if stats {
         let t = run.stage_times;
         eprintln!(

@@ -81,6 +81,7 @@ pub const OUTPUTS: &[&str] = &[
     "probes.csv",
     "filament_series.csv",
     "plume.nc",
+    plumetrace_report::geo_outputs::GEOJSON,
 ];
 
 /// Runs the plume alone ([`plumetrace_plume_run::run_plume`]) and draws its figure.

@@ -22,7 +22,12 @@ enum Side {
 /// here (and to ARCHITECTURE.md) or this test fails.
 const RULES: &[(&str, Side, &[&str])] = &[
     ("plumetrace-core", Side::Shared, &[]),
-    ("plumetrace-env", Side::Simulator, &["plumetrace-core"]),
+    ("plumetrace-netcdf", Side::Shared, &[]),
+    (
+        "plumetrace-env",
+        Side::Simulator,
+        &["plumetrace-core", "plumetrace-netcdf"],
+    ),
     ("plumetrace-guidance", Side::Onboard, &["plumetrace-core"]),
     (
         "plumetrace-planner",
@@ -52,7 +57,12 @@ const RULES: &[(&str, Side, &[&str])] = &[
     (
         "plumetrace-scenario",
         Side::Simulator,
-        &["plumetrace-core", "plumetrace-env", "plumetrace-sim"],
+        &[
+            "plumetrace-core",
+            "plumetrace-netcdf",
+            "plumetrace-env",
+            "plumetrace-sim",
+        ],
     ),
     (
         "plumetrace-mission",
@@ -109,6 +119,7 @@ const RULES: &[(&str, Side, &[&str])] = &[
         Side::App,
         &[
             "plumetrace-core",
+            "plumetrace-netcdf",
             "plumetrace-env",
             "plumetrace-sim",
             "plumetrace-scenario",
@@ -167,6 +178,7 @@ const RULES: &[(&str, Side, &[&str])] = &[
         Side::App,
         &[
             "plumetrace-core",
+            "plumetrace-netcdf",
             "plumetrace-env",
             "plumetrace-scenario",
             "plumetrace-planner",

@@ -18,6 +18,7 @@ pub mod file_name;
 pub mod finite;
 pub mod flow_gate;
 pub mod frame;
+pub mod geo;
 pub mod message;
 pub mod names;
 pub mod params;

@@ -14,6 +14,9 @@ pub enum Target {
     Family,
     /// An onboard file, checked as `plumetrace onboard FILE --check` does (nothing connected).
     Onboard,
+    /// A CF NetCDF currents file, read by the example site's scenario as `check` does, and its
+    /// flow queried.
+    Netcdf,
 }
 
 impl Target {
@@ -24,6 +27,7 @@ impl Target {
             Target::Campaign => "fuzz-campaign.toml",
             Target::Family => "fuzz.family.toml",
             Target::Onboard => "fuzz.onboard.toml",
+            Target::Netcdf => "fuzz.nc",
         }
     }
 
@@ -34,8 +38,65 @@ impl Target {
             Target::Campaign => "campaign",
             Target::Family => "family",
             Target::Onboard => "onboard",
+            Target::Netcdf => "netcdf",
         }
     }
+}
+
+/// The scenario a NetCDF input is read by: the example site with its currents file replaced.
+pub fn netcdf_scenario() -> String {
+    include_str!("../../../examples/sites/site.toml").replacen(
+        "file = \"currents.nc\"",
+        &format!("file = \"{}\"", Target::Netcdf.file_name()),
+        1,
+    )
+}
+
+/// The NetCDF seeds: the example site's currents (CDF-1, shorts, fill values, longitude and
+/// latitude, depth levels, a record dimension) and the same site on a projected grid (CDF-2,
+/// doubles, no depth), written by the codec.
+pub fn netcdf_seeds() -> Vec<(&'static str, Vec<u8>)> {
+    use plumetrace_netcdf::{Dataset, NcType};
+    let mut d = Dataset::default();
+    let t = d.record_dim("time", 3);
+    let y = d.dim("y", 9);
+    let x = d.dim("x", 15);
+    d.var("time", &[t], vec![0.0, 3600.0, 7200.0])
+        .attr("units", "seconds since 2026-06-01 01:00:00");
+    d.var(
+        "y",
+        &[y],
+        (0..9).map(|k| -200.0 + 50.0 * f64::from(k)).collect(),
+    )
+    .attr("standard_name", "projection_y_coordinate")
+    .attr("units", "m");
+    d.var(
+        "x",
+        &[x],
+        (0..15).map(|k| -100.0 + 50.0 * f64::from(k)).collect(),
+    )
+    .attr("standard_name", "projection_x_coordinate")
+    .attr("units", "m");
+    let n = 3 * 9 * 15;
+    d.var(
+        "u",
+        &[t, y, x],
+        (0..n).map(|k| 0.1 + 1e-4 * f64::from(k)).collect(),
+    )
+    .attr("standard_name", "sea_water_x_velocity")
+    .attr("units", "m s-1");
+    d.var("v", &[t, y, x], vec![2.0; n as usize])
+        .of_type(NcType::Short)
+        .attr("standard_name", "sea_water_y_velocity")
+        .attr("units", "cm s-1")
+        .attr("_FillValue", -999i16);
+    vec![
+        (
+            "site-currents",
+            include_bytes!("../../../examples/sites/currents.nc").to_vec(),
+        ),
+        ("projected", d.to_bytes().unwrap_or_default()),
+    ]
 }
 
 /// One seed of the corpus.

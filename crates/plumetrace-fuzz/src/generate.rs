@@ -58,8 +58,59 @@ const CAMPAIGN_SHARE: f64 = 0.5;
 /// Share of raw mutations among the others.
 const RAW_SHARE: f64 = 0.2;
 
+/// Every this many indices, the last is a NetCDF input (the others are drawn as before it was
+/// added).
+pub const NETCDF_EVERY: u64 = 16;
+
+/// A NetCDF input: a seed file with one to three raw mutations or overwritten header words.
+fn netcdf_input(seed: u64, index: u64) -> Input {
+    let mut rng = input_rng(seed ^ 0x6e65_7463_6466, index);
+    let seeds = crate::corpus::netcdf_seeds();
+    let (corpus, mut bytes) = seeds[rng.random_range(0..seeds.len())].clone();
+    let mut mutations = Vec::new();
+    for _ in 0..rng.random_range(1..=3) {
+        if rng.random_bool(0.5) {
+            // A header word (count, length, type, offset) set to an edge value.
+            let header = bytes.len().min(2048);
+            let at = rng.random_range(0..header.max(4) - 3) & !3;
+            let word: u32 = match rng.random_range(0..6) {
+                0 => 0,
+                1 => 1,
+                2 => 0x7FFF_FFFF,
+                3 => 0xFFFF_FFFF,
+                4 => 0x8000_0000,
+                _ => rng.random(),
+            };
+            if at + 4 <= bytes.len() {
+                bytes[at..at + 4].copy_from_slice(&word.to_be_bytes());
+            }
+            mutations.push(Applied {
+                kind: Kind::FlipBits,
+                detail: format!("header word at byte {at} set to {word:#x}"),
+            });
+        } else {
+            let raw: Vec<Kind> = Kind::ALL.into_iter().filter(|k| k.is_raw()).collect();
+            let kind = raw[rng.random_range(0..raw.len())];
+            let detail = apply_raw(kind, &mut bytes, &mut rng);
+            mutations.push(Applied { kind, detail });
+        }
+    }
+    bytes.truncate(MAX_INPUT_BYTES);
+    Input {
+        index,
+        seed,
+        corpus,
+        target: Target::Netcdf,
+        mutations,
+        bytes,
+    }
+}
+
 /// The input at `index` of the pass seeded with `seed`.
 pub fn generate(seed: u64, index: u64) -> Input {
+    if index % NETCDF_EVERY == NETCDF_EVERY - 1 {
+        return netcdf_input(seed, index);
+    }
     let mut rng = input_rng(seed, index);
     let all = seeds();
     let scenarios: Vec<&Seed> = all

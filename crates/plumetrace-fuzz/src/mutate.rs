@@ -828,8 +828,8 @@ fn polygon_target(
                 Seg::Key("mission.op_area".into()),
             ]
         }
-        // A family has no polygon of its own.
-        Target::Family => return None,
+        // A family has no polygon of its own; a NetCDF input is not a table.
+        Target::Family | Target::Netcdf => return None,
         Target::Onboard => {
             let m = root.get_mut("mission")?.as_table_mut()?;
             m.insert("op_area".into(), points_value(&square));

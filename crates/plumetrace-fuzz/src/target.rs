@@ -125,6 +125,7 @@ impl Workdir {
             Target::Campaign => self.campaign.join(target.file_name()),
             Target::Family => self.families.join(target.file_name()),
             Target::Onboard => self.scenario.join(target.file_name()),
+            Target::Netcdf => self.scenario.join(target.file_name()),
         }
     }
 
@@ -195,6 +196,7 @@ pub fn run(input: &Input, wd: &Workdir, timeout_s: f64) -> anyhow::Result<Outcom
         Target::Campaign => campaign(input, &path, deadline),
         Target::Family => family(input, &path, deadline),
         Target::Onboard => onboard(input, &path),
+        Target::Netcdf => netcdf(&path),
     }));
     let secs = start.elapsed().as_secs_f64();
     let (class, message) = match result {
@@ -261,6 +263,28 @@ fn onboard(input: &Input, path: &Path) -> Result<String, Stop> {
         rejected(format!("{}{line}: {e}", path.display()))
     })?;
     Ok(format!("onboard: {} checked", o.planner.kind().name()))
+}
+
+/// The example site's scenario over the input as its currents: read and sampled as `check`
+/// does, then the flow queried over the domain (every velocity finite).
+fn netcdf(path: &Path) -> Result<String, Stop> {
+    let scenario = path.with_file_name("fuzz-currents.toml");
+    let text = crate::corpus::netcdf_scenario();
+    std::fs::write(&scenario, &text).map_err(rejected)?;
+    let origin = Origin::File(scenario.clone());
+    let cfg = plumetrace_scenario::parse(&text, &origin).map_err(rejected)?;
+    let built = plumetrace_scenario::build(&cfg, &origin, None).map_err(rejected)?;
+    use plumetrace_env::FlowField as _;
+    let flow = built.env.flow();
+    for k in 0..=20 {
+        let p =
+            plumetrace_core::Vec2::new(-50.0 + 30.0 * f64::from(k), -160.0 + 16.0 * f64::from(k));
+        let v = flow.velocity(p);
+        if !(v.x.is_finite() && v.y.is_finite()) {
+            return Err(Stop::Nonfinite(format!("flow velocity at {p:?}: {v:?}")));
+        }
+    }
+    Ok("netcdf: currents read and sampled".into())
 }
 
 /// Sites drawn and checked per family input.

@@ -23,13 +23,13 @@
 //!
 //! and beside them [`config`] (the onboard file: planner, mission geometry, chemical input, link,
 //! time), [`command`] (the chokepoint every command passes: finite, within the vehicle's limits)
-//! and [`geo`] (latitude and longitude to the local frame and back, GeographicLib geodesics).
+//! and [`geo`] (latitude and longitude to the local frame and back: the core's geodesy, re-exported).
 //!
 //! The snapshot log and the `.alog` files a run writes are `plumetrace_log`'s formats.
 
 pub mod command;
 pub mod config;
-pub mod geo;
+pub use plumetrace_core::geo;
 pub mod link;
 #[cfg(feature = "moos")]
 pub mod moos;

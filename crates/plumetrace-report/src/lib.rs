@@ -21,6 +21,7 @@
 pub mod chart;
 pub mod error;
 pub mod figure;
+pub mod geo_outputs;
 pub mod inspect;
 pub mod plume_figure;
 pub mod replay_page;

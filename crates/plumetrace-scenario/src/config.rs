@@ -58,6 +58,9 @@ pub struct ScenarioConfig {
     /// What a plume run writes.
     #[serde(default)]
     pub output: OutputConfig,
+    /// The site's origin in latitude and longitude (where `x = y = 0`): positions may then be
+    /// given as latitude and longitude, and outputs carry both frames.
+    pub origin: Option<plumetrace_core::geo::Origin>,
 }
 
 /// `[sim]`
@@ -108,8 +111,33 @@ pub struct FlowConfig {
     pub mean: Option<MeanFlowConfig>,
     /// Farrell grid and noise parameters.
     pub farrell: Option<plumetrace_env::flow::FarrellParams>,
-    /// CSV file for "gridded" (relative to the scenario file).
+    /// File for "gridded" (relative to the scenario file): a CSV grid or CF currents in a
+    /// NetCDF classic file (told apart by its first bytes).
     pub file: Option<PathBuf>,
+    /// How to read CF currents from a NetCDF `file`.
+    pub netcdf: Option<NetcdfFlowConfig>,
+    /// "gridded": the strength of a Farrell meander added to the grid (its departure from its
+    /// mean times this; `[flow.farrell]` sets the field; default none).
+    pub meander: Option<f64>,
+}
+
+/// `[flow.netcdf]`: how CF currents are read from a NetCDF file (every key optional).
+#[derive(Debug, Clone, Default, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct NetcdfFlowConfig {
+    /// The date the vehicles start (a plume run: its start), UTC, `YYYY-MM-DD[Thh:mm:ss][Z]`
+    /// (default: the file's first time).
+    pub start: Option<String>,
+    /// Depth below the surface the levels are interpolated to, m (default: `domain.depth_m`
+    /// minus the first source's height, the plume's layer).
+    pub depth_m: Option<f64>,
+    /// Spacing of the grid the field is resampled onto, m (default: a projected, evenly spaced
+    /// grid is used node for node; otherwise the file's own spacing near the origin).
+    pub spacing_m: Option<f64>,
+    /// The eastward velocity's variable (default: found by `standard_name`).
+    pub u_variable: Option<String>,
+    /// The northward velocity's variable (default: found by `standard_name`).
+    pub v_variable: Option<String>,
 }
 
 /// `[flow.mean]`: steady (`speed_mps`, `toward_deg`) or tidal (`speed_min_mps`, `speed_max_mps`,

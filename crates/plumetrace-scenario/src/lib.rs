@@ -11,6 +11,7 @@ pub mod config;
 pub mod error;
 pub mod family;
 pub mod family_team;
+mod geographic;
 pub mod limits;
 pub mod locate;
 pub mod overrides;
@@ -52,12 +53,35 @@ pub fn parse(text: &str, origin: &Origin) -> Result<ScenarioConfig, ScenarioErro
     if let Ok(table) = text.parse::<toml::Table>()
         && let Some((key, value)) = first_datetime(&toml::Value::Table(table), "")
     {
+        let message = if key == "flow.netcdf.start" {
+            format!(
+                "is a TOML date/time ({value}); write the date as a string: start = \"{value}\""
+            )
+        } else {
+            format!("is a date/time ({value}); no scenario key takes one")
+        };
         return Err(ScenarioError::Parse {
             origin: origin.to_string(),
             line: locate::line_of(text, &key),
             path: key,
-            message: format!("is a date/time ({value}); no scenario key takes one"),
+            message,
         });
+    }
+    // Positions in latitude and longitude become metres first (a scenario without them is read
+    // straight from the text, as always).
+    if let Ok(mut table) = text.parse::<toml::Table>()
+        && geographic::any(&table)
+    {
+        geographic::to_local(&mut table).map_err(|(path, message)| {
+            ScenarioError::Parse {
+                origin: origin.to_string(),
+                line: None,
+                path,
+                message,
+            }
+            .located(text)
+        })?;
+        return deserialize(toml::Value::Table(table), origin).map_err(|e| e.located(text));
     }
     let de = toml::Deserializer::parse(text).map_err(|e| ScenarioError::Parse {
         origin: origin.to_string(),
@@ -70,7 +94,18 @@ pub fn parse(text: &str, origin: &Origin) -> Result<ScenarioConfig, ScenarioErro
 
 /// Reads a scenario from an already parsed TOML table (e.g. a scenario with overrides applied);
 /// errors name the key path.
-pub fn from_table(table: toml::Table, origin: &Origin) -> Result<ScenarioConfig, ScenarioError> {
+pub fn from_table(
+    mut table: toml::Table,
+    origin: &Origin,
+) -> Result<ScenarioConfig, ScenarioError> {
+    if geographic::any(&table) {
+        geographic::to_local(&mut table).map_err(|(path, message)| ScenarioError::Parse {
+            origin: origin.to_string(),
+            line: None,
+            path,
+            message,
+        })?;
+    }
     deserialize(toml::Value::Table(table), origin)
 }
 

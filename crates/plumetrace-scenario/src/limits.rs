@@ -93,6 +93,8 @@ const COORD_WHY: &str = "a local frame: 10,000 km is not local";
 const ANGLE_WHY: &str = "compass degrees, any number of turns up to ten";
 const TIME_WHY: &str = "115 days: longer is not a mission or a plume run";
 const DEPTH_WHY: &str = "the deepest ocean";
+const LAT_WHY: &str = "a latitude, north positive (turned into metres around [origin])";
+const LON_WHY: &str = "a longitude, east positive (turned into metres around [origin])";
 
 /// Every bound of the scenario file format.
 pub const LIMITS: &[Limit] = &[
@@ -134,6 +136,44 @@ pub const LIMITS: &[Limit] = &[
     num("flow.mean.toward_min_deg", -TURNS, TURNS, ANGLE_WHY),
     num("flow.mean.toward_max_deg", -TURNS, TURNS, ANGLE_WHY),
     pos("flow.mean.period_s", LONG, TIME_WHY),
+    num(
+        "flow.meander",
+        0.0,
+        5.0,
+        "a multiple of the Farrell field's own meander; 0 is none, beyond 5 the noise is the flow",
+    ),
+    num(
+        "flow.netcdf.depth_m",
+        0.0,
+        DEPTH,
+        "below the surface, at most the deepest ocean",
+    ),
+    num(
+        "flow.netcdf.spacing_m",
+        0.01,
+        COORD,
+        "a centimetre to the widest domain (the grid is capped at 2000 nodes a side anyway)",
+    ),
+    num(
+        "origin.lat_deg",
+        -89.0,
+        89.0,
+        "the poles have no east: the local frame needs a latitude in [-89, 89]",
+    ),
+    num(
+        "origin.lon_deg",
+        -180.0,
+        180.0,
+        "a longitude, east positive",
+    ),
+    num("sources[].lat_deg", -90.0, 90.0, LAT_WHY),
+    num("sources[].lon_deg", -180.0, 180.0, LON_WHY),
+    num("vehicles[].lat_deg", -90.0, 90.0, LAT_WHY),
+    num("vehicles[].lon_deg", -180.0, 180.0, LON_WHY),
+    num("mission.op_area_lat_lon[][0]", -90.0, 90.0, LAT_WHY),
+    num("mission.op_area_lat_lon[][1]", -180.0, 180.0, LON_WHY),
+    num("mission.subregions_lat_lon[][][0]", -90.0, 90.0, LAT_WHY),
+    num("mission.subregions_lat_lon[][][1]", -180.0, 180.0, LON_WHY),
     num("flow.mean.phase_deg", -TURNS, TURNS, ANGLE_WHY),
     num(
         "flow.farrell.nx",

@@ -5,21 +5,22 @@
 //! the same regular grid (all combinations of its distinct `x_m` and `y_m` values, in any row
 //! order). Velocities are bilinear in space and linear in time; outside the grid the nearest edge
 //! value is used and outside the time span the nearest frame is held. The file format is kept
-//! behind [`GriddedFlow::from_csv`] so that other formats (NetCDF) can produce the same grid.
+//! behind [`GriddedFlow::from_csv`]; [`GriddedFlow::from_netcdf`] (module `cf`) fills the same grid
+//! from an ocean model's CF NetCDF file.
 
-use super::{FlowField, axis_weight};
+use super::{FarrellFlow, FarrellParams, FlowField, MeanFlow, axis_weight};
 use crate::csv_grid::{read_columns, regular_axis};
-use crate::{EnvError, SimRng};
+use crate::{EnvError, Rect, SimRng};
 use plumetrace_core::Vec2;
 use std::collections::BTreeMap;
 use std::path::Path;
 
 /// One time frame: `u` and `v` row-major `ny x nx`.
 #[derive(Debug, Clone)]
-struct Frame {
-    t_s: f64,
-    u: Vec<f64>,
-    v: Vec<f64>,
+pub(super) struct Frame {
+    pub(super) t_s: f64,
+    pub(super) u: Vec<f64>,
+    pub(super) v: Vec<f64>,
 }
 
 /// A regular-grid flow field, possibly time-varying.
@@ -36,6 +37,17 @@ pub struct GriddedFlow {
     /// Index of the frame at or before the current time, and the blend towards the next one.
     frame: usize,
     blend: f64,
+    /// The Farrell meander added to the grid, if any.
+    meander: Option<Box<Meander>>,
+}
+
+/// A Farrell field's departure from its mean, scaled, added to the grid so that filaments still
+/// meander below the grid's resolution.
+#[derive(Debug, Clone)]
+struct Meander {
+    field: FarrellFlow,
+    mean_mps: Vec2,
+    strength: f64,
 }
 
 impl GriddedFlow {
@@ -123,7 +135,7 @@ impl GriddedFlow {
         ))
     }
 
-    fn from_frames_unchecked(
+    pub(super) fn from_frames_unchecked(
         x0: f64,
         dx: f64,
         nx: usize,
@@ -143,9 +155,43 @@ impl GriddedFlow {
             time_s: 0.0,
             frame: 0,
             blend: 0.0,
+            meander: None,
         };
         f.set_time(0.0);
         f
+    }
+
+    /// The grid with the meander of a Farrell field over `region` added: the field's departure
+    /// from its mean times `strength` (> 0). The field is driven by the grid's mean velocity at
+    /// time 0 (its nodes' average); it draws its noise from the flow's stream and brings its
+    /// stable step, which the environment sub-steps within. Errors name the field's parameter.
+    pub fn with_meander(
+        mut self,
+        region: Rect,
+        params: FarrellParams,
+        strength: f64,
+    ) -> Result<Self, EnvError> {
+        if !(strength.is_finite() && strength > 0.0) {
+            return Err(EnvError::invalid(
+                "meander",
+                format!("must be a number > 0, got {strength:?}"),
+            ));
+        }
+        let f = &self.frames[0];
+        let n = f.u.len().max(1) as f64;
+        let mean_mps = Vec2::new(f.u.iter().sum::<f64>() / n, f.v.iter().sum::<f64>() / n);
+        let mean = MeanFlow::Steady {
+            speed_mps: mean_mps.norm(),
+            // Compass degrees: clockwise from North (atan2(0, 0) = 0 for still water).
+            toward_deg: mean_mps.x.atan2(mean_mps.y).to_degrees(),
+        };
+        let field = FarrellFlow::substepped(region, mean, params)?;
+        self.meander = Some(Box::new(Meander {
+            field,
+            mean_mps,
+            strength,
+        }));
+        Ok(self)
     }
 
     /// Number of time frames.
@@ -200,17 +246,37 @@ impl FlowField for GriddedFlow {
         let (i, tx) = axis_weight(pos_m.x, self.x0_m, self.inv_dx, self.nx);
         let (j, ty) = axis_weight(pos_m.y, self.y0_m, self.inv_dy, self.ny);
         let (u0, v0) = self.sample(&self.frames[self.frame], i, j, tx, ty);
-        if self.blend > 0.0 {
+        let grid = if self.blend > 0.0 {
             let (u1, v1) = self.sample(&self.frames[self.frame + 1], i, j, tx, ty);
             let b = self.blend;
             Vec2::new(u0 + b * (u1 - u0), v0 + b * (v1 - v0))
         } else {
             Vec2::new(u0, v0)
+        };
+        match &self.meander {
+            None => grid,
+            Some(m) => grid + (m.field.velocity(pos_m) - m.mean_mps) * m.strength,
         }
     }
-    fn advance(&mut self, t_new_s: f64, _dt_s: f64, _rng: &mut SimRng) -> Result<(), EnvError> {
+    fn advance(&mut self, t_new_s: f64, dt_s: f64, rng: &mut SimRng) -> Result<(), EnvError> {
         self.set_time(t_new_s);
+        if let Some(m) = &mut self.meander {
+            m.field.advance(t_new_s, dt_s, rng)?;
+        }
         Ok(())
+    }
+    fn max_stable_dt_s(&self) -> Option<f64> {
+        self.meander
+            .as_ref()
+            .and_then(|m| m.field.max_stable_dt_s())
+    }
+    fn nodes(&self) -> usize {
+        self.meander
+            .as_ref()
+            .map_or(1, |m| FlowField::nodes(&m.field))
+    }
+    fn own_step_s(&self) -> Option<f64> {
+        self.meander.as_ref().and_then(|m| m.field.own_step_s())
     }
 }
 
@@ -256,6 +322,48 @@ mod tests {
         f.advance(50.0, 45.0, &mut rng).unwrap();
         let v = f.velocity(Vec2::new(15.0, 0.0));
         assert!((v.x - 4.5).abs() < 1e-12, "held last frame: {v:?}");
+    }
+
+    #[test]
+    fn the_meander_adds_a_departure_that_moves_and_the_grid_alone_draws_nothing() {
+        let mut text = String::from("x_m,y_m,u_mps,v_mps\n");
+        for y in [0.0, 100.0] {
+            for x in [0.0, 100.0] {
+                text += &format!("{x},{y},0.2,0.0\n");
+            }
+        }
+        let p = write_tmp("meander", &text);
+        let plain = GriddedFlow::from_csv(&p).unwrap();
+        let region = Rect::new(0.0, 100.0, 0.0, 100.0).unwrap();
+        let params = FarrellParams {
+            nx: 11,
+            ny: 11,
+            noise_gain: 2.0,
+            ..FarrellParams::default()
+        };
+        let e = plain
+            .clone()
+            .with_meander(region, params, 0.0)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("meander"), "{e}");
+        let mut m = plain.clone().with_meander(region, params, 1.0).unwrap();
+        assert!(m.max_stable_dt_s().is_some() && m.nodes() > 1);
+        let mut rng = stream_rng(3, StreamId::Flow);
+        let dt = m.max_stable_dt_s().unwrap().min(1.0) * 0.5;
+        for k in 1..=400 {
+            m.advance(k as f64 * dt, dt, &mut rng).unwrap();
+        }
+        let a = m.velocity(Vec2::new(50.0, 50.0));
+        let b = plain.velocity(Vec2::new(50.0, 50.0));
+        assert!((a - b).norm() > 1e-6, "{a:?} {b:?}");
+        // Without a meander the grid draws nothing from the flow's stream.
+        let mut r1 = stream_rng(3, StreamId::Flow);
+        let mut g = plain.clone();
+        g.advance(1.0, 1.0, &mut r1).unwrap();
+        let mut r2 = stream_rng(3, StreamId::Flow);
+        use rand::Rng as _;
+        assert_eq!(r1.random::<u64>(), r2.random::<u64>());
     }
 
     #[test]

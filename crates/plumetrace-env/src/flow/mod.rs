@@ -9,13 +9,16 @@
 //! - [`UniformFlow`]: the same velocity everywhere, steady or varying in time ([`MeanFlow`]);
 //! - [`FarrellFlow`]: the meandering field of Farrell et al. (2002), driven by coloured noise at
 //!   the corners of a grid and advanced by explicit advection-diffusion;
-//! - [`GriddedFlow`]: a regular grid (optionally several time frames) read from a CSV file.
+//! - [`GriddedFlow`]: a regular grid (optionally several time frames) read from a CSV file or
+//!   sampled from CF currents in a NetCDF file ([`CfOptions`]).
 
+mod cf;
 mod farrell;
 mod gridded;
 mod mean;
 mod uniform;
 
+pub use cf::CfOptions;
 pub use farrell::{ColouredNoise, FarrellFlow, FarrellParams, NoiseScheme, NoiseUpdates};
 pub use gridded::GriddedFlow;
 pub use mean::MeanFlow;

@@ -129,6 +129,8 @@ pub struct BuiltScenario {
     pub dt_s: f64,
     /// Water depth, m.
     pub depth_m: Option<f64>,
+    /// The site's origin in latitude and longitude (`[origin]`), for outputs in both frames.
+    pub site: Option<plumetrace_core::geo::Origin>,
     /// Keys that have no effect in this kind of run (`check` and `run` print them).
     pub warnings: Vec<Warning>,
 }
@@ -224,7 +226,7 @@ fn build_sections(
     let seed = seed.unwrap_or(cfg.seed);
     let timing = timing::timing(cfg)?;
     let domain = domain::domain(&cfg.domain)?;
-    let flow = flow::flow(&cfg.flow, domain, &base_dir)?;
+    let flow = flow::flow(cfg, domain, &base_dir)?;
     let plume = plume::plume(cfg, domain, &base_dir)?;
     let obstacles = obstacles::obstacles(cfg, seed)?;
     let vehicles = vehicles::vehicles(cfg, &domain)?;
@@ -255,6 +257,7 @@ fn build_sections(
         comms,
         dt_s: timing.dt_s,
         depth_m: cfg.domain.depth_m,
+        site: cfg.origin,
         warnings,
     })
 }

@@ -6,8 +6,8 @@
 //! there. Distances from the origin and bearings at it are exact; over a few kilometres the
 //! frame differs from a flat tangent plane by millimetres.
 
+use crate::Vec2;
 use geographiclib_rs::{DirectGeodesic, Geodesic, InverseGeodesic};
-use plumetrace_core::Vec2;
 use serde::{Deserialize, Serialize};
 
 /// The origin of the local frame (where `x = y = 0`).

@@ -1,0 +1,322 @@
+//! Tests of the CF currents reader: files written by the crate's own NetCDF writer.
+
+use super::*;
+use crate::flow::FlowField;
+use crate::{StreamId, stream_rng};
+use plumetrace_core::geo::Origin;
+use plumetrace_netcdf::{Dataset, NcType};
+use std::path::PathBuf;
+
+fn tmp(name: &str, bytes: &[u8]) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("plumetrace-cf-{}-{name}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let p = dir.join(name);
+    std::fs::write(&p, bytes).unwrap();
+    p
+}
+
+fn rect(x0: f64, x1: f64, y0: f64, y1: f64) -> Rect {
+    Rect::new(x0, x1, y0, y1).unwrap()
+}
+
+fn options() -> CfOptions {
+    CfOptions {
+        frame: None,
+        start_s: None,
+        duration_s: 100.0,
+        depth_m: None,
+        area: rect(0.0, 200.0, 0.0, 100.0),
+        must_cover: rect(10.0, 190.0, 10.0, 90.0),
+        spacing_m: None,
+        u_variable: None,
+        v_variable: None,
+    }
+}
+
+/// A projected grid x 0..200 step 50, y 0..100 step 50, two frames 0 and 100 s.
+fn projected() -> Dataset {
+    projected_in("m s-1")
+}
+
+fn projected_in(u_units: &str) -> Dataset {
+    let mut d = Dataset::default();
+    let t = d.record_dim("time", 2);
+    let y = d.dim("y", 3);
+    let x = d.dim("x", 5);
+    d.var("time", &[t], vec![0.0, 100.0])
+        .attr("units", "seconds since 2026-03-01 00:00:00");
+    d.var("y", &[y], vec![0.0, 50.0, 100.0])
+        .attr("standard_name", "projection_y_coordinate")
+        .attr("units", "m");
+    d.var("x", &[x], vec![0.0, 50.0, 100.0, 150.0, 200.0])
+        .attr("standard_name", "projection_x_coordinate")
+        .attr("units", "m");
+    let field = |f: fn(f64, f64, f64) -> f64| {
+        let mut out = Vec::new();
+        for tt in [0.0, 100.0] {
+            for yy in [0.0, 50.0, 100.0] {
+                for xx in [0.0, 50.0, 100.0, 150.0, 200.0] {
+                    out.push(f(tt, xx, yy));
+                }
+            }
+        }
+        out
+    };
+    d.var(
+        "u",
+        &[t, y, x],
+        field(|t, x, _| 0.1 + 0.001 * x + 0.002 * t),
+    )
+    .attr("standard_name", "sea_water_x_velocity")
+    .attr("units", u_units);
+    d.var("v", &[t, y, x], field(|_, _, y| -0.05 + 0.0003 * y))
+        .attr("standard_name", "sea_water_y_velocity")
+        .attr("units", "m s-1");
+    d
+}
+
+fn read(name: &str, d: &Dataset, o: &CfOptions) -> Result<GriddedFlow, String> {
+    let p = tmp(name, &d.to_bytes().unwrap());
+    GriddedFlow::from_netcdf(&p, o).map_err(|e| e.to_string())
+}
+
+#[test]
+fn a_projected_grid_gives_the_same_flow_as_the_csv_grid_bit_for_bit() {
+    let d = projected();
+    let mut nc = read("same.nc", &d, &options()).unwrap();
+    let mut csv = String::from("t_s,x_m,y_m,u_mps,v_mps\n");
+    for t in [0.0f64, 100.0] {
+        for y in [0.0f64, 50.0, 100.0] {
+            for x in [0.0f64, 50.0, 100.0, 150.0, 200.0] {
+                let u = 0.1 + 0.001 * x + 0.002 * t;
+                let v = -0.05 + 0.0003 * y;
+                csv += &format!("{t:?},{x:?},{y:?},{u:?},{v:?}\n");
+            }
+        }
+    }
+    let mut grid = GriddedFlow::from_csv(&tmp("same.csv", csv.as_bytes())).unwrap();
+    let mut rng = stream_rng(1, StreamId::Flow);
+    for t in [0.0, 12.5, 50.0, 99.0, 100.0, 150.0] {
+        nc.advance(t, 1.0, &mut rng).unwrap();
+        grid.advance(t, 1.0, &mut rng).unwrap();
+        for (x, y) in [
+            (0.0, 0.0),
+            (13.7, 91.1),
+            (199.0, 3.0),
+            (-20.0, 40.0),
+            (75.0, 250.0),
+        ] {
+            let (a, b) = (nc.velocity(Vec2::new(x, y)), grid.velocity(Vec2::new(x, y)));
+            assert_eq!(a.x.to_bits(), b.x.to_bits(), "t {t} ({x}, {y})");
+            assert_eq!(a.y.to_bits(), b.y.to_bits(), "t {t} ({x}, {y})");
+        }
+    }
+}
+
+/// Longitude/latitude around 50 N 4 W, depth levels 0, 10, 30 m (positive down), hourly frames
+/// in hours since a date, values packed as shorts in cm s-1 with a fill value.
+fn geographic(fill_at: Option<usize>) -> Dataset {
+    let mut d = Dataset::default();
+    let t = d.record_dim("time", 3);
+    let z = d.dim("depth", 3);
+    let la = d.dim("lat", 4);
+    let lo = d.dim("lon", 5);
+    d.var("time", &[t], vec![10.0, 11.0, 12.0])
+        .attr("standard_name", "time")
+        .attr("units", "hours since 2026-03-01 00:00:00");
+    d.var("depth", &[z], vec![0.0, 10.0, 30.0])
+        .attr("standard_name", "depth")
+        .attr("positive", "down")
+        .attr("units", "m");
+    // Latitudes north to south (descending), as some products store them.
+    d.var("lat", &[la], vec![50.03, 50.01, 49.99, 49.97])
+        .of_type(NcType::Float)
+        .attr("units", "degrees_north");
+    d.var("lon", &[lo], vec![-4.04, -4.02, -4.0, -3.98, -3.96])
+        .attr("units", "degrees_east");
+    // u (cm/s) = 10 * (hour - 9) + depth level's depth: uniform in space.
+    let mut u = Vec::new();
+    for h in [10.0, 11.0, 12.0] {
+        for depth in [0.0, 10.0, 30.0] {
+            for _ in 0..20 {
+                u.push((10.0 * (h - 9.0) + depth) * 100.0);
+            }
+        }
+    }
+    if let Some(k) = fill_at {
+        u[k] = -32767.0;
+    }
+    d.var("uo", &[t, z, la, lo], u)
+        .of_type(NcType::Short)
+        .attr("standard_name", "eastward_sea_water_velocity")
+        .attr("units", "cm s-1")
+        .attr("scale_factor", 0.01f32)
+        .attr("add_offset", 0.0)
+        .attr("_FillValue", -32767i16);
+    d.var("vo", &[t, z, la, lo], vec![5.0; 180])
+        .of_type(NcType::Float)
+        .attr("standard_name", "northward_sea_water_velocity")
+        .attr("units", "m s-1")
+        .attr("missing_value", 1e20f32);
+    d
+}
+
+fn site() -> CfOptions {
+    CfOptions {
+        frame: Some(
+            LocalFrame::new(Origin {
+                lat_deg: 50.0,
+                lon_deg: -4.0,
+            })
+            .unwrap(),
+        ),
+        // 10:30 on the day: half-way between the first two frames.
+        start_s: Some(plumetrace_netcdf::time::parse_date("2026-03-01T10:30:00Z").unwrap()),
+        duration_s: 3600.0,
+        depth_m: Some(5.0),
+        area: rect(-1000.0, 1000.0, -1000.0, 1000.0),
+        must_cover: rect(-500.0, 500.0, -500.0, 500.0),
+        spacing_m: Some(250.0),
+        u_variable: None,
+        v_variable: None,
+    }
+}
+
+#[test]
+fn a_geographic_grid_is_unpacked_interpolated_in_depth_and_offset_in_time() {
+    let mut f = read("geo.nc", &geographic(None), &site()).unwrap();
+    // At 10:30, depth 5 m: u = (10 * 1.5 + 5) cm/s = 0.20 m/s.
+    let u = f.velocity(Vec2::new(100.0, -200.0));
+    assert!((u.x - 0.20).abs() < 1e-6, "{u:?}");
+    assert!((u.y - 5.0).abs() < 1e-6, "{u:?}");
+    let mut rng = stream_rng(1, StreamId::Flow);
+    // 30 min later it is 11:00: (10 * 2 + 5) cm/s.
+    f.advance(1800.0, 1800.0, &mut rng).unwrap();
+    let u = f.velocity(Vec2::new(0.0, 0.0));
+    assert!((u.x - 0.25).abs() < 1e-6, "{u:?}");
+}
+
+#[test]
+fn a_fill_value_inside_the_op_area_is_an_error_and_outside_it_is_still_water() {
+    // Node (lat 49.99, lon -4.0) of the first frame, depth 0: inside the op-area's reach.
+    let at = 2 * 5 + 2;
+    let e = read("fill.nc", &geographic(Some(at)), &site()).unwrap_err();
+    assert!(e.contains("missing value") && e.contains("fill.nc"), "{e}");
+    // The corner node (lat 50.03, lon -4.04) is far from the op-area.
+    let f = read("fill-far.nc", &geographic(Some(0)), &site()).unwrap();
+    assert_eq!(f.frame_count(), 3);
+}
+
+#[test]
+fn the_errors_name_the_variable_attribute_or_dimension_and_suggest() {
+    let mut o = site();
+    o.u_variable = Some("u0".into());
+    let e = read("typo.nc", &geographic(None), &o).unwrap_err();
+    assert!(
+        e.contains("flow.netcdf.u_variable = \"u0\": no such variable; did you mean \"uo\"?"),
+        "{e}"
+    );
+    let mut o = site();
+    o.must_cover = rect(-500.0, 3000.0, -500.0, 500.0);
+    let e = read("cover.nc", &geographic(None), &o).unwrap_err();
+    assert!(e.contains("does not cover the op-area"), "{e}");
+    let mut o = site();
+    o.frame = None;
+    let e = read("origin.nc", &geographic(None), &o).unwrap_err();
+    assert!(e.contains("[origin] lat_deg and lon_deg"), "{e}");
+    let mut o = site();
+    o.depth_m = None;
+    let e = read("depth.nc", &geographic(None), &o).unwrap_err();
+    assert!(
+        e.contains("3 depth levels") && e.contains("flow.netcdf.depth_m"),
+        "{e}"
+    );
+    let mut o = site();
+    o.depth_m = Some(31.0);
+    let e = read("deep.nc", &geographic(None), &o).unwrap_err();
+    assert!(e.contains("below the deepest level"), "{e}");
+    let mut o = site();
+    o.duration_s = 3.0 * 3600.0;
+    let e = read("time.nc", &geographic(None), &o).unwrap_err();
+    assert!(e.contains("frames span -1800 s to 5400 s"), "{e}");
+
+    let mut d = projected();
+    d.var("w", &[0, 1, 2], vec![0.0; 30]);
+    let mut o = options();
+    o.u_variable = Some("w".into());
+    o.v_variable = Some("v".into());
+    let e = read("units.nc", &d, &o).unwrap_err();
+    assert!(e.contains("variable w: no attribute units"), "{e}");
+
+    let d = projected_in("furlongs per fortnight");
+    let e = read("furlongs.nc", &d, &options()).unwrap_err();
+    assert!(
+        e.contains(
+            "variable u: attribute units = \"furlongs per fortnight\" is not a velocity unit"
+        ),
+        "{e}"
+    );
+
+    let mut d = Dataset::default();
+    d.var("salt", &[], vec![35.0])
+        .attr("standard_name", "sea_water_salinity");
+    let e = read("nothing.nc", &d, &options()).unwrap_err();
+    assert!(
+        e.contains("no variables with standard_name eastward_sea_water_velocity")
+            && e.contains("salt (sea_water_salinity)"),
+        "{e}"
+    );
+}
+
+#[test]
+fn a_curvilinear_grid_and_other_formats_are_refused_by_name() {
+    let mut d = Dataset::default();
+    let eta = d.dim("eta", 2);
+    let xi = d.dim("xi", 2);
+    d.var("lat_rho", &[eta, xi], vec![50.0; 4])
+        .attr("units", "degrees_north");
+    d.var("lon_rho", &[eta, xi], vec![-4.0; 4])
+        .attr("units", "degrees_east");
+    for (n, sn) in [
+        ("u", "eastward_sea_water_velocity"),
+        ("v", "northward_sea_water_velocity"),
+    ] {
+        d.var(n, &[eta, xi], vec![0.0; 4])
+            .attr("standard_name", sn)
+            .attr("units", "m s-1")
+            .attr("coordinates", "lat_rho lon_rho");
+    }
+    let e = read("roms.nc", &d, &site()).unwrap_err();
+    assert!(
+        e.contains("curvilinear") && e.contains("cdo remapbil"),
+        "{e}"
+    );
+    let p = tmp("flow.csv", b"x_m,y_m,u_mps,v_mps\n");
+    let e = GriddedFlow::from_netcdf(&p, &site())
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("flow.csv: not a NetCDF file"), "{e}");
+    let p = tmp("model.nc4", b"\x89HDF\r\n\x1a\n\0\0\0\0");
+    let e = GriddedFlow::from_netcdf(&p, &site())
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("nccopy -k classic"), "{e}");
+}
+
+#[test]
+fn velocity_units_are_read_in_their_usual_spellings() {
+    for (u, s) in [
+        ("m s-1", Some(1.0)),
+        ("m/s", Some(1.0)),
+        ("m.s-1", Some(1.0)),
+        ("m s^-1", Some(1.0)),
+        ("meter second-1", Some(1.0)),
+        ("cm s-1", Some(0.01)),
+        ("cm/s", Some(0.01)),
+        ("knots", Some(1852.0 / 3600.0)),
+        ("m", None),
+        ("degC", None),
+    ] {
+        assert_eq!(velocity_scale(u), s, "{u}");
+    }
+}
