@@ -1,7 +1,15 @@
 //! Measurable properties of a drawn figure, read back from its SVG text: where each label sits
-//! (its box estimated from its font size and length), which labels overlap, and whether every
-//! axis's tick labels are distinct and increasing. The figures' tests and the visual check of
+//! (its box estimated from its font size and length), which labels overlap, whether every
+//! axis's tick labels are distinct and increasing, and (in [`series`]) whether each drawn series
+//! has a legend entry whose swatch is its mark. The figures' tests and the visual check of
 //! rendered presets use them; nothing here draws.
+
+pub mod series;
+
+pub use series::{
+    MarkedGroup, legend_entries_without_text, marked_groups, series_without_legend,
+    swatches_unlike_series,
+};
 
 /// One `<text>` element of a figure and the box it covers, px (y down).
 #[derive(Debug, Clone, PartialEq)]
@@ -27,14 +35,14 @@ pub struct TextBox {
 /// digits and lower-case words).
 const CHAR_EM: f64 = 0.55;
 
-fn attr(tag: &str, name: &str) -> Option<String> {
+pub(crate) fn attr(tag: &str, name: &str) -> Option<String> {
     let key = format!(" {name}=\"");
     let a = tag.find(&key)? + key.len();
     let b = tag[a..].find('"')? + a;
     Some(tag[a..b].to_string())
 }
 
-fn unescape(s: &str) -> String {
+pub(crate) fn unescape(s: &str) -> String {
     s.replace("&lt;", "<")
         .replace("&gt;", ">")
         .replace("&quot;", "\"")
