@@ -136,7 +136,9 @@ pub(super) struct MapLayout {
     pub(super) m_per_px: f64,
     /// Multi-vehicle: tracks in the vehicles' colours.
     pub(super) multi: bool,
+    /// The mean plume's cells, and the source map's.
     pub(super) plume: Vec<([(f64, f64); 2], RGBColor)>,
+    pub(super) source_map: Vec<([(f64, f64); 2], RGBColor)>,
     pub(super) obstacles: Vec<Vec<(f64, f64)>>,
     pub(super) layers: Vec<VehicleLayer>,
     pub(super) time_step_min: f64,
@@ -380,8 +382,8 @@ pub(super) fn map_layout(
     mark_points.extend(&over.targets);
     mark_points.extend(over.marks.iter().map(|k| k.pos));
     place_time_labels(&mut layers, &mark_points, m);
-    let mut plume = plume_cells(run, &x, &y);
-    plume.extend(posterior_cells(run, &x, &y));
+    let plume = plume_cells(run, &x, &y);
+    let source_map = posterior_cells(run, &x, &y);
     let obstacles = run
         .obstacles
         .iter()
@@ -451,6 +453,7 @@ pub(super) fn map_layout(
         m_per_px: m,
         multi,
         plume,
+        source_map,
         obstacles,
         layers,
         time_step_min: step_min,
