@@ -98,25 +98,7 @@ mod tests {
 
     use super::test_support::{layout, preset_run};
     use super::*;
-    use crate::inspect::{
-        legend_entries_without_text, series_without_legend, swatches_unlike_series,
-    };
-
-    /// What is wrong with the legend of `svg`: series without an entry, entries without a
-    /// label, swatches unlike their series.
-    fn legend_faults(svg: &str) -> Vec<String> {
-        let mut out: Vec<String> = series_without_legend(svg)
-            .into_iter()
-            .map(|s| format!("no entry: {s}"))
-            .collect();
-        out.extend(
-            legend_entries_without_text(svg)
-                .into_iter()
-                .map(|s| format!("no label: {s}")),
-        );
-        out.extend(swatches_unlike_series(svg));
-        out
-    }
+    use crate::inspect::{legend_faults, series_without_legend};
 
     #[test]
     fn every_series_of_the_demo_has_a_legend_entry_whose_swatch_is_its_mark() {

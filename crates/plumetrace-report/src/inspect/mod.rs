@@ -7,7 +7,7 @@
 pub mod series;
 
 pub use series::{
-    MarkedGroup, legend_entries_without_text, marked_groups, series_without_legend,
+    MarkedGroup, legend_entries_without_text, legend_faults, marked_groups, series_without_legend,
     swatches_unlike_series,
 };
 

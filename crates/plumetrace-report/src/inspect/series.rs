@@ -295,6 +295,27 @@ pub fn swatches_unlike_series(svg: &str) -> Vec<String> {
     out
 }
 
+/// Everything wrong with the legend of `svg`, one line each: a series with no entry
+/// ([`series_without_legend`]), an entry with no label ([`legend_entries_without_text`]), a
+/// swatch unlike its series ([`swatches_unlike_series`]).
+pub fn legend_faults(svg: &str) -> Vec<String> {
+    let mut out: Vec<String> = series_without_legend(svg)
+        .into_iter()
+        .map(|s| format!("a series with no legend entry: {s:?}"))
+        .collect();
+    out.extend(
+        legend_entries_without_text(svg)
+            .into_iter()
+            .map(|s| format!("a legend entry with no label: {s:?}")),
+    );
+    out.extend(
+        swatches_unlike_series(svg)
+            .into_iter()
+            .map(|s| format!("a swatch unlike its series: {s}")),
+    );
+    out
+}
+
 #[cfg(test)]
 mod tests {
     #![allow(clippy::unwrap_used, clippy::expect_used)]
