@@ -254,14 +254,16 @@ pub fn legend_entries_without_text(svg: &str) -> Vec<String> {
 
 /// The legend entries of `svg` whose swatch is not the mark of the series they name: every
 /// mark of the series (its shape, colour, line width, and dashes) is among the swatch's marks;
-/// of a series whose colour follows a scale, every shape. Each as `name: drawn as ..., keyed
-/// as ...`.
+/// of a series whose colour follows a scale, every shape. An entry with no swatch (a row's
+/// label, which keys the row's marks by place) is not compared. Each as `name: drawn as ...,
+/// keyed as ...`.
 pub fn swatches_unlike_series(svg: &str) -> Vec<String> {
     let groups = marked_groups(svg);
     let legend = by_name(&groups, "legend");
     let mut out = Vec::new();
     for s in by_name(&groups, "series").into_values() {
-        let Some(l) = legend.get(&s.name) else {
+        // An entry with no swatch (a row's label on its axis) keys its series by place.
+        let Some(l) = legend.get(&s.name).filter(|l| !l.marks.is_empty()) else {
             continue;
         };
         let fits = if s.ramp {
@@ -394,6 +396,16 @@ mod tests {
             "points=\"80,200 86,200 \"/>\n<polyline fill=\"none\" opacity=\"1\" stroke=\"#000000\" stroke-width=\"2\" points=\"90,200 96,200 \"/>",
         );
         assert!(swatches_unlike_series(&two_dashes).is_empty());
+        // A row's label keys its row by place: no swatch to compare.
+        let row_label = SVG.replace(
+            "<polygon opacity=\"1\" fill=\"#008C3C\" points=\"588,14 583,24 593,24 \"/>\n",
+            "",
+        );
+        assert!(
+            swatches_unlike_series(&row_label)
+                .iter()
+                .all(|b| !b.starts_with("true source"))
+        );
         // A source keyed by a dot, or in another colour.
         for wrong in [
             SVG.replace(
