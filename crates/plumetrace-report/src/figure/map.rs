@@ -344,6 +344,16 @@ where
                 },
             )?;
         }
+        // Leaders from ticks to labels placed away from them.
+        chart
+            .draw_series(
+                l.times
+                    .iter()
+                    .filter(|t| !t.label.is_empty())
+                    .filter_map(|t| t.leader)
+                    .map(|s| PathElement::new(s.to_vec(), BLACK.stroke_width(1))),
+            )
+            .map_err(ReportError::figure)?;
         chart
             .draw_series(l.times.iter().filter(|t| !t.label.is_empty()).map(|t| {
                 let w = (text_px(&t.label, TIME_FONT_PX) / 2.0).round() as i32 + 2;
