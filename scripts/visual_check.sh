@@ -80,44 +80,33 @@ grep -q 'data-replayed="true"' "$out/demo-replayed-lawnmower.state.txt"
 grep -q 'data-divergence="' "$out/demo-replayed-lawnmower.state.txt"
 
 echo "== a campaign over every planner"
-cat >"$out/campaign.toml" <<'TOML'
-name = "visual"
-seed = 5
-seeds = 3
-scenarios = ["demo"]
-[[configs]]
-name = "amp"
-[[configs]]
-name = "amp-map"
-[configs.planner]
-kind = "amp"
-map_declaration = "instead"
-[[configs]]
-name = "infotaxis"
-[configs.planner]
-kind = "infotaxis"
-[[configs]]
-name = "moth"
-[configs.planner]
-kind = "moth"
-[[configs]]
-name = "lawnmower"
-[configs.planner]
-kind = "lawnmower"
-[[configs]]
-name = "surge_cast"
-[configs.planner]
-kind = "surge_cast"
-TOML
+# One config per planner of `plumetrace planners` (and the AMP declaring from its source map): the
+# planners the demo's one vehicle can fly over the demo, the others (a team's) over the
+# formation presets.
+planners=$("$bin" planners | sed -n 's/^\([a-z_][a-z_0-9]*\): .*/\1/p')
+if [ -z "$planners" ]; then
+    echo "visual_check.sh: \`plumetrace planners\` listed no planner" >&2
+    exit 1
+fi
+config() { # NAME KIND [KEY = VALUE]
+    printf '[[configs]]\nname = "%s"\n[configs.planner]\nkind = "%s"\n%s' "$1" "$2" "${3:+$3
+}"
+}
+single="" team=""
+for k in $planners; do
+    if "$bin" check --preset demo --planner "$k" >/dev/null 2>&1; then
+        single="$single$(config "$k" "$k")"$'\n'
+        if [ "$k" = amp ]; then
+            single="$single$(config amp-map amp 'map_declaration = "instead"')"$'\n'
+        fi
+    else
+        team="$team$(config "$k" "$k")"$'\n'
+    fi
+done
+printf 'name = "visual"\nseed = 5\nseeds = 3\nscenarios = ["demo"]\n%s' "$single" >"$out/campaign.toml"
 "$bin" campaign "$out/campaign.toml" --out "$out/campaign" --jobs 2 >/dev/null
-cat >"$out/team-campaign.toml" <<'TOML'
-name = "visual-team"
-seed = 5
-seeds = 2
-scenarios = ["soares-freshwater", "soares-filaments"]
-[[configs]]
-name = "formation"
-TOML
+printf 'name = "visual-team"\nseed = 5\nseeds = 2\nscenarios = ["soares-freshwater", "soares-filaments"]\n%s' \
+    "$team" >"$out/team-campaign.toml"
 "$bin" campaign "$out/team-campaign.toml" --out "$out/team-campaign" --jobs 2 >/dev/null
 for c in campaign team-campaign; do
     for f in success errors trajectories; do

@@ -1,9 +1,8 @@
 //! The visual check of rendered outputs: every SVG figure under `PLUMETRACE_VISUAL_DIR` (written
 //! by `scripts/visual_check.sh`) has no two labels overlapping, no label over a marker or a
-//! track, distinct, increasing tick labels
-//! on every axis, and a legend entry for each drawn series whose swatch is the series' mark;
-//! every replay page's state (read from the browser into `*.state.txt`) names its timeline rows.
-//! Ignored: the script runs it with `--ignored`.
+//! track, distinct, increasing tick labels on every axis, and a legend entry for each drawn
+//! series whose swatch is the series' mark; every replay page's state (read from the browser
+//! into `*.state.txt`) names its timeline rows. Ignored: the script runs it with `--ignored`.
 
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
