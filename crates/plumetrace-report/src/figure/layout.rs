@@ -577,17 +577,16 @@ fn vehicle_layers(
 /// A box on the map: centre and half sizes, m.
 type MapBox = ((f64, f64), f64, f64);
 
-/// How far from its tick a time label may be placed, px, beyond its own side: it is moved
-/// out in steps of 10 px up to this, in eight directions.
-const LEADER_MAX_PX: f64 = 80.0;
+/// How far from its tick a time label may be placed, px: it is moved out in steps of 10 px up
+/// to this, in twelve directions.
+const LEADER_MAX_PX: f64 = 100.0;
 
 /// Places each time label on the side of its tick where it hides no marker (true and declared
 /// sources, lost points, reference targets, aborts and incidents: `marks`, each about 9 px
 /// across), overlaps no earlier label and no box in `taken` (the legend) and stays on the map
-/// `(x, y)`, preferring a side that no track crosses. With both sides crossed, the label goes
-/// further out (up to [`LEADER_MAX_PX`]) where no track crosses it, with a leader line to its
-/// tick; with no such place, it stays on a side free of markers and labels; with none, it is
-/// left out (its tick stays).
+/// `(x, y)`, on a side that no track crosses. With both sides crossed, the label goes further
+/// out (up to [`LEADER_MAX_PX`]) where no track crosses it, with a leader line to its tick; with
+/// no such place, it is left out (its tick stays).
 fn place_time_labels(
     layers: &mut [VehicleLayer],
     marks: &[(f64, f64)],
@@ -625,15 +624,11 @@ fn place_time_labels(
             let far = || {
                 further_out(mid, t.label_at, m).find(|&c| on_map(c) && clear(c) && off_tracks(c))
             };
-            let (at, leader) = match near
+            match near
                 .map(|c| (c, false))
                 .or_else(|| far().map(|c| (c, true)))
             {
-                Some(found) => (Some(found.0), found.1),
-                None => (sides.into_iter().find(|&c| clear(c)), false),
-            };
-            match at {
-                Some(at) => {
+                Some((at, leader)) => {
                     t.label_at = at;
                     t.leader = leader.then(|| leader_line(mid, at, half, m));
                     boxes.push((at, half.0, half.1));
@@ -645,14 +640,16 @@ fn place_time_labels(
 }
 
 /// Places further out from a tick at `mid` whose label would sit at `label_at`: in steps of
-/// 10 px from 25 px up to [`LEADER_MAX_PX`] beyond the label's own place, along the tick
-/// (either side) first, then the six other directions 45 degrees apart.
+/// 10 px from 25 px up to [`LEADER_MAX_PX`] from the tick, along the tick (either side)
+/// first, then the ten other directions 30 degrees apart, nearest the tick's first.
 fn further_out(mid: (f64, f64), label_at: (f64, f64), m: f64) -> impl Iterator<Item = (f64, f64)> {
     let (dx, dy) = (label_at.0 - mid.0, label_at.1 - mid.1);
     let len = dx.hypot(dy).max(1e-9);
     let (ux, uy) = (dx / len, dy / len);
     // Along the tick, the other side, then the diagonals and along the track.
-    let turns = [0.0, 180.0, 45.0, -45.0, 135.0, -135.0, 90.0, -90.0];
+    let turns = [
+        0.0, 180.0, 30.0, -30.0, 150.0, -150.0, 60.0, -60.0, 120.0, -120.0, 90.0, -90.0,
+    ];
     (0..)
         .map(|k| 25.0 + 10.0 * f64::from(k))
         .take_while(|d| *d <= LEADER_MAX_PX)

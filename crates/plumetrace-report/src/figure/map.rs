@@ -240,11 +240,11 @@ where
                 chart
                     .draw_series(l.jumps.iter().flat_map(|&([a, b], _)| {
                         let len = (b.0 - a.0).hypot(b.1 - a.1);
-                        // Dashes of 6 px, gaps of 4 px.
-                        let n = (len / (10.0 * m)).ceil().max(1.0) as usize;
+                        // Dotted as its legend swatch: dots of 3 px, gaps of 3 px.
+                        let n = (len / (6.0 * m)).ceil().max(2.0) as usize;
                         (0..n).map(move |k| {
                             let s = k as f64 / n as f64;
-                            let e = (s + 0.6 / n as f64).min(1.0);
+                            let e = (s + 0.5 / n as f64).min(1.0);
                             PathElement::new(
                                 vec![
                                     (a.0 + s * (b.0 - a.0), a.1 + s * (b.1 - a.1)),

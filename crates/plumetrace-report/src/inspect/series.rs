@@ -78,6 +78,10 @@ fn mark_of(tag: &str) -> (Option<Mark>, Option<Piece>) {
                 return (None, None);
             };
             let pts = points(tag);
+            // A line of no length draws nothing.
+            if pts.iter().all(|p| *p == pts[0]) {
+                return (None, None);
+            }
             let piece = (pts.len() == 2).then(|| ((c.clone(), width()), pts[0], pts[1]));
             let m = Mark {
                 shape: "line".into(),
@@ -338,6 +342,9 @@ mod tests {
 <g class="series" data-series="track: find">
 <polyline fill="none" opacity="1" stroke="#1F64BE" stroke-width="2" points="1,1 5,9 20,30 "/>
 </g>
+<g class="series" data-series="track: done">
+<polyline fill="none" opacity="1" stroke="#000000" stroke-width="2" points="20,30 20,30 "/>
+</g>
 <g class="series" data-series="heat" data-colour="ramp">
 <rect x="1" y="1" width="5" height="5" opacity="1" fill="#FFF1E4" stroke="none"/>
 <rect x="6" y="1" width="5" height="5" opacity="1" fill="#FFAA64" stroke="none"/>
@@ -359,7 +366,7 @@ mod tests {
     #[test]
     fn groups_are_read_with_their_marks() {
         let g = marked_groups(SVG);
-        assert_eq!(g.len(), 7);
+        assert_eq!(g.len(), 8);
         assert_eq!(g[0].kind, "series");
         let shape = |k: usize| {
             g[k].marks
@@ -370,8 +377,9 @@ mod tests {
         assert_eq!(shape(0), ["triangle"]);
         assert_eq!(shape(1), ["dashed line"], "three dashes on one line");
         assert_eq!(shape(2), ["line"]);
-        assert!(g[3].ramp);
-        assert_eq!(g[5].texts, ["op-area"]);
+        assert!(g[3].marks.is_empty(), "a line of no length draws nothing");
+        assert!(g[4].ramp);
+        assert_eq!(g[6].texts, ["op-area"]);
     }
 
     #[test]
