@@ -574,19 +574,36 @@ fn vehicle_layers(
     layers
 }
 
+/// Whether the segments `a`-`b` and `p`-`q` cross.
+fn segments_cross(a: (f64, f64), b: (f64, f64), p: (f64, f64), q: (f64, f64)) -> bool {
+    let side = |o: (f64, f64), u: (f64, f64), v: (f64, f64)| {
+        (u.0 - o.0) * (v.1 - o.1) - (u.1 - o.1) * (v.0 - o.0)
+    };
+    let (d1, d2) = (side(p, q, a), side(p, q, b));
+    let (d3, d4) = (side(a, b, p), side(a, b, q));
+    d1 * d2 < 0.0 && d3 * d4 < 0.0
+}
+
+/// Whether the segment `a`-`b` meets the box `r` (left, bottom, right, top).
+fn segment_meets_box(a: (f64, f64), b: (f64, f64), r: (f64, f64, f64, f64)) -> bool {
+    let inside = |p: (f64, f64)| r.0 <= p.0 && p.0 <= r.2 && r.1 <= p.1 && p.1 <= r.3;
+    let corners = [(r.0, r.1), (r.2, r.1), (r.2, r.3), (r.0, r.3)];
+    inside(a) || inside(b) || (0..4).any(|k| segments_cross(a, b, corners[k], corners[(k + 1) % 4]))
+}
+
 /// A box on the map: centre and half sizes, m.
 type MapBox = ((f64, f64), f64, f64);
 
 /// How far from its tick a time label may be placed, px: it is moved out in steps of 10 px up
 /// to this, in twelve directions.
-const LEADER_MAX_PX: f64 = 100.0;
+const LEADER_MAX_PX: f64 = 65.0;
 
 /// Places each time label on the side of its tick where it hides no marker (true and declared
 /// sources, lost points, reference targets, aborts and incidents: `marks`, each about 9 px
 /// across), overlaps no earlier label and no box in `taken` (the legend) and stays on the map
 /// `(x, y)`, on a side that no track crosses. With both sides crossed, the label goes further
-/// out (up to [`LEADER_MAX_PX`]) where no track crosses it, with a leader line to its tick; with
-/// no such place, it is left out (its tick stays).
+/// out (up to [`LEADER_MAX_PX`]) where no track crosses it, with a leader line to its tick that
+/// crosses no other leader or label; with no such place, it is left out (its tick stays).
 fn place_time_labels(
     layers: &mut [VehicleLayer],
     marks: &[(f64, f64)],
@@ -598,6 +615,7 @@ fn place_time_labels(
     let mut boxes: Vec<MapBox> = marks.iter().map(|&p| (p, mark_half, mark_half)).collect();
     boxes.extend(taken);
     let tracks = track_points(layers, 2.0 * m);
+    let (mut labels, mut leaders): (Vec<MapBox>, Vec<Segment>) = (Vec::new(), Vec::new());
     for l in layers {
         for t in &mut l.times {
             let half = ((text_px(&t.label, TIME_FONT_PX) / 2.0 + 2.0) * m, 7.0 * m);
@@ -621,8 +639,17 @@ fn place_time_labels(
                     && c.1 + half.1 <= y.end
             };
             let near = sides.into_iter().find(|&c| clear(c) && off_tracks(c));
+            // A leader crosses no other leader and no other label.
+            let free_leader = |c: (f64, f64)| {
+                let [a, b] = leader_line(mid, c, half, m);
+                !leaders.iter().any(|&[p, q]| segments_cross(a, b, p, q))
+                    && !labels.iter().any(|&(p, w, h)| {
+                        segment_meets_box(a, b, (p.0 - w, p.1 - h, p.0 + w, p.1 + h))
+                    })
+            };
             let far = || {
-                further_out(mid, t.label_at, m).find(|&c| on_map(c) && clear(c) && off_tracks(c))
+                further_out(mid, t.label_at, m)
+                    .find(|&c| on_map(c) && clear(c) && off_tracks(c) && free_leader(c))
             };
             match near
                 .map(|c| (c, false))
@@ -632,6 +659,8 @@ fn place_time_labels(
                     t.label_at = at;
                     t.leader = leader.then(|| leader_line(mid, at, half, m));
                     boxes.push((at, half.0, half.1));
+                    labels.push((at, half.0, half.1));
+                    leaders.extend(t.leader);
                 }
                 None => t.label.clear(),
             }
@@ -1080,6 +1109,28 @@ mod tests {
         );
         let d = (t.label_at.0 - mid.0).hypot(t.label_at.1 - mid.1) / m;
         assert!((24.9..=LEADER_MAX_PX + 0.1).contains(&d), "{d} px out");
+        assert!(segments_cross(
+            (0.0, 0.0),
+            (2.0, 2.0),
+            (0.0, 2.0),
+            (2.0, 0.0)
+        ));
+        assert!(!segments_cross(
+            (0.0, 0.0),
+            (1.0, 0.0),
+            (0.0, 1.0),
+            (1.0, 1.0)
+        ));
+        assert!(segment_meets_box(
+            (-1.0, 0.5),
+            (2.0, 0.5),
+            (0.0, 0.0, 1.0, 1.0)
+        ));
+        assert!(!segment_meets_box(
+            (-1.0, 2.0),
+            (2.0, 2.0),
+            (0.0, 0.0, 1.0, 1.0)
+        ));
         assert!(
             (to.0 - t.label_at.0).abs() <= half.0 + 1e-9
                 && (to.1 - t.label_at.1).abs() <= half.1 + 1e-9,
