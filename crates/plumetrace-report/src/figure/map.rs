@@ -389,11 +389,18 @@ where
             .virtual_paths
             .iter()
             .flat_map(|(a, course, b)| {
+                // Dashed as its legend swatch, at least two dashes: 2 m on and 2 m off, or
+                // finer on a path shorter than 8 m.
                 let len = (b - a).dot(&course.unit()).max(0.0);
-                let n = (len / 2.0).ceil() as usize;
-                (0..n).step_by(2).map(move |k| {
-                    let p = a + course.unit() * (2.0 * k as f64);
-                    let q = a + course.unit() * (2.0 * (k + 1) as f64).min(len);
+                let n = if len > 0.0 {
+                    (len / 4.0).ceil().max(2.0) as usize
+                } else {
+                    0
+                };
+                let period = len / n.max(1) as f64;
+                (0..n).map(move |k| {
+                    let p = a + course.unit() * (period * k as f64);
+                    let q = a + course.unit() * (period * (k as f64 + 0.5));
                     PathElement::new(vec![(p.x, p.y), (q.x, q.y)], AVOID_MARK.stroke_width(1))
                 })
             })
