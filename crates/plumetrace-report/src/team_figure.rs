@@ -205,6 +205,6 @@ mod tests {
         // A leader's line with its key entry gone is found.
         let leader = &run.vehicles[1].name;
         let unkeyed = svg.replace(&format!("data-legend=\"{leader}\""), "data-legend=\"\"");
-        assert_eq!(series_without_legend(&unkeyed), [leader.clone()]);
+        assert_eq!(series_without_legend(&unkeyed), [leader.as_str()]);
     }
 }

@@ -1087,7 +1087,7 @@ mod tests {
         let svg = super::super::draw_figure(&run, &rows, &old, "crossed").unwrap();
         assert_eq!(
             crate::inspect::texts_over_tracks(&svg),
-            [first.label.clone()]
+            [first.label.as_str()]
         );
         let mut new = old.clone();
         place_time_labels(&mut new.layers, &[], &[], (&lay.x, &lay.y), m);

@@ -36,6 +36,9 @@ pub struct MarkedGroup {
     pub texts: Vec<String>,
 }
 
+/// A line's two ends, px.
+type Ends = ((f64, f64), (f64, f64));
+
 /// A 2-point line: colour and width, its ends, px.
 type Piece = ((String, String), (f64, f64), (f64, f64));
 
@@ -124,7 +127,7 @@ fn mark_of(tag: &str) -> (Option<Mark>, Option<Piece>) {
 /// The line styles of `pieces` drawn broken: most of their successive pieces lie on one line
 /// with a gap between them (dashes along an outline, not ticks across a track).
 fn broken_styles(pieces: &[Piece]) -> BTreeSet<(String, String)> {
-    let mut by_style: BTreeMap<&(String, String), Vec<((f64, f64), (f64, f64))>> = BTreeMap::new();
+    let mut by_style: BTreeMap<&(String, String), Vec<Ends>> = BTreeMap::new();
     for (s, a, b) in pieces {
         by_style.entry(s).or_default().push((*a, *b));
     }
