@@ -80,9 +80,9 @@ grep -q 'data-replayed="true"' "$out/demo-replayed-lawnmower.state.txt"
 grep -q 'data-divergence="' "$out/demo-replayed-lawnmower.state.txt"
 
 echo "== a campaign over every planner"
-# One config per planner of `plumetrace planners` (and the AMP declaring from its source map): the
-# planners the demo's one vehicle can fly over the demo, the others (a team's) over the
-# formation presets.
+# Every planner of `plumetrace planners`: one config each (and the AMP declaring from its source
+# map) over the demo for those the demo's one vehicle can fly; the others (a team's) as the presets
+# that fly them have them, over those presets.
 planners=$("$bin" planners | sed -n 's/^\([a-z_][a-z_0-9]*\): .*/\1/p')
 if [ -z "$planners" ]; then
     echo "visual_check.sh: \`plumetrace planners\` listed no planner" >&2
@@ -92,21 +92,31 @@ config() { # NAME KIND [KEY = VALUE]
     printf '[[configs]]\nname = "%s"\n[configs.planner]\nkind = "%s"\n%s' "$1" "$2" "${3:+$3
 }"
 }
-single="" team=""
+single="" teams=""
 for k in $planners; do
     if "$bin" check --preset demo --planner "$k" >/dev/null 2>&1; then
         single="$single$(config "$k" "$k")"$'\n'
         if [ "$k" = amp ]; then
             single="$single$(config amp-map amp 'map_declaration = "instead"')"$'\n'
         fi
-    else
-        team="$team$(config "$k" "$k")"$'\n'
+        continue
+    fi
+    found=""
+    for p in "${missions[@]}"; do
+        if "$bin" presets --show "$p" | grep -q "^kind = \"$k\""; then
+            found=1
+            case " $teams " in *" \"$p\" "*) ;; *) teams="$teams \"$p\"" ;; esac
+        fi
+    done
+    if [ -z "$found" ]; then
+        echo "visual_check.sh: no preset flies the planner $k (and the demo cannot): add one" >&2
+        exit 1
     fi
 done
 printf 'name = "visual"\nseed = 5\nseeds = 3\nscenarios = ["demo"]\n%s' "$single" >"$out/campaign.toml"
 "$bin" campaign "$out/campaign.toml" --out "$out/campaign" --jobs 2 >/dev/null
-printf 'name = "visual-team"\nseed = 5\nseeds = 2\nscenarios = ["soares-freshwater", "soares-filaments"]\n%s' \
-    "$team" >"$out/team-campaign.toml"
+printf 'name = "visual-team"\nseed = 5\nseeds = 2\nscenarios = [%s]\n[[configs]]\nname = "team"\n' \
+    "$(echo $teams | sed 's/" "/", "/g')" >"$out/team-campaign.toml"
 "$bin" campaign "$out/team-campaign.toml" --out "$out/team-campaign" --jobs 2 >/dev/null
 for c in campaign team-campaign; do
     for f in success errors trajectories; do
