@@ -56,8 +56,9 @@ where
         .label_style(("sans-serif", 12))
         .draw()
         .map_err(err)?;
-    for (k, (v, pts)) in series.iter().enumerate() {
-        let colour = Palette99::pick(k).to_rgba();
+    for (v, pts) in series {
+        // One colour per vehicle in every panel (a panel may leave a vehicle out).
+        let colour = Palette99::pick(*v as usize).to_rgba();
         let name = names
             .get(*v as usize)
             .cloned()
@@ -201,6 +202,15 @@ mod tests {
             .chain([&"centroid".to_string()])
         {
             assert!(series.contains(v), "{v}: {series:?}");
+        }
+        // Each vehicle is drawn in one colour in every panel.
+        for v in &run.vehicles {
+            let colours: std::collections::BTreeSet<String> = marked_groups(&svg)
+                .into_iter()
+                .filter(|g| g.kind == "series" && g.name == v.name)
+                .flat_map(|g| g.marks.into_iter().map(|m| m.colour))
+                .collect();
+            assert_eq!(colours.len(), 1, "{}: {colours:?}", v.name);
         }
         // A leader's line with its key entry gone is found.
         let leader = &run.vehicles[1].name;
