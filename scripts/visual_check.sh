@@ -80,44 +80,43 @@ grep -q 'data-replayed="true"' "$out/demo-replayed-lawnmower.state.txt"
 grep -q 'data-divergence="' "$out/demo-replayed-lawnmower.state.txt"
 
 echo "== a campaign over every planner"
-cat >"$out/campaign.toml" <<'TOML'
-name = "visual"
-seed = 5
-seeds = 3
-scenarios = ["demo"]
-[[configs]]
-name = "amp"
-[[configs]]
-name = "amp-map"
-[configs.planner]
-kind = "amp"
-map_declaration = "instead"
-[[configs]]
-name = "infotaxis"
-[configs.planner]
-kind = "infotaxis"
-[[configs]]
-name = "moth"
-[configs.planner]
-kind = "moth"
-[[configs]]
-name = "lawnmower"
-[configs.planner]
-kind = "lawnmower"
-[[configs]]
-name = "surge_cast"
-[configs.planner]
-kind = "surge_cast"
-TOML
+# Every planner of `plumetrace planners`: one config each (and the AMP declaring from its source
+# map) over the demo for those the demo's one vehicle can fly; the others (a team's) as the presets
+# that fly them have them, over those presets.
+planners=$("$bin" planners | sed -n 's/^\([a-z_][a-z_0-9]*\): .*/\1/p')
+if [ -z "$planners" ]; then
+    echo "visual_check.sh: \`plumetrace planners\` listed no planner" >&2
+    exit 1
+fi
+config() { # NAME KIND [KEY = VALUE]
+    printf '[[configs]]\nname = "%s"\n[configs.planner]\nkind = "%s"\n%s' "$1" "$2" "${3:+$3
+}"
+}
+single="" teams=""
+for k in $planners; do
+    if "$bin" check --preset demo --planner "$k" >/dev/null 2>&1; then
+        single="$single$(config "$k" "$k")"$'\n'
+        if [ "$k" = amp ]; then
+            single="$single$(config amp-map amp 'map_declaration = "instead"')"$'\n'
+        fi
+        continue
+    fi
+    found=""
+    for p in "${missions[@]}"; do
+        if "$bin" presets --show "$p" | grep -q "^kind = \"$k\""; then
+            found=1
+            case " $teams " in *" \"$p\" "*) ;; *) teams="$teams \"$p\"" ;; esac
+        fi
+    done
+    if [ -z "$found" ]; then
+        echo "visual_check.sh: no preset flies the planner $k (and the demo cannot): add one" >&2
+        exit 1
+    fi
+done
+printf 'name = "visual"\nseed = 5\nseeds = 3\nscenarios = ["demo"]\n%s' "$single" >"$out/campaign.toml"
 "$bin" campaign "$out/campaign.toml" --out "$out/campaign" --jobs 2 >/dev/null
-cat >"$out/team-campaign.toml" <<'TOML'
-name = "visual-team"
-seed = 5
-seeds = 2
-scenarios = ["soares-freshwater", "soares-filaments"]
-[[configs]]
-name = "formation"
-TOML
+printf 'name = "visual-team"\nseed = 5\nseeds = 2\nscenarios = [%s]\n[[configs]]\nname = "team"\n' \
+    "$(echo $teams | sed 's/" "/", "/g')" >"$out/team-campaign.toml"
 "$bin" campaign "$out/team-campaign.toml" --out "$out/team-campaign" --jobs 2 >/dev/null
 for c in campaign team-campaign; do
     for f in success errors trajectories; do

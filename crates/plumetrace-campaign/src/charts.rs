@@ -10,6 +10,7 @@ use plotters::coord::types::RangedCoordf64;
 use plotters::prelude::*;
 use plotters::style::text_anchor;
 use plumetrace_core::Vec2;
+use plumetrace_report::marks::{self, Group};
 use plumetrace_report::{dashed, map_chart};
 use std::path::Path;
 
@@ -104,6 +105,8 @@ pub fn success_chart(c: &Campaign, groups: &[GroupSummary]) -> Result<String, Ca
         for (i, g) in groups.iter().enumerate() {
             let y = (n - 1 - i) as f64;
             let col = PALETTE[i % PALETTE.len()];
+            // The row is a series its label names.
+            marks::open(chart.plotting_area(), (0.0, y), Group::Series, &labels[i]).map_err(&e)?;
             chart
                 .draw_series([
                     PathElement::new(
@@ -124,6 +127,9 @@ pub fn success_chart(c: &Campaign, groups: &[GroupSummary]) -> Result<String, Ca
                 chart
                     .draw_series([Circle::new((g.success_rate, y), 6, col.filled())])
                     .map_err(&e)?;
+            }
+            marks::close(chart.plotting_area(), (0.0, y)).map_err(&e)?;
+            if g.success_rate.is_finite() {
                 let (px, py) = chart.backend_coord(&(g.success_ci_high, y));
                 root.draw(&Text::new(
                     format!(
@@ -139,7 +145,7 @@ pub fn success_chart(c: &Campaign, groups: &[GroupSummary]) -> Result<String, Ca
         row_labels(&root, &chart, &labels).map_err(&e)?;
         root.present().map_err(&e)?;
     }
-    Ok(svg)
+    Ok(marks::finish(&svg))
 }
 
 fn success_desc(c: &Campaign, groups: &[GroupSummary]) -> String {
@@ -172,7 +178,13 @@ fn row_labels<DB: DrawingBackend>(
                 text_anchor::HPos::Right,
                 text_anchor::VPos::Center,
             ));
-        root.draw(&Text::new(l.clone(), (px - 8, py), style))?;
+        // The row's label is its key: a legend entry with no swatch.
+        root.draw(
+            &(EmptyElement::at((px - 8, py))
+                + marks::open_text(Group::Legend, l)
+                + Text::new(l.clone(), (0, 0), style)
+                + marks::close_text()),
+        )?;
     }
     Ok(())
 }
@@ -238,6 +250,9 @@ fn success_vs_sweep(
             } else {
                 config.clone()
             };
+            let at = (lo, 0.0);
+            marks::open(chart.plotting_area(), at, Group::Series, &name).map_err(&e)?;
+            let key = name.clone();
             chart
                 .draw_series(LineSeries::new(
                     pts.iter().map(|(x, g)| (*x, g.success_rate)),
@@ -245,8 +260,13 @@ fn success_vs_sweep(
                 ))
                 .map_err(&e)?
                 .label(name)
-                .legend(move |(x, y)| {
-                    PathElement::new(vec![(x, y), (x + 16, y)], col.stroke_width(2))
+                .legend(move |p| {
+                    // The swatch is the series: its line and its dots.
+                    EmptyElement::at(p)
+                        + marks::open_text(Group::Legend, &key)
+                        + PathElement::new(vec![(0, 0), (16, 0)], col.stroke_width(2))
+                        + Circle::new((8, 0), 5, col.filled())
+                        + marks::close_text()
                 });
             chart
                 .draw_series(pts.iter().map(|(x, g)| {
@@ -266,6 +286,7 @@ fn success_vs_sweep(
                         .map(|(x, g)| Circle::new((*x, g.success_rate), 5, col.filled())),
                 )
                 .map_err(&e)?;
+            marks::close(chart.plotting_area(), at).map_err(&e)?;
         }
         chart
             .configure_series_labels()
@@ -277,7 +298,7 @@ fn success_vs_sweep(
             .map_err(&e)?;
         root.present().map_err(&e)?;
     }
-    Ok(svg)
+    Ok(marks::finish(&svg))
 }
 
 /// `errors.svg`: per group, the total, along-flow and crossflow errors of the declaring runs as
@@ -400,7 +421,10 @@ pub fn error_chart(
             }
             for (i, vals) in per_group.iter().enumerate() {
                 let y = (n - 1 - i) as f64;
+                marks::open(chart.plotting_area(), (0.0, y), Group::Series, &labels[i])
+                    .map_err(&e)?;
                 draw_box(&mut chart, y, PALETTE[i % PALETTE.len()], vals, limit).map_err(&e)?;
+                marks::close(chart.plotting_area(), (0.0, y)).map_err(&e)?;
             }
             if m == 0 {
                 row_labels(&root, &chart, &labels).map_err(&e)?;
@@ -408,7 +432,7 @@ pub fn error_chart(
         }
         root.present().map_err(&e)?;
     }
-    Ok(svg)
+    Ok(marks::finish(&svg))
 }
 
 /// The x range of an error panel: the bulk of the values (at most 2.5 times the 95th percentile
@@ -541,12 +565,12 @@ pub fn trajectory_chart(c: &Campaign, examples: &[ExampleRun]) -> Result<String,
         .fold(0.0, f64::max);
     let panel_h = (plot_w * tallest + 110.0).clamp(260.0, 900.0) as u32;
     let plot_h = f64::from(panel_h) - 110.0;
-    let (width, height) = (panel_w * cols as u32, panel_h * rows as u32 + 40);
+    let (width, height) = (panel_w * cols as u32, panel_h * rows as u32 + TITLE_PX);
     let mut svg = String::new();
     {
         let root = SVGBackend::with_string(&mut svg, (width, height)).into_drawing_area();
         root.fill(&WHITE).map_err(&e)?;
-        let (title, body) = root.split_vertically(40);
+        let (title, body) = root.split_vertically(TITLE_PX);
         let more = if examples.len() > shown.len() {
             format!(" (first {} of {} groups)", shown.len(), examples.len())
         } else {
@@ -555,14 +579,14 @@ pub fn trajectory_chart(c: &Campaign, examples: &[ExampleRun]) -> Result<String,
         title
             .draw(&Text::new(
                 format!(
-                    "{}: one example run per group (seed index 0){more}; track as logged \
-                     (a team's other members green, true), ○ lost points, ● declared, ▲ true source",
+                    "{}: one example run per group (seed index 0){more}",
                     c.file.name
                 ),
                 (12, 12),
                 ("sans-serif", 15).into_font().color(&BLACK),
             ))
             .map_err(&e)?;
+        trajectory_key(&title, shown).map_err(&e)?;
         let panels = body.split_evenly((rows, cols));
         for (k, (ex, area)) in shown.iter().zip(panels.iter()).enumerate() {
             let mut name = ex.config.clone();
@@ -605,53 +629,156 @@ pub fn trajectory_chart(c: &Campaign, examples: &[ExampleRun]) -> Result<String,
             let poly = |pts: &[[f64; 2]]| -> Vec<Vec2> {
                 pts.iter().map(|p| Vec2::new(p[0], p[1])).collect()
             };
-            chart
-                .draw_series(dashed(&poly(&ex.op_area), BLACK, 1))
-                .map_err(&e)?;
+            let at = (chart.x_range().start, chart.y_range().start);
+            let mut series = |name: &str,
+                              draw: &dyn Fn(&mut TrajectoryPanel<'_, '_>) -> Result<(), _>|
+             -> Result<(), CampaignError> {
+                marks::open(chart.plotting_area(), at, Group::Series, name).map_err(&e)?;
+                draw(&mut chart).map_err(&e)?;
+                marks::close(chart.plotting_area(), at).map_err(&e)
+            };
+            series(KEY_OP_AREA, &|ch| {
+                ch.draw_series(dashed(&poly(&ex.op_area), BLACK, 1))
+                    .map(|_| ())
+            })?;
             for r in &ex.subregions {
-                chart
-                    .draw_series(dashed(&poly(r), RGBColor(150, 150, 150), 1))
-                    .map_err(&e)?;
+                series(KEY_SUBREGION, &|ch| {
+                    ch.draw_series(dashed(&poly(r), SUBREGION, 1)).map(|_| ())
+                })?;
             }
             for other in &ex.others {
-                chart
-                    .draw_series([PathElement::new(
+                series(KEY_OTHERS, &|ch| {
+                    ch.draw_series([PathElement::new(
                         other.iter().map(|p| (p[0], p[1])).collect::<Vec<_>>(),
-                        RGBColor(60, 150, 80).stroke_width(1),
+                        OTHERS.stroke_width(1),
                     )])
-                    .map_err(&e)?;
+                    .map(|_| ())
+                })?;
             }
-            chart
-                .draw_series([PathElement::new(
+            series(KEY_TRACK, &|ch| {
+                ch.draw_series([PathElement::new(
                     ex.track.iter().map(|p| (p[0], p[1])).collect::<Vec<_>>(),
-                    RGBColor(20, 60, 160).stroke_width(1),
+                    TRACK.stroke_width(1),
                 )])
-                .map_err(&e)?;
-            chart
-                .draw_series(
-                    ex.lost_points.iter().map(|p| {
-                        Circle::new((p[0], p[1]), 4, RGBColor(230, 120, 0).stroke_width(1))
-                    }),
+                .map(|_| ())
+            })?;
+            series(KEY_LOST, &|ch| {
+                ch.draw_series(
+                    ex.lost_points
+                        .iter()
+                        .map(|p| Circle::new((p[0], p[1]), 4, LOST.stroke_width(1))),
                 )
-                .map_err(&e)?;
-            chart
-                .draw_series(
-                    ex.sources.iter().map(|p| {
-                        TriangleMarker::new((p[0], p[1]), 7, RGBColor(0, 140, 60).filled())
-                    }),
+                .map(|_| ())
+            })?;
+            series(KEY_SOURCE, &|ch| {
+                ch.draw_series(
+                    ex.sources
+                        .iter()
+                        .map(|p| TriangleMarker::new((p[0], p[1]), 7, SOURCE.filled())),
                 )
-                .map_err(&e)?;
-            chart
-                .draw_series(
+                .map(|_| ())
+            })?;
+            series(KEY_DECLARED, &|ch| {
+                ch.draw_series(
                     ex.declared
                         .iter()
                         .map(|p| Circle::new((p[0], p[1]), 5, BLACK.filled())),
                 )
-                .map_err(&e)?;
+                .map(|_| ())
+            })?;
         }
         root.present().map_err(&e)?;
     }
-    Ok(svg)
+    Ok(marks::finish(&svg))
+}
+
+/// The trajectory chart's title band, px: the title and a row of keys.
+const TITLE_PX: u32 = 64;
+/// The trajectory chart's colours: the track as logged, a team's other members (true), lost
+/// points, true sources, subregions.
+const TRACK: RGBColor = RGBColor(20, 60, 160);
+const OTHERS: RGBColor = RGBColor(60, 150, 80);
+const LOST: RGBColor = RGBColor(230, 120, 0);
+const SOURCE: RGBColor = RGBColor(0, 140, 60);
+const SUBREGION: RGBColor = RGBColor(150, 150, 150);
+/// The trajectory chart's key entries.
+const KEY_TRACK: &str = "track as logged";
+const KEY_OTHERS: &str = "a team's other members (true track)";
+const KEY_OP_AREA: &str = "op-area";
+const KEY_SUBREGION: &str = "subregion";
+const KEY_LOST: &str = "lost point";
+const KEY_DECLARED: &str = "declared source";
+const KEY_SOURCE: &str = "true source";
+
+/// A panel of the trajectory chart.
+type TrajectoryPanel<'a, 'b> =
+    ChartContext<'a, SVGBackend<'b>, Cartesian2d<RangedCoordf64, RangedCoordf64>>;
+
+/// The trajectory chart's key, in a row under its title: a swatch (the mark as the panels draw
+/// it) and a label for each kind of mark drawn in any of `shown`.
+fn trajectory_key<DB: DrawingBackend>(
+    area: &DrawingArea<DB, plotters::coord::Shift>,
+    shown: &[ExampleRun],
+) -> Result<(), DrawingAreaErrorKind<DB::ErrorType>> {
+    let any = |f: &dyn Fn(&ExampleRun) -> bool| shown.iter().any(f);
+    let line = |c: RGBColor| PathElement::new(vec![(0, 0), (16, 0)], c.stroke_width(1));
+    let dash = |c: RGBColor| {
+        EmptyElement::at((0, 0))
+            + PathElement::new(vec![(0, 0), (6, 0)], c.stroke_width(1))
+            + PathElement::new(vec![(10, 0), (16, 0)], c.stroke_width(1))
+    };
+    let style = ("sans-serif", 14)
+        .into_font()
+        .color(&BLACK)
+        .pos(text_anchor::Pos::new(
+            text_anchor::HPos::Left,
+            text_anchor::VPos::Center,
+        ));
+    let mut x = 14;
+    let y = 46;
+    let mut entry =
+        |name: &str,
+         swatch: &dyn Fn((i32, i32)) -> Result<(), DrawingAreaErrorKind<DB::ErrorType>>|
+         -> Result<(), DrawingAreaErrorKind<DB::ErrorType>> {
+            marks::open(area, (x, y), Group::Legend, name)?;
+            swatch((x, y))?;
+            area.draw(&Text::new(name.to_string(), (x + 24, y), style.clone()))?;
+            marks::close(area, (x, y))?;
+            x += 24 + (name.chars().count() as f64 * 14.0 * 0.5).round() as i32 + 22;
+            Ok(())
+        };
+    entry(KEY_TRACK, &|p| {
+        area.draw(&(EmptyElement::at(p) + line(TRACK)))
+    })?;
+    if any(&|e| !e.others.is_empty()) {
+        entry(KEY_OTHERS, &|p| {
+            area.draw(&(EmptyElement::at(p) + line(OTHERS)))
+        })?;
+    }
+    entry(KEY_OP_AREA, &|p| {
+        area.draw(&(EmptyElement::at(p) + dash(BLACK)))
+    })?;
+    if any(&|e| !e.subregions.is_empty()) {
+        entry(KEY_SUBREGION, &|p| {
+            area.draw(&(EmptyElement::at(p) + dash(SUBREGION)))
+        })?;
+    }
+    if any(&|e| !e.lost_points.is_empty()) {
+        entry(KEY_LOST, &|p| {
+            area.draw(&(EmptyElement::at(p) + Circle::new((8, 0), 4, LOST.stroke_width(1))))
+        })?;
+    }
+    if any(&|e| !e.declared.is_empty()) {
+        entry(KEY_DECLARED, &|p| {
+            area.draw(&(EmptyElement::at(p) + Circle::new((8, 0), 5, BLACK.filled())))
+        })?;
+    }
+    if any(&|e| !e.sources.is_empty()) {
+        entry(KEY_SOURCE, &|p| {
+            area.draw(&(EmptyElement::at(p) + TriangleMarker::new((8, 0), 5, SOURCE.filled())))
+        })?;
+    }
+    Ok(())
 }
 
 /// Whether an example run located its source: it declared, within `radius` (m) when it is
@@ -781,6 +908,53 @@ mod tests {
         assert!(east[1] >= 1000.0, "{rows:?}");
         assert_eq!(svg.matches("FAILED").count(), 1, "the timed-out run only");
         assert!(plumetrace_report::inspect::bad_tick_rows(&svg).is_empty());
+    }
+
+    #[test]
+    fn every_series_of_the_charts_has_a_legend_entry_whose_swatch_is_its_mark() {
+        use plumetrace_mission::Outcome;
+        use plumetrace_report::inspect::{legend_faults, marked_groups, series_without_legend};
+        let (c, rows) = multi_source_fixture();
+        let groups = summarise(&c, &rows);
+        let mut team = example(100.0, Outcome::Declared, Some(2.0));
+        team.lost_points = vec![[20.0, 30.0], [40.0, 50.0]];
+        team.declared = vec![[12.0, 50.0]];
+        team.others = vec![vec![[5.0, 5.0], [50.0, 60.0]]];
+        team.subregions = vec![vec![[10.0, 10.0], [30.0, 10.0], [30.0, 30.0]]];
+        let charts = [
+            ("success", success_chart(&c, &groups).unwrap()),
+            ("errors", error_chart(&c, &groups, &rows).unwrap()),
+            ("trajectories", trajectory_chart(&c, &[team]).unwrap()),
+        ];
+        for (name, svg) in &charts {
+            let series = marked_groups(svg)
+                .into_iter()
+                .filter(|g| g.kind == "series" && !g.marks.is_empty())
+                .count();
+            // (The fixture's runs declare nothing: its error panel has no marks.)
+            assert!(series > 0 || *name == "errors", "{name}: no series marked");
+            assert_eq!(legend_faults(svg), Vec::<String>::new(), "{name}");
+        }
+        // Every kind of mark of the trajectory panels is keyed (once only in the title's words).
+        let traj = &charts[2].1;
+        for key in [
+            KEY_TRACK,
+            KEY_OTHERS,
+            KEY_OP_AREA,
+            KEY_SUBREGION,
+            KEY_LOST,
+            KEY_DECLARED,
+            KEY_SOURCE,
+        ] {
+            assert!(
+                marked_groups(traj)
+                    .iter()
+                    .any(|g| g.kind == "series" && g.name == key && !g.marks.is_empty()),
+                "{key} drawn"
+            );
+        }
+        let unkeyed = traj.replace("data-legend=\"lost point\"", "data-legend=\"\"");
+        assert_eq!(series_without_legend(&unkeyed), ["lost point"]);
     }
 
     #[test]

@@ -13,8 +13,10 @@
 //!   replayed log;
 //! - [`run_dir`]: a flown mission's output directory (what `plumetrace run` and Python's
 //!   `RunResult.save` write);
-//! - [`inspect`]: measurable properties of a drawn figure (label boxes, overlaps, axes), read
-//!   back from its SVG;
+//! - [`inspect`]: measurable properties of a drawn figure (label boxes, overlaps, axes, a
+//!   legend entry per series), read back from its SVG;
+//! - [`marks`]: the groups a figure wraps its series and legend entries in, so that
+//!   [`inspect`] can match each drawn series with its legend entry;
 //! - [`chart`]: the map panel and dashed outlines every figure and chart shares;
 //! - [`error`]: what can go wrong ([`ReportError`]).
 
@@ -23,6 +25,7 @@ pub mod error;
 pub mod figure;
 pub mod geo_outputs;
 pub mod inspect;
+pub mod marks;
 pub mod plume_figure;
 pub mod replay_page;
 pub mod run_dir;

@@ -3,6 +3,7 @@
 
 use crate::chart::map_chart;
 use crate::error::ReportError;
+use crate::marks::{self, Group};
 use plotters::prelude::*;
 use plumetrace_env::{FlowField, GridSpec, Plume};
 use plumetrace_scenario::BuiltScenario;
@@ -88,8 +89,11 @@ pub fn plume_figure(
         panel(&bottom, sc, &g, mean, &bottom_title)?;
         root.present().map_err(plume_err)?;
     }
-    Ok(svg)
+    Ok(marks::finish(&svg))
 }
+
+/// The colour key's entries: a fraction of the panel's maximum and its name.
+const KEY: [(f64, &str); 4] = [(0.01, "1 %"), (0.1, "10 %"), (0.5, "50 %"), (1.0, "100 %")];
 
 fn panel<DB: DrawingBackend>(
     area: &DrawingArea<DB, plotters::coord::Shift>,
@@ -110,22 +114,36 @@ where
     let stride_y = g.ny.div_ceil(250).max(1);
     let dx = (g.x_max_m - g.x_min_m) / (g.nx - 1) as f64 * stride_x as f64;
     let dy = (g.y_max_m - g.y_min_m) / (g.ny - 1) as f64 * stride_y as f64;
-    let mut cells = Vec::new();
+    // The cells by the colour key's entry they are nearest (at or above it).
+    let mut cells: [Vec<Rectangle<(f64, f64)>>; 4] = Default::default();
     for j in (0..g.ny).step_by(stride_y) {
         for i in (0..g.nx).step_by(stride_x) {
             let v = values[j * g.nx + i];
             if let Some(l) = level(v, max) {
                 let x = g.x_min_m + i as f64 * (g.x_max_m - g.x_min_m) / (g.nx - 1) as f64;
                 let y = g.y_min_m + j as f64 * (g.y_max_m - g.y_min_m) / (g.ny - 1) as f64;
-                cells.push(Rectangle::new(
+                let band = KEY.iter().rposition(|k| v >= k.0 * max).unwrap_or(0);
+                cells[band].push(Rectangle::new(
                     [(x - dx / 2.0, y - dy / 2.0), (x + dx / 2.0, y + dy / 2.0)],
                     heat(l).filled(),
                 ));
             }
         }
     }
-    chart.draw_series(cells).map_err(err)?;
-    for o in sc.env.obstacles().iter() {
+    let at = (d.x_min_m, d.y_min_m);
+    let key_label = move |name: &str| format!("{name} of max {max:.3} {CONCENTRATION_UNIT}");
+    for (band, (_, name)) in cells.into_iter().zip(KEY) {
+        if !band.is_empty() {
+            marks::open(chart.plotting_area(), at, Group::Ramp, &key_label(name)).map_err(err)?;
+            chart.draw_series(band).map_err(err)?;
+            marks::close(chart.plotting_area(), at).map_err(err)?;
+        }
+    }
+    let obstacles = sc.env.obstacles();
+    if !obstacles.is_empty() {
+        marks::open(chart.plotting_area(), at, Group::Series, "obstacle").map_err(err)?;
+    }
+    for o in obstacles.iter() {
         let pts: Vec<(f64, f64)> = o
             .polygon
             .exterior()
@@ -139,7 +157,22 @@ where
             )))
             .map_err(err)?;
     }
+    if !obstacles.is_empty() {
+        marks::close(chart.plotting_area(), at).map_err(err)?;
+        // A key entry drawn by an empty series.
+        chart
+            .draw_series(std::iter::empty::<PathElement<(f64, f64)>>())
+            .map_err(err)?
+            .label("obstacle")
+            .legend(|p| {
+                EmptyElement::at(p)
+                    + marks::open_text(Group::Legend, "obstacle")
+                    + PathElement::new(vec![(0, 0), (16, 0)], GREEN.stroke_width(2))
+                    + marks::close_text()
+            });
+    }
     if let Some(f) = sc.env.plume().filaments() {
+        marks::open(chart.plotting_area(), at, Group::Series, "source").map_err(err)?;
         chart
             .draw_series(
                 f.sources()
@@ -148,7 +181,13 @@ where
             )
             .map_err(err)?
             .label("source")
-            .legend(|(x, y)| TriangleMarker::new((x + 8, y), 5, BLACK.filled()));
+            .legend(|p| {
+                EmptyElement::at(p)
+                    + marks::open_text(Group::Legend, "source")
+                    + TriangleMarker::new((8, 0), 5, BLACK.filled())
+                    + marks::close_text()
+            });
+        marks::close(chart.plotting_area(), at).map_err(err)?;
     }
     // Mean flow arrow in the upper-left corner, 10 % of the width long.
     let v = sc.env.flow().velocity(plumetrace_core::Vec2::new(
@@ -169,29 +208,29 @@ where
             let b = -u * 0.25;
             (end.0 + b.x * c - b.y * s, end.1 + b.x * s + b.y * c)
         };
+        let name = format!("mean flow {:.2} m/s", v.norm());
+        marks::open(chart.plotting_area(), at, Group::Series, &name).map_err(err)?;
         chart
             .draw_series(std::iter::once(PathElement::new(
                 vec![start, end, head(0.45), end, head(-0.45)],
                 BLUE.stroke_width(2),
             )))
             .map_err(err)?
-            .label(format!("mean flow {:.2} m/s", v.norm()))
-            .legend(|(x, y)| {
-                PathElement::new(
-                    vec![
-                        (x, y),
-                        (x + 16, y),
-                        (x + 11, y - 4),
-                        (x + 16, y),
-                        (x + 11, y + 4),
-                    ],
-                    BLUE.stroke_width(2),
-                )
+            .label(name.clone())
+            .legend(move |p| {
+                EmptyElement::at(p)
+                    + marks::open_text(Group::Legend, &name)
+                    + PathElement::new(
+                        vec![(0, 0), (16, 0), (11, -4), (16, 0), (11, 4)],
+                        BLUE.stroke_width(2),
+                    )
+                    + marks::close_text()
             });
+        marks::close(chart.plotting_area(), at).map_err(err)?;
     }
     // Colour key: swatches at 1 %, 10 %, 50 % and 100 % of the maximum.
     if max > 0.0 {
-        for (frac, name) in [(0.01, "1 %"), (0.1, "10 %"), (0.5, "50 %"), (1.0, "100 %")] {
+        for (frac, name) in KEY {
             let c = heat(level(frac * max, max).unwrap_or(0.0));
             chart
                 .draw_series(std::iter::once(Rectangle::new(
@@ -199,8 +238,13 @@ where
                     c.filled(),
                 )))
                 .map_err(err)?
-                .label(format!("{name} of max {max:.3} {CONCENTRATION_UNIT}"))
-                .legend(move |(x, y)| Rectangle::new([(x, y - 5), (x + 14, y + 5)], c.filled()));
+                .label(key_label(name))
+                .legend(move |p| {
+                    EmptyElement::at(p)
+                        + marks::open_text(Group::Legend, &key_label(name))
+                        + Rectangle::new([(0, -5), (14, 5)], c.filled())
+                        + marks::close_text()
+                });
         }
     }
     chart
@@ -249,5 +293,31 @@ mod tests {
         assert!(arrow >= 2, "{arrow} arrows");
         assert!(!svg.contains("<circle"), "no dot at the flow's end");
         assert!(crate::inspect::bad_tick_rows(&svg).is_empty());
+    }
+
+    #[test]
+    fn every_series_of_the_plume_figure_has_a_legend_entry_the_kelp_too() {
+        let cfg = load_preset("li-zhang-kelp").unwrap();
+        let sc = build(&cfg, &Origin::Preset("li-zhang-kelp".into()), Some(1)).unwrap();
+        let g = sc.output.grid;
+        let field: Vec<f64> = (0..g.nx * g.ny).map(|k| (k % 97) as f64).collect();
+        let svg = plume_figure(&sc, &field, &field, 3).unwrap();
+        let series: Vec<String> = crate::inspect::marked_groups(&svg)
+            .into_iter()
+            .filter(|g| g.kind == "series")
+            .map(|g| g.name)
+            .collect();
+        assert!(series.iter().any(|s| s == "obstacle"), "{series:?}");
+        assert!(
+            series.iter().any(|s| s.starts_with("50 % of max")),
+            "{series:?}"
+        );
+        assert_eq!(crate::inspect::legend_faults(&svg), Vec::<String>::new());
+        // Without its key entry the kelp is found.
+        let unkeyed = svg.replace("data-legend=\"obstacle\"", "data-legend=\"kelp\"");
+        assert_eq!(
+            crate::inspect::series_without_legend(&unkeyed),
+            ["obstacle"]
+        );
     }
 }

@@ -5,6 +5,7 @@
 //! plume's centre line.
 
 use crate::error::ReportError;
+use crate::marks::{self, Group};
 use plotters::prelude::*;
 use plumetrace_core::Telemetry;
 use plumetrace_mission::{EventKind, MissionRun};
@@ -55,17 +56,26 @@ where
         .label_style(("sans-serif", 12))
         .draw()
         .map_err(err)?;
-    for (k, (v, pts)) in series.iter().enumerate() {
-        let colour = Palette99::pick(k).to_rgba();
+    for (v, pts) in series {
+        // One colour per vehicle in every panel (a panel may leave a vehicle out).
+        let colour = Palette99::pick(*v as usize).to_rgba();
         let name = names
             .get(*v as usize)
             .cloned()
             .unwrap_or_else(|| format!("vehicle {v}"));
+        let at = (0.0, lo);
+        marks::open(chart.plotting_area(), at, Group::Series, &name).map_err(err)?;
         chart
             .draw_series(LineSeries::new(pts.iter().copied(), colour.stroke_width(1)))
             .map_err(err)?
-            .label(name)
-            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], colour));
+            .label(name.clone())
+            .legend(move |p| {
+                EmptyElement::at(p)
+                    + marks::open_text(Group::Legend, &name)
+                    + PathElement::new(vec![(0, 0), (16, 0)], colour.stroke_width(1))
+                    + marks::close_text()
+            });
+        marks::close(chart.plotting_area(), at).map_err(err)?;
     }
     chart
         .configure_series_labels()
@@ -157,5 +167,54 @@ pub fn team_figure(run: &MissionRun, title: &str) -> Option<Result<String, Repor
         )?;
         root.present().map_err(err)
     })();
-    Some(out.map(|()| svg))
+    Some(out.map(|()| marks::finish(&svg)))
+}
+
+#[cfg(test)]
+mod tests {
+    #![allow(clippy::unwrap_used, clippy::expect_used)]
+
+    use super::*;
+    use crate::inspect::{legend_faults, marked_groups, series_without_legend};
+    use plumetrace_mission::run_mission;
+    use plumetrace_scenario::{Origin, build, load_preset};
+
+    #[test]
+    fn every_vehicles_line_in_the_team_figure_has_a_legend_entry() {
+        let mut cfg = load_preset("soares-freshwater").unwrap();
+        if let Some(m) = cfg.mission.as_mut() {
+            m.spinup_s = m.spinup_s.min(600.0);
+            m.time_limit_s = 200.0;
+        }
+        let sc = build(&cfg, &Origin::Preset("soares-freshwater".into()), Some(3)).unwrap();
+        let run = run_mission(sc, &mut |_, _| {}).unwrap();
+        let svg = team_figure(&run, "team").unwrap().unwrap();
+        assert_eq!(legend_faults(&svg), Vec::<String>::new());
+        let series: Vec<String> = marked_groups(&svg)
+            .into_iter()
+            .filter(|g| g.kind == "series" && !g.marks.is_empty())
+            .map(|g| g.name)
+            .collect();
+        for v in run
+            .vehicles
+            .iter()
+            .map(|v| &v.name)
+            .chain([&"centroid".to_string()])
+        {
+            assert!(series.contains(v), "{v}: {series:?}");
+        }
+        // Each vehicle is drawn in one colour in every panel.
+        for v in &run.vehicles {
+            let colours: std::collections::BTreeSet<String> = marked_groups(&svg)
+                .into_iter()
+                .filter(|g| g.kind == "series" && g.name == v.name)
+                .flat_map(|g| g.marks.into_iter().map(|m| m.colour))
+                .collect();
+            assert_eq!(colours.len(), 1, "{}: {colours:?}", v.name);
+        }
+        // A leader's line with its key entry gone is found.
+        let leader = &run.vehicles[1].name;
+        let unkeyed = svg.replace(&format!("data-legend=\"{leader}\""), "data-legend=\"\"");
+        assert_eq!(series_without_legend(&unkeyed), [leader.as_str()]);
+    }
 }

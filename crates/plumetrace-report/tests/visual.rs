@@ -1,11 +1,15 @@
 //! The visual check of rendered outputs: every SVG figure under `PLUMETRACE_VISUAL_DIR` (written
-//! by `scripts/visual_check.sh`) has no two labels overlapping and distinct, increasing tick
-//! labels on every axis, and every replay page's state (read from the browser into
-//! `*.state.txt`) names its timeline rows. Ignored: the script runs it with `--ignored`.
+//! by `scripts/visual_check.sh`) has no two labels overlapping, no label over a marker or a
+//! track, distinct, increasing tick labels on every axis, and a legend entry for each drawn
+//! series whose swatch is the series' mark; every replay page's state (read from the browser
+//! into `*.state.txt`) names its timeline rows. Ignored: the script runs it with `--ignored`.
 
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
-use plumetrace_report::inspect::{bad_tick_rows, overlapping_texts, texts_over_marks};
+use plumetrace_report::inspect::{
+    bad_tick_rows, legend_faults, marked_groups, overlapping_texts, texts_over_marks,
+    texts_over_tracks,
+};
 use std::path::{Path, PathBuf};
 
 fn files(dir: &Path, out: &mut Vec<PathBuf>) {
@@ -40,8 +44,18 @@ fn rendered_figures_have_no_overlapping_labels_and_sound_axes() {
             for t in texts_over_marks(&svg) {
                 faults.push(format!("{name}: a label over a mark: {t:?}"));
             }
+            for t in texts_over_tracks(&svg) {
+                faults.push(format!("{name}: a label over a track: {t:?}"));
+            }
             for r in bad_tick_rows(&svg) {
                 faults.push(format!("{name}: tick labels not increasing: {r:?}"));
+            }
+            // Each drawn series has a legend entry, and its swatch is the series' mark.
+            if !marked_groups(&svg).iter().any(|g| g.kind == "series") {
+                faults.push(format!("{name}: no series marked"));
+            }
+            for f in legend_faults(&svg) {
+                faults.push(format!("{name}: {f}"));
             }
         } else if name.ends_with(".state.txt") {
             let state = std::fs::read_to_string(p).unwrap();

@@ -136,7 +136,9 @@ pub(super) struct MapLayout {
     pub(super) m_per_px: f64,
     /// Multi-vehicle: tracks in the vehicles' colours.
     pub(super) multi: bool,
+    /// The mean plume's cells, and the source map's.
     pub(super) plume: Vec<([(f64, f64); 2], RGBColor)>,
+    pub(super) source_map: Vec<([(f64, f64); 2], RGBColor)>,
     pub(super) obstacles: Vec<Vec<(f64, f64)>>,
     pub(super) layers: Vec<VehicleLayer>,
     pub(super) time_step_min: f64,
@@ -379,9 +381,22 @@ pub(super) fn map_layout(
     mark_points.extend(&over.lost);
     mark_points.extend(&over.targets);
     mark_points.extend(over.marks.iter().map(|k| k.pos));
-    place_time_labels(&mut layers, &mark_points, m);
-    let mut plume = plume_cells(run, &x, &y);
-    plume.extend(posterior_cells(run, &x, &y));
+    // The legend in its corner (as plotters places it: 5 px in from the plotting area's edges).
+    let taken: Vec<MapBox> = legend_corner
+        .map(|c| {
+            let (lw, lh) = legend_px(&legend);
+            let (cx, cy) = c.box_in(&x, &y, (lw + 5.0) * m, (lh + 5.0) * m);
+            (
+                ((cx.start + cx.end) / 2.0, (cy.start + cy.end) / 2.0),
+                (cx.end - cx.start) / 2.0,
+                (cy.end - cy.start) / 2.0,
+            )
+        })
+        .into_iter()
+        .collect();
+    place_time_labels(&mut layers, &mark_points, &taken, (&x, &y), m);
+    let plume = plume_cells(run, &x, &y);
+    let source_map = posterior_cells(run, &x, &y);
     let obstacles = run
         .obstacles
         .iter()
@@ -390,7 +405,7 @@ pub(super) fn map_layout(
         .collect();
 
     // What the legend and the key could hide.
-    let points = drawn_points(run, &layers, &over);
+    let points = drawn_points(run, &layers, &over, m);
     let Overlays {
         virtual_paths,
         targets,
@@ -451,6 +466,7 @@ pub(super) fn map_layout(
         m_per_px: m,
         multi,
         plume,
+        source_map,
         obstacles,
         layers,
         time_step_min: step_min,
@@ -558,22 +574,51 @@ fn vehicle_layers(
     layers
 }
 
+/// Whether the segments `a`-`b` and `p`-`q` cross.
+fn segments_cross(a: (f64, f64), b: (f64, f64), p: (f64, f64), q: (f64, f64)) -> bool {
+    let side = |o: (f64, f64), u: (f64, f64), v: (f64, f64)| {
+        (u.0 - o.0) * (v.1 - o.1) - (u.1 - o.1) * (v.0 - o.0)
+    };
+    let (d1, d2) = (side(p, q, a), side(p, q, b));
+    let (d3, d4) = (side(a, b, p), side(a, b, q));
+    d1 * d2 < 0.0 && d3 * d4 < 0.0
+}
+
+/// Whether the segment `a`-`b` meets the box `r` (left, bottom, right, top).
+fn segment_meets_box(a: (f64, f64), b: (f64, f64), r: (f64, f64, f64, f64)) -> bool {
+    let inside = |p: (f64, f64)| r.0 <= p.0 && p.0 <= r.2 && r.1 <= p.1 && p.1 <= r.3;
+    let corners = [(r.0, r.1), (r.2, r.1), (r.2, r.3), (r.0, r.3)];
+    inside(a) || inside(b) || (0..4).any(|k| segments_cross(a, b, corners[k], corners[(k + 1) % 4]))
+}
+
+/// A box on the map: centre and half sizes, m.
+type MapBox = ((f64, f64), f64, f64);
+
+/// How far from its tick a time label may be placed, px: it is moved out in steps of 10 px up
+/// to this, in twelve directions.
+const LEADER_MAX_PX: f64 = 65.0;
+
 /// Places each time label on the side of its tick where it hides no marker (true and declared
 /// sources, lost points, reference targets, aborts and incidents: `marks`, each about 9 px
-/// across) and overlaps no earlier label, preferring a side that no track crosses; with no side
-/// free of markers and labels, leaves the label out (its tick stays).
-fn place_time_labels(layers: &mut [VehicleLayer], marks: &[(f64, f64)], m: f64) {
+/// across), overlaps no earlier label and no box in `taken` (the legend) and stays on the map
+/// `(x, y)`, on a side that no track crosses. With both sides crossed, the label goes further
+/// out (up to [`LEADER_MAX_PX`]) where no track crosses it, with a leader line to its tick that
+/// crosses no other leader or label; with no such place, it is left out (its tick stays).
+fn place_time_labels(
+    layers: &mut [VehicleLayer],
+    marks: &[(f64, f64)],
+    taken: &[MapBox],
+    (x, y): (&Range<f64>, &Range<f64>),
+    m: f64,
+) {
     let mark_half = 9.0 * m;
-    // Boxes taken: centre and half sizes.
-    let mut boxes: Vec<(f64, f64, f64, f64)> = marks
-        .iter()
-        .map(|&(x, y)| (x, y, mark_half, mark_half))
-        .collect();
+    let mut boxes: Vec<MapBox> = marks.iter().map(|&p| (p, mark_half, mark_half)).collect();
+    boxes.extend(taken);
     let tracks = track_points(layers, 2.0 * m);
+    let (mut labels, mut leaders): (Vec<MapBox>, Vec<Segment>) = (Vec::new(), Vec::new());
     for l in layers {
         for t in &mut l.times {
-            let half_w = (text_px(&t.label, TIME_FONT_PX) / 2.0 + 2.0) * m;
-            let half_h = 7.0 * m;
+            let half = ((text_px(&t.label, TIME_FONT_PX) / 2.0 + 2.0) * m, 7.0 * m);
             let mid = (
                 (t.tick[0].0 + t.tick[1].0) / 2.0,
                 (t.tick[0].1 + t.tick[1].1) / 2.0,
@@ -582,24 +627,80 @@ fn place_time_labels(layers: &mut [VehicleLayer], marks: &[(f64, f64)], m: f64) 
                 t.label_at,
                 (2.0 * mid.0 - t.label_at.0, 2.0 * mid.1 - t.label_at.1),
             ];
-            let inside = |(cx, cy): (f64, f64), (x, y): (f64, f64), w: f64, h: f64| {
-                (cx - x).abs() < half_w + w && (cy - y).abs() < half_h + h
+            let overlaps = |c: (f64, f64), (p, w, h): MapBox| {
+                (c.0 - p.0).abs() < half.0 + w && (c.1 - p.1).abs() < half.1 + h
             };
-            let clear = |c: (f64, f64)| !boxes.iter().any(|&(x, y, w, h)| inside(c, (x, y), w, h));
-            let off_tracks = |c: (f64, f64)| !tracks.iter().any(|&p| inside(c, p, 0.0, 0.0));
-            let free = sides
-                .into_iter()
-                .find(|&c| clear(c) && off_tracks(c))
-                .or_else(|| sides.into_iter().find(|&c| clear(c)));
-            match free {
-                Some(at) => {
+            let clear = |c: (f64, f64)| !boxes.iter().any(|&b| overlaps(c, b));
+            let off_tracks = |c: (f64, f64)| !tracks.iter().any(|&p| overlaps(c, (p, 0.0, 0.0)));
+            let on_map = |c: (f64, f64)| {
+                c.0 - half.0 >= x.start
+                    && c.0 + half.0 <= x.end
+                    && c.1 - half.1 >= y.start
+                    && c.1 + half.1 <= y.end
+            };
+            let near = sides.into_iter().find(|&c| clear(c) && off_tracks(c));
+            // A leader crosses no other leader and no other label.
+            let free_leader = |c: (f64, f64)| {
+                let [a, b] = leader_line(mid, c, half, m);
+                !leaders.iter().any(|&[p, q]| segments_cross(a, b, p, q))
+                    && !labels.iter().any(|&(p, w, h)| {
+                        segment_meets_box(a, b, (p.0 - w, p.1 - h, p.0 + w, p.1 + h))
+                    })
+            };
+            let far = || {
+                further_out(mid, t.label_at, m)
+                    .find(|&c| on_map(c) && clear(c) && off_tracks(c) && free_leader(c))
+            };
+            match near
+                .map(|c| (c, false))
+                .or_else(|| far().map(|c| (c, true)))
+            {
+                Some((at, leader)) => {
                     t.label_at = at;
-                    boxes.push((at.0, at.1, half_w, half_h));
+                    t.leader = leader.then(|| leader_line(mid, at, half, m));
+                    boxes.push((at, half.0, half.1));
+                    labels.push((at, half.0, half.1));
+                    leaders.extend(t.leader);
                 }
                 None => t.label.clear(),
             }
         }
     }
+}
+
+/// Places further out from a tick at `mid` whose label would sit at `label_at`: in steps of
+/// 10 px from 25 px up to [`LEADER_MAX_PX`] from the tick, along the tick (either side)
+/// first, then the ten other directions 30 degrees apart, nearest the tick's first.
+fn further_out(mid: (f64, f64), label_at: (f64, f64), m: f64) -> impl Iterator<Item = (f64, f64)> {
+    let (dx, dy) = (label_at.0 - mid.0, label_at.1 - mid.1);
+    let len = dx.hypot(dy).max(1e-9);
+    let (ux, uy) = (dx / len, dy / len);
+    // Along the tick, the other side, then the diagonals and along the track.
+    let turns = [
+        0.0, 180.0, 30.0, -30.0, 150.0, -150.0, 60.0, -60.0, 120.0, -120.0, 90.0, -90.0,
+    ];
+    (0..)
+        .map(|k| 25.0 + 10.0 * f64::from(k))
+        .take_while(|d| *d <= LEADER_MAX_PX)
+        .flat_map(move |d| {
+            turns.into_iter().map(move |deg: f64| {
+                let (s, c) = deg.to_radians().sin_cos();
+                let (vx, vy) = (ux * c - uy * s, ux * s + uy * c);
+                (mid.0 + vx * d * m, mid.1 + vy * d * m)
+            })
+        })
+}
+
+/// The leader from a tick at `mid` to its label's box centred at `at` (half sizes `half`, m):
+/// from 6 px off the tick to the box's edge.
+fn leader_line(mid: (f64, f64), at: (f64, f64), half: (f64, f64), m: f64) -> Segment {
+    let (dx, dy) = (at.0 - mid.0, at.1 - mid.1);
+    let len = dx.hypot(dy).max(1e-9);
+    // How far back from the centre the line leaves the box.
+    let back = (half.0 / dx.abs().max(1e-9)).min(half.1 / dy.abs().max(1e-9));
+    let from = (mid.0 + dx / len * 6.0 * m, mid.1 + dy / len * 6.0 * m);
+    let to = (at.0 - dx * back.min(1.0), at.1 - dy * back.min(1.0));
+    [from, to]
 }
 
 /// Points along every drawn track (true and estimated), no more than `step` apart, so a label
@@ -629,13 +730,30 @@ fn track_points(layers: &[VehicleLayer], step: f64) -> Vec<(f64, f64)> {
 }
 
 /// Every point drawn on the map that the legend, the key or a marker's label could hide.
-fn drawn_points(run: &MissionRun, layers: &[VehicleLayer], over: &Overlays) -> Vec<(f64, f64)> {
+fn drawn_points(
+    run: &MissionRun,
+    layers: &[VehicleLayer],
+    over: &Overlays,
+    m: f64,
+) -> Vec<(f64, f64)> {
     let mut points: Vec<(f64, f64)> = Vec::new();
     for l in layers {
         points.extend(&l.truth);
         points.extend(l.runs.iter().flat_map(|(_, p)| p.iter().copied()));
         points.extend(l.outside.iter().flatten());
-        points.extend(l.times.iter().map(|t| t.label_at));
+        // Each time label's box (its centre and corners) and leader.
+        for t in l.times.iter().filter(|t| !t.label.is_empty()) {
+            let (w, h) = ((text_px(&t.label, TIME_FONT_PX) / 2.0 + 2.0) * m, 7.0 * m);
+            let (cx, cy) = t.label_at;
+            points.extend([
+                (cx, cy),
+                (cx - w, cy - h),
+                (cx + w, cy - h),
+                (cx - w, cy + h),
+                (cx + w, cy + h),
+            ]);
+            points.extend(t.leader.iter().flatten());
+        }
     }
     points.extend(&over.lost);
     points.extend(&over.declared);
@@ -917,20 +1035,110 @@ mod tests {
         crossing.times.clear();
         crossing.truth = vec![(at.0, at.1 - 3.0 * m), (at.0, at.1 + 3.0 * m)];
         layers.push(crossing);
-        place_time_labels(&mut layers, &[], m);
+        let map = (&lay.x, &lay.y);
+        place_time_labels(&mut layers, &[], &[], map, m);
         let t = &layers[0].times[0];
         assert_eq!(
             t.label_at, other,
             "the label moves to the side no track crosses"
         );
-        // Crossed on both sides, it keeps its first place rather than vanish.
-        let mut both = layers.clone();
-        both[0].times[0].label_at = at;
-        both.last_mut().unwrap().truth = vec![at, other];
-        place_time_labels(&mut both, &[], m);
-        assert_eq!(both[0].times[0].label_at, at);
-        assert_eq!(both[0].times[0].label, first.label);
+        assert_eq!(t.leader, None, "beside its tick, no leader");
         assert_eq!(t.label, first.label);
+    }
+
+    #[test]
+    fn a_time_label_crossed_on_both_sides_goes_further_out_with_a_leader() {
+        let run = demo(240.0);
+        let rows = super::super::model::rows_by_vehicle(&run);
+        let lay = layout(&run);
+        let m = lay.m_per_px;
+        let first = lay.layers[0].times[0].clone();
+        let at = first.label_at;
+        let mid = (
+            (first.tick[0].0 + first.tick[1].0) / 2.0,
+            (first.tick[0].1 + first.tick[1].1) / 2.0,
+        );
+        let other = (2.0 * mid.0 - at.0, 2.0 * mid.1 - at.1);
+        // Two tracks along the vehicle's, one through each side of the tick (lanes of a
+        // survey, or the track flown back).
+        let (nx, ny) = ((at.0 - mid.0) / (15.0 * m), (at.1 - mid.1) / (15.0 * m));
+        let lane = |c: (f64, f64)| {
+            vec![
+                (c.0 + ny * 60.0 * m, c.1 - nx * 60.0 * m),
+                (c.0 - ny * 60.0 * m, c.1 + nx * 60.0 * m),
+            ]
+        };
+        let mut old = lay.clone();
+        for l in &mut old.layers {
+            l.truth.clear();
+            l.runs.clear();
+            l.faults.clear();
+            l.outside.clear();
+        }
+        old.layers[0].times.truncate(1);
+        for c in [at, other] {
+            let mut crossing = old.layers[0].clone();
+            crossing.times.clear();
+            crossing.truth = lane(c);
+            old.layers.push(crossing);
+        }
+        // Placed as before: on its first side, over a track; the visual check's property
+        // finds it.
+        let svg = super::super::draw_figure(&run, &rows, &old, "crossed").unwrap();
+        assert_eq!(
+            crate::inspect::texts_over_tracks(&svg),
+            [first.label.as_str()]
+        );
+        let mut new = old.clone();
+        place_time_labels(&mut new.layers, &[], &[], (&lay.x, &lay.y), m);
+        let t = &new.layers[0].times[0];
+        assert_eq!(t.label, first.label, "kept, not left out");
+        let tracks = track_points(&new.layers, m);
+        let half = ((text_px(&t.label, TIME_FONT_PX) / 2.0 + 2.0) * m, 7.0 * m);
+        assert!(
+            tracks
+                .iter()
+                .all(|p| (p.0 - t.label_at.0).abs() >= half.0
+                    || (p.1 - t.label_at.1).abs() >= half.1),
+            "{t:?} over a track"
+        );
+        let [from, to] = t.leader.expect("a leader to its tick");
+        assert!(
+            (from.0 - mid.0).hypot(from.1 - mid.1) < 7.0 * m,
+            "{from:?} from the tick"
+        );
+        let d = (t.label_at.0 - mid.0).hypot(t.label_at.1 - mid.1) / m;
+        assert!((24.9..=LEADER_MAX_PX + 0.1).contains(&d), "{d} px out");
+        assert!(segments_cross(
+            (0.0, 0.0),
+            (2.0, 2.0),
+            (0.0, 2.0),
+            (2.0, 0.0)
+        ));
+        assert!(!segments_cross(
+            (0.0, 0.0),
+            (1.0, 0.0),
+            (0.0, 1.0),
+            (1.0, 1.0)
+        ));
+        assert!(segment_meets_box(
+            (-1.0, 0.5),
+            (2.0, 0.5),
+            (0.0, 0.0, 1.0, 1.0)
+        ));
+        assert!(!segment_meets_box(
+            (-1.0, 2.0),
+            (2.0, 2.0),
+            (0.0, 0.0, 1.0, 1.0)
+        ));
+        assert!(
+            (to.0 - t.label_at.0).abs() <= half.0 + 1e-9
+                && (to.1 - t.label_at.1).abs() <= half.1 + 1e-9,
+            "{to:?} at the label's box"
+        );
+        let svg = super::super::draw_figure(&run, &rows, &new, "crossed").unwrap();
+        assert!(crate::inspect::texts_over_tracks(&svg).is_empty());
+        assert!(crate::inspect::overlapping_texts(&svg).is_empty());
     }
 
     #[test]
@@ -942,6 +1150,7 @@ mod tests {
             &run,
             &layout(&run).layers,
             &Overlays::of(&run, &super::super::model::rows_by_vehicle(&run)),
+            1.0,
         );
         assert!(area.iter().all(|p| points.contains(p)));
     }

@@ -11,6 +11,7 @@ use super::style::{
     behaviour_label, icon_element, label_style, text_px,
 };
 use crate::error::ReportError;
+use crate::marks::{self, Group};
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
 use plumetrace_core::BehaviourKind;
@@ -41,6 +42,76 @@ pub(super) fn legend_px(entries: &[LegendEntry]) -> (f64, f64) {
     let w = (em * 0.7 * chars as f64).round() + 30.0 + 20.0;
     let h = LEGEND_FONT_PX * 1.25 * (entries.len() - 1) as f64 + (em * 1.24).round() + 20.0;
     (w, h)
+}
+
+/// The names of the legend's rows that the map's series carry too (see [`crate::marks`]).
+pub(super) mod names {
+    use super::super::style::behaviour_label;
+    use plumetrace_core::BehaviourKind;
+    use plumetrace_mission::{FaultWindow, MissionRun};
+
+    pub(in super::super) const PLUME: &str = "mean plume at vehicle altitude";
+    pub(in super::super) const SOURCE_MAP: &str = "source map, log10 p (6 decades)";
+    pub(in super::super) const OP_AREA: &str = "op-area";
+    pub(in super::super) const SUBREGION: &str = "subregion";
+    pub(in super::super) const OBSTACLE: &str = "obstacle (kelp)";
+    pub(in super::super) const OUTSIDE: &str = "true track outside the op-area";
+    pub(in super::super) const FIX: &str = "navigation fix (the estimate jumps)";
+    pub(in super::super) const DETECTION: &str = "detection";
+    pub(in super::super) const VIRTUAL_PATH: &str = "virtual path";
+    pub(in super::super) const TARGET: &str = "reference target";
+    pub(in super::super) const LOST: &str = "lost point";
+    pub(in super::super) const SOURCE: &str = "true source";
+    pub(in super::super) const DECLARED: &str = "declared source";
+
+    /// The true tracks.
+    pub(in super::super) fn truth(multi: bool) -> &'static str {
+        if multi { "true tracks" } else { "true track" }
+    }
+
+    /// A vehicle among several with no estimate of its own to draw.
+    pub(in super::super) fn truth_only(run: &MissionRun, vehicle: u32) -> Option<String> {
+        run.vehicles
+            .get(vehicle as usize)
+            .map(|v| format!("{}: true track only (no position estimate)", v.name))
+    }
+
+    /// A run of a vehicle's estimated track: by behaviour (one vehicle), by vehicle (several).
+    pub(in super::super) fn track(
+        run: &MissionRun,
+        vehicle: u32,
+        b: Option<BehaviourKind>,
+        multi: bool,
+    ) -> String {
+        match (b, run.vehicles.get(vehicle as usize)) {
+            (Some(b), _) if !multi => format!("track: {}", behaviour_label(b)),
+            (_, Some(v)) if multi => format!(
+                "{} ({}) estimated track",
+                v.name,
+                v.planner.map_or("no planner", |k| k.name())
+            ),
+            _ => "track (navigation estimate)".into(),
+        }
+    }
+
+    /// A fault window (`alone`: the only one drawn, so named with its times).
+    pub(in super::super) fn fault(f: &FaultWindow, alone: bool) -> String {
+        if alone {
+            format!(
+                "fault {:.1}-{:.1} min: {}",
+                f.start_s / 60.0,
+                f.end_s / 60.0,
+                f.what
+            )
+        } else {
+            format!("fault: {}", f.what)
+        }
+    }
+
+    /// The time marks.
+    pub(in super::super) fn times(step_min: f64) -> String {
+        format!("time along the track, every {step_min:.0} min")
+    }
 }
 
 /// Adds a row to the legend unless it is there already.
@@ -82,24 +153,24 @@ fn area_rows(
     if !plume_cells(run, bx, by).is_empty() {
         add(
             legend,
-            "mean plume at vehicle altitude".into(),
+            names::PLUME.into(),
             Icon::Patch(RGBColor(255, 170, 100), 1.0),
         );
     }
     if !posterior_cells(run, bx, by).is_empty() {
         add(
             legend,
-            "source map, log10 p (6 decades)".into(),
+            names::SOURCE_MAP.into(),
             Icon::Patch(RGBColor(35, 85, 185), 1.0),
         );
     }
     if run.op_area.len() > 1 {
-        add(legend, "op-area".into(), Icon::Dashed(BLACK, 2));
+        add(legend, names::OP_AREA.into(), Icon::Dashed(BLACK, 2));
     }
     if run.subregions.iter().any(|r| r.len() > 1) {
         add(
             legend,
-            "subregion".into(),
+            names::SUBREGION.into(),
             Icon::Dashed(RGBColor(120, 120, 120), 1),
         );
     }
@@ -110,23 +181,19 @@ fn area_rows(
     {
         add(
             legend,
-            "obstacle (kelp)".into(),
+            names::OBSTACLE.into(),
             Icon::Patch(OBSTACLE_FILL, 0.55),
         );
     }
     if rows.values().any(|r| r.len() > 1) {
         add(
             legend,
-            if multi { "true tracks" } else { "true track" }.into(),
+            names::truth(multi).into(),
             Icon::Line(TRUE_TRACK, 1),
         );
     }
     if any_outside {
-        add(
-            legend,
-            "true track outside the op-area".into(),
-            Icon::Line(OUTSIDE_TRACK, 2),
-        );
+        add(legend, names::OUTSIDE.into(), Icon::Line(OUTSIDE_TRACK, 2));
     }
 }
 
@@ -147,39 +214,18 @@ fn track_rows(
         let (runs, _) = est_track(rs, f64::INFINITY);
         // Jumps of 5 m or more may be drawn (those shorter than 10 px are not).
         has_jumps |= !est_track(rs, 5.0).1.is_empty();
-        let info = run.vehicles.get(vid as usize);
         if multi && !runs.iter().any(|(_, p)| moves(p)) {
             // No estimate of its own to draw: its true track is all the map has of it.
-            if let Some(v) = info {
-                add(
-                    legend,
-                    format!("{}: true track only (no position estimate)", v.name),
-                    Icon::Line(TRUE_TRACK, 1),
-                );
+            if let Some(label) = names::truth_only(run, vid) {
+                add(legend, label, Icon::Line(TRUE_TRACK, 1));
             }
         }
         for (b, _) in runs.iter().filter(|(_, p)| moves(p)) {
-            match (b, info) {
-                (Some(b), _) if !multi => add(
-                    legend,
-                    format!("track: {}", behaviour_label(*b)),
-                    Icon::Line(behaviour_colour(*b), 2),
-                ),
-                (_, Some(v)) if multi => add(
-                    legend,
-                    format!(
-                        "{} ({}) estimated track",
-                        v.name,
-                        v.planner.map_or("no planner", |k| k.name())
-                    ),
-                    Icon::Line(colour, 2),
-                ),
-                _ => add(
-                    legend,
-                    "track (navigation estimate)".into(),
-                    Icon::Line(colour, 2),
-                ),
-            }
+            let icon = match b {
+                Some(b) if !multi => Icon::Line(behaviour_colour(*b), 2),
+                _ => Icon::Line(colour, 2),
+            };
+            add(legend, names::track(run, vid, *b, multi), icon);
         }
     }
     // The reading panel's behaviour strips: the colours the track does not explain (with
@@ -211,16 +257,7 @@ fn track_rows(
     faults_drawn.dedup();
     for &(vid, k) in &faults_drawn {
         if let Some(f) = run.vehicles.get(vid as usize).and_then(|v| v.faults.get(k)) {
-            let label = if faults_drawn.len() == 1 {
-                format!(
-                    "fault {:.1}-{:.1} min: {}",
-                    f.start_s / 60.0,
-                    f.end_s / 60.0,
-                    f.what
-                )
-            } else {
-                format!("fault: {}", f.what)
-            };
+            let label = names::fault(f, faults_drawn.len() == 1);
             add(legend, label, Icon::Band(FAULT_FILL));
         }
     }
@@ -238,41 +275,41 @@ fn mark_rows(
     over: &Overlays,
 ) {
     if has_jumps {
-        add(
-            legend,
-            "navigation fix (the estimate jumps)".into(),
-            Icon::Dotted(BLACK),
-        );
+        add(legend, names::FIX.into(), Icon::Dotted(BLACK));
     }
     if rows.values().flatten().any(|r| r.detection) {
         // (Thinned to one per DETECTION_GAP_S; the module's docs say so.)
-        add(legend, "detection".into(), Icon::Tick(DETECTION_MARK, 0.6));
+        add(
+            legend,
+            names::DETECTION.into(),
+            Icon::Tick(DETECTION_MARK, 0.6),
+        );
     }
     if rows
         .values()
         .filter_map(|r| r.last())
         .any(|r| r.t_s + 1e-6 >= step_min * 60.0)
     {
-        add(
-            legend,
-            format!("time along the track, every {step_min:.0} min"),
-            Icon::TimeTick,
-        );
+        add(legend, names::times(step_min), Icon::TimeTick);
     }
     if !over.virtual_paths.is_empty() {
-        add(legend, "virtual path".into(), Icon::Dashed(AVOID_MARK, 1));
+        add(
+            legend,
+            names::VIRTUAL_PATH.into(),
+            Icon::Dashed(AVOID_MARK, 1),
+        );
     }
     if !over.targets.is_empty() {
-        add(legend, "reference target".into(), Icon::Diamond(AVOID_MARK));
+        add(legend, names::TARGET.into(), Icon::Diamond(AVOID_MARK));
     }
     if !over.lost.is_empty() {
-        add(legend, "lost point".into(), Icon::Ring(LOST_MARK));
+        add(legend, names::LOST.into(), Icon::Ring(LOST_MARK));
     }
     if !run.sources.is_empty() {
-        add(legend, "true source".into(), Icon::Triangle(SOURCE_MARK));
+        add(legend, names::SOURCE.into(), Icon::Triangle(SOURCE_MARK));
     }
     if !over.declared.is_empty() {
-        add(legend, "declared source".into(), Icon::Dot(BLACK));
+        add(legend, names::DECLARED.into(), Icon::Dot(BLACK));
     }
     for m in &over.marks {
         add(legend, m.kind.legend().into(), m.kind.icon());
@@ -325,10 +362,15 @@ where
     for (k, e) in lay.legend.iter().enumerate() {
         let (c, r) = ((k / rows) as i32, (k % rows) as i32);
         let (x, y) = (x0 + 10 + c * col_w, 12 + 16 * r);
-        area.draw(&icon_element!(e.icon, (x, y), 0))
-            .map_err(ReportError::figure)?;
-        area.draw(&Text::new(e.label.clone(), (x + 26, y), style.clone()))
-            .map_err(ReportError::figure)?;
+        // The swatch and its label, as one legend entry.
+        area.draw(
+            &(EmptyElement::at((x, y))
+                + marks::open_text(Group::Legend, &e.label)
+                + icon_element!(e.icon, (0, 0), 0)
+                + Text::new(e.label.clone(), (26, 0), style.clone())
+                + marks::close_text()),
+        )
+        .map_err(ReportError::figure)?;
     }
     Ok(())
 }

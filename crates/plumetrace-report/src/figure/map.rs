@@ -3,6 +3,7 @@
 //! (mean flow and scale bar) and the legend in its corner.
 
 use super::layout::MapLayout;
+use super::legend::names;
 use super::model::flow_words;
 use super::style::{
     AVOID_MARK, DETECTION_MARK, FAULT_FILL, LEGEND_FONT_PX, LOST_MARK, OBSTACLE_FILL,
@@ -11,6 +12,7 @@ use super::style::{
 };
 use crate::chart::{MapChart, dashed, map_chart};
 use crate::error::ReportError;
+use crate::marks::{self, Group};
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
 use plumetrace_mission::MissionRun;
@@ -27,18 +29,24 @@ where
 {
     let mut chart = map_chart(area, title, lay.x.clone(), lay.y.clone())?;
     draw_area(&mut chart, run, lay)?;
-    draw_tracks(&mut chart, lay)?;
+    draw_tracks(&mut chart, run, lay)?;
     draw_fixes(&mut chart, lay)?;
     draw_along_tracks(&mut chart, run, lay)?;
     draw_markers(&mut chart, run, lay)?;
     draw_key(&mut chart, run, lay)?;
     for e in lay.legend.iter().filter(|_| lay.legend_corner.is_some()) {
         let icon = e.icon;
+        let label = e.label.clone();
         chart
             .draw_series(std::iter::empty::<PathElement<(f64, f64)>>())
             .map_err(ReportError::figure)?
             .label(e.label.clone())
-            .legend(move |p| icon_element!(icon, p, 0));
+            .legend(move |p| {
+                EmptyElement::at(p)
+                    + marks::open_text(Group::Legend, &label)
+                    + icon_element!(icon, (0, 0), 0)
+                    + marks::close_text()
+            });
     }
     if let (Some(corner), false) = (lay.legend_corner, lay.legend.is_empty()) {
         chart
@@ -53,6 +61,23 @@ where
     Ok(())
 }
 
+/// Draws what `draw` draws on the map as one marked group of `kind` named `name` (see
+/// [`crate::marks`]).
+fn marked<'a, DB: DrawingBackend>(
+    chart: &mut MapChart<'a, DB>,
+    kind: Group,
+    name: &str,
+    draw: impl FnOnce(&mut MapChart<'a, DB>) -> Result<(), ReportError>,
+) -> Result<(), ReportError>
+where
+    DB::ErrorType: 'static,
+{
+    let at = (chart.x_range().start, chart.y_range().start);
+    marks::open(chart.plotting_area(), at, kind, name).map_err(ReportError::figure)?;
+    draw(chart)?;
+    marks::close(chart.plotting_area(), at).map_err(ReportError::figure)
+}
+
 /// The map's background: the mean plume and source map, obstacles, the op-area and subregions.
 fn draw_area<DB: DrawingBackend>(
     chart: &mut MapChart<'_, DB>,
@@ -62,29 +87,47 @@ fn draw_area<DB: DrawingBackend>(
 where
     DB::ErrorType: 'static,
 {
-    if !lay.plume.is_empty() {
-        chart
-            .draw_series(
-                lay.plume
-                    .iter()
-                    .map(|(r, c)| Rectangle::new(*r, c.filled())),
-            )
-            .map_err(ReportError::figure)?;
+    for (cells, name) in [
+        (&lay.plume, names::PLUME),
+        (&lay.source_map, names::SOURCE_MAP),
+    ] {
+        if cells.is_empty() {
+            continue;
+        }
+        marked(chart, Group::Ramp, name, |chart| {
+            chart
+                .draw_series(cells.iter().map(|(r, c)| Rectangle::new(*r, c.filled())))
+                .map(|_| ())
+                .map_err(ReportError::figure)
+        })?;
     }
-    chart
-        .draw_series(
-            lay.obstacles
-                .iter()
-                .map(|o| Polygon::new(o.clone(), OBSTACLE_FILL.mix(0.55).filled())),
-        )
-        .map_err(ReportError::figure)?;
-    chart
-        .draw_series(dashed(&run.op_area, BLACK, 2))
-        .map_err(ReportError::figure)?;
-    for r in &run.subregions {
-        chart
-            .draw_series(dashed(r, RGBColor(120, 120, 120), 1))
-            .map_err(ReportError::figure)?;
+    if !lay.obstacles.is_empty() {
+        marked(chart, Group::Series, names::OBSTACLE, |chart| {
+            chart
+                .draw_series(
+                    lay.obstacles
+                        .iter()
+                        .map(|o| Polygon::new(o.clone(), OBSTACLE_FILL.mix(0.55).filled())),
+                )
+                .map(|_| ())
+                .map_err(ReportError::figure)
+        })?;
+    }
+    if run.op_area.len() > 1 {
+        marked(chart, Group::Series, names::OP_AREA, |chart| {
+            chart
+                .draw_series(dashed(&run.op_area, BLACK, 2))
+                .map(|_| ())
+                .map_err(ReportError::figure)
+        })?;
+    }
+    for r in run.subregions.iter().filter(|r| r.len() > 1) {
+        marked(chart, Group::Series, names::SUBREGION, |chart| {
+            chart
+                .draw_series(dashed(r, RGBColor(120, 120, 120), 1))
+                .map(|_| ())
+                .map_err(ReportError::figure)
+        })?;
     }
     Ok(())
 }
@@ -93,46 +136,89 @@ where
 /// op-area.
 fn draw_tracks<DB: DrawingBackend>(
     chart: &mut MapChart<'_, DB>,
+    run: &MissionRun,
     lay: &MapLayout,
 ) -> Result<(), ReportError>
 where
     DB::ErrorType: 'static,
 {
     // Under the tracks: the track flown during faults.
+    let faults: std::collections::BTreeSet<(u32, usize)> = lay
+        .layers
+        .iter()
+        .flat_map(|l| l.faults.iter().map(|(k, _)| (l.vehicle, *k)))
+        .collect();
     for l in &lay.layers {
-        chart
-            .draw_series(l.faults.iter().map(|(_, pts)| {
-                PathElement::new(pts.clone(), FAULT_FILL.mix(0.5).stroke_width(10))
-            }))
-            .map_err(ReportError::figure)?;
+        for (k, pts) in &l.faults {
+            let Some(f) = run
+                .vehicles
+                .get(l.vehicle as usize)
+                .and_then(|v| v.faults.get(*k))
+            else {
+                continue;
+            };
+            marked(
+                chart,
+                Group::Series,
+                &names::fault(f, faults.len() == 1),
+                |chart| {
+                    chart
+                        .draw_series(std::iter::once(PathElement::new(
+                            pts.clone(),
+                            FAULT_FILL.mix(0.5).stroke_width(10),
+                        )))
+                        .map(|_| ())
+                        .map_err(ReportError::figure)
+                },
+            )?;
+        }
+    }
+    let moves = |pts: &[(f64, f64)]| pts.iter().any(|p| *p != pts[0]);
+    for l in &lay.layers {
+        let own = l.runs.iter().any(|(_, p)| moves(p));
+        let name = match names::truth_only(run, l.vehicle) {
+            Some(only) if lay.multi && !own => only,
+            _ => names::truth(lay.multi).to_string(),
+        };
+        marked(chart, Group::Series, &name, |chart| {
+            chart
+                .draw_series(std::iter::once(PathElement::new(
+                    l.truth.clone(),
+                    TRUE_TRACK.stroke_width(1),
+                )))
+                .map(|_| ())
+                .map_err(ReportError::figure)
+        })?;
     }
     for l in &lay.layers {
-        chart
-            .draw_series(std::iter::once(PathElement::new(
-                l.truth.clone(),
-                TRUE_TRACK.stroke_width(1),
-            )))
-            .map_err(ReportError::figure)?;
+        for (b, pts) in &l.runs {
+            let c = match b {
+                Some(b) if !lay.multi => behaviour_colour(*b),
+                _ => l.colour,
+            };
+            let name = names::track(run, l.vehicle, *b, lay.multi);
+            marked(chart, Group::Series, &name, |chart| {
+                chart
+                    .draw_series(std::iter::once(PathElement::new(
+                        pts.clone(),
+                        c.stroke_width(2),
+                    )))
+                    .map(|_| ())
+                    .map_err(ReportError::figure)
+            })?;
+        }
     }
-    for l in &lay.layers {
-        chart
-            .draw_series(l.runs.iter().map(|(b, pts)| {
-                let c = match b {
-                    Some(b) if !lay.multi => behaviour_colour(*b),
-                    _ => l.colour,
-                };
-                PathElement::new(pts.clone(), c.stroke_width(2))
-            }))
-            .map_err(ReportError::figure)?;
-    }
-    for l in &lay.layers {
-        chart
-            .draw_series(
-                l.outside
-                    .iter()
-                    .map(|p| PathElement::new(p.clone(), OUTSIDE_TRACK.stroke_width(2))),
-            )
-            .map_err(ReportError::figure)?;
+    for l in lay.layers.iter().filter(|l| !l.outside.is_empty()) {
+        marked(chart, Group::Series, names::OUTSIDE, |chart| {
+            chart
+                .draw_series(
+                    l.outside
+                        .iter()
+                        .map(|p| PathElement::new(p.clone(), OUTSIDE_TRACK.stroke_width(2))),
+                )
+                .map(|_| ())
+                .map_err(ReportError::figure)
+        })?;
     }
     Ok(())
 }
@@ -149,24 +235,29 @@ where
     let m = lay.m_per_px;
     // Position fixes: dotted from the estimate before to the estimate after.
     for l in &lay.layers {
-        chart
-            .draw_series(l.jumps.iter().flat_map(|&([a, b], _)| {
-                let len = (b.0 - a.0).hypot(b.1 - a.1);
-                // Dashes of 6 px, gaps of 4 px.
-                let n = (len / (10.0 * m)).ceil().max(1.0) as usize;
-                (0..n).map(move |k| {
-                    let s = k as f64 / n as f64;
-                    let e = (s + 0.6 / n as f64).min(1.0);
-                    PathElement::new(
-                        vec![
-                            (a.0 + s * (b.0 - a.0), a.1 + s * (b.1 - a.1)),
-                            (a.0 + e * (b.0 - a.0), a.1 + e * (b.1 - a.1)),
-                        ],
-                        BLACK.stroke_width(1),
-                    )
-                })
-            }))
-            .map_err(ReportError::figure)?;
+        if !l.jumps.is_empty() {
+            marked(chart, Group::Series, names::FIX, |chart| {
+                chart
+                    .draw_series(l.jumps.iter().flat_map(|&([a, b], _)| {
+                        let len = (b.0 - a.0).hypot(b.1 - a.1);
+                        // Dotted as its legend swatch: dots of 3 px, gaps of 3 px.
+                        let n = (len / (6.0 * m)).ceil().max(2.0) as usize;
+                        (0..n).map(move |k| {
+                            let s = k as f64 / n as f64;
+                            let e = (s + 0.5 / n as f64).min(1.0);
+                            PathElement::new(
+                                vec![
+                                    (a.0 + s * (b.0 - a.0), a.1 + s * (b.1 - a.1)),
+                                    (a.0 + e * (b.0 - a.0), a.1 + e * (b.1 - a.1)),
+                                ],
+                                BLACK.stroke_width(1),
+                            )
+                        })
+                    }))
+                    .map(|_| ())
+                    .map_err(ReportError::figure)
+            })?;
+        }
         // Jumps of 40 px or more say how far and when.
         chart
             .draw_series(
@@ -223,21 +314,44 @@ where
             }
         }
     }
-    for l in &lay.layers {
-        chart
-            .draw_series(
-                l.detections
-                    .iter()
-                    .map(|s| PathElement::new(s.to_vec(), DETECTION_MARK.mix(0.6).stroke_width(1))),
-            )
-            .map_err(ReportError::figure)?;
+    for l in lay.layers.iter().filter(|l| !l.detections.is_empty()) {
+        marked(chart, Group::Series, names::DETECTION, |chart| {
+            chart
+                .draw_series(
+                    l.detections.iter().map(|s| {
+                        PathElement::new(s.to_vec(), DETECTION_MARK.mix(0.6).stroke_width(1))
+                    }),
+                )
+                .map(|_| ())
+                .map_err(ReportError::figure)
+        })?;
     }
     for l in &lay.layers {
+        if !l.times.is_empty() {
+            marked(
+                chart,
+                Group::Series,
+                &names::times(lay.time_step_min),
+                |chart| {
+                    chart
+                        .draw_series(
+                            l.times
+                                .iter()
+                                .map(|t| PathElement::new(t.tick.to_vec(), BLACK.stroke_width(2))),
+                        )
+                        .map(|_| ())
+                        .map_err(ReportError::figure)
+                },
+            )?;
+        }
+        // Leaders from ticks to labels placed away from them.
         chart
             .draw_series(
                 l.times
                     .iter()
-                    .map(|t| PathElement::new(t.tick.to_vec(), BLACK.stroke_width(2))),
+                    .filter(|t| !t.label.is_empty())
+                    .filter_map(|t| t.leader)
+                    .map(|s| PathElement::new(s.to_vec(), BLACK.stroke_width(1))),
             )
             .map_err(ReportError::figure)?;
         chart
@@ -275,62 +389,97 @@ where
             .virtual_paths
             .iter()
             .flat_map(|(a, course, b)| {
+                // Dashed as its legend swatch, at least two dashes: 2 m on and 2 m off, or
+                // finer on a path shorter than 8 m.
                 let len = (b - a).dot(&course.unit()).max(0.0);
-                let n = (len / 2.0).ceil() as usize;
-                (0..n).step_by(2).map(move |k| {
-                    let p = a + course.unit() * (2.0 * k as f64);
-                    let q = a + course.unit() * (2.0 * (k + 1) as f64).min(len);
+                let n = if len > 0.0 {
+                    (len / 4.0).ceil().max(2.0) as usize
+                } else {
+                    0
+                };
+                let period = len / n.max(1) as f64;
+                (0..n).map(move |k| {
+                    let p = a + course.unit() * (period * k as f64);
+                    let q = a + course.unit() * (period * (k as f64 + 0.5));
                     PathElement::new(vec![(p.x, p.y), (q.x, q.y)], AVOID_MARK.stroke_width(1))
                 })
             })
             .collect();
-        chart.draw_series(segments).map_err(ReportError::figure)?;
+        marked(chart, Group::Series, names::VIRTUAL_PATH, |chart| {
+            chart
+                .draw_series(segments)
+                .map(|_| ())
+                .map_err(ReportError::figure)
+        })?;
     }
-    chart
-        .draw_series(lay.targets.iter().map(|&(x, y)| {
-            Polygon::new(
-                vec![(x, y + 1.2), (x + 1.2, y), (x, y - 1.2), (x - 1.2, y)],
-                AVOID_MARK.filled(),
-            )
-        }))
-        .map_err(ReportError::figure)?;
-    chart
-        .draw_series(
-            lay.lost
-                .iter()
-                .map(|&p| Circle::new(p, 5, LOST_MARK.stroke_width(2))),
-        )
-        .map_err(ReportError::figure)?;
-    chart
-        .draw_series(
-            run.sources
-                .iter()
-                .map(|s| TriangleMarker::new((s.x, s.y), 9, SOURCE_MARK.filled())),
-        )
-        .map_err(ReportError::figure)?;
-    chart
-        .draw_series(
-            lay.declared
-                .iter()
-                .map(|&p| Circle::new(p, 7, BLACK.filled())),
-        )
-        .map_err(ReportError::figure)?;
+    if !lay.targets.is_empty() {
+        marked(chart, Group::Series, names::TARGET, |chart| {
+            chart
+                .draw_series(lay.targets.iter().map(|&(x, y)| {
+                    Polygon::new(
+                        vec![(x, y + 1.2), (x + 1.2, y), (x, y - 1.2), (x - 1.2, y)],
+                        AVOID_MARK.filled(),
+                    )
+                }))
+                .map(|_| ())
+                .map_err(ReportError::figure)
+        })?;
+    }
+    if !lay.lost.is_empty() {
+        marked(chart, Group::Series, names::LOST, |chart| {
+            chart
+                .draw_series(
+                    lay.lost
+                        .iter()
+                        .map(|&p| Circle::new(p, 5, LOST_MARK.stroke_width(2))),
+                )
+                .map(|_| ())
+                .map_err(ReportError::figure)
+        })?;
+    }
+    if !run.sources.is_empty() {
+        marked(chart, Group::Series, names::SOURCE, |chart| {
+            chart
+                .draw_series(
+                    run.sources
+                        .iter()
+                        .map(|s| TriangleMarker::new((s.x, s.y), 9, SOURCE_MARK.filled())),
+                )
+                .map(|_| ())
+                .map_err(ReportError::figure)
+        })?;
+    }
+    if !lay.declared.is_empty() {
+        marked(chart, Group::Series, names::DECLARED, |chart| {
+            chart
+                .draw_series(
+                    lay.declared
+                        .iter()
+                        .map(|&p| Circle::new(p, 7, BLACK.filled())),
+                )
+                .map(|_| ())
+                .map_err(ReportError::figure)
+        })?;
+    }
     for k in &lay.marks {
         let icon = k.kind.icon();
         let text = k.kind.text(k.t_s);
         let (ox, oy) = k.label_px;
         let w = text_px(&text, 12.0).round() as i32;
         let style = label_style(12, BLACK, Pos::new(HPos::Left, VPos::Center));
-        chart
-            .draw_series(std::iter::once(
-                icon_element!(icon, k.pos, -8)
-                    + Rectangle::new(
-                        [(ox - 2, oy), (ox + w + 2, oy + 16)],
-                        WHITE.mix(0.8).filled(),
-                    )
-                    + Text::new(text, (ox, oy + 8), style),
-            ))
-            .map_err(ReportError::figure)?;
+        marked(chart, Group::Series, k.kind.legend(), |chart| {
+            chart
+                .draw_series(std::iter::once(
+                    icon_element!(icon, k.pos, -8)
+                        + Rectangle::new(
+                            [(ox - 2, oy), (ox + w + 2, oy + 16)],
+                            WHITE.mix(0.8).filled(),
+                        )
+                        + Text::new(text, (ox, oy + 8), style),
+                ))
+                .map(|_| ())
+                .map_err(ReportError::figure)
+        })?;
     }
     Ok(())
 }

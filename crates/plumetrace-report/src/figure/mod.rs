@@ -38,15 +38,16 @@ pub(crate) mod style;
 mod test_support;
 
 use crate::error::ReportError;
-use layout::map_layout;
+use layout::{MapLayout, map_layout};
 use legend::{draw_legend_band, legend_band};
 use map::draw_map;
 use model::{panel_vehicles, rows_by_vehicle};
 use panel::{draw_panel, panel_h_px};
 use plotters::prelude::*;
-use plumetrace_mission::MissionRun;
+use plumetrace_mission::{MissionRun, TrajectoryRow};
 use posterior::{POSTERIOR_PX, draw_posteriors};
 use raster::posterior_snapshots;
+use std::collections::BTreeMap;
 use style::WIDTH_PX;
 
 /// Detection ticks: at most one per this many seconds of each vehicle's mission.
@@ -56,8 +57,18 @@ pub const DETECTION_GAP_S: f64 = 2.0;
 pub fn mission_figure(run: &MissionRun, title: &str) -> Result<String, ReportError> {
     let rows = rows_by_vehicle(run);
     let lay = map_layout(run, &rows, title)?;
-    let panel = panel_vehicles(run, &rows);
-    let (_, _, band_h) = legend_band(&lay);
+    draw_figure(run, &rows, &lay, title)
+}
+
+/// The figure of `run` laid out as `lay`.
+fn draw_figure(
+    run: &MissionRun,
+    rows: &BTreeMap<u32, Vec<&TrajectoryRow>>,
+    lay: &MapLayout,
+    title: &str,
+) -> Result<String, ReportError> {
+    let panel = panel_vehicles(run, rows);
+    let (_, _, band_h) = legend_band(lay);
     let snaps = posterior_snapshots(run);
     let snaps_h = if snaps.is_empty() { 0 } else { POSTERIOR_PX };
     let height = lay.map_h_px + band_h + snaps_h + panel_h_px(panel.len());
@@ -68,15 +79,76 @@ pub fn mission_figure(run: &MissionRun, title: &str) -> Result<String, ReportErr
         let (top, rest) = root.split_vertically(lay.map_h_px);
         let (band, rest) = rest.split_vertically(band_h);
         let (maps, bottom) = rest.split_vertically(snaps_h);
-        draw_map(&top, run, &lay, title)?;
-        draw_legend_band(&band, &lay)?;
+        draw_map(&top, run, lay, title)?;
+        draw_legend_band(&band, lay)?;
         if !snaps.is_empty() {
-            draw_posteriors(&maps, run, &rows, &snaps)?;
+            draw_posteriors(&maps, run, rows, &snaps)?;
         }
         if !panel.is_empty() {
-            draw_panel(&bottom, run, &rows, &lay, &panel)?;
+            draw_panel(&bottom, run, rows, lay, &panel)?;
         }
         root.present().map_err(ReportError::figure)?;
     }
-    Ok(svg)
+    Ok(crate::marks::finish(&svg))
+}
+
+#[cfg(test)]
+mod tests {
+    #![allow(clippy::unwrap_used, clippy::expect_used)]
+
+    use super::test_support::{layout, preset_run};
+    use super::*;
+    use crate::inspect::{legend_faults, series_without_legend};
+
+    #[test]
+    fn every_series_of_the_demo_has_a_legend_entry_whose_swatch_is_its_mark() {
+        let run = preset_run("demo", 900.0);
+        let svg = mission_figure(&run, "demo").unwrap();
+        let groups = crate::inspect::marked_groups(&svg);
+        for name in [
+            "true track",
+            "op-area",
+            "true source",
+            "mean plume at vehicle altitude",
+        ] {
+            assert!(
+                groups.iter().any(|g| g.kind == "series" && g.name == name),
+                "{name} is marked"
+            );
+        }
+        assert_eq!(legend_faults(&svg), Vec::<String>::new());
+    }
+
+    #[test]
+    fn a_formations_leaders_without_a_legend_entry_are_found() {
+        let run = preset_run("soares-freshwater", 300.0);
+        let rows = rows_by_vehicle(&run);
+        let lay = layout(&run);
+        let svg = draw_figure(&run, &rows, &lay, "formation").unwrap();
+        assert_eq!(legend_faults(&svg), Vec::<String>::new());
+        // Each vehicle's reading line is keyed by its strip's swatch.
+        let groups = crate::inspect::marked_groups(&svg);
+        for v in &run.vehicles {
+            assert!(
+                groups
+                    .iter()
+                    .any(|g| g.kind == "legend" && g.name == v.name),
+                "{}",
+                v.name
+            );
+        }
+        // The legend as it once was: the first vehicle's track only.
+        let tracks: Vec<String> = lay
+            .legend
+            .iter()
+            .map(|e| e.label.clone())
+            .filter(|l| l.ends_with("estimated track"))
+            .collect();
+        assert!(tracks.len() > 1, "{tracks:?}");
+        let mut old = lay.clone();
+        old.legend.retain(|e| !tracks[1..].contains(&e.label));
+        let svg = draw_figure(&run, &rows, &old, "formation").unwrap();
+        let missing = series_without_legend(&svg);
+        assert_eq!(missing, tracks[1..].to_vec());
+    }
 }

@@ -85,6 +85,8 @@ pub(super) struct TimeMark {
     pub(super) tick: Segment,
     pub(super) label_at: (f64, f64),
     pub(super) label: String,
+    /// A label placed away from its tick: the line from the tick to the label's box.
+    pub(super) leader: Option<Segment>,
 }
 
 /// Whether the estimate jumped from row `a` to the next row `b` (a position fix): it moved
@@ -287,6 +289,7 @@ pub(super) fn time_marks(
             ],
             label_at: (p.0 + nrm.x * label_m, p.1 + nrm.y * label_m),
             label: format!("{:.0} min", t / 60.0),
+            leader: None,
         });
     }
     out

@@ -10,6 +10,7 @@ use super::style::{
     behaviour_colour, label_style, text_px,
 };
 use crate::error::ReportError;
+use crate::marks::{self, Group};
 use plotters::coord::types::RangedCoordf64;
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
@@ -231,12 +232,22 @@ where
             .map(|r| (r.t_s / 60.0, r.reading_v))
             .collect();
         let colour = reading_colour(lay, v, k);
+        // With several vehicles each line is a series its strip's name keys.
+        let name = run.vehicles.get(v as usize).filter(|_| lay.multi);
+        let at = (0.0, y_lo);
+        if let Some(i) = name {
+            marks::open(chart.plotting_area(), at, Group::Series, &i.name)
+                .map_err(ReportError::figure)?;
+        }
         chart
             .draw_series(std::iter::once(PathElement::new(
                 min_max_columns(&pts, t_max_min, cols),
                 colour.stroke_width(1),
             )))
             .map_err(ReportError::figure)?;
+        if name.is_some() {
+            marks::close(chart.plotting_area(), at).map_err(ReportError::figure)?;
+        }
     }
     Ok(())
 }
@@ -476,24 +487,23 @@ where
         } else {
             (-6, None)
         };
-        if let Some(c) = swatch {
-            strips
-                .draw_series(std::iter::once(
-                    EmptyElement::at((0.0, y0 + 0.5))
-                        + PathElement::new(vec![(-20, 0), (-6, 0)], c.stroke_width(2)),
-                ))
-                .map_err(ReportError::figure)?;
-        }
-        strips
-            .draw_series(std::iter::once(
-                EmptyElement::at((0.0, y0 + 0.5))
-                    + Text::new(
-                        name,
-                        (name_dx, 0),
-                        label_style(11, BLACK, Pos::new(HPos::Right, VPos::Center)),
-                    ),
-            ))
-            .map_err(ReportError::figure)?;
+        let text = Text::new(
+            name.clone(),
+            (name_dx, 0),
+            label_style(11, BLACK, Pos::new(HPos::Right, VPos::Center)),
+        );
+        let at = EmptyElement::at((0.0, y0 + 0.5));
+        let drawn = match swatch {
+            // The swatch is the reading line: its colour and width.
+            Some(c) => strips.draw_series(std::iter::once(
+                at + marks::open_text(Group::Legend, &name)
+                    + PathElement::new(vec![(-20, 0), (-6, 0)], c.stroke_width(1))
+                    + text
+                    + marks::close_text(),
+            )),
+            None => strips.draw_series(std::iter::once(at + text)),
+        };
+        drawn.map_err(ReportError::figure)?;
     }
     Ok(())
 }

@@ -98,7 +98,7 @@ pub(super) enum Icon {
     Dashed(RGBColor, u32),
     /// A dotted thin line.
     Dotted(RGBColor),
-    /// A wide translucent band (the fault underlay).
+    /// A wide translucent line (the fault underlay).
     Band(RGBColor),
     /// A filled patch at an opacity.
     Patch(RGBColor, f64),
@@ -141,7 +141,10 @@ impl IconParts {
         let rect = |x0: i32, x1: i32| vec![(x0, -5), (x1, -5), (x1, 5), (x0, 5)];
         match icon {
             Icon::Line(c, w) => p.lines[0] = (vec![(0, 0), (16, 0)], c.stroke_width(w)),
-            Icon::Dashed(c, w) => p.lines[0] = (vec![(0, 0), (6, 0)], c.stroke_width(w)),
+            Icon::Dashed(c, w) => {
+                p.lines[0] = (vec![(0, 0), (6, 0)], c.stroke_width(w));
+                p.lines[1] = (vec![(10, 0), (16, 0)], c.stroke_width(w));
+            }
             Icon::Dotted(c) => {
                 p.lines = [
                     (vec![(0, 0), (3, 0)], c.stroke_width(1)),
@@ -149,7 +152,7 @@ impl IconParts {
                     (vec![(12, 0), (15, 0)], c.stroke_width(1)),
                 ];
             }
-            Icon::Band(c) => p.polygon = (rect(0, 16), c.mix(0.5).filled()),
+            Icon::Band(c) => p.lines[0] = (vec![(0, 0), (16, 0)], c.mix(0.5).stroke_width(10)),
             Icon::Patch(c, a) => p.polygon = (rect(0, 14), c.mix(a).filled()),
             Icon::Tick(c, a) => {
                 p.lines = [

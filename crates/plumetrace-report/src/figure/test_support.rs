@@ -11,12 +11,17 @@ use plumetrace_scenario::{Origin, build, load_preset};
 
 /// The demo mission cut short: 600 s of spin-up, `limit_s` of mission, seed 3.
 pub(super) fn demo(limit_s: f64) -> MissionRun {
-    let mut cfg = load_preset("demo").unwrap();
+    preset_run("demo", limit_s)
+}
+
+/// A preset's mission cut short: `limit_s` of mission after at most 600 s of spin-up, seed 3.
+pub(super) fn preset_run(name: &str, limit_s: f64) -> MissionRun {
+    let mut cfg = load_preset(name).unwrap();
     if let Some(m) = cfg.mission.as_mut() {
         m.spinup_s = m.spinup_s.min(600.0);
         m.time_limit_s = limit_s;
     }
-    let sc = build(&cfg, &Origin::Preset("demo".into()), Some(3)).unwrap();
+    let sc = build(&cfg, &Origin::Preset(name.into()), Some(3)).unwrap();
     run_mission(sc, &mut |_, _| {}).unwrap()
 }
 

@@ -1,7 +1,15 @@
 //! Measurable properties of a drawn figure, read back from its SVG text: where each label sits
-//! (its box estimated from its font size and length), which labels overlap, and whether every
-//! axis's tick labels are distinct and increasing. The figures' tests and the visual check of
+//! (its box estimated from its font size and length), which labels overlap, whether every
+//! axis's tick labels are distinct and increasing, and (in [`series`]) whether each drawn series
+//! has a legend entry whose swatch is its mark. The figures' tests and the visual check of
 //! rendered presets use them; nothing here draws.
+
+pub mod series;
+
+pub use series::{
+    MarkedGroup, legend_entries_without_text, legend_faults, marked_groups, series_without_legend,
+    swatches_unlike_series,
+};
 
 /// One `<text>` element of a figure and the box it covers, px (y down).
 #[derive(Debug, Clone, PartialEq)]
@@ -27,14 +35,14 @@ pub struct TextBox {
 /// digits and lower-case words).
 const CHAR_EM: f64 = 0.55;
 
-fn attr(tag: &str, name: &str) -> Option<String> {
+pub(crate) fn attr(tag: &str, name: &str) -> Option<String> {
     let key = format!(" {name}=\"");
     let a = tag.find(&key)? + key.len();
     let b = tag[a..].find('"')? + a;
     Some(tag[a..b].to_string())
 }
 
-fn unescape(s: &str) -> String {
+pub(crate) fn unescape(s: &str) -> String {
     s.replace("&lt;", "<")
         .replace("&gt;", ">")
         .replace("&quot;", "\"")
@@ -170,6 +178,84 @@ pub fn texts_over_marks(svg: &str) -> Vec<String> {
         .collect()
 }
 
+/// The segments of every drawn track of `svg`: the lines of each marked series (see
+/// [`crate::marks`]) whose name says it is a track, px.
+pub fn track_segments(svg: &str) -> Vec<((f64, f64), (f64, f64))> {
+    let mut out = Vec::new();
+    for part in svg.split("<g class=\"series\"").skip(1) {
+        let Some(close) = part.find("</g>") else {
+            continue;
+        };
+        let group = &part[..close];
+        let name = attr(&format!(" {}", group.trim_start()), "data-series").unwrap_or_default();
+        if !name.contains("track") {
+            continue;
+        }
+        for line in group.split("<polyline").skip(1) {
+            let pts: Vec<(f64, f64)> = attr(line, "points")
+                .unwrap_or_default()
+                .split_whitespace()
+                .filter_map(|p| p.split_once(','))
+                .filter_map(|(x, y)| Some((x.parse().ok()?, y.parse().ok()?)))
+                .collect();
+            out.extend(pts.windows(2).map(|w| (w[0], w[1])));
+        }
+    }
+    out
+}
+
+/// Whether the segment `a`-`b` passes through the box `r` (left, top, right, bottom).
+fn segment_crosses(a: (f64, f64), b: (f64, f64), r: (f64, f64, f64, f64)) -> bool {
+    // Liang-Barsky: clip the segment's parameter range to each side of the box.
+    let (dx, dy) = (b.0 - a.0, b.1 - a.1);
+    let (mut t0, mut t1) = (0.0f64, 1.0f64);
+    for (p, q) in [
+        (-dx, a.0 - r.0),
+        (dx, r.2 - a.0),
+        (-dy, a.1 - r.1),
+        (dy, r.3 - a.1),
+    ] {
+        if p == 0.0 {
+            if q < 0.0 {
+                return false;
+            }
+        } else {
+            let t = q / p;
+            if p < 0.0 {
+                t0 = t0.max(t);
+            } else {
+                t1 = t1.min(t);
+            }
+        }
+    }
+    t0 <= t1
+}
+
+/// The labels of `svg` that a drawn track passes through (their boxes shrunk by 1 px each way),
+/// with the vehicles' names written at their tracks' starts left out.
+pub fn texts_over_tracks(svg: &str) -> Vec<String> {
+    let tracks = track_segments(svg);
+    let starts: Vec<(f64, f64)> = tracks.iter().map(|s| s.0).collect();
+    text_boxes(svg)
+        .into_iter()
+        .filter(|t| {
+            !starts
+                .iter()
+                .any(|p| (p.0 - t.at.0).abs() < 0.5 && (p.1 - t.at.1).abs() < 0.5)
+        })
+        .filter(|t| {
+            let r = (
+                t.rect.0 + 1.0,
+                t.rect.1 + 1.0,
+                t.rect.2 - 1.0,
+                t.rect.3 - 1.0,
+            );
+            tracks.iter().any(|&(a, b)| segment_crosses(a, b, r))
+        })
+        .map(|t| t.text)
+        .collect()
+}
+
 /// The figure's axes: each run of numeric tick labels along one line (x axes: centred labels
 /// hanging from one y; y axes: right-aligned labels centred on one x) that follow each other in
 /// the drawing with no other label between them, in order along the axis (left to right, bottom
@@ -220,6 +306,24 @@ pub fn bad_tick_rows(svg: &str) -> Vec<Vec<String>> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_label_a_track_passes_through_is_found() {
+        let svg = r##"<svg><g class="series" data-series="true track">
+<polyline fill="none" opacity="1" stroke="#878787" stroke-width="1" points="0,50 200,50 "/>
+</g>
+<g class="series" data-series="op-area">
+<polyline fill="none" opacity="1" stroke="#000000" stroke-width="2" points="0,80 200,80 "/>
+</g>
+<text x="100" y="50" dy="0.5ex" text-anchor="middle" font-size="10">8 min</text>
+<text x="100" y="30" dy="0.5ex" text-anchor="middle" font-size="10">6 min</text>
+<text x="100" y="80" dy="0.5ex" text-anchor="middle" font-size="10">border</text>
+<text x="0" y="50" font-size="10">AUV 1</text>
+</svg>"##;
+        // The op-area is not a track; a name at its track's start is meant to be there.
+        assert_eq!(texts_over_tracks(svg), ["8 min"]);
+        assert_eq!(track_segments(svg).len(), 1);
+    }
 
     const SVG: &str = r##"<svg><text x="100" y="50" dy="0.76em" text-anchor="middle" font-size="10">0</text>
 <text x="150" y="50" dy="0.76em" text-anchor="middle" font-size="10">
