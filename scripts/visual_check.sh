@@ -125,5 +125,6 @@ for c in campaign team-campaign; do
 done
 
 echo "== the properties"
-PLUMETRACE_VISUAL_DIR="$out" cargo test --release -q -p plumetrace-report --test visual -- --ignored
+# The whole workspace selected, as `.ci/run` builds its release tests, so the two share one build.
+PLUMETRACE_VISUAL_DIR="$out" cargo test --release -q --workspace --test visual -- --ignored
 echo "visual check: $(ls "$out/png" | wc -l) pictures in $out/png, every property holds"
