@@ -136,7 +136,7 @@ pub struct Task {
     pub scenario: String,
     /// What a planner is given: vehicles and sensors, in words.
     pub vehicles: String,
-    /// The mission's time limit, s (the scenario's; checked).
+    /// The mission's time limit, s (the scenario's; [`task_campaign`] checks it).
     pub time_limit_s: f64,
     /// Success: a declaration within this distance of the source (of every source), m.
     pub success_radius_m: f64,
@@ -153,6 +153,10 @@ pub struct Task {
     pub tuning_seeds: u64,
     /// Test seeds the benchmark flies by default (the first ones).
     pub seeds: u64,
+    /// Planner keys every entrant is given on this task (a campaign configuration's `set`:
+    /// bare keys of the planner, e.g. `avoid_obstacles` where there are obstacles).
+    #[serde(default, skip_serializing_if = "toml::Table::is_empty")]
+    pub set: toml::Table,
 }
 
 #[derive(Debug, Deserialize)]
@@ -542,7 +546,7 @@ pub fn task_campaign(
             .map(|e| ConfigFile {
                 name: e.name.clone(),
                 planner: e.planner.clone(),
-                set: toml::Table::new(),
+                set: task.set.clone(),
             })
             .collect(),
         sweep: toml::Table::new(),
@@ -671,14 +675,49 @@ mod tests {
             ),
             (
                 good.replacen("vehicles =", "vehicle =", 1),
-                "tasks[0].vehicle: unknown field `vehicle`; did you mean `vehicles`? (line 31)",
+                "tasks[0].vehicle: unknown field `vehicle`; did you mean `vehicles`? (line #)",
             ),
         ];
+        let vehicles_line = good[..good.find("vehicles =").unwrap()]
+            .matches('\n')
+            .count()
+            + 1;
         for (text, want) in cases {
+            let want = want.replace('#', &vehicles_line.to_string());
             let e = TaskSet::parse(&text, "t.toml").unwrap_err().to_string();
             assert!(e.starts_with("t.toml: "), "{e}");
-            assert!(e.contains(want), "{e}\nwant: {want}");
+            assert!(e.contains(&want), "{e}\nwant: {want}");
         }
+    }
+
+    #[test]
+    fn every_task_builds_with_every_planner_and_states_its_time_limit() {
+        let set = TaskSet::builtin().unwrap();
+        let dir = tempfile::tempdir().unwrap();
+        for t in &set.tasks {
+            let entrants: Vec<Entrant> = t.planners.iter().map(|p| Entrant::named(p)).collect();
+            let c = task_campaign(&set, t, &entrants, 3, dir.path()).unwrap();
+            assert_eq!(c.file.seed, t.test_seed);
+            assert_eq!(c.configs.len(), t.planners.len());
+            // The benchmark's own campaign is the one `campaign` refuses without --test-seeds.
+            assert!(c.refuse_test_seeds().is_err(), "{}", t.name);
+        }
+        let mut wrong = set.clone();
+        wrong.tasks[0].time_limit_s = 3600.0;
+        let e = task_campaign(
+            &wrong,
+            &wrong.tasks[0],
+            &[Entrant::named("amp")],
+            1,
+            dir.path(),
+        )
+        .unwrap_err()
+        .to_string();
+        assert_eq!(
+            e,
+            "benchmarks/tasks-v1.toml: task 'coastal'.time_limit_s: says 3600 s, but its \
+             scenario's time limit is 7200 s"
+        );
     }
 
     #[test]
