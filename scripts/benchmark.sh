@@ -51,13 +51,18 @@ if [ -n "$jobs" ]; then cmd+=(--jobs "$jobs"); shown="$shown --jobs $jobs"; fi
 echo "== ${cmd[*]}" >&2
 log="$out.log"
 # CPU time (user + system) of the script's finished children, s, from bash's `times`.
+# (`times` runs in this shell, not in a pipe's subshell, which has no finished children.)
+times_file="$(mktemp)"
+trap 'rm -f "$times_file"' EXIT
 children_cpu() {
-    times | tail -1 | awk '{ split($1, u, "m"); split($2, s, "m"); sub("s", "", u[2]); sub("s", "", s[2]); print u[1] * 60 + u[2] + s[1] * 60 + s[2] }'
+    tail -1 "$times_file" | awk '{ split($1, u, "m"); split($2, s, "m"); sub("s", "", u[2]); sub("s", "", s[2]); print u[1] * 60 + u[2] + s[1] * 60 + s[2] }'
 }
+times > "$times_file"
 cpu0=$(children_cpu)
 start=$(date +%s.%N)
 "${cmd[@]}" 2>&1 | tee "$log" >&2
 wall=$(awk -v a="$start" -v b="$(date +%s.%N)" 'BEGIN { print b - a }')
+times > "$times_file"
 cpu=$(awk -v a="$cpu0" -v b="$(children_cpu)" 'BEGIN { print b - a }')
 
 board="$out/leaderboard.md"

@@ -163,6 +163,11 @@ fn plan<'a>(set: &'a TaskSet, a: &BenchmarkArgs) -> Result<Vec<(&'a Task, Vec<En
     }
     for f in &a.planner_file {
         let e = Entrant::from_file(f)?;
+        // Every key checked by the registry here, so an error names this file.
+        if let Some(t) = &e.planner {
+            plumetrace_planner::PlannerConfig::from_table(t, "")
+                .with_context(|| f.display().to_string())?;
+        }
         let kind = e
             .planner
             .as_ref()
