@@ -106,13 +106,15 @@ mkdir -p "$images"
     echo
     echo "The tasks are [\`benchmarks/tasks-v1.toml\`](../../benchmarks/tasks-v1.toml), described in"
     echo "[the benchmark](../benchmark.md). Everything below is the command's own \`leaderboard.md\`,"
-    echo "copied whole (its charts copied to \`docs/images/benchmark/\`); run the script again to"
+    echo "copied whole (its success charts copied to \`docs/images/benchmark/\`; the error charts are in"
+    echo "each task's directory); run the script again to"
     echo "regenerate it."
     echo
     # The leaderboard's title becomes a section; its task headings move down one level; its charts
     # point at the copies.
     sed -e '1s/^# /## /' -e '2,$s/^## /### /' \
-        -e 's#](\([a-z0-9_-]*\)/\(success\|errors\)\.svg)#](../images/benchmark/\1-\2.svg)#g' "$board"
+        -e 's# !\[errors of each planner on `[a-z0-9_-]*`\]([a-z0-9_-]*/errors\.svg)##' \
+        -e 's#](\([a-z0-9_-]*\)/success\.svg)#](../images/benchmark/\1-success.svg)#g' "$board"
     echo
     echo "Time per task (this call):"
     echo
@@ -121,9 +123,7 @@ mkdir -p "$images"
 for d in "$out"/*/; do
     t="$(basename "$d")"
     [ "$t" = "tasks" ] && continue
-    for c in success errors; do
-        if [ -f "$d/$c.svg" ]; then cp "$d/$c.svg" "$images/$t-$c.svg"; fi
-    done
+    if [ -f "$d/success.svg" ]; then cp "$d/success.svg" "$images/$t-success.svg"; fi
 done
 mv "$page.tmp" "$page"
 bash scripts/results.sh --index

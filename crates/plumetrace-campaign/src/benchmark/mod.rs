@@ -458,29 +458,28 @@ impl Entrant {
         if let Some(toml::Value::Table(inner)) = table.remove("planner") {
             table = inner;
         }
-        if plumetrace_mission::PlannerKind::ALL
-            .iter()
-            .all(|k| Some(k.name()) != plumetrace_planner_kind(&table))
+        let given = kind_of(&table);
+        if given
+            .and_then(plumetrace_mission::PlannerKind::from_name)
+            .is_none()
         {
             let known: Vec<&str> = plumetrace_mission::PlannerKind::ALL
                 .iter()
                 .map(|k| k.name())
                 .collect();
-            let given = plumetrace_planner_kind(&table).unwrap_or("");
             return Err(CampaignError::Invalid {
                 file: path.display().to_string(),
                 key: "kind".into(),
-                message: if given.is_empty() {
-                    format!(
+                message: match given {
+                    None => format!(
                         "missing: a planner file names its planner (kind = \"amp\"; one of {})",
                         known.join(", ")
-                    )
-                } else {
-                    format!(
-                        "'{given}' is not a planner{}; planners: {}",
-                        hint(&plumetrace_core::closest(given, &known).map(str::to_string)),
+                    ),
+                    Some(g) => format!(
+                        "'{g}' is not a planner{}; planners: {}",
+                        hint(&plumetrace_core::closest(g, &known).map(str::to_string)),
                         known.join(", ")
-                    )
+                    ),
                 },
             });
         }
@@ -496,7 +495,8 @@ impl Entrant {
     }
 }
 
-fn plumetrace_planner_kind(t: &toml::Table) -> Option<&str> {
+/// The `kind` a planner table names.
+fn kind_of(t: &toml::Table) -> Option<&str> {
     t.get("kind").and_then(toml::Value::as_str)
 }
 
