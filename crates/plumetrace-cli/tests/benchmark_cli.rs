@@ -271,7 +271,7 @@ fn benchmark_errors_name_what_is_wrong() {
         ],
         "mine.toml: kind: 'mot' is not a planner (did you mean 'moth'?)",
     );
-    std::fs::write(&bad, "kind = \"moth\"\nbeta_degg = 3.0\n").unwrap();
+    std::fs::write(&bad, "kind = \"moth\"\nspeed_mp = 3.0\n").unwrap();
     fails_with(
         &[
             "benchmark",
@@ -282,7 +282,7 @@ fn benchmark_errors_name_what_is_wrong() {
             "--out",
             o,
         ],
-        "config 'mine'",
+        "mine.toml: speed_mp: unknown field `speed_mp`; did you mean `speed_mps`?",
     );
     let foreign = tmp.path().join("foreign");
     std::fs::create_dir_all(&foreign).unwrap();
