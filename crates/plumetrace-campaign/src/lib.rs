@@ -24,6 +24,7 @@
 //! | `campaign.json`, `campaign.toml` | the fingerprint that ties the directory to its campaign, and a copy of the file |
 //! | `runs.parquet` | with the `parquet` feature: the sorted runs as Parquet |
 
+pub mod benchmark;
 pub mod charts;
 pub mod error;
 pub mod example;
@@ -40,5 +41,5 @@ pub use error::CampaignError;
 pub use execute::{CampaignReport, RunOptions, Share, run_campaign};
 pub use merge::{MergeReport, merge};
 pub use runs::{RUNS_FILE, RunRow};
-pub use spec::{Campaign, RunKey, Shard};
+pub use spec::{Campaign, RunKey, Shard, TestSeeds};
 pub use stats::{GroupSummary, wilson};

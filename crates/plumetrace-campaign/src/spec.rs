@@ -57,6 +57,16 @@ pub struct ConfigFile {
     pub set: toml::Table,
 }
 
+/// Whether a campaign may fly the test seeds of the benchmark's tasks.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum TestSeeds {
+    /// Refuse a campaign that reaches one (tuning, the default).
+    #[default]
+    Refuse,
+    /// Fly them (evaluation, asked for with `--test-seeds`).
+    Allow,
+}
+
 /// Most seeds per group.
 pub const MAX_SEEDS: u64 = 1_000_000;
 /// Most runs of one campaign (its run list is made in memory).
@@ -219,8 +229,18 @@ pub fn parse_campaign(text: &str, path: &Path) -> Result<CampaignFile, CampaignE
 }
 
 impl Campaign {
-    /// Reads a campaign file, loads its scenarios and checks every group builds.
+    /// Reads a campaign file, loads its scenarios and checks every group builds; a campaign
+    /// that would fly a test seed of a benchmark task is refused ([`Campaign::load_with`]).
     pub fn load(path: &Path, seeds: Option<u64>) -> Result<Self, CampaignError> {
+        Campaign::load_with(path, seeds, TestSeeds::Refuse)
+    }
+
+    /// [`Campaign::load`], saying whether the test seeds of the benchmark's tasks may be flown.
+    pub fn load_with(
+        path: &Path,
+        seeds: Option<u64>,
+        test_seeds: TestSeeds,
+    ) -> Result<Self, CampaignError> {
         let text = plumetrace_env::input::read_text(path, plumetrace_env::input::MAX_TEXT_BYTES)
             .map_err(|e| CampaignError::Io {
                 path: path.display().to_string(),
@@ -231,8 +251,47 @@ impl Campaign {
             file.seeds = n;
         }
         let c = Campaign::resolve(file, path, text, true)?;
+        if test_seeds == TestSeeds::Refuse {
+            c.refuse_test_seeds()?;
+        }
         c.check_groups()?;
         Ok(c)
+    }
+
+    /// Refuses a campaign whose runs reach a test seed of a benchmark task on that task's
+    /// scenario (a family's name, or a scenario's `name`).
+    pub fn refuse_test_seeds(&self) -> Result<(), CampaignError> {
+        let Ok(set) = crate::benchmark::TaskSet::builtin() else {
+            return Ok(());
+        };
+        for (i, s) in self.scenarios.iter().enumerate() {
+            let name = match &s.family {
+                Some(f) => Some(f.file.name.as_str()),
+                None => s.table.get("name").and_then(toml::Value::as_str),
+            };
+            let Some(name) = name else { continue };
+            if let Some(hit) = set.test_seed_use(name, self.file.seed, self.file.seeds) {
+                let task = set.task(&hit.task).ok();
+                return Err(CampaignError::Invalid {
+                    file: self.path.display().to_string(),
+                    key: "seed".into(),
+                    message: format!(
+                        "seed {} with {} seeds flies test seeds of benchmark task '{}' (task \
+                         set {}) on scenarios[{i}] '{}' (seed index {} is one); tune on its \
+                         tuning seed{}, or pass --test-seeds to fly the test seeds on purpose",
+                        self.file.seed,
+                        self.file.seeds,
+                        hit.task,
+                        set.version,
+                        s.label,
+                        hit.seed_index,
+                        task.map(|t| format!(" {}", t.tuning_seed))
+                            .unwrap_or_default(),
+                    ),
+                });
+            }
+        }
+        Ok(())
     }
 
     /// Expands a parsed file; `read_scenarios` false skips loading scenario files (merging needs

@@ -1,7 +1,7 @@
 //! `plumetrace campaign` and `plumetrace merge`.
 
 use anyhow::{Context, Result};
-use plumetrace_campaign::{Campaign, RunOptions, Shard, Share, merge, run_campaign};
+use plumetrace_campaign::{Campaign, RunOptions, Shard, Share, TestSeeds, merge, run_campaign};
 use std::path::PathBuf;
 use std::time::Instant;
 
@@ -31,6 +31,10 @@ pub struct CampaignArgs {
     /// The same as `--share none`.
     #[arg(long, conflicts_with = "share")]
     pub separate_spinups: bool,
+    /// Allow flying the test seeds of a benchmark task (refused by default: they are for
+    /// evaluation, not tuning).
+    #[arg(long)]
+    pub test_seeds: bool,
 }
 
 /// What runs of the same seed share (`--share`).
@@ -46,7 +50,15 @@ pub enum ShareArg {
 
 /// Runs (or resumes) a campaign and prints where the results are.
 pub fn run(args: &CampaignArgs) -> Result<()> {
-    let c = Campaign::load(&args.file, args.seeds)?;
+    let c = Campaign::load_with(
+        &args.file,
+        args.seeds,
+        if args.test_seeds {
+            TestSeeds::Allow
+        } else {
+            TestSeeds::Refuse
+        },
+    )?;
     let started = Instant::now();
     let planned = c.shard_runs(args.shard).len() as u64;
     let progress = crate::progress::Progress::new(planned, "runs");

@@ -28,6 +28,7 @@ macro_rules! outln {
 
 mod args;
 mod bench;
+mod benchmark;
 mod campaign;
 mod frontseat;
 mod load;
@@ -92,6 +93,9 @@ enum Command {
     Campaign(campaign::CampaignArgs),
     /// Merge the output directories of a campaign's shards.
     Merge(campaign::MergeArgs),
+    /// Fly the benchmark's tasks on their test seeds with the planners asked for (every
+    /// planner on the same sites) and write the leaderboard.
+    Benchmark(benchmark::BenchmarkArgs),
     /// Draw sites of a scenario family and write each as a scenario file (to fly or inspect).
     Family(FamilyArgs),
     /// Benchmarks; print one JSON object.
@@ -139,6 +143,7 @@ fn dispatch(cli: Cli) -> Result<()> {
         Command::Campaign(args) => campaign::run(&args),
         Command::Merge(args) => campaign::run_merge(&args),
         Command::Family(args) => family(&args),
+        Command::Benchmark(args) => benchmark::run(&args),
         Command::Bench(b) => bench::run(&b),
     }
 }
@@ -188,12 +193,33 @@ struct FamilyArgs {
     /// Where to write `site-K.toml` (a new or empty directory).
     #[arg(long)]
     out: PathBuf,
+    /// Allow drawing the test seeds of a benchmark task (refused by default: they are for
+    /// evaluation, not tuning).
+    #[arg(long)]
+    test_seeds: bool,
 }
 
 /// `plumetrace family FILE --sample N --out DIR`: draws N sites and writes each as a scenario
 /// file (with the drawn values in its opening comment), checked by the same build as `run`.
 fn family(a: &FamilyArgs) -> Result<()> {
     let f = plumetrace_scenario::Family::load(&a.file)?;
+    if !a.test_seeds {
+        let set = plumetrace_campaign::benchmark::TaskSet::builtin()?;
+        if let Some(hit) = set.test_seed_use(&f.file.name, a.seed, a.sample) {
+            let tuning = set.task(&hit.task).map(|t| t.tuning_seed)?;
+            anyhow::bail!(
+                "{}: --seed {} with --sample {} draws test seeds of benchmark task '{}' (task set \
+                 {}; site {} is one); draw its tuning seed {tuning}, or pass --test-seeds to draw \
+                 the test sites on purpose",
+                a.file.display(),
+                a.seed,
+                a.sample,
+                hit.task,
+                set.version,
+                hit.seed_index
+            );
+        }
+    }
     if a.out.exists() && !a.out.is_dir() {
         anyhow::bail!(
             "{}: is a file, not a directory; give a new or empty --out directory",
