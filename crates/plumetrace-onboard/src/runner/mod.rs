@@ -197,23 +197,21 @@ mod tests {
         )
     }
 
+    /// The AMP over a Bluefin link with one more `[link]` line and a time limit.
+    fn amp_over_bluefin(link_line: &str, time_limit_s: f64) -> Onboard {
+        let text = format!(
+            "[mission]\nop_area = [[60.0, -80.0], [460.0, -80.0], [460.0, 80.0], [60.0, 80.0]]\n\
+             prior_flow_toward_deg = 90.0\n[planner]\nkind = \"amp\"\n[link]\n\
+             protocol = \"bluefin\"\naddress = \"127.0.0.1:1\"\n\
+             origin = {{ lat_deg = 36.18, lon_deg = -75.75 }}\n{link_line}\n\
+             [run]\ntime_limit_s = {time_limit_s:?}\n"
+        );
+        Onboard::from_toml(&text).unwrap_or_else(|e| panic!("{e}\n{text}"))
+    }
+
     #[test]
     fn in_real_time_stale_navigation_pauses_the_planner_and_sends_the_safe_command() {
-        let text = r#"
-[mission]
-op_area = [[60.0, -80.0], [460.0, -80.0], [460.0, 80.0], [60.0, 80.0]]
-prior_flow_toward_deg = 90.0
-[planner]
-kind = "amp"
-[link]
-protocol = "bluefin"
-address = "127.0.0.1:1"
-origin = { lat_deg = 36.18, lon_deg = -75.75 }
-stale_nav_s = 0.3
-[run]
-time_limit_s = 1.6
-"#;
-        let onboard = Onboard::from_toml(text).unwrap_or_else(|e| panic!("{e}"));
+        let onboard = amp_over_bluefin("stale_nav_s = 0.3", 1.6);
         let mut events = vec![(0.0, LinkEvent::Connected)];
         events.extend([0.0, 0.1, 0.2].map(nav));
         // Silence from 0.2 s to 1.0 s.
@@ -262,21 +260,7 @@ time_limit_s = 1.6
 
     #[test]
     fn a_link_that_connects_and_drops_without_navigation_gives_up() {
-        let text = r#"
-[mission]
-op_area = [[60.0, -80.0], [460.0, -80.0], [460.0, 80.0], [60.0, 80.0]]
-prior_flow_toward_deg = 90.0
-[planner]
-kind = "amp"
-[link]
-protocol = "bluefin"
-address = "127.0.0.1:1"
-origin = { lat_deg = 36.18, lon_deg = -75.75 }
-give_up_s = 0.5
-[run]
-time_limit_s = 5.0
-"#;
-        let onboard = Onboard::from_toml(text).unwrap_or_else(|e| panic!("{e}"));
+        let onboard = amp_over_bluefin("give_up_s = 0.5", 5.0);
         let flapping = |from: f64| {
             (0..20).flat_map(move |k| {
                 let t = from + 0.1 * k as f64;
