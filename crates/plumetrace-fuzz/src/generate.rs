@@ -260,7 +260,7 @@ mod tests {
             assert!(!input.mutations.is_empty());
             targets.insert(input.target);
             seen.extend(input.mutations.iter().map(|m| m.kind));
-            if seen.len() == Kind::ALL.len() && targets.len() == 4 {
+            if seen.len() == Kind::ALL.len() && targets.len() == 5 {
                 break;
             }
         }
@@ -272,8 +272,8 @@ mod tests {
         assert!(missing.is_empty(), "never produced: {missing:?}");
         assert_eq!(
             targets.len(),
-            4,
-            "scenarios, campaigns, families and onboard files"
+            5,
+            "scenarios, campaigns, families, onboard files and NetCDF currents"
         );
     }
 }
