@@ -18,8 +18,7 @@ cli_target="${CARGO_TARGET_DIR:-$root/target}"
 # have in common.
 export CARGO_TARGET_DIR="$cli_target"
 cargo fmt --manifest-path "$py/Cargo.toml" --check
-# In the dev profile, as the workspace's own lints, whose checked dependencies it reuses.
-cargo clippy --manifest-path "$py/Cargo.toml" --all-targets -- -D warnings
+cargo clippy --release --manifest-path "$py/Cargo.toml" --all-targets -- -D warnings
 
 # The environment (maturin, Gymnasium, pytest, the optional dependencies) is made once by
 # scripts/venvs.sh; the package itself is installed into it anew every time.
