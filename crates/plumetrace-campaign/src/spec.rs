@@ -581,10 +581,11 @@ impl Campaign {
         fn collect(v: &toml::Value, out: &mut std::collections::BTreeSet<String>) {
             match v {
                 toml::Value::Table(t) => {
-                    if let Some(toml::Value::String(k)) = t.get("kind")
+                    // `kind`, or its older name `strategy`, as the planner registry reads them.
+                    if let Some(k) = plumetrace_mission::planner_kind_name(t)
                         && plumetrace_mission::PlannerKind::from_name(k).is_some()
                     {
-                        out.insert(k.clone());
+                        out.insert(k.to_owned());
                     }
                     t.values().for_each(|v| collect(v, out));
                 }
@@ -936,6 +937,33 @@ mod tests {
         assert_ne!(c.fingerprint(), c.fingerprint_with(other));
         // Only the planners the campaign flies count: one added to the registry changes nothing.
         assert_eq!(c.planner_kinds().into_iter().collect::<Vec<_>>(), ["amp"]);
+    }
+
+    #[test]
+    fn a_planner_named_by_its_older_key_counts_in_the_fingerprint() {
+        let kinds = |key: &str| {
+            let text = format!(
+                "name = \"c\"\nseed = 1\nseeds = 1\nscenarios = [\"demo\"]\n\
+                 [[configs]]\nname = \"m\"\n[configs.planner]\n{key} = \"moth\"\n"
+            );
+            let path = Path::new("c.toml");
+            let file = parse_campaign(&text, path).unwrap();
+            let c = Campaign::resolve(file, path, text.clone(), true).unwrap();
+            (
+                c.planner_kinds().into_iter().collect::<Vec<_>>(),
+                c.fingerprint(),
+            )
+        };
+        let (by_kind, print_kind) = kinds("kind");
+        let (by_strategy, print_strategy) = kinds("strategy");
+        assert_eq!(by_kind, ["moth"]);
+        assert_eq!(
+            by_strategy,
+            ["moth"],
+            "`strategy` names the planner as `kind` does"
+        );
+        // The two files differ only in the key's spelling, which the configurations record.
+        assert_ne!(print_kind, print_strategy);
     }
 
     #[test]

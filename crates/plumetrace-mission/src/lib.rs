@@ -41,6 +41,7 @@ pub use mission::{
 };
 pub use outcome::{EndReason, MissionEnd, MissionEvent, Outcome, VehicleStatus};
 pub use plumetrace_planner::PlannerKind;
+pub use plumetrace_planner::planners::kind_name as planner_kind_name;
 pub use plumetrace_planner::registry_defaults as planner_defaults;
 pub use record::{
     EventKind, EventRecord, Observer, PlumeFrame, PlumeFrames, RecordError, StepView, TrajectoryRow,

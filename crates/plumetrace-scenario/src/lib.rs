@@ -69,27 +69,45 @@ pub fn parse(text: &str, origin: &Origin) -> Result<ScenarioConfig, ScenarioErro
     }
     // Positions in latitude and longitude become metres first (a scenario without them is read
     // straight from the text, as always).
-    if let Ok(mut table) = text.parse::<toml::Table>()
-        && geographic::any(&table)
-    {
-        geographic::to_local(&mut table).map_err(|(path, message)| {
-            ScenarioError::Parse {
-                origin: origin.to_string(),
-                line: None,
-                path,
-                message,
-            }
-            .located(text)
-        })?;
-        return deserialize(toml::Value::Table(table), origin).map_err(|e| e.located(text));
-    }
+    let parse_error = match text.parse::<toml::Table>() {
+        Ok(mut table) if geographic::any(&table) => {
+            geographic::to_local(&mut table).map_err(|(path, message)| {
+                ScenarioError::Parse {
+                    origin: origin.to_string(),
+                    line: None,
+                    path,
+                    message,
+                }
+                .located(text)
+            })?;
+            return deserialize(toml::Value::Table(table), origin).map_err(|e| e.located(text));
+        }
+        Ok(_) => None,
+        Err(e) => Some(e),
+    };
     let de = toml::Deserializer::parse(text).map_err(|e| ScenarioError::Parse {
         origin: origin.to_string(),
         line: None,
         path: String::new(),
         message: e.to_string(),
     })?;
-    deserialize(de, origin).map_err(|e| e.located(text))
+    let cfg = deserialize(de, origin).map_err(|e| e.located(text))?;
+    // A whole number a count takes but TOML's integers cannot hold (above 9223372036854775807)
+    // cannot be checked against its bound later (the check reads the scenario back as TOML):
+    // the parser's report shows where it is. Seeds, written back as strings, are not affected.
+    let unbounded = parse_error.filter(|_| toml::Value::try_from(&cfg).is_err());
+    match unbounded {
+        None => Ok(cfg),
+        Some(e) => Err(ScenarioError::Parse {
+            origin: origin.to_string(),
+            line: None,
+            path: String::new(),
+            message: format!(
+                "{}\n(TOML's whole numbers go up to 9223372036854775807)",
+                e.to_string().trim_end()
+            ),
+        }),
+    }
 }
 
 /// Reads a scenario from an already parsed TOML table (e.g. a scenario with overrides applied);

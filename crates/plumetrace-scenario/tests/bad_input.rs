@@ -732,6 +732,39 @@ fn kelp_seeds_take_every_64_bit_value_as_the_run_seed_does() {
 }
 
 #[test]
+fn a_count_beyond_toml_integers_is_shown_where_it_is_written() {
+    // A count read as a 64-bit unsigned number takes 2^63, which TOML's integers cannot hold:
+    // the error shows the line and the number, where it used to name no key at all.
+    let text = demo_with(|t| {
+        t.replacen(
+            "[plume]\n",
+            "[plume]\nmax_filaments = 9223372036854775808\n",
+            1,
+        )
+    });
+    let e = error_of(&text);
+    assert!(
+        e.starts_with("scenario.toml: TOML parse error at line ")
+            && e.contains("max_filaments = 9223372036854775808")
+            && e.ends_with("(TOML's whole numbers go up to 9223372036854775807)"),
+        "{e}"
+    );
+    // Within TOML's integers, the key's bound says what is wrong.
+    let text = demo_with(|t| {
+        t.replacen(
+            "[plume]\n",
+            "[plume]\nmax_filaments = 9223372036854775807\n",
+            1,
+        )
+    });
+    let e = error_of(&text);
+    assert!(
+        e.contains("plume.max_filaments: must be >= 1.0 and <= 10000000.0"),
+        "{e}"
+    );
+}
+
+#[test]
 fn flow_sub_steps_count_in_the_step_budget_with_their_grid() {
     // A 0.1 s plume run on a fine grid whose stable step needs about 250,000 sub-steps per step
     // is within the budget; a 10 s one would take about 2.5e13 node updates and ran for days.
