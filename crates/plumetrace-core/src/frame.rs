@@ -2,11 +2,7 @@
 
 use crate::Heading;
 
-/// A horizontal vector or position `(east, north)` in metres (or m/s for velocities).
-pub type Vec2 = nalgebra::Vector2<f64>;
-
-/// A 3-D vector or position `(east, north, up)`; for positions `z` is the height above the seabed.
-pub type Vec3 = nalgebra::Vector3<f64>;
+pub use crate::vector::{Vec2, Vec3};
 
 /// Unit vector of a compass heading: `(east, north) = (sin psi, cos psi)`.
 pub fn heading_vector(h: Heading) -> Vec2 {

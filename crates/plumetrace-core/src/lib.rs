@@ -23,6 +23,7 @@ pub mod message;
 pub mod names;
 pub mod params;
 pub mod planner;
+pub mod vector;
 pub mod vehicle;
 
 pub use angle::{Heading, wrap_deg_180, wrap_deg_360, wrap_rad_pi};
