@@ -35,6 +35,7 @@ WATCHED = [
     "CPT_DETECTION",
     "CPT_DECLARATION",
     "VIEW_POLYGON",
+    "VIEW_SEGLIST",
     "VIEW_MARKER",
     "VIEW_POINT",
 ]
