@@ -805,3 +805,25 @@ fn the_first_timing_reply_does_not_move_the_skew() {
         );
     }
 }
+
+#[test]
+fn the_link_names_the_process_posting_the_navigation() {
+    let (port, server) = fake_moosdb(Script {
+        end_at: 2.0,
+        ..Script::default()
+    });
+    let o = onboard(port, 1.0, "real_time");
+    let mut link = runner::link_for(&o, None).unwrap();
+    let name = link.sensor_source().unwrap();
+    assert_eq!(*name.lock().unwrap(), "", "not known before any posting");
+    let mut seen = Vec::new();
+    let report = runner::run(&o, &mut *link, None, &mut |_, _| {
+        seen.push(name.lock().unwrap().clone());
+    })
+    .unwrap();
+    drop(link);
+    server.join().unwrap();
+    assert!(report.decisions > 0);
+    // Known by the first decision: the source of the NAV_X postings (run.alog's source column).
+    assert!(seen.iter().all(|n| n == "uSimMarine"), "{seen:?}");
+}

@@ -77,6 +77,8 @@ pub struct MoosLink {
     // planner's points.
     geometry: Vec<(&'static str, String)>,
     views: Views,
+    // The process posting NAV_X, as its postings name it (for run.alog's source column).
+    nav_source: plumetrace_log::alog::SharedName,
 }
 
 impl MoosLink {
@@ -115,6 +117,7 @@ impl MoosLink {
             outbox: Vec::new(),
             geometry: Vec::new(),
             views: Views::default(),
+            nav_source: Default::default(),
         }
     }
 
@@ -394,6 +397,13 @@ impl MoosLink {
         }
         self.nav
             .take(m, self.settings.chem_variable.as_deref(), events)?;
+        if m.key == "NAV_X"
+            && !m.source.is_empty()
+            && let Ok(mut name) = self.nav_source.lock()
+            && *name != m.source
+        {
+            name.clone_from(&m.source);
+        }
         if m.time.is_finite() && m.time > self.clock && m.time > 0.0 {
             self.clock = m.time;
             events.push(LinkEvent::Clock(UtcTime::from_seconds(
@@ -621,6 +631,10 @@ impl Link for MoosLink {
 
     fn connected(&self) -> bool {
         self.conn.is_some() && self.phase == Phase::Ready
+    }
+
+    fn sensor_source(&self) -> Option<plumetrace_log::alog::SharedName> {
+        Some(self.nav_source.clone())
     }
 
     fn decided(&mut self, _snapshot: &SensorSnapshot, d: &Decision) {
