@@ -1,10 +1,11 @@
 #!/usr/bin/env bash
 # The MOOS link against a real MOOSDB: starts MOOSDB on a free port with a mission file of its
-# own, flies `plumetrace onboard` (built with the moos feature) against a simulated vehicle
-# (scripts/moos_vehicle.py, a MOOS client in Python's standard library), checks what the planner
-# publishes, restarts the MOOSDB once and checks that the client reconnects and goes on, then
-# prints PASS or FAIL per check. Exits 1 on any failure; says it skipped (and exits 0) when
-# there is no MOOSDB on the PATH.
+# own, leaves stale navigation stored in it, flies `plumetrace onboard` (built with the moos
+# feature) against a simulated vehicle (scripts/moos_vehicle.py, a MOOS client in Python's
+# standard library) after a posting over 1 MiB, checks what the planner publishes, restarts the
+# MOOSDB once and checks that the client reconnects and goes on, then prints PASS or FAIL per
+# check. Exits 1 on any failure; says it skipped (and exits 0) when there is no MOOSDB on the
+# PATH.
 #
 #   scripts/moos_interop.sh [--bin PATH] [--keep]
 #
@@ -12,8 +13,9 @@
 # the target directory); --keep: keep the working directory (mission file, onboard file and
 # output, every process's log) and print its path.
 #
-# The clients connect over loopback. MOOSDB itself has no option to listen on one address
-# only: it listens on every interface, on a free port, for the minute the script takes.
+# The clients connect over loopback. MOOSDB has no option to listen on one address only: a stock
+# build listens on every interface (on a free port, for the 40 s the script takes); the script
+# says which address it listens on.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -53,6 +55,7 @@ OVERRIDE_AT=10       # the vehicle posts MOOS_MANUAL_OVERRIDE = true, and false 
 DB_DOWN_AT=18        # the MOOSDB is stopped ...
 DB_DOWN_FOR=2        # ... and started again this much later on the same port
 COMMUNITY=plumetrace_interop
+CONSOLIDATION_MS=150 # the MOOSDB asks pPlumetrace for this much between its packets (--response)
 
 WORK="$(mktemp -d "${TMPDIR:-/tmp}/moos-interop.XXXXXX")"
 DB_PID=""
@@ -123,7 +126,8 @@ EOF
 
 start_db() {
     (cd "$WORK" && exec MOOSDB interop.moos --moos_port="$PORT" --audit_port="$AUDIT_PORT" \
-        --moos_suicide_disable --moos_no_colour) >> "$WORK/moosdb.log" 2>&1 &
+        --response="pPlumetrace:$CONSOLIDATION_MS" --moos_suicide_disable --moos_no_colour) \
+        >> "$WORK/moosdb.log" 2>&1 &
     DB_PID=$!
     # Ready when it accepts a connection (the probe shows in its log as a failed handshake).
     for _ in $(seq 100); do
@@ -140,12 +144,33 @@ start_db() {
 
 echo "moos_interop: MOOSDB ($(command -v MOOSDB)) on 127.0.0.1:$PORT, community $COMMUNITY, in $WORK"
 start_db
-python3 scripts/moos_vehicle.py --port "$PORT" --log "$WORK/vehicle.tsv" \
-    --duration $((TIME_LIMIT + 15)) --start-x 110 --override-at "$OVERRIDE_AT" --override-for 3 \
-    2> "$WORK/vehicle.log" &
-VEHICLE_PID=$!
+LISTEN="$(python3 - "$PORT" <<'PY' 2>/dev/null || true
+import sys
+port = int(sys.argv[1])
+for line in open("/proc/net/tcp").readlines()[1:]:
+    local, state = line.split()[1], line.split()[3]
+    addr, p = local.split(":")
+    if state == "0A" and int(p, 16) == port:
+        print(".".join(str(int(addr[i:i + 2], 16)) for i in (6, 4, 2, 0)))
+PY
+)"
+echo "moos_interop: the MOOSDB listens on ${LISTEN:-?}:$PORT$([ "$LISTEN" = 0.0.0.0 ] && echo ' (every interface)')"
+# Stored values a client is sent at registration, however old: navigation of another vehicle,
+# posted 50 s ago.
+python3 scripts/moos_vehicle.py --port "$PORT" --log /dev/null --prime stale --name uOldVehicle \
+    2>> "$WORK/vehicle.log"
 "$BIN" onboard "$WORK/onboard.toml" --out "$WORK/onboard-out" > "$WORK/onboard.log" 2>&1 &
 ONBOARD_PID=$!
+# A second later, once it has registered: a posting over 1 MiB on a variable it reads; then the
+# vehicle.
+sleep 1 &
+wait $!
+python3 scripts/moos_vehicle.py --port "$PORT" --log /dev/null --prime huge --name uBigPoster \
+    2>> "$WORK/vehicle.log"
+python3 scripts/moos_vehicle.py --port "$PORT" --log "$WORK/vehicle.tsv" \
+    --duration $((TIME_LIMIT + 15)) --start-x 110 --override-at "$((OVERRIDE_AT - 1))" \
+    --override-for 3 2>> "$WORK/vehicle.log" &
+VEHICLE_PID=$!
 
 # Waits up to $1 s, less if the onboard process ends first (in the background, so a signal is
 # taken at once).
@@ -218,8 +243,16 @@ WELCOMES="$(grep -c "welcome to community $COMMUNITY" "$LINKLOG" 2>/dev/null || 
 WELCOME="$(grep -m1 -o "welcome to community $COMMUNITY.*" "$LINKLOG" 2>/dev/null || true)"
 check "handshake" "$(ok test "${WELCOMES:-0}" -ge 1)" "link.log: ${WELCOME:-no welcome}"
 REJECTED="$(report lines_rejected)"
-check "traffic" "$(ok python3 -c "import json, sys; r = json.load(open(sys.argv[1]))['lines_rejected']; sys.exit(any(k != 'stale' for k in r))" "$REPORT" 2>/dev/null)" \
-    "$(report lines_accepted) messages taken, rejected by kind: $REJECTED (only stored values older than stale_nav_s may be)"
+check "traffic" "$(ok python3 -c "import json, sys; r = json.load(open(sys.argv[1]))['lines_rejected']; sys.exit(any(k not in ('stale', 'too_large') for k in r))" "$REPORT" 2>/dev/null)" \
+    "$(report lines_accepted) messages taken, rejected by kind: $REJECTED (only the stored values below may be)"
+# The four stale NAV_* not taken, the posting over 1 MiB skipped once, and the connection kept
+# (the restart check counts the connections).
+stored_values() {
+    python3 -c "import json, sys; r = json.load(open(sys.argv[1]))['lines_rejected']; sys.exit(not (r.get('stale', 0) >= 4 and r.get('too_large', 0) == 1))" "$REPORT" 2>/dev/null
+}
+FIRST_X="$(awk '$2 == "NAV_X" { print $4; exit }' "$WORK/onboard-out/run.alog" 2>/dev/null)"
+check "stale, huge" "$(ok test "$(ok stored_values)" = 0 -a -n "$FIRST_X" -a "${FIRST_X%%.*}" != 999)" \
+    "stale: $(report lines_rejected | grep -o "'stale': [0-9]*" || echo none), over 1 MiB: $(report lines_rejected | grep -o "'too_large': [0-9]*" || echo none); first NAV_X logged: ${FIRST_X:-none} (the stale one was 999)"
 
 # set_points KEY LO HI: at least 50 postings, each in [LO, HI].
 set_points() { [ "$(count "$1")" -ge 50 ] && in_range "$1" "$2" "$3"; }
@@ -251,6 +284,37 @@ MARKER="$(postings VIEW_MARKER | grep -E '^type=diamond,x=-?[0-9.]+,y=-?[0-9.]+,
 check "VIEW_MARKER" "$(ok test -n "$MARKER")" "$(count VIEW_MARKER) postings; last estimate: ${MARKER:-none}"
 POINT="$(postings VIEW_POINT | grep -E '^x=-?[0-9.]+,y=-?[0-9.]+,label=cpt_lost_[0-9]+,vertex_color=red,vertex_size=4$' | head -n 1 || true)"
 check "VIEW_POINT" "$(ok test -n "$POINT")" "$(count VIEW_POINT) postings; first: ${POINT:-none}"
+
+# The consolidation period the MOOSDB asked for: taken from its timing replies, and no two
+# packets of set-points closer than that (less 30 ms for the vehicle's receipt times) once the
+# first replies have come (the first few set-points of a connection are not paced yet). A stop
+# is never held back, and the set-point waiting for the period goes with it, so a packet with a
+# stop does not count.
+PERIOD="$(grep -m1 -o 'consolidation period [0-9.]* s' "$LINKLOG" 2>/dev/null || true)"
+GAPS="$(python3 - "$TSV" <<'PY' 2>/dev/null || true
+import sys
+rows = [l.rstrip("\n").split("\t") for l in open(sys.argv[1])]
+rows = [r for r in rows if len(r) == 5 and r[3] == "pPlumetrace"]
+stops = [float(r[0]) for r in rows if r[2] == "DESIRED_SPEED" and float(r[4]) == 0.0]
+by_conn = {}
+for r in rows:
+    t = float(r[0])
+    if r[2] == "DESIRED_HEADING" and not any(0 <= s - t < 0.005 for s in stops):
+        by_conn.setdefault(r[1], []).append(t)
+gaps = [b - a for ts in by_conn.values() for a, b in zip(ts[4:], ts[5:])]
+if gaps:
+    print(f"{min(gaps):.3f} {sum(gaps) / len(gaps):.3f}")
+PY
+)"
+paced() {
+    [ -n "$PERIOD" ] && [ -n "$GAPS" ] &&
+        awk -v g="${GAPS%% *}" -v p="$CONSOLIDATION_MS" 'BEGIN { exit !(g >= p / 1000 - 0.03) }'
+}
+check "consolidation" "$(ok paced)" \
+    "MOOSDB --response=pPlumetrace:$CONSOLIDATION_MS; link.log: ${PERIOD:-none}; set-point gaps min/mean ${GAPS:-?} s"
+SKEW="$(grep -m1 -o 'skew [^)]*' "$LINKLOG" 2>/dev/null || true)"
+check "skew" "$(ok test "$SKEW" = "skew not estimated: the MOOSDB is on this host")" \
+    "${SKEW:-none} (as libMOOS does for a MOOSDB on the same host)"
 
 AFTER="$(count DESIRED_HEADING 2)"
 CONNECTIONS="$(report connections)"

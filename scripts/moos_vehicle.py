@@ -9,6 +9,11 @@ The wire format is the one crates/plumetrace-onboard/src/moos/wire.rs documents:
 packets of messages, the `ELKS CAN'T DANCE 2/8/10` handshake, a timing message each second.
 It reconnects when the MOOSDB goes away, and posts MOOS_MANUAL_OVERRIDE when told to.
 
+With --prime stale it only posts NAV_X, NAV_Y, NAV_HEADING and NAV_SPEED of a vehicle far from
+the one that will fly, stamped 50 s ago (the values a MOOSDB keeps and sends to a client that
+registers later, as a vehicle that stopped posting would leave them); with --prime huge, a
+MOOS_MANUAL_OVERRIDE string of 1.5 MiB; then it disconnects.
+
 The plume: the water flows toward the east; a source at (--source-x, --source-y) spreads a
 Gaussian plume downflow of it whose width grows one metre per ten, with a peak reading of 1.
 """
@@ -218,6 +223,34 @@ class Vehicle:
         self.x += self.speed * math.sin(h) * dt
         self.y += self.speed * math.cos(h) * dt
 
+    def prime(self, what):
+        self.connect()
+        if self.sock is None:
+            sys.exit("vehicle: --prime: no MOOSDB")
+        if what == "stale":
+            old = time.time() - 50.0
+            posts = [
+                message(b"N", k, old, v, source=self.args.name)
+                for k, v in [
+                    ("NAV_X", 999.0),
+                    ("NAV_Y", 999.0),
+                    ("NAV_HEADING", 0.0),
+                    ("NAV_SPEED", 1.0),
+                ]
+            ]
+            told = "NAV_* at (999, 999) stamped 50 s ago"
+        else:
+            # A string: a MOOSDB keeps a variable's type, and the override is a string.
+            posts = [self.msg(b"N", "MOOS_MANUAL_OVERRIDE", string="x" * (1536 * 1024))]
+            told = "MOOS_MANUAL_OVERRIDE of 1.5 MiB"
+        self.send(posts)
+        # The MOOSDB has them once it answers the next timing message.
+        self.last_timing = 0.0
+        self.send([])
+        self.read_packets(1.0)
+        self.note(f"primed: {told}")
+        self.drop("primed")
+
     def run(self):
         a = self.args
         override = []
@@ -277,10 +310,18 @@ def main():
         "--override-at", type=float, help="post MOOS_MANUAL_OVERRIDE = true then"
     )
     p.add_argument("--override-for", type=float, default=3.0)
+    p.add_argument(
+        "--prime",
+        choices=["stale", "huge"],
+        help="only post stale NAV_* or an override string over 1 MiB, then leave",
+    )
     args = p.parse_args()
     signal.signal(signal.SIGTERM, lambda *_: sys.exit(0))
     with open(args.log, "w", buffering=1) as log:
-        Vehicle(args, log).run()
+        if args.prime:
+            Vehicle(args, log).prime(args.prime)
+        else:
+            Vehicle(args, log).run()
 
 
 if __name__ == "__main__":

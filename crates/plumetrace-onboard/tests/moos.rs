@@ -741,7 +741,7 @@ fn cpt_paused_goes_back_to_false_after_a_reconnection() {
 /// thread does.
 #[test]
 fn the_consolidation_period_paces_the_set_points() {
-    let (report, rec, _) = fly(
+    let (report, rec, log) = fly(
         Script {
             consolidation_s: 0.5,
             ..Script::default()
@@ -761,6 +761,13 @@ fn the_consolidation_period_paces_the_set_points() {
     assert!(gaps.len() >= 3 && mean >= 0.45, "{gaps:?}");
     assert!(gaps.iter().all(|g| *g >= 0.25), "{gaps:?}");
     assert!(report.decisions as usize > times.len(), "{report:?}");
+    // The period is written to the traffic log once, when it changes.
+    assert_eq!(
+        log.matches("# consolidation period 0.500 s (the MOOSDB's timing reply)")
+            .count(),
+        1,
+        "{log}"
+    );
 }
 
 /// A MOOSDB on this host: no skew correction (libMOOS turns it off), so postings carry this

@@ -363,7 +363,17 @@ impl MoosLink {
     fn timing_reply(&mut self, m: &Message) {
         // The MOOSDB's consolidation period paces outgoing mail (bounded: a second at most).
         if m.double2.is_finite() {
-            self.outgoing_delay = Duration::from_secs_f64(m.double2.clamp(0.0, 1.0));
+            let delay = Duration::from_secs_f64(m.double2.clamp(0.0, 1.0));
+            if delay != self.outgoing_delay {
+                self.outgoing_delay = delay;
+                self.log(
+                    '#',
+                    &format!(
+                        "consolidation period {:.3} s (the MOOSDB's timing reply): at most one packet of set-points per period",
+                        delay.as_secs_f64()
+                    ),
+                );
+            }
         }
         self.timing_replies += 1;
         // As libMOOS: the first reply does not count towards the skew.
