@@ -14,6 +14,10 @@ the one that will fly, stamped 50 s ago (the values a MOOSDB keeps and sends to 
 registers later, as a vehicle that stopped posting would leave them); with --prime huge, a
 MOOS_MANUAL_OVERRIDE string of 1.5 MiB; then it disconnects.
 
+With --proxy PORT it is no vehicle but a TCP relay: it listens on PORT, passes each connection
+through to the MOOSDB, and cuts the open ones when sent SIGUSR1, as a lost network would,
+while the MOOSDB stays up.
+
 The plume: the water flows toward the east; a source at (--source-x, --source-y) spreads a
 Gaussian plume downflow of it whose width grows one metre per ten, with a peak reading of 1.
 """
@@ -295,6 +299,51 @@ class Vehicle:
         self.drop("done")
 
 
+def proxy(args):
+    """Relays connections on --proxy to the MOOSDB; cuts the open ones on SIGUSR1."""
+    listener = socket.socket()
+    listener.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
+    listener.bind(("127.0.0.1", args.proxy))
+    listener.listen(4)
+    started = time.time()
+    pairs = []
+    cut = []
+    signal.signal(signal.SIGUSR1, lambda *_: cut.append(True))
+    while time.time() - started < args.duration:
+        socks = [listener] + [s for p in pairs for s in p]
+        try:
+            ready, _, _ = select.select(socks, [], [], 0.05)
+        except InterruptedError:
+            ready = []
+        for s in ready:
+            if s is listener:
+                client, _ = listener.accept()
+                try:
+                    pairs.append((client, socket.create_connection(("127.0.0.1", args.port), 2.0)))
+                except OSError:
+                    client.close()
+                continue
+            pair = next(p for p in pairs if s in p)
+            other = pair[1] if s is pair[0] else pair[0]
+            try:
+                data = s.recv(65536)
+                if data:
+                    other.sendall(data)
+                    continue
+            except OSError:
+                pass
+            for x in pair:
+                x.close()
+            pairs.remove(pair)
+        if cut:
+            cut.clear()
+            print(f"proxy: {time.time() - started:6.2f} s: cutting {len(pairs)} connection(s)", file=sys.stderr, flush=True)
+            for pair in pairs:
+                for x in pair:
+                    x.close()
+            pairs = []
+
+
 def main():
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("--port", type=int, required=True)
@@ -315,8 +364,12 @@ def main():
         choices=["stale", "huge"],
         help="only post stale NAV_* or an override string over 1 MiB, then leave",
     )
+    p.add_argument("--proxy", type=int, help="relay this port to the MOOSDB instead")
     args = p.parse_args()
     signal.signal(signal.SIGTERM, lambda *_: sys.exit(0))
+    if args.proxy is not None:
+        proxy(args)
+        return
     with open(args.log, "w", buffering=1) as log:
         if args.prime:
             Vehicle(args, log).prime(args.prime)
