@@ -1,10 +1,11 @@
 #!/usr/bin/env bash
 # The MOOS link against a real MOOSDB: starts MOOSDB on a free port with a mission file of its
-# own, flies `plumetrace onboard` (built with the moos feature) against a simulated vehicle
-# (scripts/moos_vehicle.py, a MOOS client in Python's standard library), checks what the planner
-# publishes, restarts the MOOSDB once and checks that the client reconnects and goes on, then
-# prints PASS or FAIL per check. Exits 1 on any failure; says it skipped (and exits 0) when
-# there is no MOOSDB on the PATH.
+# own, leaves stale navigation stored in it, flies `plumetrace onboard` (built with the moos
+# feature) against a simulated vehicle (scripts/moos_vehicle.py, a MOOS client in Python's
+# standard library) after a posting over 1 MiB, checks what the planner publishes, cuts the
+# client's connection once (through a relay, the MOOSDB up) and restarts the MOOSDB once and
+# checks that the client reconnects and goes on, then prints PASS or FAIL per check. Exits 1 on
+# any failure; says it skipped (and exits 0) when there is no MOOSDB on the PATH.
 #
 #   scripts/moos_interop.sh [--bin PATH] [--keep]
 #
@@ -12,8 +13,9 @@
 # the target directory); --keep: keep the working directory (mission file, onboard file and
 # output, every process's log) and print its path.
 #
-# The clients connect over loopback. MOOSDB itself has no option to listen on one address
-# only: it listens on every interface, on a free port, for the minute the script takes.
+# The clients connect over loopback. MOOSDB has no option to listen on one address only: a stock
+# build listens on every interface (on a free port, for the 40 s the script takes); the script
+# says which address it listens on.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -47,20 +49,23 @@ if [ ! -x "$BIN" ]; then
     exit 1
 fi
 
-# Timing, in seconds from the start of the onboard process (the vehicle starts with it).
-TIME_LIMIT=32        # the onboard run's time limit
-OVERRIDE_AT=10       # the vehicle posts MOOS_MANUAL_OVERRIDE = true, and false 3 s later
+# Timing, in seconds from the start of the vehicle (about a second after the onboard process).
+TIME_LIMIT=32        # the onboard run's time limit (from its own start)
+OVERRIDE_AT=9        # the vehicle posts MOOS_MANUAL_OVERRIDE = true, and false 3 s later
 DB_DOWN_AT=18        # the MOOSDB is stopped ...
 DB_DOWN_FOR=2        # ... and started again this much later on the same port
+CUT_AT=11            # the relay between the client and the MOOSDB cuts the connection (paused)
 COMMUNITY=plumetrace_interop
+CONSOLIDATION_MS=150 # the MOOSDB asks pPlumetrace for this much between its packets (--response)
 
 WORK="$(mktemp -d "${TMPDIR:-/tmp}/moos-interop.XXXXXX")"
 DB_PID=""
 VEHICLE_PID=""
 ONBOARD_PID=""
+PROXY_PID=""
 stop() {
     local pid
-    for pid in "$ONBOARD_PID" "$VEHICLE_PID" "$DB_PID"; do
+    for pid in "$ONBOARD_PID" "$VEHICLE_PID" "$PROXY_PID" "$DB_PID"; do
         if [ -n "$pid" ] && kill -0 "$pid" 2>/dev/null; then
             kill "$pid" 2>/dev/null || true
             wait "$pid" 2>/dev/null || true
@@ -83,6 +88,7 @@ free_port() {
 }
 PORT="$(free_port)"
 AUDIT_PORT="$(free_port)"
+PROXY_PORT="$(free_port)"
 
 cat > "$WORK/interop.moos" <<EOF
 // Written by scripts/moos_interop.sh: a community of its own on a free port.
@@ -113,7 +119,7 @@ reconnect_max_s = 1.0
 give_up_s = 20.0
 [link.moos]
 host = "127.0.0.1"
-port = $PORT
+port = $PROXY_PORT
 app_name = "pPlumetrace"
 chem_variable = "CHEM_READING"
 [run]
@@ -123,7 +129,8 @@ EOF
 
 start_db() {
     (cd "$WORK" && exec MOOSDB interop.moos --moos_port="$PORT" --audit_port="$AUDIT_PORT" \
-        --moos_suicide_disable --moos_no_colour) >> "$WORK/moosdb.log" 2>&1 &
+        --response="pPlumetrace:$CONSOLIDATION_MS" --moos_suicide_disable --moos_no_colour) \
+        >> "$WORK/moosdb.log" 2>&1 &
     DB_PID=$!
     # Ready when it accepts a connection (the probe shows in its log as a failed handshake).
     for _ in $(seq 100); do
@@ -140,12 +147,44 @@ start_db() {
 
 echo "moos_interop: MOOSDB ($(command -v MOOSDB)) on 127.0.0.1:$PORT, community $COMMUNITY, in $WORK"
 start_db
-python3 scripts/moos_vehicle.py --port "$PORT" --log "$WORK/vehicle.tsv" \
-    --duration $((TIME_LIMIT + 15)) --start-x 110 --override-at "$OVERRIDE_AT" --override-for 3 \
-    2> "$WORK/vehicle.log" &
-VEHICLE_PID=$!
+LISTEN="$(python3 - "$PORT" <<'PY' 2>/dev/null || true
+import sys
+port = int(sys.argv[1])
+for line in open("/proc/net/tcp").readlines()[1:]:
+    local, state = line.split()[1], line.split()[3]
+    addr, p = local.split(":")
+    if state == "0A" and int(p, 16) == port:
+        print(".".join(str(int(addr[i:i + 2], 16)) for i in (6, 4, 2, 0)))
+PY
+)"
+echo "moos_interop: the MOOSDB listens on ${LISTEN:-?}:$PORT$([ "$LISTEN" = 0.0.0.0 ] && echo ' (every interface)')"
+# Stored values a client is sent at registration, however old: navigation of another vehicle,
+# posted 50 s ago.
+python3 scripts/moos_vehicle.py --port "$PORT" --log /dev/null --prime stale --name uOldVehicle \
+    2>> "$WORK/vehicle.log"
+# The client reaches the MOOSDB through a relay that cuts its connection once, during the
+# override's pause, while the MOOSDB stays up (CPT_PAUSED must still end false).
+python3 scripts/moos_vehicle.py --port "$PORT" --log /dev/null --proxy "$PROXY_PORT" \
+    --duration $((TIME_LIMIT + 40)) 2>> "$WORK/vehicle.log" &
+PROXY_PID=$!
+for _ in $(seq 100); do
+    if python3 -c "import socket; socket.create_connection(('127.0.0.1', $PROXY_PORT), 0.2).close()" 2>/dev/null; then
+        break
+    fi
+    sleep 0.1
+done
 "$BIN" onboard "$WORK/onboard.toml" --out "$WORK/onboard-out" > "$WORK/onboard.log" 2>&1 &
 ONBOARD_PID=$!
+# A second later, once it has registered: a posting over 1 MiB on a variable it reads; then the
+# vehicle.
+sleep 1 &
+wait $!
+python3 scripts/moos_vehicle.py --port "$PORT" --log /dev/null --prime huge --name uBigPoster \
+    2>> "$WORK/vehicle.log"
+python3 scripts/moos_vehicle.py --port "$PORT" --log "$WORK/vehicle.tsv" \
+    --duration $((TIME_LIMIT + 15)) --start-x 110 --override-at "$OVERRIDE_AT" \
+    --override-for 3 2>> "$WORK/vehicle.log" &
+VEHICLE_PID=$!
 
 # Waits up to $1 s, less if the onboard process ends first (in the background, so a signal is
 # taken at once).
@@ -156,7 +195,9 @@ wait_onboard() {
         wait $!
     done
 }
-wait_onboard "$DB_DOWN_AT"
+wait_onboard "$CUT_AT"
+kill -USR1 "$PROXY_PID" 2>/dev/null || true
+wait_onboard $((DB_DOWN_AT - CUT_AT))
 if kill -0 "$ONBOARD_PID" 2>/dev/null; then
     echo "moos_interop: stopping the MOOSDB for ${DB_DOWN_FOR} s"
     kill "$DB_PID" 2>/dev/null || true
@@ -218,8 +259,16 @@ WELCOMES="$(grep -c "welcome to community $COMMUNITY" "$LINKLOG" 2>/dev/null || 
 WELCOME="$(grep -m1 -o "welcome to community $COMMUNITY.*" "$LINKLOG" 2>/dev/null || true)"
 check "handshake" "$(ok test "${WELCOMES:-0}" -ge 1)" "link.log: ${WELCOME:-no welcome}"
 REJECTED="$(report lines_rejected)"
-check "traffic" "$(ok python3 -c "import json, sys; r = json.load(open(sys.argv[1]))['lines_rejected']; sys.exit(any(k != 'stale' for k in r))" "$REPORT" 2>/dev/null)" \
-    "$(report lines_accepted) messages taken, rejected by kind: $REJECTED (only stored values older than stale_nav_s may be)"
+check "traffic" "$(ok python3 -c "import json, sys; r = json.load(open(sys.argv[1]))['lines_rejected']; sys.exit(any(k not in ('stale', 'too_large') for k in r))" "$REPORT" 2>/dev/null)" \
+    "$(report lines_accepted) messages taken, rejected by kind: $REJECTED (only the stored values below may be)"
+# The four stale NAV_* not taken, the posting over 1 MiB skipped (again at a registration while
+# it is still the stored value), and the connection kept (the restart check counts them).
+stored_values() {
+    python3 -c "import json, sys; r = json.load(open(sys.argv[1]))['lines_rejected']; sys.exit(not (r.get('stale', 0) >= 4 and r.get('too_large', 0) >= 1))" "$REPORT" 2>/dev/null
+}
+FIRST_X="$(awk '$2 == "NAV_X" { print $4; exit }' "$WORK/onboard-out/run.alog" 2>/dev/null || true)"
+check "stale, huge" "$(ok test "$(ok stored_values)" = 0 -a -n "$FIRST_X" -a "${FIRST_X%%.*}" != 999)" \
+    "stale: $(report lines_rejected | grep -o "'stale': [0-9]*" || echo none), over 1 MiB: $(report lines_rejected | grep -o "'too_large': [0-9]*" || echo none); first NAV_X logged: ${FIRST_X:-none} (the stale one was 999)"
 
 # set_points KEY LO HI: at least 50 postings, each in [LO, HI].
 set_points() { [ "$(count "$1")" -ge 50 ] && in_range "$1" "$2" "$3"; }
@@ -238,7 +287,7 @@ STOP_WHILE_PAUSED="$(awk -F'\t' '$4 != "pPlumetrace" { next }
     { prev = $3 "=" ($3 == "DESIRED_SPEED" ? $5 + 0 : $5) } END { print n + 0 }' "$TSV")"
 paused_then_resumed() { echo "$PAUSED" | grep -q "true .*false" && [ "$STOP_WHILE_PAUSED" -ge 1 ]; }
 check "CPT_PAUSED" "$(ok paused_then_resumed)" \
-    "values in order: ${PAUSED:-none}; pauses sent with DESIRED_SPEED = 0: $STOP_WHILE_PAUSED"
+    "values in order: ${PAUSED:-none} (the connection cut at ${CUT_AT} s between them); pauses sent with DESIRED_SPEED = 0: $STOP_WHILE_PAUSED"
 LAST_STATUS="$(postings CPT_STATUS | tail -n 1)"
 check "CPT_STATUS" "$(ok test "$LAST_STATUS" = ended)" "last value: ${LAST_STATUS:-none}"
 
@@ -252,10 +301,46 @@ check "VIEW_MARKER" "$(ok test -n "$MARKER")" "$(count VIEW_MARKER) postings; la
 POINT="$(postings VIEW_POINT | grep -E '^x=-?[0-9.]+,y=-?[0-9.]+,label=cpt_lost_[0-9]+,vertex_color=red,vertex_size=4$' | head -n 1 || true)"
 check "VIEW_POINT" "$(ok test -n "$POINT")" "$(count VIEW_POINT) postings; first: ${POINT:-none}"
 
+# The consolidation period the MOOSDB asked for: taken from its timing replies, and no two
+# packets of set-points sent closer than that (by the client's traffic log: the vehicle's
+# receipt times bunch on a loaded machine) once the first reply has come. A stop is never held
+# back, and the set-point waiting for the period goes with it, so a packet with a stop does not
+# count.
+PERIOD="$(grep -m1 -o 'consolidation period [0-9.]* s' "$LINKLOG" 2>/dev/null || true)"
+GAPS="$(python3 - "$LINKLOG" <<'PY' 2>/dev/null || true
+import sys
+paced, sends, stops = False, [], set()
+for line in open(sys.argv[1]):
+    f = line.split()
+    if len(f) < 4:
+        continue
+    if f[1] == "#" and f[2] == "consolidation":
+        paced = True
+    if paced and f[1] == ">" and f[2] == "N":
+        if f[3] == "DESIRED_HEADING":
+            sends.append(f[0])
+        elif f[3] == "DESIRED_SPEED" and f[5] == "0":
+            stops.add(f[0])
+times = [float(t) for t in sends if t not in stops]
+gaps = [b - a for a, b in zip(times, times[1:])]
+if gaps:
+    print(f"{min(gaps):.3f} {sum(gaps) / len(gaps):.3f}")
+PY
+)"
+paced() {
+    [ -n "$PERIOD" ] && [ -n "$GAPS" ] &&
+        awk -v g="${GAPS%% *}" -v p="$CONSOLIDATION_MS" 'BEGIN { exit !(g >= p / 1000 - 0.005) }'
+}
+check "consolidation" "$(ok paced)" \
+    "MOOSDB --response=pPlumetrace:$CONSOLIDATION_MS; link.log: ${PERIOD:-none}; set-point gaps min/mean ${GAPS:-?} s"
+SKEW="$(grep -m1 -o 'skew [^)]*' "$LINKLOG" 2>/dev/null || true)"
+check "skew" "$(ok test "$SKEW" = "skew not estimated: the MOOSDB is on this host")" \
+    "${SKEW:-none} (as libMOOS does for a MOOSDB on the same host)"
+
 AFTER="$(count DESIRED_HEADING 2)"
 CONNECTIONS="$(report connections)"
-check "restart" "$(ok test "$CONNECTIONS" = 2 -a "${WELCOMES:-0}" = 2 -a "$AFTER" -ge 20)" \
-    "the client connected $CONNECTIONS times; $AFTER DESIRED_HEADING postings after the MOOSDB came back"
+check "cut, restart" "$(ok test "$CONNECTIONS" = 3 -a "${WELCOMES:-0}" = 3 -a "$AFTER" -ge 20)" \
+    "the client connected $CONNECTIONS times (the start, the cut, the restart); $AFTER DESIRED_HEADING postings after the MOOSDB came back"
 
 echo "moos_interop: $PASSED passed, $FAILED failed (MOOSDB $(MOOSDB --moos_print_version 2>/dev/null | grep -m1 -io 'version[^,]*' || echo '?'))"
 if [ "$FAILED" -gt 0 ]; then

@@ -9,6 +9,15 @@ The wire format is the one crates/plumetrace-onboard/src/moos/wire.rs documents:
 packets of messages, the `ELKS CAN'T DANCE 2/8/10` handshake, a timing message each second.
 It reconnects when the MOOSDB goes away, and posts MOOS_MANUAL_OVERRIDE when told to.
 
+With --prime stale it only posts NAV_X, NAV_Y, NAV_HEADING and NAV_SPEED of a vehicle far from
+the one that will fly, stamped 50 s ago (the values a MOOSDB keeps and sends to a client that
+registers later, as a vehicle that stopped posting would leave them); with --prime huge, a
+MOOS_MANUAL_OVERRIDE string of 1.5 MiB; then it disconnects.
+
+With --proxy PORT it is no vehicle but a TCP relay: it listens on PORT, passes each connection
+through to the MOOSDB, and cuts the open ones when sent SIGUSR1, as a lost network would,
+while the MOOSDB stays up.
+
 The plume: the water flows toward the east; a source at (--source-x, --source-y) spreads a
 Gaussian plume downflow of it whose width grows one metre per ten, with a peak reading of 1.
 """
@@ -35,6 +44,7 @@ WATCHED = [
     "CPT_DETECTION",
     "CPT_DECLARATION",
     "VIEW_POLYGON",
+    "VIEW_SEGLIST",
     "VIEW_MARKER",
     "VIEW_POINT",
 ]
@@ -217,6 +227,34 @@ class Vehicle:
         self.x += self.speed * math.sin(h) * dt
         self.y += self.speed * math.cos(h) * dt
 
+    def prime(self, what):
+        self.connect()
+        if self.sock is None:
+            sys.exit("vehicle: --prime: no MOOSDB")
+        if what == "stale":
+            old = time.time() - 50.0
+            posts = [
+                message(b"N", k, old, v, source=self.args.name)
+                for k, v in [
+                    ("NAV_X", 999.0),
+                    ("NAV_Y", 999.0),
+                    ("NAV_HEADING", 0.0),
+                    ("NAV_SPEED", 1.0),
+                ]
+            ]
+            told = "NAV_* at (999, 999) stamped 50 s ago"
+        else:
+            # A string: a MOOSDB keeps a variable's type, and the override is a string.
+            posts = [self.msg(b"N", "MOOS_MANUAL_OVERRIDE", string="x" * (1536 * 1024))]
+            told = "MOOS_MANUAL_OVERRIDE of 1.5 MiB"
+        self.send(posts)
+        # The MOOSDB has them once it answers the next timing message.
+        self.last_timing = 0.0
+        self.send([])
+        self.read_packets(1.0)
+        self.note(f"primed: {told}")
+        self.drop("primed")
+
     def run(self):
         a = self.args
         override = []
@@ -261,6 +299,51 @@ class Vehicle:
         self.drop("done")
 
 
+def proxy(args):
+    """Relays connections on --proxy to the MOOSDB; cuts the open ones on SIGUSR1."""
+    listener = socket.socket()
+    listener.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
+    listener.bind(("127.0.0.1", args.proxy))
+    listener.listen(4)
+    started = time.time()
+    pairs = []
+    cut = []
+    signal.signal(signal.SIGUSR1, lambda *_: cut.append(True))
+    while time.time() - started < args.duration:
+        socks = [listener] + [s for p in pairs for s in p]
+        try:
+            ready, _, _ = select.select(socks, [], [], 0.05)
+        except InterruptedError:
+            ready = []
+        for s in ready:
+            if s is listener:
+                client, _ = listener.accept()
+                try:
+                    pairs.append((client, socket.create_connection(("127.0.0.1", args.port), 2.0)))
+                except OSError:
+                    client.close()
+                continue
+            pair = next(p for p in pairs if s in p)
+            other = pair[1] if s is pair[0] else pair[0]
+            try:
+                data = s.recv(65536)
+                if data:
+                    other.sendall(data)
+                    continue
+            except OSError:
+                pass
+            for x in pair:
+                x.close()
+            pairs.remove(pair)
+        if cut:
+            cut.clear()
+            print(f"proxy: {time.time() - started:6.2f} s: cutting {len(pairs)} connection(s)", file=sys.stderr, flush=True)
+            for pair in pairs:
+                for x in pair:
+                    x.close()
+            pairs = []
+
+
 def main():
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("--port", type=int, required=True)
@@ -276,10 +359,22 @@ def main():
         "--override-at", type=float, help="post MOOS_MANUAL_OVERRIDE = true then"
     )
     p.add_argument("--override-for", type=float, default=3.0)
+    p.add_argument(
+        "--prime",
+        choices=["stale", "huge"],
+        help="only post stale NAV_* or an override string over 1 MiB, then leave",
+    )
+    p.add_argument("--proxy", type=int, help="relay this port to the MOOSDB instead")
     args = p.parse_args()
     signal.signal(signal.SIGTERM, lambda *_: sys.exit(0))
+    if args.proxy is not None:
+        proxy(args)
+        return
     with open(args.log, "w", buffering=1) as log:
-        Vehicle(args, log).run()
+        if args.prime:
+            Vehicle(args, log).prime(args.prime)
+        else:
+            Vehicle(args, log).run()
 
 
 if __name__ == "__main__":

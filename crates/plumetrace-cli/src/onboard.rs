@@ -5,9 +5,10 @@
 
 use crate::output::write_atomic;
 use anyhow::{Context, Result};
-use plumetrace_log::alog::AlogWriter;
+use plumetrace_log::alog::{AlogWriter, AltitudeHold};
 use plumetrace_log::snapshot::{Header, SnapshotLogFile};
 use plumetrace_onboard::config::Onboard;
+use plumetrace_onboard::config::ProtocolKind;
 use plumetrace_onboard::runner::{self, RunReport};
 use serde::Serialize;
 use std::path::{Path, PathBuf};
@@ -176,12 +177,7 @@ fn fly(onboard: &Onboard, args: &OnboardArgs) -> Result<()> {
     let start_unix = std::time::SystemTime::now()
         .duration_since(std::time::UNIX_EPOCH)
         .map_or(0.0, |d| d.as_secs_f64());
-    let mut alog = AlogWriter::new(
-        std::io::BufWriter::new(alog_file),
-        &alog_path.display().to_string(),
-        start_unix,
-        "pPlumetrace",
-    )?;
+    let mut alog = run_alog(onboard, &*link, alog_file, &alog_path, start_unix)?;
     let mut log_error = None;
     let mut inputs: Vec<&mut dyn plumetrace_onboard::link::Link> = Vec::new();
     inputs.extend(chem.as_mut().map(|c| c as _));
@@ -228,4 +224,38 @@ fn fly(onboard: &Onboard, args: &OnboardArgs) -> Result<()> {
         args.out.display()
     );
     Ok(())
+}
+
+/// `run.alog` as the vehicle's MOOS community would log the run: the planner's postings under
+/// its MOOS name, the vehicle's under the process the link learns posts them, an altitude hold
+/// as the set-point the link sends.
+fn run_alog(
+    onboard: &Onboard,
+    link: &dyn plumetrace_onboard::link::Link,
+    file: std::fs::File,
+    path: &Path,
+    start_unix: f64,
+) -> std::io::Result<AlogWriter<std::io::BufWriter<std::fs::File>>> {
+    let l = &onboard.file.link;
+    let (name, hold) = match l.protocol {
+        ProtocolKind::Moos => (
+            l.moos
+                .as_ref()
+                .map_or("pPlumetrace", |m| m.app_name.as_str()),
+            AltitudeHold::AsDepth,
+        ),
+        ProtocolKind::Iver => ("pPlumetrace", AltitudeHold::AsDepth),
+        ProtocolKind::Bluefin => ("pPlumetrace", AltitudeHold::AsAltitude),
+    };
+    let mut alog = AlogWriter::new(
+        std::io::BufWriter::new(file),
+        &path.display().to_string(),
+        start_unix,
+        name,
+    )?
+    .altitude_hold(hold);
+    if let Some(source) = link.sensor_source() {
+        alog = alog.learned_sensor_source(source);
+    }
+    Ok(alog)
 }

@@ -184,6 +184,9 @@ fn bluefin_over_tcp_in_lock_step_declares_and_replays_exactly_and_again_the_same
         alog.iter().any(|(v, _)| v == "CPT_DECLARATION"),
         "the declaration is in run.alog"
     );
+    // The altitude hold as the Bluefin link sent it: DESIRED_ALTITUDE, no DESIRED_DEPTH.
+    assert!(alog.iter().any(|(v, _)| v == "DESIRED_ALTITUDE"));
+    assert!(!alog.iter().any(|(v, _)| v == "DESIRED_DEPTH"));
     // Lock-step is deterministic: a second flight logs the same decisions.
     let again = tempfile::tempdir().unwrap();
     let (ob2, _) = fly(again.path(), &["--listen", "127.0.0.1:0"]);

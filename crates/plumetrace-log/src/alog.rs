@@ -2,18 +2,20 @@
 //! own tools (`alogview`, `alogscan`, `aloggrep`, `alogclip`, ...).
 //!
 //! Layout, as pLogger writes it: header lines starting with `%%` (`LOG FILE`, `FILE OPENED ON`
-//! with the start as a UTC date, `LOGSTART` with the start in Unix seconds), then one line per
-//! posting, `TIME VARIABLE SOURCE VALUE`, columns padded with spaces (MOOS tools split on white
-//! space), `TIME` in seconds since `LOGSTART`, numbers written with every digit they need to read
-//! back exactly. The source is the process that would post the variable in a MOOS community: the
-//! vehicle's interface for what it measures (`NAV_*`, `CPT_READING`), the planner's process for
-//! the rest.
+//! with the start as a UTC date, `LOGSTART` with the start in Unix seconds to the microsecond),
+//! then one line per posting, `TIME VARIABLE SOURCE VALUE`, columns padded with spaces (MOOS tools
+//! split on white space), `TIME` in seconds since `LOGSTART` with five decimals, numbers written
+//! with every digit they need to read back exactly (pLogger rounds them to five decimals). The
+//! source is the process that posts the variable in a MOOS community: the vehicle's interface for
+//! what it measures (`NAV_*`, `CPT_READING`; `iVehicle` unless the writer is told its name, as the
+//! MOOS link learns it from the postings), the planner's process for the rest.
 //!
 //! Variables: `NAV_X`, `NAV_Y` (m, east and north), `NAV_HEADING` (deg), `NAV_SPEED` (m/s),
 //! `NAV_DEPTH`, `NAV_ALTITUDE` (m), `DESIRED_HEADING`, `DESIRED_SPEED`, `DESIRED_DEPTH` (for an
 //! altitude hold: the depth that leaves that altitude over the water depth measured, as the MOOS
 //! and Iver links send it) and `DESIRED_ALTITUDE` (an altitude hold, as the Bluefin link sends
-//! it), and the plume-tracing ones: `CPT_BEHAVIOUR` (when it changes), `CPT_READING` (every
+//! it); [`AltitudeHold`] says which of the two an altitude hold is logged as (a vehicle's log
+//! has the one its link sends). Then the plume-tracing ones: `CPT_BEHAVIOUR` (when it changes), `CPT_READING` (every
 //! chemical sample, at its time), `CPT_DETECTION` and `CPT_DECLARATION` (`x=..,y=..[,rule=..]`),
 //! `CPT_STATUS` (when the plan finishes or aborts). Values never contain spaces.
 
@@ -41,11 +43,30 @@ pub const VARIABLES: &[&str] = &[
     "CPT_STATUS",
 ];
 
+/// How an altitude hold is logged: as the link that flew it sent it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum AltitudeHold {
+    /// Both `DESIRED_DEPTH` (the depth that leaves the altitude) and `DESIRED_ALTITUDE`: a
+    /// simulated mission, flown by no link.
+    #[default]
+    Both,
+    /// `DESIRED_DEPTH` only (the MOOS and Iver links).
+    AsDepth,
+    /// `DESIRED_ALTITUDE` only (the Bluefin link).
+    AsAltitude,
+}
+
+/// The name of the process posting the vehicle's measurements, shared with whatever learns it
+/// while the log is written (empty: not known).
+pub type SharedName = std::sync::Arc<std::sync::Mutex<String>>;
+
 /// Writes one vehicle's postings.
 pub struct AlogWriter<W: Write> {
     out: W,
     source: String,
     sensor_source: String,
+    learned_source: Option<SharedName>,
+    altitude_hold: AltitudeHold,
     last_time: f64,
 }
 
@@ -68,6 +89,13 @@ fn start_now() -> f64 {
     std::time::SystemTime::now()
         .duration_since(std::time::UNIX_EPOCH)
         .map_or(0.0, |d| d.as_secs_f64())
+}
+
+/// The start as pLogger writes `LOGSTART`: Unix seconds to the microsecond, without trailing
+/// zeros.
+fn logstart(unix_s: f64) -> String {
+    let s = format!("{unix_s:.6}");
+    s.trim_end_matches('0').trim_end_matches('.').to_string()
 }
 
 /// `unix_s` as a UTC date, `Www Mmm dd hh:mm:ss yyyy` (as pLogger writes its opening time).
@@ -120,12 +148,14 @@ impl<W: Write> AlogWriter<W> {
         writeln!(out, "{bar}")?;
         writeln!(out, "%% LOG FILE:       {}", clean(name))?;
         writeln!(out, "%% FILE OPENED ON  {}", utc_date(start))?;
-        writeln!(out, "%% LOGSTART               {start:.2}")?;
+        writeln!(out, "%% LOGSTART        {:>20}", logstart(start))?;
         writeln!(out, "{bar}")?;
         Ok(AlogWriter {
             out,
             source: clean(source),
             sensor_source: "iVehicle".into(),
+            learned_source: None,
+            altitude_hold: AltitudeHold::Both,
             last_time: f64::NEG_INFINITY,
         })
     }
@@ -134,6 +164,19 @@ impl<W: Write> AlogWriter<W> {
     /// (`NAV_*`, `CPT_READING`).
     pub fn sensor_source(mut self, source: &str) -> Self {
         self.sensor_source = clean(source);
+        self
+    }
+
+    /// The same writer taking the source column of the vehicle's postings from `name` whenever
+    /// it is not empty (the MOOS link fills it with the process that posts `NAV_X`).
+    pub fn learned_sensor_source(mut self, name: SharedName) -> Self {
+        self.learned_source = Some(name);
+        self
+    }
+
+    /// The same writer logging an altitude hold as `hold` says.
+    pub fn altitude_hold(mut self, hold: AltitudeHold) -> Self {
+        self.altitude_hold = hold;
         self
     }
 
@@ -152,8 +195,8 @@ impl<W: Write> AlogWriter<W> {
         };
         writeln!(
             self.out,
-            "{:<14} {var:<20} {source:<16} {}",
-            format!("{t:.3}"),
+            "{:<15} {var:<20} {source:<15} {}",
+            format!("{t:.5}"),
             clean(value)
         )
     }
@@ -181,6 +224,12 @@ impl<W: Write> AlogWriter<W> {
 
     /// Posts what one snapshot and its decision say.
     pub fn decision(&mut self, s: &SensorSnapshot, d: &Decision) -> std::io::Result<()> {
+        if let Some(name) = &self.learned_source {
+            let name = name.lock().map(|n| clean(&n)).unwrap_or_default();
+            if !name.is_empty() {
+                self.sensor_source = name;
+            }
+        }
         for c in &s.chem {
             self.sensed(c.time_s, "CPT_READING", c.reading)?;
         }
@@ -202,11 +251,16 @@ impl<W: Write> AlogWriter<W> {
         match d.command.vertical {
             VerticalCommand::Depth(v) => self.num(t, "DESIRED_DEPTH", v)?,
             VerticalCommand::Altitude(v) => {
+                let hold = self.altitude_hold;
                 // The depth that leaves this altitude over the water depth measured.
-                if let (Some(depth), Some(alt)) = (s.nav.depth_m, s.nav.altitude_m) {
+                if let (Some(depth), Some(alt), AltitudeHold::Both | AltitudeHold::AsDepth) =
+                    (s.nav.depth_m, s.nav.altitude_m, hold)
+                {
                     self.num(t, "DESIRED_DEPTH", (depth + alt - v).max(0.0))?;
                 }
-                self.num(t, "DESIRED_ALTITUDE", v)?;
+                if hold != AltitudeHold::AsDepth {
+                    self.num(t, "DESIRED_ALTITUDE", v)?;
+                }
             }
             VerticalCommand::Surface => self.num(t, "DESIRED_DEPTH", 0.0)?,
         }
@@ -316,8 +370,14 @@ mod tests {
             seen.insert(f[1].to_string(), f[3].to_string());
         }
         assert_eq!(header, 5);
+        // As pLogger: Unix seconds in a column of 20, to the microsecond without trailing zeros.
         assert!(
-            text.contains("%% LOGSTART               1700000000.00\n"),
+            text.contains("%% LOGSTART                  1700000000\n"),
+            "{text}"
+        );
+        // Times with five decimals in a column of 15, as pLogger's.
+        assert!(
+            text.contains("\n0.10000         NAV_X                iVehicle        10.1\n"),
             "{text}"
         );
         assert!(
@@ -333,6 +393,81 @@ mod tests {
         assert_eq!(seen["CPT_READING"], "0.00012345678901234");
         assert_eq!(seen["CPT_DECLARATION"], "x=100.00,y=0.50,rule=along_flow");
         assert_eq!(seen["CPT_STATUS"], "finished");
+    }
+
+    fn flown(hold: AltitudeHold, learned: Option<&str>) -> String {
+        let snap = SensorSnapshot {
+            time_s: 3.25,
+            vehicle: VehicleId(0),
+            nav: NavEstimate {
+                pos_m: Some(Vec2::new(1.0, 2.0)),
+                heading: Heading::from_deg(10.0),
+                speed_mps: 1.0,
+                altitude_m: Some(4.0),
+                depth_m: Some(16.0),
+                last_fix_s: None,
+            },
+            chem: Vec::new(),
+            flow: None,
+            ranges: None,
+            inbox: Vec::new(),
+        };
+        let d = Decision::new(
+            Command {
+                heading: Heading::from_deg(0.0),
+                speed_mps: 1.0,
+                vertical: VerticalCommand::Altitude(2.0),
+            },
+            PlanStatus::Running,
+        );
+        let mut w = AlogWriter::new(Vec::new(), "v.alog", 1_796_430_583.214_037, "pPlumetrace")
+            .unwrap_or_else(|e| panic!("{e}"))
+            .altitude_hold(hold);
+        if let Some(name) = learned {
+            let shared = SharedName::default();
+            w = w.learned_sensor_source(shared.clone());
+            assert!(w.decision(&snap, &d).is_ok());
+            if let Ok(mut n) = shared.lock() {
+                *n = name.to_string();
+            }
+        }
+        assert!(w.decision(&snap, &d).is_ok());
+        String::from_utf8(w.finish().unwrap_or_default()).unwrap_or_default()
+    }
+
+    #[test]
+    fn a_vehicle_log_has_the_set_point_its_link_sent_and_its_start_to_the_microsecond() {
+        let moos = flown(AltitudeHold::AsDepth, None);
+        assert!(
+            moos.contains("%% LOGSTART           1796430583.214037\n"),
+            "{moos}"
+        );
+        assert!(
+            moos.contains("3.25000         DESIRED_DEPTH        pPlumetrace     18\n"),
+            "{moos}"
+        );
+        assert!(!moos.contains("DESIRED_ALTITUDE"), "{moos}");
+        let bluefin = flown(AltitudeHold::AsAltitude, None);
+        assert!(
+            bluefin.contains("DESIRED_ALTITUDE     pPlumetrace     2\n"),
+            "{bluefin}"
+        );
+        assert!(!bluefin.contains("DESIRED_DEPTH"), "{bluefin}");
+        let both = flown(AltitudeHold::Both, None);
+        assert!(both.contains("DESIRED_DEPTH ") && both.contains("DESIRED_ALTITUDE "));
+    }
+
+    #[test]
+    fn the_vehicle_postings_take_the_source_the_link_learned() {
+        let text = flown(AltitudeHold::AsDepth, Some("uSim Marine"));
+        let sources: Vec<&str> = text
+            .lines()
+            .filter(|l| l.contains(" NAV_X "))
+            .filter_map(|l| l.split_whitespace().nth(2))
+            .collect();
+        // Before a name is known, iVehicle; then the name (white space cannot be in a column).
+        assert_eq!(sources, ["iVehicle", "uSim_Marine"], "{text}");
+        assert!(text.contains("DESIRED_DEPTH        pPlumetrace"), "{text}");
     }
 
     #[test]

@@ -94,6 +94,12 @@ pub trait Link {
         _decision: &plumetrace_core::Decision,
     ) {
     }
+    /// The name of the process posting the vehicle's measurements, for a link whose traffic
+    /// carries one (MOOS: the source of the `NAV_X` postings), filled in as it is learned; for
+    /// `run.alog`'s source column.
+    fn sensor_source(&self) -> Option<plumetrace_log::alog::SharedName> {
+        None
+    }
 }
 
 /// A link's timing settings.

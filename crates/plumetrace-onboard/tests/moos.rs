@@ -741,7 +741,7 @@ fn cpt_paused_goes_back_to_false_after_a_reconnection() {
 /// thread does.
 #[test]
 fn the_consolidation_period_paces_the_set_points() {
-    let (report, rec, _) = fly(
+    let (report, rec, log) = fly(
         Script {
             consolidation_s: 0.5,
             ..Script::default()
@@ -761,6 +761,13 @@ fn the_consolidation_period_paces_the_set_points() {
     assert!(gaps.len() >= 3 && mean >= 0.45, "{gaps:?}");
     assert!(gaps.iter().all(|g| *g >= 0.25), "{gaps:?}");
     assert!(report.decisions as usize > times.len(), "{report:?}");
+    // The period is written to the traffic log once, when it changes.
+    assert_eq!(
+        log.matches("# consolidation period 0.500 s (the MOOSDB's timing reply)")
+            .count(),
+        1,
+        "{log}"
+    );
 }
 
 /// A MOOSDB on this host: no skew correction (libMOOS turns it off), so postings carry this
@@ -804,4 +811,26 @@ fn the_first_timing_reply_does_not_move_the_skew() {
             "posted {ahead:.3} s ahead"
         );
     }
+}
+
+#[test]
+fn the_link_names_the_process_posting_the_navigation() {
+    let (port, server) = fake_moosdb(Script {
+        end_at: 2.0,
+        ..Script::default()
+    });
+    let o = onboard(port, 1.0, "real_time");
+    let mut link = runner::link_for(&o, None).unwrap();
+    let name = link.sensor_source().unwrap();
+    assert_eq!(*name.lock().unwrap(), "", "not known before any posting");
+    let mut seen = Vec::new();
+    let report = runner::run(&o, &mut *link, None, &mut |_, _| {
+        seen.push(name.lock().unwrap().clone());
+    })
+    .unwrap();
+    drop(link);
+    server.join().unwrap();
+    assert!(report.decisions > 0);
+    // Known by the first decision: the source of the NAV_X postings (run.alog's source column).
+    assert!(seen.iter().all(|n| n == "uSimMarine"), "{seen:?}");
 }

@@ -77,6 +77,8 @@ pub struct MoosLink {
     // planner's points.
     geometry: Vec<(&'static str, String)>,
     views: Views,
+    // The process posting NAV_X, as its postings name it (for run.alog's source column).
+    nav_source: plumetrace_log::alog::SharedName,
 }
 
 impl MoosLink {
@@ -115,6 +117,7 @@ impl MoosLink {
             outbox: Vec::new(),
             geometry: Vec::new(),
             views: Views::default(),
+            nav_source: Default::default(),
         }
     }
 
@@ -360,7 +363,17 @@ impl MoosLink {
     fn timing_reply(&mut self, m: &Message) {
         // The MOOSDB's consolidation period paces outgoing mail (bounded: a second at most).
         if m.double2.is_finite() {
-            self.outgoing_delay = Duration::from_secs_f64(m.double2.clamp(0.0, 1.0));
+            let delay = Duration::from_secs_f64(m.double2.clamp(0.0, 1.0));
+            if delay != self.outgoing_delay {
+                self.outgoing_delay = delay;
+                self.log(
+                    '#',
+                    &format!(
+                        "consolidation period {:.3} s (the MOOSDB's timing reply): at most one packet of set-points per period",
+                        delay.as_secs_f64()
+                    ),
+                );
+            }
         }
         self.timing_replies += 1;
         // As libMOOS: the first reply does not count towards the skew.
@@ -394,6 +407,13 @@ impl MoosLink {
         }
         self.nav
             .take(m, self.settings.chem_variable.as_deref(), events)?;
+        if m.key == "NAV_X"
+            && !m.source.is_empty()
+            && let Ok(mut name) = self.nav_source.lock()
+            && *name != m.source
+        {
+            name.clone_from(&m.source);
+        }
         if m.time.is_finite() && m.time > self.clock && m.time > 0.0 {
             self.clock = m.time;
             events.push(LinkEvent::Clock(UtcTime::from_seconds(
@@ -621,6 +641,10 @@ impl Link for MoosLink {
 
     fn connected(&self) -> bool {
         self.conn.is_some() && self.phase == Phase::Ready
+    }
+
+    fn sensor_source(&self) -> Option<plumetrace_log::alog::SharedName> {
+        Some(self.nav_source.clone())
     }
 
     fn decided(&mut self, _snapshot: &SensorSnapshot, d: &Decision) {

@@ -7,8 +7,8 @@
 //! - [`nav`]: navigation assembled from the postings;
 //! - [`link`]: the client as a vehicle link (handshake, registrations, timing and skew,
 //!   reconnection, what it publishes);
-//! - [`view`]: what pMarineViewer draws of the planner (`VIEW_POLYGON`, `VIEW_MARKER`,
-//!   `VIEW_POINT`).
+//! - [`view`]: what pMarineViewer draws of the planner (`VIEW_POLYGON` or `VIEW_SEGLIST`,
+//!   `VIEW_MARKER`, `VIEW_POINT`).
 //!
 //! # Variables
 //!
@@ -27,12 +27,12 @@
 //! hold goes out as the depth that leaves that altitude over the last `NAV_DEPTH` plus
 //! `NAV_ALTITUDE`, and without both no depth goes out), `CPT_BEHAVIOUR`, `CPT_DETECTION`,
 //! `CPT_DECLARATION`, `CPT_STATUS` (the names and values of the `.alog` writer,
-//! [`plumetrace_log::alog`]),
-//! `CPT_PAUSED` (`true` when the planner pauses, `false` when it steers again), and for
-//! pMarineViewer the op-area and subregions (`VIEW_POLYGON`, at each connection), the source
-//! estimate and the declarations (`VIEW_MARKER`) and the lost points (`VIEW_POINT`). The safe
-//! command (`link.safe_command = "stop"`) is `DESIRED_SPEED = 0`; at the end of a run the safe
-//! command goes out and `CPT_STATUS = ended`. No flow (current) variable is read: the runner
+//! [`plumetrace_log::alog`]), `CPT_PAUSED` (`true` when the planner pauses, `false` when it
+//! steers again), and for pMarineViewer the op-area and subregions (`VIEW_POLYGON`, or
+//! `VIEW_SEGLIST` for one that is not convex, at each connection), the source estimate and the
+//! declarations (`VIEW_MARKER`) and the lost points (`VIEW_POINT`). The safe command
+//! (`link.safe_command = "stop"`) is `DESIRED_SPEED = 0`; at the end of a run the safe command
+//! goes out and `CPT_STATUS = ended`. No flow (current) variable is read: the runner
 //! takes no flow from any link yet.
 
 pub mod link;

@@ -3,6 +3,10 @@
 //! `VIEW_POINT`, in the string formats of MOOS-IvP's geometry library (`x=..,y=..,label=..`
 //! pairs; a posting with a label already drawn replaces that shape).
 //!
+//! MOOS-IvP's polygon parser returns an empty polygon for one it does not find convex (nothing is
+//! drawn), so a polygon that is not convex by its rule ([`moos_convex`]) is posted as a closed
+//! `VIEW_SEGLIST` (its first vertex repeated at the end) under the same label instead.
+//!
 //! Labels: `cpt_op_area`, `cpt_subregion_K` (K from 0), `cpt_estimate` (one marker, moved as
 //! the estimate moves by more than 0.5 m), `cpt_lost_N` and `cpt_declared_N` (N from 1: every
 //! one stays on the map).
@@ -12,16 +16,77 @@ use plumetrace_core::{Decision, PlannerEvent, Telemetry, Vec2};
 /// How far the estimate moves before its marker is posted again, m.
 const ESTIMATE_STEP_M: f64 = 0.5;
 
-/// A polygon as `VIEW_POLYGON` takes it.
-pub fn polygon(points: &[[f64; 2]], label: &str, color: &str) -> String {
-    let pts: Vec<String> = points
+/// A polygon as pMarineViewer draws it: `VIEW_POLYGON` when MOOS-IvP reads it as convex, else a
+/// closed `VIEW_SEGLIST` (the parser would drop it as a polygon).
+pub fn polygon(points: &[[f64; 2]], label: &str, color: &str) -> (&'static str, String) {
+    // The vertices as the string carries them (two decimals), as the parser reads them back.
+    let mut pts: Vec<[f64; 2]> = points
+        .iter()
+        .map(|p| {
+            let r = |v: f64| format!("{v:.2}").parse::<f64>().unwrap_or(v);
+            [r(p[0]), r(p[1])]
+        })
+        .collect();
+    let var = if moos_convex(&pts) {
+        "VIEW_POLYGON"
+    } else {
+        pts.extend(pts.first().copied());
+        "VIEW_SEGLIST"
+    };
+    let pts: Vec<String> = pts
         .iter()
         .map(|p| format!("{:.2},{:.2}", p[0], p[1]))
         .collect();
-    format!(
-        "pts={{{}}},label={label},edge_color={color},vertex_color={color},vertex_size=2,edge_size=1",
-        pts.join(":")
+    (
+        var,
+        format!(
+            "pts={{{}}},label={label},edge_color={color},vertex_color={color},vertex_size=2,edge_size=1",
+            pts.join(":")
+        ),
     )
+}
+
+/// Which side of the line through `a` and `b` point `c` lies on, as MOOS-IvP's
+/// `XYPolygon::side` decides it (2: on the line, or `a` and `b` the same point).
+fn side(a: [f64; 2], b: [f64; 2], c: [f64; 2]) -> u8 {
+    if a[0] == b[0] {
+        return if a[1] == b[1] || c[0] == a[0] {
+            2
+        } else if c[0] > a[0] {
+            0
+        } else {
+            1
+        };
+    }
+    let m = (b[1] - a[1]) / (b[0] - a[0]);
+    let k = b[1] - m * b[0];
+    let y = m * c[0] + k;
+    if y > c[1] {
+        0
+    } else if y < c[1] {
+        1
+    } else {
+        2
+    }
+}
+
+/// Whether MOOS-IvP's `XYPolygon::determine_convexity` finds `pts` convex: at least three
+/// vertices, and for every edge the other vertices not on its line all lie on one side of it
+/// (and at least one is off it).
+pub fn moos_convex(pts: &[[f64; 2]]) -> bool {
+    let n = pts.len();
+    n >= 3
+        && (0..n).all(|i| {
+            let (a, b) = (pts[i], pts[(i + 1) % n]);
+            let mut sides = (0..n)
+                .filter(|&j| j != i && j != (i + 1) % n)
+                .map(|j| side(a, b, pts[j]))
+                .filter(|&s| s != 2);
+            match sides.next() {
+                Some(first) => sides.all(|s| s == first),
+                None => false,
+            }
+        })
 }
 
 /// A marker as `VIEW_MARKER` takes it.
@@ -40,14 +105,11 @@ pub fn point(p: Vec2, label: &str, color: &str, size: u32) -> String {
     )
 }
 
-/// The mission's geometry: the op-area and each subregion.
+/// The mission's geometry: the op-area and each subregion (see [`polygon`] for which variable).
 pub fn geometry(op_area: &[[f64; 2]], subregions: &[Vec<[f64; 2]>]) -> Vec<(&'static str, String)> {
-    let mut out = vec![("VIEW_POLYGON", polygon(op_area, "cpt_op_area", "yellow"))];
+    let mut out = vec![polygon(op_area, "cpt_op_area", "yellow")];
     for (k, r) in subregions.iter().enumerate() {
-        out.push((
-            "VIEW_POLYGON",
-            polygon(r, &format!("cpt_subregion_{k}"), "gray"),
-        ));
+        out.push(polygon(r, &format!("cpt_subregion_{k}"), "gray"));
     }
     out
 }
@@ -125,6 +187,45 @@ mod tests {
     }
 
     #[test]
+    fn convexity_is_decided_as_moos_ivp_decides_it() {
+        let square = [[0.0, 0.0], [0.0, 100.0], [100.0, 100.0], [100.0, 0.0]];
+        assert!(moos_convex(&square), "clockwise");
+        let mut ccw = square;
+        ccw.reverse();
+        assert!(moos_convex(&ccw), "anticlockwise");
+        // A vertex on an edge's line is allowed; all on one line, or fewer than 3, is not.
+        assert!(moos_convex(&[
+            [0.0, 0.0],
+            [50.0, 0.0],
+            [100.0, 0.0],
+            [100.0, 100.0]
+        ]));
+        assert!(!moos_convex(&[[0.0, 0.0], [50.0, 0.0], [100.0, 0.0]]));
+        assert!(!moos_convex(&[[0.0, 0.0], [1.0, 1.0]]));
+        // A dent, and a bow tie.
+        assert!(!moos_convex(&[
+            [0.0, 0.0],
+            [100.0, 0.0],
+            [50.0, 10.0],
+            [100.0, 100.0],
+            [0.0, 100.0]
+        ]));
+        assert!(!moos_convex(&[
+            [0.0, 0.0],
+            [100.0, 100.0],
+            [100.0, 0.0],
+            [0.0, 100.0]
+        ]));
+        // Rounded to the two decimals the string carries: a dent of 1 mm is gone.
+        let (var, _) = polygon(
+            &[[0.0, 0.0], [50.0, 0.001], [100.0, 0.0], [100.0, 100.0]],
+            "x",
+            "gray",
+        );
+        assert_eq!(var, "VIEW_POLYGON");
+    }
+
+    #[test]
     fn the_planner_is_drawn_in_pmarineviewer_strings() {
         let g = geometry(
             &[[60.0, -80.0], [460.0, -80.0], [460.0, 80.0]],
@@ -138,6 +239,22 @@ mod tests {
             )
         );
         assert!(g[1].1.contains("label=cpt_subregion_0"), "{g:?}");
+        // Not convex (an L), as MOOS-IvP's parser would drop it: a closed seglist instead.
+        let ell = [
+            [0.0, 0.0],
+            [100.0, 0.0],
+            [100.0, 50.0],
+            [50.0, 50.0],
+            [50.0, 100.0],
+            [0.0, 100.0],
+        ];
+        assert_eq!(
+            polygon(&ell, "cpt_op_area", "yellow"),
+            (
+                "VIEW_SEGLIST",
+                "pts={0.00,0.00:100.00,0.00:100.00,50.00:50.00,50.00:50.00,100.00:0.00,100.00:0.00,0.00},label=cpt_op_area,edge_color=yellow,vertex_color=yellow,vertex_size=2,edge_size=1".to_string()
+            )
+        );
         let mut v = Views::default();
         let lost = PlannerEvent::LostPoint {
             pos_m: Vec2::new(100.0, -2.5),
