@@ -68,6 +68,9 @@ pub enum Incident {
     LeftDomain,
     /// The vehicle entered an obstacle (kelp is no-go for vehicles).
     Collided,
+    /// The vehicle reached the seabed (over a seabed that is not flat: the seabed rose faster
+    /// than the vehicle could climb).
+    HitBottom,
 }
 
 /// What the world reports about a vehicle in a step (planners report their own events).
@@ -694,7 +697,7 @@ impl Fleet {
             self.communicate(t, &mut report.events)
         });
         timed(&mut times.decide_s, || {
-            self.decide(t, planners, &mut report)
+            self.decide(t, env.seabed(), planners, &mut report)
         });
         timed(&mut times.control_s, || {
             self.control(&report.decisions, &mut report.events)
@@ -770,6 +773,7 @@ impl Fleet {
     fn decide(
         &mut self,
         t: f64,
+        seabed: Option<&plumetrace_env::Seabed>,
         planners: &mut [Option<Box<dyn Planner>>],
         report: &mut StepReport,
     ) {
@@ -800,10 +804,11 @@ impl Fleet {
             let snapshot = SensorSnapshot {
                 time_s: t,
                 vehicle: v.vehicle.id,
-                nav: v.nav.estimate(
+                nav: v.nav.estimate_over(
                     &v.vehicle.state,
                     v.vehicle.params.kind,
                     depth,
+                    seabed.map(|s| s.height_at(v.vehicle.state.pos_m.x, v.vehicle.state.pos_m.y)),
                     &mut v.rng_measure,
                 ),
                 chem: std::mem::take(&mut v.pending_chem),
@@ -853,8 +858,19 @@ impl Fleet {
         let dt = self.dt_s;
         for v in self.vehicles.iter_mut().filter(|v| v.active) {
             let flow = env.flow().velocity(v.vehicle.state.pos_m);
-            v.vehicle
-                .step(&v.command, flow, self.water_depth_m, dt, &mut v.rng_motion);
+            match env.seabed() {
+                None => v
+                    .vehicle
+                    .step(&v.command, flow, self.water_depth_m, dt, &mut v.rng_motion),
+                Some(sb) => v.vehicle.step_over(
+                    &v.command,
+                    flow,
+                    self.water_depth_m,
+                    Some(&|p: Vec2| sb.height_at(p.x, p.y)),
+                    dt,
+                    &mut v.rng_motion,
+                ),
+            }
             let measured = v.last_flow.map(|f| f.velocity_mps);
             if let Some(fix) = v
                 .nav
@@ -879,6 +895,11 @@ impl Fleet {
                 Some(Incident::LeftDomain)
             } else if env.obstacles().contains(p) {
                 Some(Incident::Collided)
+            } else if env
+                .seabed()
+                .is_some_and(|s| v.vehicle.state.z_m < s.height_at(p.x, p.y))
+            {
+                Some(Incident::HitBottom)
             } else {
                 None
             };
