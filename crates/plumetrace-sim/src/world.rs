@@ -20,7 +20,8 @@
 //! 5. **control**: a command that is not finite is recorded as an event and replaced by the
 //!    vehicle's previous command (the safe one: finite, and what the vehicle is already doing);
 //! 6. **integrate**: vehicle dynamics in the local current, then navigation (fixes jump here);
-//! 7. **check**: vehicles that left the domain or entered an obstacle are stopped with an incident;
+//! 7. **check**: vehicles that left the domain, entered an obstacle or went below the seabed are
+//!    stopped with an incident;
 //! 8. **record**: observers of the run (in the mission) look at the world after the step; their
 //!    time is added with [`World::add_record_time`].
 //!
