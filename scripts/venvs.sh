@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # The Python virtual environments the checks use, made or brought up to date in one place:
 #   fuzzy    scripts/.venv-fuzzy   scikit-fuzzy 0.5.0 and what it imports (fuzzy_crosscheck.sh)
-#   netcdf   scripts/.venv-netcdf  numpy and scipy (netcdf_check.sh)
+#   netcdf   scripts/.venv-netcdf  numpy, scipy and xarray (netcdf_check.sh)
 #   package  target/py-venv        maturin, Gymnasium, pytest and the package's optional
 #                                  dependencies (python_tests.sh)
 #   all      the three
@@ -17,7 +17,7 @@ root=$(cd "$here/.." && pwd)
 packages() {
     case "$1" in
         fuzzy) echo "scikit-fuzzy==0.5.0 numpy scipy networkx packaging" ;;
-        netcdf) echo "numpy scipy" ;;
+        netcdf) echo "numpy scipy xarray" ;;
         package) echo "numpy maturin==1.16.0 gymnasium==1.4.0 pytest>=7 pandas pyarrow tqdm dask[distributed] matplotlib" ;;
         *) return 1 ;;
     esac

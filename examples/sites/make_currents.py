@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
-"""Writes currents.nc: a small synthetic ocean-model forecast for the example site, in CF-1.8
-NetCDF classic (CDF-1), with the standard library only.
+"""Writes currents.nc and seabed.nc: a small synthetic ocean-model forecast and bathymetry for
+the example site, in CF-1.8 NetCDF classic (CDF-1), with the standard library only.
 
 A tidal coastal current off a coast to the north: eastward 0.15 m/s on average, swinging by
 0.05 m/s over the M2 tide (12.42 h) with a small cross-shore part, slower towards the coast
@@ -10,7 +10,13 @@ and with depth. Longitude/latitude grid (about 55 m between nodes), four depth l
 Copernicus-style product holds, only smaller. The output is the same, byte for byte, on every
 run.
 
-    python3 make_currents.py [OUT]      (default: currents.nc beside this script)
+The seabed (seabed.nc) slopes down away from the coast, from 10 m deep along the north edge to
+18 m along the south edge (1.8 %), with a channel 3 m deep and about 60 m wide cut along the
+current south of the source, on a finer longitude/latitude grid (about 21 m) than the currents.
+It is stored as GEBCO stores its grids: an elevation, negative below sea level, as floats. Both
+files are the same, byte for byte, on every run.
+
+    python3 make_currents.py [DIR]      (default: beside this script)
 """
 
 import math
@@ -25,6 +31,21 @@ HOURS = [float(h) for h in range(7)]
 FILL = -32767
 SCALE = 0.001
 M2_H = 12.42
+
+
+# The seabed's grid: finer than the currents', over the same area.
+SEABED_LAT = [50.3480 + 0.0002 * k for k in range(21)]
+SEABED_LON = [-4.1510 + 0.0003 * k for k in range(31)]
+CHANNEL_LAT = 50.34964  # about 40 m south of the origin
+CHANNEL_HALF_WIDTH_DEG = 0.00027  # about 30 m
+
+
+def elevation(lat, lon):
+    """The seabed's height above mean sea level, m (negative: under water), to a centimetre."""
+    offshore = (LAT[-1] - lat) / (LAT[-1] - LAT[0])
+    channel = 3.0 * math.exp(-(((lat - CHANNEL_LAT) / CHANNEL_HALF_WIDTH_DEG) ** 2))
+    wobble = 0.5 * math.sin(2.0 * math.pi * (lon - LON[0]) / 0.004)
+    return round(-(10.0 + 8.0 * offshore + channel + wobble), 2)
 
 
 def current(hour, depth, lat):
@@ -73,7 +94,24 @@ def attrs(pairs):
 
 
 def main():
-    out = sys.argv[1] if len(sys.argv) > 1 else os.path.join(os.path.dirname(__file__), "currents.nc")
+    out_dir = sys.argv[1] if len(sys.argv) > 1 else os.path.dirname(os.path.abspath(__file__))
+    write_currents(os.path.join(out_dir, "currents.nc"))
+    write_seabed(os.path.join(out_dir, "seabed.nc"))
+
+
+def write_seabed(out):
+    dims = [("lat", len(SEABED_LAT)), ("lon", len(SEABED_LON))]
+    values = [elevation(lat, lon) for lat in SEABED_LAT for lon in SEABED_LON]
+    variables = [
+        ("lat", [0], [("standard_name", "latitude"), ("units", "degrees_north")], 6, "d", SEABED_LAT),
+        ("lon", [1], [("standard_name", "longitude"), ("units", "degrees_east")], 6, "d", SEABED_LON),
+        ("elevation", [0, 1], [("standard_name", "height_above_mean_sea_level"), ("units", "m"), ("positive", "up")], 5, "f", values),
+    ]
+    title = "synthetic sloping, channelled seabed for the plumetrace site example"
+    write_classic(out, dims, variables, 0, title)
+
+
+def write_currents(out):
     dims = [("time", 0), ("depth", len(DEPTH)), ("lat", len(LAT)), ("lon", len(LON))]
     # (name, dim ids, attributes, type tag, struct code, values)
     variables = [
@@ -84,8 +122,14 @@ def main():
         ("uo", [0, 1, 2, 3], [("standard_name", "eastward_sea_water_velocity"), ("units", "m s-1"), ("scale_factor", SCALE), ("add_offset", 0.0), ("_FillValue", FILL)], 3, "h", packed(0)),
         ("vo", [0, 1, 2, 3], [("standard_name", "northward_sea_water_velocity"), ("units", "m s-1"), ("scale_factor", SCALE), ("add_offset", 0.0), ("_FillValue", FILL)], 3, "h", packed(1)),
     ]
-    size = {"d": 8, "h": 2}
-    n_rec = len(HOURS)
+    title = "synthetic tidal coastal current for the plumetrace site example"
+    write_classic(out, dims, variables, len(HOURS), title)
+
+
+def write_classic(out, dims, variables, n_rec, title):
+    """Writes a CDF-1 file: dims as (name, length; 0 for the record dimension), variables as
+    (name, dim ids, attributes, type tag, struct code, values)."""
+    size = {"d": 8, "f": 4, "h": 2}
 
     def slab(v):  # bytes of one record (record variables) or of the whole variable
         n = size[v[4]]
@@ -99,7 +143,7 @@ def main():
         h += struct.pack(">ii", 0x0A, len(dims)) + b"".join(name(n) + struct.pack(">i", l) for n, l in dims)
         h += attrs([
             ("Conventions", "CF-1.8"),
-            ("title", "synthetic tidal coastal current for the plumetrace site example"),
+            ("title", title),
             ("source", "examples/sites/make_currents.py"),
         ])
         h += struct.pack(">ii", 0x0B, len(variables))
@@ -108,7 +152,7 @@ def main():
             h += attrs(v[2]) + struct.pack(">iii", v[3], (slab(v) + 3) // 4 * 4, begin)
         return h
 
-    is_rec = [0 in v[1] and v[1][0] == 0 for v in variables]
+    is_rec = [bool(v[1]) and dims[v[1][0]][1] == 0 for v in variables]
     length = len(header([0] * len(variables)))
     begins, at = [], length
     for v, r in zip(variables, is_rec):

@@ -307,3 +307,66 @@ fn positions_in_degrees_without_an_origin_are_located() {
         "{e}"
     );
 }
+
+/// A ridge across the demo's op-area: 20 m of water east of x = 420 m, 3 m west of x = 400 m.
+fn ridge() -> Vec<u8> {
+    let xs: Vec<f64> = (0..28).map(|k| -10.0 + 20.0 * f64::from(k)).collect();
+    let ys: Vec<f64> = (0..17).map(|k| -160.0 + 20.0 * f64::from(k)).collect();
+    let mut d = Dataset::default();
+    let y = d.dim("y", ys.len());
+    let x = d.dim("x", xs.len());
+    d.var("y", &[y], ys.clone())
+        .attr("axis", "Y")
+        .attr("units", "m");
+    d.var("x", &[x], xs.clone())
+        .attr("axis", "X")
+        .attr("units", "m");
+    let mut depth = Vec::new();
+    for _ in &ys {
+        for &xx in &xs {
+            depth.push(3.0 + 17.0 * ((xx - 400.0) / 20.0).clamp(0.0, 1.0));
+        }
+    }
+    d.var("depth", &[y, x], depth)
+        .attr("standard_name", "sea_floor_depth_below_sea_surface")
+        .attr("units", "m");
+    d.to_bytes().unwrap()
+}
+
+#[test]
+fn a_vehicle_that_meets_a_ridge_hits_the_bottom_and_the_summary_says_so() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    std::fs::write(d.join("ridge.nc"), ridge()).unwrap();
+    let text = demo()
+        .replacen(
+            "depth_m = 8.0\n",
+            "\n[bathymetry]\nfile = \"ridge.nc\"\n",
+            1,
+        )
+        .replacen("time_limit_s = 2400.0", "time_limit_s = 300.0", 1)
+        .replacen("duration_s = 2400.0", "duration_s = 300.0", 1)
+        .replacen("spinup_s = 3500.0", "spinup_s = 300.0", 1);
+    let s = d.join("ridge.toml");
+    std::fs::write(&s, text).unwrap();
+    let out = d.join("run");
+    run_ok(&["run", s.to_str().unwrap(), "--out", out.to_str().unwrap()]);
+    let events = std::fs::read_to_string(out.join("events.jsonl")).unwrap();
+    assert!(
+        events.contains("\"event\":\"incident\",\"what\":\"hit_bottom\""),
+        "{events}"
+    );
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    assert_eq!(summary["outcome"], "collided");
+    let v = &summary["vehicles"][0];
+    assert_eq!(v["status"], "collided");
+    // It starts 50 m east of the ridge and meets it on one of its mapping lines.
+    let t = v["hit_bottom_s"].as_f64().unwrap();
+    assert!(t > 20.0 && t < 300.0, "{t}");
+    let ended = summary["ended"]["t_s"].as_f64().unwrap();
+    assert!(
+        (ended - t).abs() < 1e-9,
+        "the mission ends there: {ended} {t}"
+    );
+}

@@ -4,9 +4,11 @@ use crate::field::{ConcentrationField, GridSpec};
 use crate::flow::{FlowField, FlowModel};
 use crate::obstacle::ObstacleSet;
 use crate::plume::FilamentPlume;
+use crate::seabed::Seabed;
 use crate::{EnvError, Rect, SimRng, StreamId, stream_rng};
 use plumetrace_core::{Vec2, Vec3};
 use rand::RngCore;
+use std::sync::Arc;
 
 /// The plume models: a live filament plume or a steady field.
 pub enum Plume {
@@ -70,6 +72,8 @@ pub struct Environment {
     flow: FlowModel,
     plume: Plume,
     obstacles: ObstacleSet,
+    /// The seabed, if not flat at `z = 0`.
+    seabed: Option<Arc<Seabed>>,
     dt_s: f64,
     step: u64,
     /// Simulated time spent in spin-up before step 0, s.
@@ -99,6 +103,7 @@ impl Environment {
             flow,
             plume,
             obstacles,
+            seabed: None,
             dt_s,
             step: 0,
             spinup_s: 0.0,
@@ -159,6 +164,7 @@ impl Environment {
             flow: self.flow.clone(),
             plume,
             obstacles: self.obstacles.clone(),
+            seabed: self.seabed.clone(),
             dt_s: self.dt_s,
             step: self.step,
             spinup_s: self.spinup_s,
@@ -223,6 +229,24 @@ impl Environment {
     /// Mutable plume access (e.g. to seed filaments at t = 0).
     pub fn plume_mut(&mut self) -> &mut Plume {
         &mut self.plume
+    }
+
+    /// Puts a seabed under the environment (`None`: flat at `z = 0`), the filament plume's too.
+    pub fn set_seabed(&mut self, seabed: Option<Arc<Seabed>>) {
+        if let Plume::Filaments(p) = &mut self.plume {
+            p.set_seabed(seabed.clone());
+        }
+        self.seabed = seabed;
+    }
+
+    /// The seabed, if not flat.
+    pub fn seabed(&self) -> Option<&Seabed> {
+        self.seabed.as_deref()
+    }
+
+    /// The seabed's height at `p`, m: 0 over a flat seabed.
+    pub fn seabed_height_at(&self, p: Vec2) -> f64 {
+        self.seabed.as_ref().map_or(0.0, |s| s.height_at(p.x, p.y))
     }
 
     /// The obstacles.

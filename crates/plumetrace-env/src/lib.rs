@@ -21,6 +21,7 @@ pub mod normal;
 pub mod obstacle;
 pub mod plume;
 pub mod rng;
+pub mod seabed;
 mod simd;
 pub mod steady;
 
@@ -35,3 +36,4 @@ pub use plume::{
     DownflowSink, FilamentParams, FilamentPlume, PlumeStats, Source, VerticalBoundary,
 };
 pub use rng::{SimRng, StreamId, derive_seed, stream_rng};
+pub use seabed::{Seabed, SeabedOptions};

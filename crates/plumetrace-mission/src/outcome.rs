@@ -65,7 +65,9 @@ impl Outcome {
     pub fn of_incident(what: Incident) -> Self {
         match what {
             Incident::LeftDomain => Outcome::LeftDomain,
-            Incident::Collided => Outcome::Collided,
+            // The seabed is an obstacle too: campaigns count it with the collisions, and the
+            // event names it.
+            Incident::Collided | Incident::HitBottom => Outcome::Collided,
         }
     }
 }
@@ -112,7 +114,7 @@ impl VehicleStatus {
     pub fn of_incident(what: Incident) -> Self {
         match what {
             Incident::LeftDomain => VehicleStatus::LeftDomain,
-            Incident::Collided => VehicleStatus::Collided,
+            Incident::Collided | Incident::HitBottom => VehicleStatus::Collided,
         }
     }
 }

@@ -10,7 +10,7 @@
 use crate::outcome::{MissionEvent, VehicleStatus};
 use plumetrace_core::{BehaviourKind, PlannerEvent, Telemetry, Vec2, Vec3, VehicleId};
 use plumetrace_env::{ConcentrationField, FlowField, GridSpec, MeanConcentrationGrid};
-use plumetrace_sim::{StepReport, WorldEvent, WorldView};
+use plumetrace_sim::{Incident, StepReport, WorldEvent, WorldView};
 use serde::Serialize;
 
 /// What observers see after a step.
@@ -274,6 +274,8 @@ pub struct VehicleTrack {
     pub longest_quiet: Option<(f64, BehaviourKind)>,
     /// The farthest the true position went outside the op-area, m (0: never outside).
     pub max_outside_m: f64,
+    /// When the vehicle reached the seabed (the incident `hit_bottom`), s.
+    pub hit_bottom_s: Option<f64>,
     last_pos: Option<Vec2>,
     /// The behaviour in control and since when it has had no detection.
     quiet_since: Option<(BehaviourKind, f64)>,
@@ -345,6 +347,16 @@ impl Observer for TrackStats {
         for (i, b) in behaviour_switches(step.report) {
             if let Some(track) = self.tracks.get_mut(i) {
                 track.quiet_since = Some((b, t));
+            }
+        }
+        for (id, e) in &step.report.events {
+            if let WorldEvent::Incident {
+                what: Incident::HitBottom,
+            } = e
+                && let Some(track) = self.tracks.get_mut(id.0 as usize)
+            {
+                // Found by the step's check, at its end.
+                track.hit_bottom_s.get_or_insert(step.world.time_s());
             }
         }
         for v in step.world.vehicles() {

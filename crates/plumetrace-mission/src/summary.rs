@@ -77,6 +77,10 @@ pub struct VehicleSummary {
     pub longest_quiet_behaviour: Option<BehaviourKind>,
     /// The farthest its true position went outside the op-area, m.
     pub max_outside_m: f64,
+    /// When it reached the seabed (a seabed from `[bathymetry]`; its status is then
+    /// `collided`), s; absent when it did not.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub hit_bottom_s: Option<f64>,
 }
 
 /// The mission's key numbers.
@@ -204,6 +208,7 @@ impl Summary {
                     longest_quiet_s: t.longest_quiet.map(|q| q.0),
                     longest_quiet_behaviour: t.longest_quiet.map(|q| q.1),
                     max_outside_m: t.max_outside_m,
+                    hit_bottom_s: t.hit_bottom_s,
                 }
             })
             .collect::<Vec<_>>();

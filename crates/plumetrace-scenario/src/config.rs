@@ -29,6 +29,9 @@ pub struct ScenarioConfig {
     pub domain: DomainConfig,
     /// The flow field.
     pub flow: FlowConfig,
+    /// A seabed that is not flat, from a bathymetry file (absent: flat at `z = 0`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub bathymetry: Option<BathymetryConfig>,
     /// The plume model.
     #[serde(default)]
     pub plume: PlumeConfig,
@@ -87,6 +90,22 @@ pub struct DomainConfig {
     pub y_max_m: f64,
     /// Water depth, m (the surface reflects filaments); absent = no surface.
     pub depth_m: Option<f64>,
+}
+
+/// `[bathymetry]`: the seabed's depth from a CF NetCDF file. Heights (`z_m` of sources, AUV
+/// altitudes) are then above the seabed where they are, and the surface is the deepest water
+/// over the domain.
+#[derive(Debug, Clone, Default, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BathymetryConfig {
+    /// The file (relative to the scenario file): NetCDF classic, CF depths or elevations.
+    pub file: PathBuf,
+    /// The depth's variable (default: found by `standard_name`, or named depth, h,
+    /// bathymetry, elevation or z).
+    pub variable: Option<String>,
+    /// Node spacing of the grid the seabed is sampled onto, m (default: the file's own spacing
+    /// near the origin; at most 2000 nodes a side).
+    pub spacing_m: Option<f64>,
 }
 
 /// Which flow model.

@@ -155,6 +155,12 @@ pub const LIMITS: &[Limit] = &[
         "a centimetre to the widest domain (the grid is capped at 2000 nodes a side anyway)",
     ),
     num(
+        "bathymetry.spacing_m",
+        0.01,
+        COORD,
+        "a centimetre to the widest domain (the grid is capped at 2000 nodes a side anyway)",
+    ),
+    num(
         "origin.lat_deg",
         -89.0,
         89.0,

@@ -233,11 +233,28 @@ impl Navigator {
         water_depth_m: Option<f64>,
         rng: &mut SimRng,
     ) -> NavEstimate {
+        self.estimate_over(truth, kind, water_depth_m, None, rng)
+    }
+
+    /// [`NavEstimate::estimate`] over a seabed that is not flat: `seabed_m` is the seabed's
+    /// height under the vehicle (`None`: flat at 0), from which the altimeter measures.
+    pub fn estimate_over(
+        &self,
+        truth: &VehicleState,
+        kind: VehicleKind,
+        water_depth_m: Option<f64>,
+        seabed_m: Option<f64>,
+        rng: &mut SimRng,
+    ) -> NavEstimate {
         let p = self.params;
         let (ns, na): (f64, f64) = (StandardNormal.sample(rng), StandardNormal.sample(rng));
+        let height = match seabed_m {
+            None => truth.z_m,
+            Some(f) => truth.z_m - f,
+        };
         let (altitude_m, depth_m) = match kind {
             VehicleKind::Auv => (
-                Some((truth.z_m + p.altimeter_sd_m * na).max(0.0)),
+                Some((height + p.altimeter_sd_m * na).max(0.0)),
                 water_depth_m.map(|d| (d - truth.z_m).max(0.0)),
             ),
             VehicleKind::Surface => (None, Some(0.0)),

@@ -20,7 +20,8 @@
 //! 5. **control**: a command that is not finite is recorded as an event and replaced by the
 //!    vehicle's previous command (the safe one: finite, and what the vehicle is already doing);
 //! 6. **integrate**: vehicle dynamics in the local current, then navigation (fixes jump here);
-//! 7. **check**: vehicles that left the domain or entered an obstacle are stopped with an incident;
+//! 7. **check**: vehicles that left the domain, entered an obstacle or went below the seabed are
+//!    stopped with an incident;
 //! 8. **record**: observers of the run (in the mission) look at the world after the step; their
 //!    time is added with [`World::add_record_time`].
 //!
@@ -68,6 +69,9 @@ pub enum Incident {
     LeftDomain,
     /// The vehicle entered an obstacle (kelp is no-go for vehicles).
     Collided,
+    /// The vehicle reached the seabed (over a seabed that is not flat: the seabed rose faster
+    /// than the vehicle could climb).
+    HitBottom,
 }
 
 /// What the world reports about a vehicle in a step (planners report their own events).
@@ -694,7 +698,7 @@ impl Fleet {
             self.communicate(t, &mut report.events)
         });
         timed(&mut times.decide_s, || {
-            self.decide(t, planners, &mut report)
+            self.decide(t, env.seabed(), planners, &mut report)
         });
         timed(&mut times.control_s, || {
             self.control(&report.decisions, &mut report.events)
@@ -770,6 +774,7 @@ impl Fleet {
     fn decide(
         &mut self,
         t: f64,
+        seabed: Option<&plumetrace_env::Seabed>,
         planners: &mut [Option<Box<dyn Planner>>],
         report: &mut StepReport,
     ) {
@@ -800,10 +805,11 @@ impl Fleet {
             let snapshot = SensorSnapshot {
                 time_s: t,
                 vehicle: v.vehicle.id,
-                nav: v.nav.estimate(
+                nav: v.nav.estimate_over(
                     &v.vehicle.state,
                     v.vehicle.params.kind,
                     depth,
+                    seabed.map(|s| s.height_at(v.vehicle.state.pos_m.x, v.vehicle.state.pos_m.y)),
                     &mut v.rng_measure,
                 ),
                 chem: std::mem::take(&mut v.pending_chem),
@@ -853,8 +859,19 @@ impl Fleet {
         let dt = self.dt_s;
         for v in self.vehicles.iter_mut().filter(|v| v.active) {
             let flow = env.flow().velocity(v.vehicle.state.pos_m);
-            v.vehicle
-                .step(&v.command, flow, self.water_depth_m, dt, &mut v.rng_motion);
+            match env.seabed() {
+                None => v
+                    .vehicle
+                    .step(&v.command, flow, self.water_depth_m, dt, &mut v.rng_motion),
+                Some(sb) => v.vehicle.step_over(
+                    &v.command,
+                    flow,
+                    self.water_depth_m,
+                    Some(&|p: Vec2| sb.height_at(p.x, p.y)),
+                    dt,
+                    &mut v.rng_motion,
+                ),
+            }
             let measured = v.last_flow.map(|f| f.velocity_mps);
             if let Some(fix) = v
                 .nav
@@ -879,6 +896,11 @@ impl Fleet {
                 Some(Incident::LeftDomain)
             } else if env.obstacles().contains(p) {
                 Some(Incident::Collided)
+            } else if env
+                .seabed()
+                .is_some_and(|s| v.vehicle.state.z_m < s.height_at(p.x, p.y))
+            {
+                Some(Incident::HitBottom)
             } else {
                 None
             };

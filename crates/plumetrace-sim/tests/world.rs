@@ -778,3 +778,56 @@ fn fleets_sharing_an_environment_step_as_in_worlds_of_their_own() {
     shared.step().unwrap();
     assert!(late.step(&shared, &mut none).is_err());
 }
+
+/// The seabed of [`env`]'s domain rising eastward at `slope` from 40 m of water at x = 0 (a
+/// ridge with a plateau 1 m deep beyond where it would reach the surface).
+fn sloping(slope: f64) -> std::sync::Arc<plumetrace_env::Seabed> {
+    let area = Rect::new(0.0, 200.0, 0.0, 200.0).unwrap();
+    let n = 201;
+    let depths: Vec<f64> = (0..n * 3)
+        .map(|k| (40.0 - slope * (k % n) as f64).max(1.0))
+        .collect();
+    std::sync::Arc::new(plumetrace_env::Seabed::from_depths(area, n, 3, &depths).unwrap())
+}
+
+#[test]
+fn altitude_hold_follows_a_sloping_seabed_and_a_steep_one_is_hit() {
+    // A 10 % slope: the AUV, flying upslope at 2 m/s with altitude 2 m, climbs with it.
+    let mut e = env(vec![]);
+    e.set_seabed(Some(sloping(0.1)));
+    let mut w = World::new(e, vec![auv(0, (10.0, 100.0), 90.0)], DT, Some(40.0)).unwrap();
+    let mut planners = vec![Some(hold(90.0, 2.0))];
+    let mut lowest = f64::INFINITY;
+    for _ in 0..800 {
+        let r = w.step(&mut planners).unwrap();
+        assert!(
+            !r.events
+                .iter()
+                .any(|(_, e)| matches!(e, WorldEvent::Incident { .. })),
+            "{:?}",
+            r.events
+        );
+        let s = &w.vehicles()[0].vehicle.state;
+        let floor = w.env().seabed_height_at(s.pos_m);
+        lowest = lowest.min(s.z_m - floor);
+    }
+    // Above the seabed all the way (the lag on a 10 % slope at 2 m/s is about 1 m; the
+    // altitude error's sd 0.35 m).
+    assert!(lowest > 0.0 && lowest < 1.9, "{lowest}");
+    // A 100 % slope rises 2 m a second under it: the vertical response cannot keep up.
+    let mut e = env(vec![]);
+    e.set_seabed(Some(sloping(1.0)));
+    let mut w = World::new(e, vec![auv(0, (10.0, 100.0), 90.0)], DT, Some(40.0)).unwrap();
+    let mut hit = None;
+    for _ in 0..400 {
+        let r = w.step(&mut planners).unwrap();
+        if let Some((_, WorldEvent::Incident { what })) = r.events.first() {
+            hit = Some((*what, w.vehicles()[0].vehicle.state.pos_m.x));
+            break;
+        }
+    }
+    let (what, x) = hit.expect("the vehicle hits the seabed");
+    assert_eq!(what, Incident::HitBottom);
+    assert!(x > 10.0 && x < 40.0, "{x}");
+    assert!(!w.vehicles()[0].active);
+}

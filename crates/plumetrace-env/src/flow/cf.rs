@@ -82,19 +82,19 @@ enum Axis {
 
 /// The velocity's axes: for each kind, its position in the variable's dimensions and values.
 #[derive(Debug, Default)]
-struct Axes {
+pub(crate) struct Axes {
     /// (position, values in epoch seconds)
-    time: Option<(usize, Vec<f64>)>,
+    pub(crate) time: Option<(usize, Vec<f64>)>,
     /// (position, depths in metres, positive down)
-    depth: Option<(usize, Vec<f64>)>,
+    pub(crate) depth: Option<(usize, Vec<f64>)>,
     /// (position, values: degrees or metres)
-    x: Option<(usize, Vec<f64>)>,
-    y: Option<(usize, Vec<f64>)>,
-    geographic: bool,
+    pub(crate) x: Option<(usize, Vec<f64>)>,
+    pub(crate) y: Option<(usize, Vec<f64>)>,
+    pub(crate) geographic: bool,
 }
 
 /// A located error in the file.
-fn err(path: &Path, message: impl Into<String>) -> EnvError {
+pub(crate) fn err(path: &Path, message: impl Into<String>) -> EnvError {
     EnvError::File {
         path: path.to_path_buf(),
         message: message.into(),
@@ -208,7 +208,7 @@ fn axis_of(c: &Var) -> Option<Axis> {
 }
 
 /// Metres per unit of a projected or depth coordinate.
-fn length_scale(c: &Var, path: &Path) -> Result<f64, EnvError> {
+pub(crate) fn length_scale(c: &Var, path: &Path) -> Result<f64, EnvError> {
     match c
         .text("units")
         .map(|u| u.trim().to_ascii_lowercase())
@@ -293,7 +293,7 @@ fn dim_kind(
 }
 
 /// The velocity's axes, from the coordinate variables of its dimensions.
-fn axes(file: &NcFile, u: &Var, path: &Path) -> Result<Axes, EnvError> {
+pub(crate) fn axes(file: &NcFile, u: &Var, path: &Path) -> Result<Axes, EnvError> {
     let mut a = Axes::default();
     let mut kinds = Vec::new();
     for (pos, &d) in u.dims.iter().enumerate() {
@@ -729,7 +729,7 @@ fn fill_or_fail(
 }
 
 /// `r` grown by `m` on every side.
-fn expand(r: &Rect, m: f64) -> Rect {
+pub(crate) fn expand(r: &Rect, m: f64) -> Rect {
     Rect {
         x_min_m: r.x_min_m - m,
         x_max_m: r.x_max_m + m,
@@ -770,7 +770,7 @@ fn check_cover(
 
 /// Index of the cell holding `p` on a monotonic axis and the weight towards its next node;
 /// `None` outside.
-fn locate(axis: &[f64], p: f64) -> Option<(usize, f64)> {
+pub(crate) fn locate(axis: &[f64], p: f64) -> Option<(usize, f64)> {
     let n = axis.len();
     if n < 2 {
         return (n == 1).then_some((0, 0.0));
@@ -794,7 +794,7 @@ fn locate(axis: &[f64], p: f64) -> Option<(usize, f64)> {
 }
 
 /// The nearest in-range position on an axis (for nodes outside the op-area's reach).
-fn clamp_to(axis: &[f64], p: f64) -> f64 {
+pub(crate) fn clamp_to(axis: &[f64], p: f64) -> f64 {
     let (a, b) = (axis[0], axis[axis.len() - 1]);
     p.clamp(a.min(b), a.max(b))
 }
@@ -857,7 +857,16 @@ fn resample(
         area.height_m() / (ny - 1) as f64,
     );
     let reach = expand(&o.must_cover, dx.max(dy));
-    check_cover_points(o, xs, ys, frame.is_some(), spacing, &to_file, path)?;
+    check_cover_points(
+        "the currents'",
+        o.must_cover,
+        xs,
+        ys,
+        frame.is_some(),
+        spacing,
+        &to_file,
+        path,
+    )?;
     // Each node's cell in the file, found once for every frame (outside the op-area a node
     // beyond the grid takes its nearest edge).
     let mut cells = Vec::with_capacity(nx * ny);
@@ -908,10 +917,12 @@ fn resample(
     ))
 }
 
-/// Whether every point of the op-area's edge (every `spacing`, and its corners) lies in the
-/// file's grid.
-fn check_cover_points(
-    o: &CfOptions,
+/// Whether every point of the op-area `r`'s edge (every `spacing`, and its corners) lies in the
+/// file's grid; `what` names the grid's owner in the message (`the currents'`).
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn check_cover_points(
+    what: &str,
+    r: Rect,
     xs: &[f64],
     ys: &[f64],
     geographic: bool,
@@ -919,7 +930,6 @@ fn check_cover_points(
     to_file: &dyn Fn(f64, f64) -> (f64, f64),
     path: &Path,
 ) -> Result<(), EnvError> {
-    let r = o.must_cover;
     let steps = |len: f64| ((len / spacing).ceil() as usize).clamp(1, MAX_NODES_PER_SIDE);
     let (nx, ny) = (steps(r.width_m()), steps(r.height_m()));
     let mut edge = Vec::new();
@@ -946,7 +956,7 @@ fn check_cover_points(
             return Err(err(
                 path,
                 format!(
-                    "the currents' grid ({nx_name} {x0} to {x1}, {ny_name} {y0} to {y1}) does not \
+                    "{what} grid ({nx_name} {x0} to {x1}, {ny_name} {y0} to {y1}) does not \
                      cover the op-area: its point ({x:.1}, {y:.1}) m is at {nx_name} {fx:.6}, \
                      {ny_name} {fy:.6}"
                 ),
@@ -957,7 +967,7 @@ fn check_cover_points(
 }
 
 /// The file's smallest node spacing in metres (near the origin for a geographic grid).
-fn native_spacing(xs: &[f64], ys: &[f64], frame: Option<&LocalFrame>) -> f64 {
+pub(crate) fn native_spacing(xs: &[f64], ys: &[f64], frame: Option<&LocalFrame>) -> f64 {
     let step = |a: &[f64]| {
         a.windows(2)
             .map(|w| (w[1] - w[0]).abs())

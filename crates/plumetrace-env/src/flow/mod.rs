@@ -12,7 +12,7 @@
 //! - [`GriddedFlow`]: a regular grid (optionally several time frames) read from a CSV file or
 //!   sampled from CF currents in a NetCDF file ([`CfOptions`]).
 
-mod cf;
+pub(crate) mod cf;
 mod farrell;
 mod gridded;
 mod mean;

@@ -4,12 +4,13 @@ use super::index::CellIndex;
 use crate::error::{EnvError, require_finite, require_non_negative, require_positive};
 use crate::field::ConcentrationField;
 use crate::flow::FlowField;
+use crate::seabed::Seabed;
 use crate::{Rect, SimRng};
 use plumetrace_core::Vec3;
 use rand::{Rng, RngCore};
 use rand_distr::{Distribution, Poisson};
 use serde::{Deserialize, Serialize};
-use std::sync::OnceLock;
+use std::sync::{Arc, OnceLock};
 
 /// A chemical source.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -182,6 +183,8 @@ pub struct FilamentPlume {
     transport_steps: u64,
     /// Where filaments are dropped as out of every sensor's reach, if anywhere.
     sink: Option<DownflowSink>,
+    /// The seabed filaments reflect at, if not flat at `z = 0` ([`FilamentPlume::set_seabed`]).
+    seabed: Option<Arc<Seabed>>,
     /// Plume time, s (the end of the last step).
     time_s: f64,
     stats: PlumeStats,
@@ -311,6 +314,7 @@ impl FilamentPlume {
             keys_given: 0,
             transport_steps: 0,
             sink: None,
+            seabed: None,
             time_s: 0.0,
             stats: PlumeStats::default(),
             index: OnceLock::new(),
@@ -338,11 +342,25 @@ impl FilamentPlume {
             keys_given: self.keys_given,
             transport_steps: self.transport_steps,
             sink: self.sink,
+            seabed: self.seabed.clone(),
             time_s: self.time_s,
             stats: self.stats,
             index: OnceLock::new(),
             boxes: OnceLock::new(),
         }
+    }
+
+    /// Puts a seabed under the plume (`None`: flat at `z = 0`): filaments then reflect at the
+    /// seabed's height where they are, and concentrations add their images in it. Only with a
+    /// reflecting boundary; the sources' heights are the caller's (on the seabed or above it).
+    pub fn set_seabed(&mut self, seabed: Option<Arc<Seabed>>) {
+        self.index = OnceLock::new();
+        self.seabed = seabed;
+    }
+
+    /// The seabed under the plume, if not flat.
+    pub fn seabed(&self) -> Option<&Seabed> {
+        self.seabed.as_deref()
     }
 
     /// The sources.
@@ -563,6 +581,18 @@ impl FilamentPlume {
             offset,
             sink: (sink_dir, sink_line),
         });
+        if let (Some(sb), VerticalBoundary::Reflecting { .. }) =
+            (&self.seabed, self.params.vertical)
+        {
+            // The pass above reflected at the datum (the seabed's lowest point); here each
+            // filament reflects at the seabed where it is.
+            for k in 0..self.z.len() {
+                let f = sb.height_at(self.x[k], self.y[k]);
+                if self.z[k] < f {
+                    self.z[k] = reflect(self.z[k], f, ceiling);
+                }
+            }
+        }
         (left, beyond)
     }
 
@@ -607,6 +637,12 @@ impl FilamentPlume {
                 self.birth_s[i] = t_new_s - age;
                 self.x[i] = src.x + vel.x * age + sx * n3[0];
                 self.y[i] = src.y + vel.y * age + sy * n3[1];
+                let floor = match (&self.seabed, self.params.vertical) {
+                    (Some(sb), VerticalBoundary::Reflecting { .. }) => {
+                        sb.height_at(self.x[i], self.y[i])
+                    }
+                    _ => floor,
+                };
                 self.z[i] = reflect(src.z + sz * n3[2], floor, ceiling);
                 left |= !self.domain.contains_xy(self.x[i], self.y[i]);
             }
@@ -685,6 +721,7 @@ impl FilamentPlume {
                 self.domain,
                 self.params.cutoff_radii,
                 self.params.vertical,
+                self.seabed.as_deref(),
             )
         })
     }
@@ -779,6 +816,11 @@ impl FilamentPlume {
             let amp = self.mass[k] / (norm * r2 * r2.sqrt());
             let k2 = -0.5 / r2;
             let z = self.z[k];
+            // Over a seabed, the image is in the seabed where the filament is.
+            let floor = match (&self.seabed, floor) {
+                (Some(sb), Some(_)) => Some(sb.height_at(self.x[k], self.y[k])),
+                _ => floor,
+            };
             for zc in [
                 Some(z),
                 floor.map(|f| 2.0 * f - z),

@@ -49,8 +49,26 @@ impl CellIndex {
         domain: Rect,
         cutoff_radii: f64,
         vertical: VerticalBoundary,
+        seabed: Option<&crate::seabed::Seabed>,
     ) -> Self {
         let n = plume.x.len();
+        // Over a seabed each filament's image in the seabed where it is joins the index as an
+        // entry of its own (after the filaments), and no image is taken at z = 0.
+        let images: Vec<f64> = match (seabed, vertical) {
+            (Some(sb), VerticalBoundary::Reflecting { .. }) => (0..n)
+                .map(|k| 2.0 * sb.height_at(plume.x[k], plume.y[k]) - plume.z[k])
+                .collect(),
+            _ => Vec::new(),
+        };
+        let total = n + images.len();
+        // Entry `e`'s filament and height.
+        let of = |e: usize| -> (usize, f64) {
+            if e < n {
+                (e, plume.z[e])
+            } else {
+                (e - n, images[e - n])
+            }
+        };
         // The oldest filament is the largest (radii only grow).
         let r2_max = (0..n).map(|k| plume.radius_sq(k)).fold(0.0_f64, f64::max);
         let search_m = cutoff_radii * r2_max.sqrt();
@@ -68,8 +86,9 @@ impl CellIndex {
             j * ncx + i
         };
         let mut starts = vec![0u32; ncx * ncy + 1];
-        let mut cells = Vec::with_capacity(n);
-        for k in 0..n {
+        let mut cells = Vec::with_capacity(total);
+        for e in 0..total {
+            let k = of(e).0;
             let c = cell_of(plume.x[k], plume.y[k]);
             cells.push(c as u32);
             starts[c + 1] += 1;
@@ -86,24 +105,31 @@ impl CellIndex {
             amp: 0.0,
             neg_inv_2r2: 0.0,
         };
-        let mut entries = vec![blank; n];
+        let mut entries = vec![blank; total];
         let norm = (2.0 * std::f64::consts::PI).powf(1.5);
         let cut2 = cutoff_radii * cutoff_radii;
-        for (k, &cell) in cells.iter().enumerate() {
+        for (e, &cell) in cells.iter().enumerate() {
             let c = cell as usize;
             let slot = fill[c] as usize;
             fill[c] += 1;
+            let (k, z) = of(e);
             let r2 = plume.radius_sq(k);
             entries[slot] = Entry {
                 x: plume.x[k],
                 y: plume.y[k],
-                z: plume.z[k],
+                z,
                 lim2: cut2 * r2,
                 amp: plume.mass[k] / (norm * r2 * r2.sqrt()),
                 neg_inv_2r2: -0.5 / r2,
             };
         }
+        // (An image's own image in the surface lies above the surface by the water's depth
+        // and more: out of reach of any point in the water but for filaments as wide as the
+        // water is deep.)
         let (floor, ceiling) = match vertical {
+            VerticalBoundary::Reflecting { .. } if !images.is_empty() => {
+                (None, ceiling_of(vertical))
+            }
             VerticalBoundary::Reflecting { depth_m } => (Some(0.0), depth_m),
             VerticalBoundary::Unbounded => (None, None),
         };
@@ -400,5 +426,13 @@ impl CellIndex {
             n += 1;
         }
         (t, n)
+    }
+}
+
+/// The surface's height of a vertical boundary, if it has one.
+fn ceiling_of(vertical: VerticalBoundary) -> Option<f64> {
+    match vertical {
+        VerticalBoundary::Reflecting { depth_m } => depth_m,
+        VerticalBoundary::Unbounded => None,
     }
 }

@@ -29,6 +29,7 @@ from ._api import (
     run_plume,
 )
 from ._plumetrace import Plume, PlumetraceError, __version__
+from . import sites
 
 __all__ = [
     "Plume",

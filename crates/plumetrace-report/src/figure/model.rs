@@ -53,6 +53,7 @@ impl MarkKind {
             MarkKind::Aborted => "planner aborted".to_string(),
             MarkKind::Incident(Incident::LeftDomain) => "left the domain".to_string(),
             MarkKind::Incident(Incident::Collided) => "collided with an obstacle".to_string(),
+            MarkKind::Incident(Incident::HitBottom) => "hit the seabed".to_string(),
         };
         format!("{what} ({:.1} min)", t_s / 60.0)
     }
@@ -64,6 +65,7 @@ impl MarkKind {
             MarkKind::Aborted => "aborted",
             MarkKind::Incident(Incident::LeftDomain) => "left domain",
             MarkKind::Incident(Incident::Collided) => "collided",
+            MarkKind::Incident(Incident::HitBottom) => "hit bottom",
         }
     }
 }

@@ -4,7 +4,7 @@ use super::Invalid;
 use crate::config::{FlowConfig, FlowKind, MeanFlowConfig, ScenarioConfig};
 use plumetrace_core::geo::LocalFrame;
 use plumetrace_env::flow::{CfOptions, FarrellFlow, GriddedFlow, MeanFlow, UniformFlow};
-use plumetrace_env::{EnvError, FlowModel, Rect};
+use plumetrace_env::{EnvError, FlowModel, Rect, Seabed};
 use std::io::Read as _;
 use std::path::Path;
 
@@ -16,6 +16,7 @@ pub(super) fn flow(
     cfg: &ScenarioConfig,
     domain: Rect,
     base_dir: &Path,
+    seabed: Option<&Seabed>,
 ) -> Result<FlowModel, Invalid> {
     let f = &cfg.flow;
     if f.netcdf.is_some() && f.model != FlowKind::Gridded {
@@ -57,7 +58,7 @@ pub(super) fn flow(
             };
             let path = base_dir.join(file);
             let grid = if is_netcdf(&path) {
-                GriddedFlow::from_netcdf(&path, &cf_options(cfg, domain)?)
+                GriddedFlow::from_netcdf(&path, &cf_options(cfg, domain, seabed)?)
             } else if f.netcdf.is_some() {
                 return Err(Invalid::new(
                     "flow.netcdf",
@@ -117,7 +118,11 @@ fn is_netcdf(path: &Path) -> bool {
 
 /// How `[flow.netcdf]` and the scenario read CF currents: the site's origin, the date and span
 /// of the run, the plume's layer depth, the simulated area and the op-area.
-fn cf_options(cfg: &ScenarioConfig, domain: Rect) -> Result<CfOptions, Invalid> {
+fn cf_options(
+    cfg: &ScenarioConfig,
+    domain: Rect,
+    seabed: Option<&Seabed>,
+) -> Result<CfOptions, Invalid> {
     let n = cfg.flow.netcdf.clone().unwrap_or_default();
     let frame = cfg
         .origin
@@ -137,11 +142,32 @@ fn cf_options(cfg: &ScenarioConfig, domain: Rect) -> Result<CfOptions, Invalid> 
         .map_err(|e| Invalid::new("flow.netcdf.start", e.to_string()))?
         .map(|t| t - spinup_s);
     let depth_m = n.depth_m.or_else(|| {
-        let water = cfg.domain.depth_m?;
-        let z = cfg.sources.first().map_or(0.0, |s| s.z_m);
+        let first = cfg.sources.first();
+        let water = match seabed {
+            // Over a seabed, the water's depth at the first source.
+            Some(sb) => first.map_or(sb.surface_m(), |s| sb.depth_at(s.x_m, s.y_m)),
+            None => cfg.domain.depth_m?,
+        };
+        let z = first.map_or(0.0, |s| s.z_m);
         Some((water - z).max(0.0))
     });
-    let must_cover = match cfg.mission.as_ref().and_then(|m| m.op_area.as_ref()) {
+    let must_cover = op_area_rect(cfg, domain);
+    Ok(CfOptions {
+        frame,
+        start_s,
+        duration_s: run_s,
+        depth_m,
+        area: domain,
+        must_cover,
+        spacing_m: n.spacing_m,
+        u_variable: n.u_variable,
+        v_variable: n.v_variable,
+    })
+}
+
+/// The op-area's bounding rectangle (the domain without one): where a file's grid must reach.
+pub(super) fn op_area_rect(cfg: &ScenarioConfig, domain: Rect) -> Rect {
+    match cfg.mission.as_ref().and_then(|m| m.op_area.as_ref()) {
         Some(pts) if !pts.is_empty() => {
             let fold = |k: usize, f: fn(f64, f64) -> f64, init: f64| {
                 pts.iter().map(|p| p[k]).fold(init, f)
@@ -154,18 +180,7 @@ fn cf_options(cfg: &ScenarioConfig, domain: Rect) -> Result<CfOptions, Invalid> 
             }
         }
         _ => domain,
-    };
-    Ok(CfOptions {
-        frame,
-        start_s,
-        duration_s: run_s,
-        depth_m,
-        area: domain,
-        must_cover,
-        spacing_m: n.spacing_m,
-        u_variable: n.u_variable,
-        v_variable: n.v_variable,
-    })
+    }
 }
 
 /// The mean flow of `[flow.mean]`, if the table is given.

@@ -2,7 +2,8 @@
 //! naming the key path of anything wrong.
 //!
 //! One module per section of the file, in the order the sections are built (the first error
-//! found is the one reported): `timing` (`[sim]`, `mission.env_dt_s`), `domain`, `flow`,
+//! found is the one reported): `timing` (`[sim]`, `mission.env_dt_s`), `domain`,
+//! `bathymetry`, `flow`,
 //! `plume` (with `[[sources]]`), `obstacles` (with `[[kelp]]`), `vehicles` (their `sensors` and
 //! planners), `comms`, `mission` and `output`. Each section's key paths are spelled in its
 //! module: the models' errors name only their own fields
@@ -10,6 +11,7 @@
 //! number's own bound is the limits table's ([`crate::limits`]), checked before anything is
 //! built; the sections check what involves several keys or a model's own validity.
 
+mod bathymetry;
 mod comms;
 mod domain;
 mod flow;
@@ -226,10 +228,11 @@ fn build_sections(
     let seed = seed.unwrap_or(cfg.seed);
     let timing = timing::timing(cfg)?;
     let domain = domain::domain(&cfg.domain)?;
-    let flow = flow::flow(cfg, domain, &base_dir)?;
-    let plume = plume::plume(cfg, domain, &base_dir)?;
+    let seabed = bathymetry::seabed(cfg, domain, &base_dir)?;
+    let flow = flow::flow(cfg, domain, &base_dir, seabed.as_deref())?;
+    let plume = plume::plume(cfg, domain, &base_dir, seabed.clone())?;
     let obstacles = obstacles::obstacles(cfg, seed)?;
-    let vehicles = vehicles::vehicles(cfg, &domain)?;
+    let vehicles = vehicles::vehicles(cfg, &domain, seabed.as_deref())?;
     obstacles::starts_clear(cfg, &obstacles)?;
     let comms = comms::comms(&cfg.comms)?;
     let mut env = Environment::new(
@@ -241,6 +244,13 @@ fn build_sections(
         seed,
     )
     .map_err(|e| Invalid::env("sim", e))?;
+    let depth_m = seabed
+        .as_ref()
+        .map(|s| s.surface_m())
+        .or(cfg.domain.depth_m);
+    if seabed.is_some() {
+        env.set_seabed(seabed);
+    }
     timing.check_run_flow_steps(env.flow())?;
     let mission = mission::mission(cfg, &domain, &timing, &vehicles, &mut env)?;
     let output = output::output(cfg, &domain, &timing)?;
@@ -256,7 +266,7 @@ fn build_sections(
         origin: origin.clone(),
         comms,
         dt_s: timing.dt_s,
-        depth_m: cfg.domain.depth_m,
+        depth_m,
         site: cfg.origin,
         warnings,
     })

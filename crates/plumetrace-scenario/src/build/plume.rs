@@ -9,18 +9,28 @@ use plumetrace_core::Vec3;
 use plumetrace_env::plume::Dispersion;
 use plumetrace_env::steady::{GaussianPlume, GriddedConcentration};
 use plumetrace_env::{
-    EnvError, FilamentParams, FilamentPlume, Plume, Rect, Source, VerticalBoundary,
+    EnvError, FilamentParams, FilamentPlume, Plume, Rect, Seabed, Source, VerticalBoundary,
 };
 use std::path::Path;
+use std::sync::Arc;
 
 /// The plume of `[plume]` from the sources; a gridded concentration's file is read relative to
 /// `base_dir`.
-pub(super) fn plume(cfg: &ScenarioConfig, domain: Rect, base_dir: &Path) -> Result<Plume, Invalid> {
+///
+/// Over a seabed (`[bathymetry]`) a source's `z_m` is its height above the seabed where it is,
+/// and the surface is the seabed's deepest water.
+pub(super) fn plume(
+    cfg: &ScenarioConfig,
+    domain: Rect,
+    base_dir: &Path,
+    seabed: Option<Arc<Seabed>>,
+) -> Result<Plume, Invalid> {
+    let floor = |x: f64, y: f64| seabed.as_ref().map_or(0.0, |sb| sb.height_at(x, y));
     let sources: Vec<Source> = cfg
         .sources
         .iter()
         .map(|s| Source {
-            pos_m: Vec3::new(s.x_m, s.y_m, s.z_m),
+            pos_m: Vec3::new(s.x_m, s.y_m, s.z_m + floor(s.x_m, s.y_m)),
             mass_rate_per_s: s.mass_rate_per_s,
             filament_rate_hz: s.filament_rate_hz,
         })
@@ -32,7 +42,7 @@ pub(super) fn plume(cfg: &ScenarioConfig, domain: Rect, base_dir: &Path) -> Resu
         ));
     }
     match cfg.plume.model {
-        PlumeKind::Filaments => filaments(cfg, domain, sources),
+        PlumeKind::Filaments => filaments(cfg, domain, sources, seabed),
         PlumeKind::Gaussian => gaussian(cfg, &sources),
         PlumeKind::Gridded => {
             let Some(file) = &cfg.plume.file else {
@@ -49,7 +59,12 @@ pub(super) fn plume(cfg: &ScenarioConfig, domain: Rect, base_dir: &Path) -> Resu
 }
 
 /// The filament plume, with its initial filaments released.
-fn filaments(cfg: &ScenarioConfig, domain: Rect, sources: Vec<Source>) -> Result<Plume, Invalid> {
+fn filaments(
+    cfg: &ScenarioConfig,
+    domain: Rect,
+    sources: Vec<Source>,
+    seabed: Option<Arc<Seabed>>,
+) -> Result<Plume, Invalid> {
     let p = &cfg.plume;
     let dispersion = if p.pompy_compatible {
         Dispersion::PompyCompatible {
@@ -63,7 +78,10 @@ fn filaments(cfg: &ScenarioConfig, domain: Rect, sources: Vec<Source>) -> Result
     };
     let vertical = match p.seabed {
         SeabedKind::Reflecting => VerticalBoundary::Reflecting {
-            depth_m: cfg.domain.depth_m,
+            depth_m: match &seabed {
+                Some(sb) => Some(sb.surface_m()),
+                None => cfg.domain.depth_m,
+            },
         },
         SeabedKind::None => VerticalBoundary::Unbounded,
     };
@@ -87,6 +105,9 @@ fn filaments(cfg: &ScenarioConfig, domain: Rect, sources: Vec<Source>) -> Result
         ));
     }
     let mut fp = FilamentPlume::new(domain, sources, params).map_err(plume_error)?;
+    if seabed.is_some() {
+        fp.set_seabed(seabed);
+    }
     for k in 0..fp.sources().len() {
         fp.release_at_source(k, p.initial_filaments);
     }

@@ -6,16 +6,32 @@ use super::{Invalid, PlannerRef, VehicleSetup};
 use crate::config::{ModemConfig, ScenarioConfig, VehicleConfig};
 use plumetrace_core::params::quoted_key;
 use plumetrace_core::{Heading, Vec2, VehicleId, VehicleKind};
-use plumetrace_env::Rect;
+use plumetrace_env::{Rect, Seabed};
 use plumetrace_sim::{Vehicle, VehicleParams};
 
 /// Every vehicle, with the planner it flies; every planner table must be flown.
-pub(super) fn vehicles(cfg: &ScenarioConfig, domain: &Rect) -> Result<Vec<VehicleSetup>, Invalid> {
+///
+/// Over a seabed (`[bathymetry]`) an AUV starts at its altitude above the seabed where it is,
+/// and a surface craft at the surface (the deepest water).
+pub(super) fn vehicles(
+    cfg: &ScenarioConfig,
+    domain: &Rect,
+    seabed: Option<&Seabed>,
+) -> Result<Vec<VehicleSetup>, Invalid> {
     let legacy = cfg.planner.as_ref().map(legacy_planner).transpose()?;
     let mut vehicles = Vec::new();
     for (k, v) in cfg.vehicles.iter().enumerate() {
         check_name(cfg, k)?;
-        let mut setup = vehicle_setup(v, k, domain, cfg.domain.depth_m)?;
+        let depth_m = match seabed {
+            Some(sb) => Some(sb.surface_m()),
+            None => cfg.domain.depth_m,
+        };
+        let mut setup = vehicle_setup(v, k, domain, depth_m)?;
+        if let (Some(sb), VehicleKind::Auv) = (seabed, v.kind) {
+            let p = setup.vehicle.state.pos_m;
+            let z = setup.vehicle.state.z_m + sb.height_at(p.x, p.y);
+            setup.vehicle.state.z_m = z.min(sb.surface_m());
+        }
         setup.planner = match &v.planner {
             Some(name) => Some(named_planner(cfg, k, name)?),
             None if v.kind == VehicleKind::Auv => legacy.clone(),

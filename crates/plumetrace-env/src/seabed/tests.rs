@@ -1,0 +1,321 @@
+//! Tests of the seabed: the bathymetry reader (files written by the crate's own NetCDF writer)
+//! and filaments over a sloping seabed.
+
+use super::*;
+use crate::field::ConcentrationField;
+use crate::flow::MeanFlow;
+use crate::flow::{FlowModel, UniformFlow};
+use crate::plume::{FilamentParams, FilamentPlume, Source, VerticalBoundary};
+use crate::{StreamId, stream_rng};
+use plumetrace_core::Vec3;
+use plumetrace_core::geo::Origin;
+use plumetrace_netcdf::{Dataset, NcType};
+use std::path::PathBuf;
+use std::sync::Arc;
+
+fn tmp(name: &str, bytes: &[u8]) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("plumetrace-seabed-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let p = dir.join(name);
+    std::fs::write(&p, bytes).unwrap();
+    p
+}
+
+fn rect(x0: f64, x1: f64, y0: f64, y1: f64) -> Rect {
+    Rect::new(x0, x1, y0, y1).unwrap()
+}
+
+/// A projected grid, x 0..400 step 100, y 0..200 step 100: depth 30 m at x = 0 rising 5 m
+/// per 100 m eastward (a 5 % slope).
+fn projected() -> Dataset {
+    projected_with(Some("m"), None)
+}
+
+/// [`projected`] with the depth's units (or none) and a fill value.
+fn projected_with(units: Option<&str>, fill: Option<f64>) -> Dataset {
+    let mut d = Dataset::default();
+    let y = d.dim("y", 3);
+    let x = d.dim("x", 5);
+    d.var("y", &[y], vec![0.0, 100.0, 200.0])
+        .attr("standard_name", "projection_y_coordinate")
+        .attr("units", "m");
+    d.var("x", &[x], vec![0.0, 100.0, 200.0, 300.0, 400.0])
+        .attr("standard_name", "projection_x_coordinate")
+        .attr("units", "m");
+    let mut depth = Vec::new();
+    for _ in 0..3 {
+        for k in 0..5 {
+            depth.push(30.0 - 5.0 * k as f64);
+        }
+    }
+    let v = d
+        .var("depth", &[y, x], depth)
+        .attr("standard_name", "sea_floor_depth_below_sea_surface");
+    if let Some(u) = units {
+        v.attr("units", u);
+    }
+    if let Some(f) = fill {
+        v.attr("_FillValue", f);
+    }
+    d
+}
+
+fn options() -> SeabedOptions {
+    SeabedOptions {
+        frame: None,
+        area: rect(0.0, 400.0, 0.0, 200.0),
+        must_cover: rect(50.0, 350.0, 50.0, 150.0),
+        spacing_m: Some(50.0),
+        variable: None,
+    }
+}
+
+fn read(name: &str, d: &Dataset, o: &SeabedOptions) -> Result<Seabed, String> {
+    let p = tmp(name, &d.to_bytes().unwrap());
+    Seabed::from_netcdf(&p, o).map_err(|e| e.to_string())
+}
+
+#[test]
+fn a_projected_depth_grid_gives_heights_above_the_deepest_point() {
+    let s = read("slope.nc", &projected(), &options()).unwrap();
+    assert_eq!(s.surface_m(), 30.0);
+    assert_eq!(s.shallowest_m(), 10.0);
+    assert!((s.height_at(0.0, 100.0) - 0.0).abs() < 1e-12);
+    assert!((s.height_at(250.0, 37.0) - 12.5).abs() < 1e-12);
+    assert!((s.depth_at(400.0, 200.0) - 10.0).abs() < 1e-12);
+    // Beyond the grid: the edge's value; a NaN position does not panic.
+    assert!((s.height_at(-50.0, 500.0) - 0.0).abs() < 1e-12);
+    assert!(s.height_at(f64::NAN, 0.0).is_finite());
+}
+
+/// GEBCO's layout: `elevation` on lat/lon, negative below sea level, integers.
+fn gebco(land_at: Option<usize>) -> Dataset {
+    let mut d = Dataset::default();
+    let la = d.dim("lat", 4);
+    let lo = d.dim("lon", 5);
+    d.var("lat", &[la], vec![49.97, 49.99, 50.01, 50.03])
+        .attr("standard_name", "latitude")
+        .attr("units", "degrees_north");
+    d.var("lon", &[lo], vec![-4.04, -4.02, -4.0, -3.98, -3.96])
+        .attr("standard_name", "longitude")
+        .attr("units", "degrees_east");
+    let mut e: Vec<f64> = (0..20).map(|k| -40.0 + (k % 5) as f64).collect();
+    if let Some(k) = land_at {
+        e[k] = 300.0;
+    }
+    d.var("elevation", &[la, lo], e)
+        .of_type(NcType::Short)
+        .attr("standard_name", "height_above_reference_ellipsoid")
+        .attr("units", "m");
+    d
+}
+
+fn site() -> SeabedOptions {
+    SeabedOptions {
+        frame: Some(
+            LocalFrame::new(Origin {
+                lat_deg: 50.0,
+                lon_deg: -4.0,
+            })
+            .unwrap(),
+        ),
+        area: rect(-1000.0, 1000.0, -1000.0, 1000.0),
+        must_cover: rect(-500.0, 500.0, -500.0, 500.0),
+        spacing_m: Some(100.0),
+        variable: None,
+    }
+}
+
+#[test]
+fn a_gebco_elevation_on_longitude_and_latitude_is_read_as_depth() {
+    let s = read("gebco.nc", &gebco(None), &site()).unwrap();
+    // -40 m at lon -4.04, one metre shallower each 0.02 deg east: -38 m at the origin.
+    assert!(
+        (s.depth_at(0.0, 0.0) - 38.0).abs() < 0.01,
+        "{}",
+        s.depth_at(0.0, 0.0)
+    );
+    // Land (elevation > 0) outside the op-area takes the shallowest water.
+    let s = read("land-out.nc", &gebco(Some(0)), &site()).unwrap();
+    assert!(s.depth_at(-1000.0, -1000.0) > 0.0);
+    let e = read("land-in.nc", &gebco(Some(7)), &site()).unwrap_err();
+    assert!(
+        e.contains("variable elevation: the seabed is at or above the surface")
+            && e.contains("inside the op-area")
+            && e.contains("positive = \"up\""),
+        "{e}"
+    );
+}
+
+#[test]
+fn the_errors_name_the_variable_attribute_or_dimension_and_suggest() {
+    // A typo'd variable.
+    let mut o = options();
+    o.variable = Some("dept".into());
+    let e = read("typo.nc", &projected(), &o).unwrap_err();
+    assert!(
+        e.contains(
+            "typo.nc: bathymetry.variable = \"dept\": no such variable; did you mean \"depth\"?"
+        ),
+        "{e}"
+    );
+    // No depth at all.
+    let mut d = Dataset::default();
+    let x = d.dim("x", 2);
+    let y = d.dim("y", 2);
+    d.var("x", &[x], vec![0.0, 1.0]).attr("axis", "X");
+    d.var("y", &[y], vec![0.0, 1.0]).attr("axis", "Y");
+    d.var("temp", &[y, x], vec![1.0; 4]).attr("units", "K");
+    let e = read("none.nc", &d, &options()).unwrap_err();
+    assert!(
+        e.contains("no seabed depth") && e.contains("name it with bathymetry.variable"),
+        "{e}"
+    );
+    // Units that are not a length, and none.
+    let e = read("nounits.nc", &projected_with(None, None), &options()).unwrap_err();
+    assert!(
+        e.contains("variable depth: no attribute units (m or km expected)"),
+        "{e}"
+    );
+    let e = read(
+        "units.nc",
+        &projected_with(Some("fathoms"), None),
+        &options(),
+    )
+    .unwrap_err();
+    assert!(
+        e.contains("variable depth: attribute units = \"fathoms\" is not a length (m or km)"),
+        "{e}"
+    );
+    // A fill value inside the op-area.
+    let e = read(
+        "fill.nc",
+        &projected_with(Some("m"), Some(20.0)),
+        &options(),
+    )
+    .unwrap_err();
+    assert!(
+        e.contains("variable depth: a missing value (_FillValue or missing_value) at")
+            && e.contains("where the op-area needs the seabed"),
+        "{e}"
+    );
+    // A grid that does not cover the op-area.
+    let mut o = options();
+    o.must_cover = rect(50.0, 450.0, 50.0, 150.0);
+    let e = read("cover.nc", &projected(), &o).unwrap_err();
+    assert!(
+        e.contains("the bathymetry's grid (x 0 to 400, y 0 to 200) does not cover the op-area"),
+        "{e}"
+    );
+    // Longitude and latitude without an origin.
+    let mut o = site();
+    o.frame = None;
+    let e = read("origin.nc", &gebco(None), &o).unwrap_err();
+    assert!(
+        e.contains("give the site's origin ([origin] lat_deg and lon_deg)"),
+        "{e}"
+    );
+    // A time axis.
+    let mut d = Dataset::default();
+    let t = d.dim("time", 2);
+    let y = d.dim("y", 2);
+    let x = d.dim("x", 2);
+    d.var("time", &[t], vec![0.0, 1.0])
+        .attr("units", "hours since 2026-01-01");
+    d.var("x", &[x], vec![0.0, 400.0]).attr("axis", "X");
+    d.var("y", &[y], vec![0.0, 200.0]).attr("axis", "Y");
+    d.var("h", &[t, y, x], vec![10.0; 8]).attr("units", "m");
+    let e = read("time.nc", &d, &options()).unwrap_err();
+    assert!(
+        e.contains(
+            "variable h: dimension time is a time axis of 2 values; a seabed is one 2-D grid"
+        ),
+        "{e}"
+    );
+    // Not a file, not NetCDF.
+    let e = Seabed::from_netcdf(Path::new("/no/such/seabed.nc"), &options())
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("/no/such/seabed.nc"), "{e}");
+    let e = Seabed::from_netcdf(&tmp("text.nc", b"x,y,depth\n"), &options())
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("text.nc"), "{e}");
+}
+
+/// A 10 % slope rising eastward across 200 m (20 m), in 40 m of water at the west.
+fn slope() -> Arc<Seabed> {
+    let area = rect(0.0, 200.0, -50.0, 50.0);
+    let depths: Vec<f64> = (0..3 * 21)
+        .map(|k| 40.0 - 0.1 * (10.0 * (k % 21) as f64))
+        .collect();
+    Arc::new(Seabed::from_depths(area, 21, 3, &depths).unwrap())
+}
+
+#[test]
+fn filaments_never_go_below_a_sloping_seabed() {
+    let sb = slope();
+    let area = rect(0.0, 200.0, -50.0, 50.0);
+    let params = FilamentParams {
+        vertical: VerticalBoundary::Reflecting {
+            depth_m: Some(sb.surface_m()),
+        },
+        // A strong vertical walk, so that many filaments meet the seabed.
+        dispersion: crate::plume::Dispersion::Physical {
+            horizontal_m2ps: 0.05,
+            vertical_m2ps: 0.05,
+        },
+        ..FilamentParams::default()
+    };
+    // A source on the seabed, 0.1 m up, in a current running upslope.
+    let src = Vec3::new(20.0, 0.0, sb.height_at(20.0, 0.0) + 0.1);
+    let mut p = FilamentPlume::new(
+        area,
+        vec![Source {
+            pos_m: src,
+            mass_rate_per_s: 1.0,
+            filament_rate_hz: 20.0,
+        }],
+        params,
+    )
+    .unwrap();
+    p.set_seabed(Some(sb.clone()));
+    let flow = FlowModel::Uniform(
+        UniformFlow::new(MeanFlow::Steady {
+            speed_mps: 0.3,
+            toward_deg: 90.0,
+        })
+        .unwrap(),
+    );
+    let mut rng = stream_rng(7, StreamId::Plume);
+    let mut checked = 0usize;
+    let mut near = 0usize;
+    for k in 1..=600 {
+        p.step(&flow, k as f64, 1.0, &mut rng);
+        for (pos, _) in p.filaments() {
+            let f = sb.height_at(pos.x, pos.y);
+            assert!(pos.z >= f, "filament at {pos:?} below the seabed at {f}");
+            assert!(pos.z <= sb.surface_m());
+            checked += 1;
+            near += usize::from(pos.z - f < 0.5);
+        }
+    }
+    assert!(checked > 100_000 && near > 1000, "{checked} {near}");
+    // The concentration at the seabed adds the image there: the index and the scan agree.
+    p.prepare_queries();
+    let q = Vec3::new(60.0, 0.0, sb.height_at(60.0, 0.0) + 0.2);
+    let (a, b) = (p.concentration(q), p.concentration_full_scan(q));
+    assert!(a > 0.0 && (a - b).abs() <= 1e-9 * a, "{a} {b}");
+}
+
+#[test]
+fn from_depths_refuses_what_is_not_water() {
+    let area = rect(0.0, 1.0, 0.0, 1.0);
+    let e = Seabed::from_depths(area, 2, 2, &[1.0, 2.0, 0.0, 3.0]).unwrap_err();
+    assert_eq!(
+        e.to_string(),
+        "depths[2]: must be a finite depth > 0 m, got 0.0"
+    );
+    assert!(Seabed::from_depths(area, 1, 2, &[1.0, 2.0]).is_err());
+    assert!(Seabed::from_depths(area, 2, 2, &[1.0]).is_err());
+}
