@@ -8,6 +8,7 @@
 mod campaign;
 mod error;
 mod gym;
+mod gym_vec;
 mod planner;
 mod plume;
 mod run;
@@ -35,6 +36,7 @@ fn _plumetrace(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(campaign::run_columns, m)?)?;
     m.add_class::<plume::Plume>()?;
     m.add_class::<gym::EnvCore>()?;
-    m.add_class::<gym::VecEnvCore>()?;
+    m.add_class::<gym::ObsCore>()?;
+    m.add_class::<gym_vec::VecEnvCore>()?;
     Ok(())
 }
