@@ -35,6 +35,15 @@ fn obs_array<'py>(py: Python<'py>, obs: &[[f32; 12]]) -> PyResult<Bound<'py, PyA
     Ok(a.into_pyarray(py))
 }
 
+/// The run seed that seed `s` of an environment's sequence flies: `s`, or with a pool of
+/// seeds, `pool[s % len]`.
+fn pick(pool: &Option<Vec<u64>>, s: u64) -> u64 {
+    match pool {
+        Some(p) if !p.is_empty() => p[(s % p.len() as u64) as usize],
+        _ => s,
+    }
+}
+
 /// What one environment does at a vector step.
 enum Work {
     /// Starts an episode with this seed (next-step autoreset).
@@ -81,6 +90,8 @@ fn work_on(maker: &Maker, ep: &mut Option<Episode>, work: &Work) -> Result<Done,
 pub struct VecEnvCore {
     maker: Maker,
     same_step: bool,
+    /// Run seeds to fly: a derived seed `d` flies `pool[d % len]`.
+    pool: Option<Vec<u64>>,
     episodes: Vec<Option<Episode>>,
     base_seeds: Vec<u64>,
     counts: Vec<u64>,
@@ -92,18 +103,24 @@ pub struct VecEnvCore {
 #[pymethods]
 impl VecEnvCore {
     /// `n` environments on `scenario`, with settings and overrides as for `EnvCore`;
-    /// `same_step` chooses the same-step autoreset (otherwise next-step).
+    /// `same_step` chooses the same-step autoreset (otherwise next-step); `seeds`, a list of
+    /// run seeds, makes every episode fly one of them (seed `d` of the sequence above flies
+    /// `seeds[d % len(seeds)]`), e.g. a benchmark task's tuning seeds.
     #[new]
-    #[pyo3(signature = (scenario, n, same_step=false, set=None, **kwargs))]
+    #[pyo3(signature = (scenario, n, same_step=false, seeds=None, set=None, **kwargs))]
     fn new(
         scenario: &str,
         n: usize,
         same_step: bool,
+        seeds: Option<Vec<u64>>,
         set: Option<&Bound<'_, PyDict>>,
         kwargs: Option<&Bound<'_, PyDict>>,
     ) -> PyResult<Self> {
         if !(1..=4096).contains(&n) {
             return Err(msg(format!("n = {n} environments is outside 1..=4096")));
+        }
+        if seeds.as_ref().is_some_and(Vec::is_empty) {
+            return Err(msg("seeds is empty: give at least one run seed".to_string()));
         }
         let none = InfoRow {
             run_seed: 0,
@@ -115,6 +132,7 @@ impl VecEnvCore {
         Ok(VecEnvCore {
             maker: maker(scenario, set, kwargs)?,
             same_step,
+            pool: seeds,
             episodes: (0..n).map(|_| None).collect(),
             base_seeds: vec![0; n],
             counts: vec![0; n],
@@ -151,12 +169,13 @@ impl VecEnvCore {
             )));
         }
         let maker = &self.maker;
+        let pool = &self.pool;
         let mut work: Vec<(&mut Option<Episode>, Option<Work>)> = self
             .episodes
             .iter_mut()
             .zip(&seeds)
             .zip(&mask)
-            .map(|((ep, s), m)| (ep, m.then_some(Work::Reset(*s))))
+            .map(|((ep, s), m)| (ep, m.then_some(Work::Reset(pick(pool, *s)))))
             .collect();
         let outs: Vec<Option<Result<Done, String>>> = py.detach(|| {
             work.par_iter_mut()
@@ -210,7 +229,7 @@ impl VecEnvCore {
         let acts = actions.as_array();
         let mut plan = Vec::with_capacity(n);
         for i in 0..n {
-            let next = derive_seed(self.base_seeds[i], self.counts[i] + 1);
+            let next = pick(&self.pool, derive_seed(self.base_seeds[i], self.counts[i] + 1));
             let row = action3(&acts.row(i).to_vec())?;
             plan.push(if self.needs_reset[i] || self.episodes[i].is_none() {
                 Work::Reset(next)

@@ -29,6 +29,7 @@ fn _plumetrace(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(run::planners, m)?)?;
     m.add_function(wrap_pyfunction!(run::run_plume, m)?)?;
     m.add_function(wrap_pyfunction!(run::scenario_kind, m)?)?;
+    m.add_function(wrap_pyfunction!(run::derive_seed, m)?)?;
     m.add_function(wrap_pyfunction!(plume::_plume_from_state, m)?)?;
     m.add_class::<run::RunRecord>()?;
     m.add_function(wrap_pyfunction!(campaign::campaign, m)?)?;

@@ -28,13 +28,14 @@ from ._api import (
     run_columns,
     run_plume,
 )
-from ._plumetrace import Plume, PlumetraceError, __version__
+from ._plumetrace import Plume, PlumetraceError, __version__, derive_seed
 
 __all__ = [
     "Plume",
     "PlumetraceError",
     "RunResult",
     "campaign",
+    "derive_seed",
     "merge",
     "planners",
     "presets",

@@ -96,6 +96,8 @@ class Plume:
     ) -> Tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]: ...
     def stats(self) -> Dict[str, float]: ...
 
+def derive_seed(seed: int, k: int) -> int: ...
+
 class EnvCore:
     def __init__(self, scenario: str, set: Optional[Dict[str, Any]] = None, **kwargs: Any) -> None: ...
     @staticmethod
@@ -126,6 +128,7 @@ class VecEnvCore:
         scenario: str,
         n: int,
         same_step: bool = False,
+        seeds: Optional[List[int]] = None,
         set: Optional[Dict[str, Any]] = None,
         **kwargs: Any,
     ) -> None: ...

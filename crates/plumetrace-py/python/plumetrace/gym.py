@@ -178,7 +178,9 @@ class PlumeTracingVecEnv(gymnasium.vector.VectorEnv):
     Gymnasium's synchronous vector environment gives them). ``reset(seed=s)`` gives environment
     ``i`` the run seed ``s + i`` (or ``s[i]`` for a list); its later episodes have seeds derived
     from that one. ``reset(options={"reset_mask": m})`` resets only the environments where the
-    boolean array ``m`` is true. ``info`` has the keys ``INFO_KEYS`` (each with its mask
+    boolean array ``m`` is true. ``seeds`` (a list of run seeds, e.g. a benchmark task's tuning
+    seeds) makes every episode fly one of them: seed ``d`` of the sequence above flies
+    ``seeds[d % len(seeds)]``. ``info`` has the keys ``INFO_KEYS`` (each with its mask
     ``_key``) at every reset and step, as the synchronous and asynchronous vector modes give.
     """
 
@@ -194,6 +196,7 @@ class PlumeTracingVecEnv(gymnasium.vector.VectorEnv):
         set: Optional[Mapping[str, Any]] = None,
         render_mode: Optional[str] = None,
         autoreset_mode: Union[AutoresetMode, str] = AutoresetMode.NEXT_STEP,
+        seeds: Optional[Sequence[int]] = None,
         **settings: Any,
     ) -> None:
         if render_mode is not None:
@@ -213,6 +216,7 @@ class PlumeTracingVecEnv(gymnasium.vector.VectorEnv):
             scenario,
             num_envs,
             same_step=mode == AutoresetMode.SAME_STEP,
+            seeds=[int(s) for s in seeds] if seeds is not None else None,
             set=dict(set) if set else None,
             **settings,
         )

@@ -40,7 +40,8 @@ class PlumeTracingSB3VecEnv(VecEnv):
     """``num_envs`` copies of the environment on ``scenario`` as one SB3 ``VecEnv``; ``set``
     and ``**settings`` as for ``plumetrace.gym.PlumeTracingEnv``. ``seed(s)`` (or ``seed=s``
     here) gives copy ``i`` the run seed ``s + i`` at the next reset, as SB3's own vectorised
-    environments do."""
+    environments do; ``seeds`` (a list of run seeds) makes every episode fly one of them, as
+    for ``plumetrace.gym.PlumeTracingVecEnv``."""
 
     def __init__(
         self,
@@ -48,10 +49,11 @@ class PlumeTracingSB3VecEnv(VecEnv):
         scenario: str = "demo",
         set: Optional[Mapping[str, Any]] = None,
         seed: Optional[int] = None,
+        seeds: Optional[Sequence[int]] = None,
         **settings: Any,
     ) -> None:
         self._vec = PlumeTracingVecEnv(
-            num_envs, scenario, set=set, autoreset_mode="same_step", **settings
+            num_envs, scenario, set=set, autoreset_mode="same_step", seeds=seeds, **settings
         )
         super().__init__(
             num_envs, self._vec.single_observation_space, self._vec.single_action_space
