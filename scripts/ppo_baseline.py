@@ -164,6 +164,8 @@ def main():
     ap.add_argument("--test-seeds", type=int, default=None,
                     help="test seeds flown (default: the task's seeds, 100 for coastal)")
     ap.add_argument("--out", default=str(ROOT / "target" / "ppo"))
+    ap.add_argument("--evaluate", metavar="POLICY.zip",
+                    help="fly a saved policy on the test seeds instead of training one")
     args = ap.parse_args()
     version, task = task_of(args.task)
     scenario = str(ROOT / task["scenario"]) if "/" in task["scenario"] else task["scenario"]
@@ -174,15 +176,19 @@ def main():
     out = pathlib.Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
 
-    print(f"training PPO on {args.task}'s {task['tuning_seeds']} tuning seeds: "
-          f"{args.timesteps} steps, {args.envs} environments", flush=True)
-    path = out / f"ppo_{args.task}.zip"
-    model, took, tuning = train(task, scenario, args, path)
-    if set(tuning) & set(tests):
-        sys.exit("ppo_baseline.py: a tuning seed is a test seed")
-    model.save(path)
-    print(f"trained in {took:.0f} s ({args.timesteps / took:.0f} steps/s); "
-          f"saved {out / f'ppo_{args.task}.zip'}", flush=True)
+    if args.evaluate:
+        model, took = PPO.load(args.evaluate, device="cpu"), 0.0
+        print(f"flying {args.evaluate}", flush=True)
+    else:
+        print(f"training PPO on {args.task}'s {task['tuning_seeds']} tuning seeds: "
+              f"{args.timesteps} steps, {args.envs} environments", flush=True)
+        path = out / f"ppo_{args.task}.zip"
+        model, took, tuning = train(task, scenario, args, path)
+        if set(tuning) & set(tests):
+            sys.exit("ppo_baseline.py: a tuning seed is a test seed")
+        model.save(path)
+        print(f"trained in {took:.0f} s ({args.timesteps / took:.0f} steps/s); saved {path}",
+              flush=True)
 
     start = time.perf_counter()
     rows = evaluate(model, task, scenario, tests)

@@ -229,7 +229,10 @@ impl VecEnvCore {
         let acts = actions.as_array();
         let mut plan = Vec::with_capacity(n);
         for i in 0..n {
-            let next = pick(&self.pool, derive_seed(self.base_seeds[i], self.counts[i] + 1));
+            let next = pick(
+                &self.pool,
+                derive_seed(self.base_seeds[i], self.counts[i] + 1),
+            );
             let row = action3(&acts.row(i).to_vec())?;
             plan.push(if self.needs_reset[i] || self.episodes[i].is_none() {
                 Work::Reset(next)

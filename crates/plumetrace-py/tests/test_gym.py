@@ -249,3 +249,19 @@ def test_a_policy_flies_as_a_planner_on_the_environments_observations():
     with pytest.raises(ValueError, match=r"the policy gave 2 action components, not 3"):
         plumetrace.run("demo", seed=8, outputs=False,
                        planner=pg.PolicyPlanner(lambda o: np.zeros(2), "demo", 8))
+
+
+def test_a_seed_list_makes_every_episode_fly_one_of_them():
+    # As the PPO baseline trains on a benchmark task's tuning seeds only.
+    pool = [plumetrace.derive_seed(3201, k) for k in range(5)]
+    v = pg.PlumeTracingVecEnv(num_envs=2, scenario="demo", autoreset_mode="same_step",
+                              seeds=pool)
+    _, info = v.reset(seed=1)
+    seen = set(info["run_seed"].tolist())
+    for _ in range(6):  # every step declares, so every step ends both episodes
+        _, _, term, _, info = v.step(np.array([[0.0, 0.0, 1.0], [0.0, 0.0, 1.0]]))
+        assert term.all()
+        seen |= set(info["run_seed"].tolist()) | set(info["final_info"]["run_seed"].tolist())
+    assert seen <= set(pool) and len(seen) >= 3
+    with pytest.raises(plumetrace.PlumetraceError, match="seeds is empty"):
+        pg.PlumeTracingVecEnv(num_envs=2, scenario="demo", seeds=[])
