@@ -28,6 +28,9 @@ from stable_baselines3.common.callbacks import BaseCallback
 from stable_baselines3.common.vec_env import VecMonitor
 
 ROOT = pathlib.Path(__file__).resolve().parents[1]
+# One thread for torch: the policy is small, and the environments step in Rust's own threads
+# (torch's waiting threads otherwise spin on the cores the environments need).
+torch.set_num_threads(1)
 # The policy decides every 5 s (the environment's default is 1 s): episodes of the task's
 # 7200 s are at most 1,440 decisions, within reach of PPO's discounting.
 SETTINGS = {"decision_period_s": 5.0}
@@ -144,10 +147,11 @@ def entry(rows):
 
 
 def markdown_row(e):
+    """The entry as a row of the leaderboard's table, unranked (it flew apart from the rest)."""
     f = lambda x: "–" if x is None else f"{x:.1f}"  # noqa: E731
     g = lambda x: "–" if x is None else f"{x:.0f}"  # noqa: E731
     lo, hi = e["success_ci95"]
-    return (f"| ppo | {e['runs']} | {e['successes']}/{e['runs']} = {e['success_rate']:.2f} "
+    return (f"| – | ppo | {e['runs']} | {e['successes']}/{e['runs']} = {e['success_rate']:.2f} "
             f"({lo:.2f} – {hi:.2f}) | {e['sources_located']}/{e['sources']} | "
             f"{f(e['error_median_m'])} / {f(e['error_p90_m'])} | {f(e['along_median_m'])} / "
             f"{f(e['cross_median_m'])} | {f(e['along_signed_median_m'])} | "
