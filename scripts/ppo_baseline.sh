@@ -4,7 +4,8 @@
 # through the Python planner seam (scripts/ppo_baseline.py says how).
 #
 #   scripts/ppo_baseline.sh            the documented budget: 200,000 environment steps on 4
-#                                      copies, then the task's 100 test seeds; into target/ppo
+#                                      copies (373 s on 2 busy cores), then the task's 100 test
+#                                      seeds (182 s); into target/ppo
 #   scripts/ppo_baseline.sh --tiny     CI: 2,048 steps on 2 copies, 2 test seeds, after the
 #                                      Stable-Baselines3 tests of the package (check_env, the
 #                                      VecEnv adapter, a short PPO run); into target/ppo-tiny
