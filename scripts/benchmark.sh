@@ -10,7 +10,8 @@
 #
 # Options: --jobs N (worker threads, default: one per core), --bin PATH (a built plumetrace,
 # default: builds the release binary of this checkout), --seeds-per-task N, --keep (resume into
-# target/benchmark instead of starting afresh).
+# target/benchmark instead of starting afresh), --ppo FILE (the learned baseline's row,
+# target/ppo/ppo.md from scripts/ppo_baseline.sh, added unranked to the coastal table).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -19,6 +20,7 @@ bin=""
 keep=0
 smoke=0
 seeds=""
+ppo=""
 while [ $# -gt 0 ]; do
     case "$1" in
         --jobs) jobs="$2"; shift 2 ;;
@@ -26,7 +28,8 @@ while [ $# -gt 0 ]; do
         --seeds-per-task) seeds="$2"; shift 2 ;;
         --keep) keep=1; shift ;;
         --smoke) smoke=1; shift ;;
-        -h|--help) sed -n '2,13p' "$0"; exit 0 ;;
+        --ppo) ppo="$2"; shift 2 ;;
+        -h|--help) sed -n '2,15p' "$0"; exit 0 ;;
         *) echo "benchmark.sh: unknown argument $1 (see --help)" >&2; exit 2 ;;
     esac
 done
@@ -120,6 +123,21 @@ mkdir -p "$images"
     echo
     sed -n 's/^\([a-z0-9_-]*\): \([0-9]*\) planners x \([0-9]*\) test seeds: \([0-9]*\) runs.* in \([0-9.]*\) s$/- `\1`: \2 planners x \3 test seeds, \4 runs, \5 s/p' "$log"
 } > "$page.tmp"
+if [ -n "$ppo" ]; then
+    # The learned baseline flew apart (through Python): its row joins the coastal table unranked.
+    ppo_json="$(dirname "$ppo")/ppo.json"
+    steps="$(sed -n 's/^ *"timesteps": \([0-9]*\),$/\1/p' "$ppo_json")"
+    note="\`ppo\` (unranked): the learned baseline, PPO trained for $steps environment steps on the task's tuning seeds by \`scripts/ppo_baseline.sh\` and flown on the same test seeds through the Python planner seam ([the benchmark](../benchmark.md#a-learned-baseline-ppo))."
+    awk -v row="$(cat "$ppo")" -v note="$note" '
+        /^### `coastal`/ { c = 1 }
+        /^### / && !/`coastal`/ { c = 0 }
+        {
+            if (c && intable && $0 !~ /^\|/) { print row; print ""; print note; intable = 0 }
+            if (c && $0 ~ /^\| [0-9]+ \|/) intable = 1
+            print
+        }' "$page.tmp" > "$page.ppo"
+    mv "$page.ppo" "$page.tmp"
+fi
 for d in "$out"/*/; do
     t="$(basename "$d")"
     [ "$t" = "tasks" ] && continue

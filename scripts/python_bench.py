@@ -96,14 +96,15 @@ def gym_costs(steps, seed, envs):
     """Steps per second: random actions (episodes end often, so resets, each with the
     scenario's spin-up, are counted in), and a held course that keeps the episode going."""
     out = {}
-    for name, policy in [("random", None), ("held", np.array([0.0, 0.0]))]:
+    # The third action component (declare) stays at -1: the episodes never declare.
+    for name, policy in [("random", None), ("held", np.array([0.0, 0.0, -1.0]))]:
         env = pg.PlumeTracingEnv("demo")
         rng = np.random.default_rng(seed)
         env.reset(seed=seed)
         resets = 0
         t0 = time.perf_counter()
         for _ in range(steps):
-            a = rng.uniform(-1, 1, 2) if policy is None else policy
+            a = np.append(rng.uniform(-1, 1, 2), -1.0) if policy is None else policy
             _, _, term, trunc, _ = env.step(a)
             if term or trunc:
                 env.reset()
@@ -116,7 +117,8 @@ def gym_costs(steps, seed, envs):
             k = max(1, steps // n)
             t0 = time.perf_counter()
             for _ in range(k):
-                a = rng.uniform(-1, 1, (n, 2)) if policy is None else np.tile(policy, (n, 1))
+                a = (np.column_stack([rng.uniform(-1, 1, (n, 2)), -np.ones(n)])
+                     if policy is None else np.tile(policy, (n, 1)))
                 v.step(a)
             out[f"vec{n}_{name}_steps_per_s"] = n * k / (time.perf_counter() - t0)
     return out

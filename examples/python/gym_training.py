@@ -5,8 +5,9 @@ stepped in Rust.
     python gym_training.py [--iterations 20] [--envs 4] [--steps 300]
 
 Needs gymnasium (`pip install "plumetrace[gym]"`). The policy maps the 12 observation
-components to the two actions (turn, speed); each candidate is scored by its summed reward over
-`--steps` steps of `--envs` environments on the same seeds.
+components to the three actions (turn, speed, declare); each candidate is scored by its summed
+reward over `--steps` steps of `--envs` environments on the same seeds. (For a deep-learning
+baseline, PPO through Stable-Baselines3, see scripts/ppo_baseline.sh.)
 """
 
 import argparse
@@ -44,11 +45,11 @@ def main() -> None:
     ap.add_argument("--steps", type=int, default=300)
     ap.add_argument("--seed", type=int, default=1)
     args = ap.parse_args()
-    env = gym.make_vec("plumetrace/PlumeTracing-v0", num_envs=args.envs,
+    env = gym.make_vec("plumetrace/PlumeTracing-v1", num_envs=args.envs,
                        vectorization_mode="vector_entry_point", scenario="demo")
     rng = np.random.default_rng(args.seed)
     n_obs = len(plumetrace.gym.OBS_NAMES)
-    best = np.zeros((n_obs, 2))
+    best = np.zeros((n_obs, len(plumetrace.gym.ACTION_NAMES)))
     best_score = score(env, best, args.steps, args.seed)
     print(f"start: {best_score:+.3f}")
     for i in range(args.iterations):

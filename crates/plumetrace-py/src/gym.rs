@@ -2,36 +2,38 @@
 //! agent flying one vehicle through the same `Planner` seam as every planner.
 //!
 //! The agent's planner is asked every `decision_period_s`; each environment step runs the
-//! mission to the next decision. The action `(turn, speed)` in `[-1, 1]^2` becomes a heading
-//! change of `turn * max_turn_deg` from the vehicle's measured heading and a speed from
-//! `speed_min_mps` to `speed_max_mps`; it is applied at the next decision of the vehicle, one
-//! decision period after the observation it answers (the vehicle's reaction time).
+//! mission to the next decision. The action `(turn, speed, declare)` in `[-1, 1]^3` becomes a
+//! heading change of `turn * max_turn_deg` from the vehicle's measured heading, a speed from
+//! `speed_min_mps` to `speed_max_mps`, and, when `declare` is above `declare_threshold`, a
+//! declaration of the source at the vehicle's position estimate; it is applied at the next
+//! decision of the vehicle, one decision period after the observation it answers (the vehicle's
+//! reaction time).
 //!
 //! The observation is what the vehicle knows, never the truth ([`OBS_NAMES`], bounds in
-//! [`OBS_LOW`]/[`OBS_HIGH`]). The reward, which may use the truth (it is the experimenter's, not
-//! the planner's): `-decision_period_s / time_limit_s` per step (a whole episode of waiting sums
-//! to -1), `+detection_reward` for each step with a detection, `+1` and the end of the episode
-//! (terminated) when the vehicle comes within `success_radius_m` of a source horizontally, `-1`
-//! and the end (terminated) when it leaves the op-area or the mission ends otherwise (an
-//! incident; a vehicle that starts outside the op-area may drive in first); truncated at the
-//! scenario's time limit.
+//! [`OBS_LOW`]/[`OBS_HIGH`]), built by [`Observer`] (which `ObsCore` gives Python, so a trained
+//! policy flies through the Python planner seam on the same observations). The reward, which
+//! may use the truth (it is the experimenter's, not the planner's): `-decision_period_s /
+//! time_limit_s` per step (a whole episode of waiting sums to -1), `+detection_reward` for each
+//! step with a detection until the episode's detection rewards reach `detection_reward_max`;
+//! a declaration ends the episode (terminated) with `+1` when it lies within the success radius
+//! of a source, `-1` otherwise; `-1` and the end (terminated) when the vehicle leaves the
+//! op-area or the mission ends otherwise (an incident; a vehicle that starts outside the op-area
+//! may drive in first); truncated at the scenario's time limit. So an episode with a correct
+//! declaration returns at least 0, and any other at most `detection_reward_max - 1 +
+//! decision_period_s / time_limit_s`: staying in the plume never pays as well as finding the
+//! source.
 
 use crate::error::msg;
 use crate::scenario::{Source, overrides};
-use numpy::ndarray::Array2;
-use numpy::{
-    IntoPyArray, PyArray1, PyArray2, PyReadonlyArray1, PyReadonlyArray2, PyUntypedArrayMethods,
-};
+use numpy::{IntoPyArray, PyArray1, PyReadonlyArray1};
 use plumetrace_core::{
-    Command, Decision, Heading, PlanStatus, Planner, SensorSnapshot, Vec2, VehicleKind,
-    VerticalCommand,
+    Command, Decision, DeclarationKind, Heading, PlanStatus, Planner, PlannerEvent, SensorSnapshot,
+    Vec2, VehicleKind, VerticalCommand,
 };
-use plumetrace_env::derive_seed;
 use plumetrace_guidance::OpArea;
 use plumetrace_mission::{EndReason, Mission, MissionOptions, MissionSetup, VehicleStatus};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
-use rayon::prelude::*;
 use std::collections::VecDeque;
 use std::sync::{Arc, Mutex};
 
@@ -64,9 +66,12 @@ const SINCE_SCALE_S: f64 = 600.0;
 /// What the agent's planner and the environment share.
 #[derive(Default)]
 struct Shared {
-    action: [f64; 2],
+    action: [f64; 3],
     snapshot: Option<SensorSnapshot>,
     calls: u64,
+    /// Set at the decision that declares: the declared point (`None` without a position
+    /// estimate, which counts as a false declaration).
+    declared: Option<Option<Vec2>>,
 }
 
 /// The agent's side of the `Planner` seam.
@@ -76,27 +81,43 @@ struct AgentPlanner {
     vertical: VerticalCommand,
 }
 
+/// The command an action gives at a decision with `snapshot`, and whether it declares.
+fn command_of(
+    st: &Settings,
+    vertical: VerticalCommand,
+    snapshot: &SensorSnapshot,
+    [turn, speed, declare]: [f64; 3],
+) -> (Command, bool) {
+    let heading = Heading::from_deg(snapshot.nav.heading.deg() + turn * st.max_turn_deg);
+    let speed_mps = st.speed_min_mps + 0.5 * (speed + 1.0) * (st.speed_max_mps - st.speed_min_mps);
+    let command = Command {
+        heading,
+        speed_mps,
+        vertical,
+    };
+    (command, declare > st.declare_threshold)
+}
+
 impl Planner for AgentPlanner {
     fn decide(&mut self, snapshot: &SensorSnapshot) -> Decision {
         let mut s = match self.shared.lock() {
             Ok(s) => s,
             Err(p) => p.into_inner(),
         };
-        let [turn, speed] = s.action;
-        let st = &self.settings;
-        let heading = Heading::from_deg(snapshot.nav.heading.deg() + turn * st.max_turn_deg);
-        let speed_mps =
-            st.speed_min_mps + 0.5 * (speed + 1.0) * (st.speed_max_mps - st.speed_min_mps);
+        let (command, declare) = command_of(&self.settings, self.vertical, snapshot, s.action);
         s.snapshot = Some(snapshot.clone());
         s.calls += 1;
-        Decision::new(
-            Command {
-                heading,
-                speed_mps,
-                vertical: self.vertical,
-            },
-            PlanStatus::Running,
-        )
+        let mut decision = Decision::new(command, PlanStatus::Running);
+        if declare && s.declared.is_none() {
+            s.declared = Some(snapshot.nav.pos_m);
+            if let Some(p) = snapshot.nav.pos_m {
+                decision.events.push(PlannerEvent::Declared {
+                    pos_m: p,
+                    rule: DeclarationKind::CUSTOM,
+                });
+            }
+        }
+        decision
     }
 
     fn decision_period_s(&self) -> f64 {
@@ -106,46 +127,183 @@ impl Planner for AgentPlanner {
 
 /// The environment's settings (documented in `plumetrace.gym`).
 #[derive(Debug, Clone, Copy)]
-struct Settings {
+pub struct Settings {
     vehicle: usize,
     decision_period_s: f64,
     max_turn_deg: f64,
     speed_min_mps: f64,
     speed_max_mps: f64,
-    success_radius_m: f64,
+    /// `None`: the scenario's `mission.success_radius_m`.
+    success_radius_m: Option<f64>,
     detection_reward: f64,
+    detection_reward_max: f64,
+    declare_threshold: f64,
+}
+
+/// The observation of a vehicle's snapshots: what it knows, scaled to the bounds; it keeps the
+/// recent detections, so one observer serves one episode.
+pub struct Observer {
+    threshold: f64,
+    centre: Vec2,
+    half: Vec2,
+    time_limit_s: f64,
+    recent: VecDeque<bool>,
+    last_detection_s: Option<f64>,
+}
+
+impl Observer {
+    /// The observer of vehicle `k` of `setup` (its planner's detection threshold, the op-area,
+    /// the time limit), and the vertical command the agent keeps.
+    fn of(setup: &MissionSetup, k: usize) -> Result<(Observer, VerticalCommand), String> {
+        let v = setup.vehicles.get(k).ok_or_else(|| {
+            format!(
+                "vehicle {k}: the scenario has {} vehicles",
+                setup.vehicles.len()
+            )
+        })?;
+        let planned = setup
+            .planners
+            .get(k)
+            .and_then(Option::as_ref)
+            .ok_or_else(|| format!("vehicle {k} ({}) has no planner table", v.name))?;
+        let threshold = planned.config.detection_threshold_v().ok_or_else(|| {
+            format!(
+                "vehicle {k}'s planner ({}) has no detection threshold",
+                planned.config.kind()
+            )
+        })?;
+        let vertical = match v.vehicle.params.kind {
+            VehicleKind::Surface => VerticalCommand::Surface,
+            _ => VerticalCommand::Altitude(v.vehicle.state.z_m),
+        };
+        let (x0, x1, y0, y1) =
+            plumetrace_mission::record::bounds_of(setup.geometry.op_area.vertices());
+        let observer = Observer {
+            threshold,
+            centre: Vec2::new(0.5 * (x0 + x1), 0.5 * (y0 + y1)),
+            half: Vec2::new((0.5 * (x1 - x0)).max(1.0), (0.5 * (y1 - y0)).max(1.0)),
+            time_limit_s: setup.spec.time_limit_s,
+            recent: VecDeque::with_capacity(RECENT),
+            last_detection_s: None,
+        };
+        Ok((observer, vertical))
+    }
+
+    /// The observation of `s` (and it joins the recent detections).
+    fn observe(&mut self, s: &SensorSnapshot) -> [f32; 12] {
+        let max_reading = s.chem.iter().map(|c| c.reading).fold(0.0_f64, f64::max);
+        let detected = max_reading > self.threshold;
+        if detected {
+            self.last_detection_s = Some(s.time_s);
+        }
+        if self.recent.len() == RECENT {
+            self.recent.pop_front();
+        }
+        self.recent.push_back(detected);
+        let rel = s.nav.pos_m.map_or(Vec2::new(0.0, 0.0), |p| {
+            Vec2::new(
+                (p.x - self.centre.x) / self.half.x,
+                (p.y - self.centre.y) / self.half.y,
+            )
+        });
+        let h = s.nav.heading.rad();
+        let flow = s.flow.map_or(Vec2::new(0.0, 0.0), |f| f.velocity_mps);
+        let latest = s.chem.last().map_or(0.0, |c| c.reading);
+        let raw = [
+            rel.x,
+            rel.y,
+            h.sin(),
+            h.cos(),
+            s.nav.speed_mps / 3.0,
+            (latest / self.threshold.max(1e-12)).tanh(),
+            f64::from(u8::from(detected)),
+            self.recent.iter().filter(|d| **d).count() as f64 / RECENT as f64,
+            self.last_detection_s
+                .map_or(1.0, |t| ((s.time_s - t) / SINCE_SCALE_S).min(1.0)),
+            flow.x,
+            flow.y,
+            s.time_s / self.time_limit_s.max(1.0),
+        ];
+        let mut obs = [0.0_f32; 12];
+        for i in 0..12 {
+            let v = if raw[i].is_finite() { raw[i] } else { 0.0 };
+            obs[i] = (v as f32).clamp(OBS_LOW[i], OBS_HIGH[i]);
+        }
+        obs
+    }
 }
 
 /// One episode in flight.
-struct Episode {
+pub(crate) struct Episode {
     mission: Mission,
     shared: Arc<Mutex<Shared>>,
-    threshold: f64,
+    observer: Observer,
     area: OpArea,
-    centre: Vec2,
-    half: Vec2,
     sources: Vec<Vec2>,
-    recent: VecDeque<bool>,
-    last_detection_s: Option<f64>,
+    radius_m: f64,
+    seed: u64,
+    bonus: f64,
     calls: u64,
     over: bool,
     entered: bool,
 }
 
-/// What one step gives back.
-struct StepOut {
-    obs: [f32; 12],
-    reward: f64,
-    terminated: bool,
-    truncated: bool,
-    success: bool,
-    reason: &'static str,
+/// `error_m` without a declaration (or of one without a position estimate): -1, not NaN, so
+/// that two equal episodes have equal `info` (as the checkers compare them).
+pub(crate) const NO_ERROR: f64 = -1.0;
+
+/// What `info` holds at every step and reset, in every vector mode.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct InfoRow {
+    pub run_seed: u64,
+    pub time_s: f64,
+    pub success: bool,
+    pub reason: &'static str,
+    /// Distance of the declaration from the nearest source, m ([`NO_ERROR`] without one).
+    pub error_m: f64,
 }
 
-struct Maker {
+impl InfoRow {
+    /// The keys of `info`, in order.
+    pub const KEYS: [&'static str; 5] = ["run_seed", "time_s", "success", "reason", "error_m"];
+
+    pub fn to_dict<'py>(self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let d = PyDict::new(py);
+        d.set_item("run_seed", self.run_seed)?;
+        d.set_item("time_s", self.time_s)?;
+        d.set_item("success", self.success)?;
+        d.set_item("reason", self.reason)?;
+        d.set_item("error_m", self.error_m)?;
+        Ok(d)
+    }
+}
+
+/// What one step gives back.
+pub(crate) struct StepOut {
+    pub obs: [f32; 12],
+    pub reward: f64,
+    pub terminated: bool,
+    pub truncated: bool,
+    pub info: InfoRow,
+}
+
+impl StepOut {
+    /// The first observation of an episode, as a step's result (reward 0).
+    pub fn first(ep: &Episode, obs: [f32; 12]) -> StepOut {
+        StepOut {
+            obs,
+            reward: 0.0,
+            terminated: false,
+            truncated: false,
+            info: ep.info(false, "", NO_ERROR),
+        }
+    }
+}
+
+pub(crate) struct Maker {
     source: Source,
     overrides: Vec<(String, toml::Value)>,
-    settings: Settings,
+    pub settings: Settings,
     /// The spun-up environments of the last few seeds reset to, newest last: a reset to one of
     /// them starts from a copy (the same bits as spinning up again) instead of spinning up.
     spun: Mutex<VecDeque<(u64, plumetrace_env::Environment)>>,
@@ -186,7 +344,7 @@ impl Maker {
         Ok(())
     }
 
-    fn episode(&self, seed: u64) -> Result<(Episode, [f32; 12]), String> {
+    pub fn episode(&self, seed: u64) -> Result<(Episode, [f32; 12]), String> {
         let sc = self
             .source
             .build(Some(seed), &self.overrides)
@@ -194,29 +352,12 @@ impl Maker {
         let mut setup = MissionSetup::new(sc).map_err(|e| crate::error::located(&e))?;
         self.spin_up(seed, &mut setup)?;
         let k = self.settings.vehicle;
-        let v = setup.vehicles.get(k).ok_or_else(|| {
-            format!(
-                "vehicle {k}: the scenario has {} vehicles",
-                setup.vehicles.len()
-            )
-        })?;
-        let planned = setup
-            .planners
-            .get(k)
-            .and_then(Option::as_ref)
-            .ok_or_else(|| format!("vehicle {k} ({}) has no planner table", v.name))?;
-        let threshold = planned.config.detection_threshold_v().ok_or_else(|| {
-            format!(
-                "vehicle {k}'s planner ({}) has no detection threshold",
-                planned.config.kind()
-            )
-        })?;
-        let vertical = match v.vehicle.params.kind {
-            VehicleKind::Surface => VerticalCommand::Surface,
-            _ => VerticalCommand::Altitude(v.vehicle.state.z_m),
-        };
+        let (observer, vertical) = Observer::of(&setup, k)?;
+        let radius_m = self
+            .settings
+            .success_radius_m
+            .unwrap_or(setup.spec.success_radius_m);
         let area = setup.geometry.op_area.clone();
-        let (x0, x1, y0, y1) = plumetrace_mission::record::bounds_of(area.vertices());
         let mut mission = Mission::new(
             setup,
             MissionOptions {
@@ -244,13 +385,12 @@ impl Maker {
         let mut ep = Episode {
             mission,
             shared,
-            threshold,
+            observer,
             area,
-            centre: Vec2::new(0.5 * (x0 + x1), 0.5 * (y0 + y1)),
-            half: Vec2::new((0.5 * (x1 - x0)).max(1.0), (0.5 * (y1 - y0)).max(1.0)),
             sources,
-            recent: VecDeque::with_capacity(RECENT),
-            last_detection_s: None,
+            radius_m,
+            seed,
+            bonus: 0.0,
             calls: 0,
             over: false,
             entered: false,
@@ -261,8 +401,19 @@ impl Maker {
 }
 
 impl Episode {
+    /// The `info` of this episode now.
+    fn info(&self, success: bool, reason: &'static str, error_m: f64) -> InfoRow {
+        InfoRow {
+            run_seed: self.seed,
+            time_s: self.mission.time_s(),
+            success,
+            reason,
+            error_m,
+        }
+    }
+
     /// Runs the mission to the agent's next decision and scores it.
-    fn advance(&mut self, st: Settings) -> Result<StepOut, String> {
+    pub fn advance(&mut self, st: Settings) -> Result<StepOut, String> {
         let mut ended = None;
         loop {
             if let Some(end) = self.mission.step().map_err(|e| crate::error::located(&e))? {
@@ -275,22 +426,27 @@ impl Episode {
                 break;
             }
         }
-        let snap = self
+        let (snap, declared) = self
             .shared
             .lock()
             .ok()
-            .and_then(|s| s.snapshot.clone())
+            .and_then(|mut s| Some((s.snapshot.clone()?, s.declared.take())))
             .ok_or_else(|| "the vehicle never reached a decision".to_string())?;
-        let obs = self.observe(&snap);
-        let detected = obs[6] > 0.5;
+        let obs = self.observer.observe(&snap);
+        let bonus = if obs[6] > 0.5 {
+            st.detection_reward
+                .min(st.detection_reward_max - self.bonus)
+                .max(0.0)
+        } else {
+            0.0
+        };
+        self.bonus += bonus;
         let mut out = StepOut {
             obs,
-            reward: -st.decision_period_s / self.mission.time_limit_s().max(1.0)
-                + if detected { st.detection_reward } else { 0.0 },
+            reward: -st.decision_period_s / self.mission.time_limit_s().max(1.0) + bonus,
             terminated: false,
             truncated: false,
-            success: false,
-            reason: "",
+            info: self.info(false, "", NO_ERROR),
         };
         let truth = self.mission.world().vehicles()[st.vehicle]
             .vehicle
@@ -299,78 +455,44 @@ impl Episode {
         // A vehicle may start outside the op-area (it drives in first): leaving counts only
         // once it has been inside.
         self.entered |= self.area.contains(truth);
-        if self
-            .sources
-            .iter()
-            .any(|s| (*s - truth).norm() <= st.success_radius_m)
-        {
-            out.reward += 1.0;
+        if let Some(at) = declared {
+            let error = at.and_then(|p| {
+                self.sources
+                    .iter()
+                    .map(|s| (*s - p).norm())
+                    .min_by(f64::total_cmp)
+            });
+            let error_m = error.unwrap_or(NO_ERROR);
             out.terminated = true;
-            out.success = true;
-            out.reason = "reached_source";
+            if error.is_some_and(|e| e <= self.radius_m) {
+                out.reward += 1.0;
+                out.info = self.info(true, "declared", error_m);
+            } else {
+                out.reward -= 1.0;
+                out.info = self.info(false, "false_declaration", error_m);
+            }
         } else if ended.is_some_and(|e| !matches!(e.reason, EndReason::TimeLimit)) {
             // An incident (leaving the domain, a collision) names itself, even where the
             // vehicle also left the op-area.
             out.reward -= 1.0;
             out.terminated = true;
-            out.reason = end_reason(self.mission.statuses(), st.vehicle);
+            out.info.reason = end_reason(self.mission.statuses(), st.vehicle);
         } else if !self.area.contains(truth) && self.entered {
             out.reward -= 1.0;
             out.terminated = true;
-            out.reason = "left_op_area";
+            out.info.reason = "left_op_area";
         } else if ended.is_some()
             || self.mission.time_s() + st.decision_period_s > self.mission.time_limit_s()
         {
             out.truncated = true;
-            out.reason = "time_limit";
+            out.info.reason = "time_limit";
         }
         self.over = out.terminated || out.truncated;
         Ok(out)
     }
 
-    fn observe(&mut self, s: &SensorSnapshot) -> [f32; 12] {
-        let max_reading = s.chem.iter().map(|c| c.reading).fold(0.0_f64, f64::max);
-        let detected = max_reading > self.threshold;
-        if detected {
-            self.last_detection_s = Some(s.time_s);
-        }
-        if self.recent.len() == RECENT {
-            self.recent.pop_front();
-        }
-        self.recent.push_back(detected);
-        let rel = s.nav.pos_m.map_or(Vec2::new(0.0, 0.0), |p| {
-            Vec2::new(
-                (p.x - self.centre.x) / self.half.x,
-                (p.y - self.centre.y) / self.half.y,
-            )
-        });
-        let h = s.nav.heading.rad();
-        let flow = s.flow.map_or(Vec2::new(0.0, 0.0), |f| f.velocity_mps);
-        let latest = s.chem.last().map_or(0.0, |c| c.reading);
-        let raw = [
-            rel.x,
-            rel.y,
-            h.sin(),
-            h.cos(),
-            s.nav.speed_mps / 3.0,
-            (latest / self.threshold.max(1e-12)).tanh(),
-            f64::from(u8::from(detected)),
-            self.recent.iter().filter(|d| **d).count() as f64 / RECENT as f64,
-            self.last_detection_s
-                .map_or(1.0, |t| ((s.time_s - t) / SINCE_SCALE_S).min(1.0)),
-            flow.x,
-            flow.y,
-            s.time_s / self.mission.time_limit_s().max(1.0),
-        ];
-        let mut obs = [0.0_f32; 12];
-        for i in 0..12 {
-            let v = if raw[i].is_finite() { raw[i] } else { 0.0 };
-            obs[i] = (v as f32).clamp(OBS_LOW[i], OBS_HIGH[i]);
-        }
-        obs
-    }
-
-    fn act(&mut self, action: [f64; 2]) {
+    /// Sets the action the agent's next decision applies (non-finite components held at 0).
+    pub fn act(&mut self, action: [f64; 3]) {
         if let Ok(mut s) = self.shared.lock() {
             s.action = action.map(|a| {
                 if a.is_finite() {
@@ -401,7 +523,7 @@ fn end_reason(statuses: &[VehicleStatus], agent: usize) -> &'static str {
 }
 
 /// The environment's settings, as `gym.make` takes them.
-pub const SETTINGS: [&str; 7] = [
+pub const SETTINGS: [&str; 9] = [
     "vehicle",
     "decision_period_s",
     "max_turn_deg",
@@ -409,9 +531,11 @@ pub const SETTINGS: [&str; 7] = [
     "speed_max_mps",
     "success_radius_m",
     "detection_reward",
+    "detection_reward_max",
+    "declare_threshold",
 ];
 
-fn settings<'py>(
+pub(crate) fn settings<'py>(
     kw: Option<&Bound<'py, PyDict>>,
 ) -> PyResult<(Settings, Option<Bound<'py, PyDict>>)> {
     let mut st = Settings {
@@ -420,8 +544,10 @@ fn settings<'py>(
         max_turn_deg: 30.0,
         speed_min_mps: 0.3,
         speed_max_mps: 1.5,
-        success_radius_m: 10.0,
+        success_radius_m: None,
         detection_reward: 0.01,
+        detection_reward_max: 0.2,
+        declare_threshold: 0.5,
     };
     let rest = kw.map(|k| k.copy()).transpose()?;
     if let Some(d) = &rest {
@@ -454,10 +580,17 @@ fn settings<'py>(
             st.speed_max_mps = x;
         }
         if let Some(x) = take("success_radius_m", 0.0, 10_000.0)? {
-            st.success_radius_m = x;
+            st.success_radius_m = Some(x);
         }
-        if let Some(x) = take("detection_reward", -1.0, 1.0)? {
+        if let Some(x) = take("detection_reward", 0.0, 1.0)? {
             st.detection_reward = x;
+        }
+        // Below 1, so that no episode without a correct declaration returns as much as one with.
+        if let Some(x) = take("detection_reward_max", 0.0, 0.9)? {
+            st.detection_reward_max = x;
+        }
+        if let Some(x) = take("declare_threshold", -1.0, 1.0)? {
+            st.declare_threshold = x;
         }
     }
     if st.speed_min_mps > st.speed_max_mps {
@@ -469,7 +602,7 @@ fn settings<'py>(
     Ok((st, rest))
 }
 
-fn maker(
+pub(crate) fn maker(
     scenario: &str,
     set: Option<&Bound<'_, PyDict>>,
     kwargs: Option<&Bound<'_, PyDict>>,
@@ -520,14 +653,17 @@ fn check_overrides(maker: &Maker, rest: Option<&Bound<'_, PyDict>>) -> PyResult<
 }
 
 /// The registered environment's id.
-const ENV_ID: &str = "plumetrace/PlumeTracing-v0";
+const ENV_ID: &str = "plumetrace/PlumeTracing-v1";
 
-fn info<'py>(py: Python<'py>, ep: &Episode, out: &StepOut) -> PyResult<Bound<'py, PyDict>> {
-    let d = PyDict::new(py);
-    d.set_item("time_s", ep.mission.time_s())?;
-    d.set_item("success", out.success)?;
-    d.set_item("reason", out.reason)?;
-    Ok(d)
+/// Reads an action of three components (turn, speed, declare).
+pub(crate) fn action3(a: &[f64]) -> PyResult<[f64; 3]> {
+    match a {
+        [t, s, d] => Ok([*t, *s, *d]),
+        _ => Err(msg(format!(
+            "the action has {} components, not 3 (turn, speed, declare)",
+            a.len()
+        ))),
+    }
 }
 
 /// One environment: `reset(seed)` builds the episode's mission (every random stream of the
@@ -567,23 +703,34 @@ impl EnvCore {
         (OBS_LOW.to_vec(), OBS_HIGH.to_vec())
     }
 
+    /// The keys of `info`, at every reset and step.
+    #[staticmethod]
+    fn info_keys() -> Vec<&'static str> {
+        InfoRow::KEYS.to_vec()
+    }
+
     /// The decision period, s.
     #[getter]
     fn decision_period_s(&self) -> f64 {
         self.maker.settings.decision_period_s
     }
 
-    /// Starts an episode with run seed `seed`; returns the first observation.
-    fn reset<'py>(&mut self, py: Python<'py>, seed: u64) -> PyResult<Bound<'py, PyArray1<f32>>> {
+    /// Starts an episode with run seed `seed`; returns the first observation and `info`.
+    fn reset<'py>(
+        &mut self,
+        py: Python<'py>,
+        seed: u64,
+    ) -> PyResult<(Bound<'py, PyArray1<f32>>, Bound<'py, PyDict>)> {
         self.episode = None;
         let maker = &self.maker;
         let (ep, obs) = py.detach(|| maker.episode(seed)).map_err(msg)?;
+        let info = StepOut::first(&ep, obs).info.to_dict(py)?;
         self.episode = Some(ep);
-        Ok(obs.to_vec().into_pyarray(py))
+        Ok((obs.to_vec().into_pyarray(py), info))
     }
 
-    /// Applies `action` (turn, speed in [-1, 1]) and runs to the next decision; returns
-    /// `(observation, reward, terminated, truncated, info)`.
+    /// Applies `action` (turn, speed, declare in [-1, 1]) and runs to the next decision;
+    /// returns `(observation, reward, terminated, truncated, info)`.
     #[allow(clippy::type_complexity)]
     fn step<'py>(
         &mut self,
@@ -596,10 +743,7 @@ impl EnvCore {
         bool,
         Bound<'py, PyDict>,
     )> {
-        let a = action.as_array();
-        if a.len() != 2 {
-            return Err(msg(format!("the action has {} components, not 2", a.len())));
-        }
+        let a = action3(&action.as_array().to_vec())?;
         let ep = self
             .episode
             .as_mut()
@@ -609,181 +753,106 @@ impl EnvCore {
                 "the episode is over (terminated or truncated): call reset()".to_string(),
             ));
         }
-        ep.act([a[0], a[1]]);
+        ep.act(a);
         let settings = self.maker.settings;
         let out = py.detach(|| ep.advance(settings)).map_err(msg)?;
-        let info = info(py, ep, &out)?;
         Ok((
             out.obs.to_vec().into_pyarray(py),
             out.reward,
             out.terminated,
             out.truncated,
-            info,
+            out.info.to_dict(py)?,
         ))
     }
 }
 
-/// `n` environments stepped together in Rust (in parallel; results do not depend on the
-/// thread count). An environment whose episode ended resets at the next step (that step's
-/// action is ignored and its reward is 0), with the seed `derive_seed(base, episode index)`
-/// of its own sequence.
+/// The environment's observation and command outside the environment, for a policy flown
+/// through the Python planner seam: built for one scenario and run seed (the site of a family),
+/// it turns each snapshot into the observation the environment gives and an action into the
+/// command the environment's agent gives.
 #[pyclass(module = "plumetrace._plumetrace", unsendable)]
-pub struct VecEnvCore {
-    maker: Maker,
-    episodes: Vec<Option<Episode>>,
-    base_seeds: Vec<u64>,
-    counts: Vec<u64>,
-    needs_reset: Vec<bool>,
+pub struct ObsCore {
+    settings: Settings,
+    observer: Observer,
+    vertical: VerticalCommand,
 }
 
 #[pymethods]
-impl VecEnvCore {
-    /// `n` environments on `scenario`, with settings and overrides as for `EnvCore`.
+impl ObsCore {
+    /// The observer of `scenario` at run seed `seed`, with the environment's settings and
+    /// scenario overrides as for `EnvCore`.
     #[new]
-    #[pyo3(signature = (scenario, n, set=None, **kwargs))]
+    #[pyo3(signature = (scenario, seed, set=None, **kwargs))]
     fn new(
         scenario: &str,
-        n: usize,
+        seed: u64,
         set: Option<&Bound<'_, PyDict>>,
         kwargs: Option<&Bound<'_, PyDict>>,
     ) -> PyResult<Self> {
-        if !(1..=4096).contains(&n) {
-            return Err(msg(format!("n = {n} environments is outside 1..=4096")));
-        }
-        Ok(VecEnvCore {
-            maker: maker(scenario, set, kwargs)?,
-            episodes: (0..n).map(|_| None).collect(),
-            base_seeds: vec![0; n],
-            counts: vec![0; n],
-            needs_reset: vec![true; n],
+        let maker = maker(scenario, set, kwargs)?;
+        let sc = maker.source.build(Some(seed), &maker.overrides)?;
+        let setup = MissionSetup::new(sc).map_err(crate::error::to_py)?;
+        let (observer, vertical) = Observer::of(&setup, maker.settings.vehicle).map_err(msg)?;
+        Ok(ObsCore {
+            settings: maker.settings,
+            observer,
+            vertical,
         })
     }
 
-    /// Number of environments.
+    /// The decision period, s.
     #[getter]
-    fn num_envs(&self) -> usize {
-        self.episodes.len()
+    fn decision_period_s(&self) -> f64 {
+        self.settings.decision_period_s
     }
 
-    /// Resets every environment: environment `i` gets seed `seed + i` for this episode and
-    /// derives its later episodes from it. Returns observations of shape `(n, 12)`.
-    fn reset<'py>(&mut self, py: Python<'py>, seed: u64) -> PyResult<Bound<'py, PyArray2<f32>>> {
-        let n = self.episodes.len();
-        for i in 0..n {
-            self.base_seeds[i] = seed.wrapping_add(i as u64);
-            self.counts[i] = 0;
-        }
-        let maker = &self.maker;
-        let seeds = self.base_seeds.clone();
-        let made: Vec<Result<(Episode, [f32; 12]), String>> =
-            py.detach(|| seeds.par_iter().map(|s| maker.episode(*s)).collect());
-        let mut flat = Vec::with_capacity(n * 12);
-        for (i, m) in made.into_iter().enumerate() {
-            let (ep, obs) = m.map_err(|e| msg(format!("environment {i}: {e}")))?;
-            self.episodes[i] = Some(ep);
-            self.needs_reset[i] = false;
-            flat.extend_from_slice(&obs);
-        }
-        let a = Array2::from_shape_vec((n, 12), flat).map_err(|e| msg(e.to_string()))?;
-        Ok(a.into_pyarray(py))
-    }
-
-    /// Steps every environment with `actions` of shape `(n, 2)`; returns `(observations,
-    /// rewards, terminated, truncated, successes, reasons)` (a reason is empty while an episode
-    /// goes on).
-    #[allow(clippy::type_complexity)]
-    fn step<'py>(
+    /// The observation of a snapshot (JSON, the snapshot log's layout); it joins the recent
+    /// detections, so call it once per decision.
+    fn observe<'py>(
         &mut self,
         py: Python<'py>,
-        actions: PyReadonlyArray2<'py, f64>,
-    ) -> PyResult<(
-        Bound<'py, PyArray2<f32>>,
-        Bound<'py, PyArray1<f64>>,
-        Bound<'py, PyArray1<bool>>,
-        Bound<'py, PyArray1<bool>>,
-        Bound<'py, PyArray1<bool>>,
-        Vec<&'static str>,
-    )> {
-        let n = self.episodes.len();
-        let shape = actions.shape();
-        if shape != [n, 2] {
-            return Err(msg(format!(
-                "actions must have shape ({n}, 2), not {shape:?}"
-            )));
-        }
-        let acts = actions.as_array();
-        let maker = &self.maker;
-        let settings = maker.settings;
-        let mut work: Vec<(usize, &mut Option<Episode>, bool, u64, [f64; 2])> = self
-            .episodes
-            .iter_mut()
-            .enumerate()
-            .map(|(i, ep)| {
-                let seed = derive_seed(self.base_seeds[i], self.counts[i] + 1);
-                (
-                    i,
-                    ep,
-                    self.needs_reset[i],
-                    seed,
-                    [acts[[i, 0]], acts[[i, 1]]],
-                )
-            })
-            .collect();
-        type Out = Result<(StepOut, bool), String>;
-        let outs: Vec<Out> = py.detach(|| {
-            work.par_iter_mut()
-                .map(|(_, ep, reset, seed, action)| -> Out {
-                    if *reset || ep.is_none() {
-                        let (e, obs) = maker.episode(*seed)?;
-                        **ep = Some(e);
-                        return Ok((
-                            StepOut {
-                                obs,
-                                reward: 0.0,
-                                terminated: false,
-                                truncated: false,
-                                success: false,
-                                reason: "",
-                            },
-                            true,
-                        ));
-                    }
-                    let e = ep.as_mut().ok_or("no episode")?;
-                    e.act(*action);
-                    Ok((e.advance(settings)?, false))
-                })
-                .collect()
-        });
-        drop(work);
-        let mut flat = Vec::with_capacity(n * 12);
-        let (mut rew, mut term, mut trunc, mut succ) = (
-            Vec::with_capacity(n),
-            Vec::with_capacity(n),
-            Vec::with_capacity(n),
-            Vec::with_capacity(n),
-        );
-        let mut reasons = Vec::with_capacity(n);
-        for (i, o) in outs.into_iter().enumerate() {
-            let (out, was_reset) = o.map_err(|e| msg(format!("environment {i}: {e}")))?;
-            if was_reset {
-                self.counts[i] += 1;
-            }
-            self.needs_reset[i] = out.terminated || out.truncated;
-            flat.extend_from_slice(&out.obs);
-            rew.push(out.reward);
-            term.push(out.terminated);
-            trunc.push(out.truncated);
-            succ.push(out.success);
-            reasons.push(out.reason);
-        }
-        let obs = Array2::from_shape_vec((n, 12), flat).map_err(|e| msg(e.to_string()))?;
-        Ok((
-            obs.into_pyarray(py),
-            rew.into_pyarray(py),
-            term.into_pyarray(py),
-            trunc.into_pyarray(py),
-            succ.into_pyarray(py),
-            reasons,
-        ))
+        snapshot: &str,
+    ) -> PyResult<Bound<'py, PyArray1<f32>>> {
+        let s = snapshot_of(snapshot)?;
+        Ok(self.observer.observe(&s).to_vec().into_pyarray(py))
     }
+
+    /// The command (a Python planner's dict) that `action` gives at the decision with
+    /// `snapshot`: a declaration at the position estimate ends the vehicle's mission.
+    fn command<'py>(
+        &self,
+        py: Python<'py>,
+        snapshot: &str,
+        action: PyReadonlyArray1<'py, f64>,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let s = snapshot_of(snapshot)?;
+        let a = action3(&action.as_array().to_vec())?;
+        let a = a.map(|x| {
+            if x.is_finite() {
+                x.clamp(-1.0, 1.0)
+            } else {
+                0.0
+            }
+        });
+        let (c, declare) = command_of(&self.settings, self.vertical, &s, a);
+        let d = PyDict::new(py);
+        d.set_item("heading_deg", c.heading.deg())?;
+        d.set_item("speed_mps", c.speed_mps)?;
+        match c.vertical {
+            VerticalCommand::Altitude(z) => d.set_item("altitude_m", z)?,
+            VerticalCommand::Depth(z) => d.set_item("depth_m", z)?,
+            VerticalCommand::Surface => d.set_item("surface", true)?,
+        }
+        if declare {
+            if let Some(p) = s.nav.pos_m {
+                d.set_item("declare", (p.x, p.y))?;
+            }
+            d.set_item("done", true)?;
+        }
+        Ok(d)
+    }
+}
+
+fn snapshot_of(text: &str) -> PyResult<SensorSnapshot> {
+    serde_json::from_str(text).map_err(|e| msg(format!("the snapshot is not a snapshot: {e}")))
 }

@@ -8,6 +8,7 @@
 mod campaign;
 mod error;
 mod gym;
+mod gym_vec;
 mod planner;
 mod plume;
 mod run;
@@ -28,6 +29,7 @@ fn _plumetrace(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(run::planners, m)?)?;
     m.add_function(wrap_pyfunction!(run::run_plume, m)?)?;
     m.add_function(wrap_pyfunction!(run::scenario_kind, m)?)?;
+    m.add_function(wrap_pyfunction!(run::derive_seed, m)?)?;
     m.add_function(wrap_pyfunction!(plume::_plume_from_state, m)?)?;
     m.add_class::<run::RunRecord>()?;
     m.add_function(wrap_pyfunction!(campaign::campaign, m)?)?;
@@ -35,6 +37,7 @@ fn _plumetrace(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(campaign::run_columns, m)?)?;
     m.add_class::<plume::Plume>()?;
     m.add_class::<gym::EnvCore>()?;
-    m.add_class::<gym::VecEnvCore>()?;
+    m.add_class::<gym::ObsCore>()?;
+    m.add_class::<gym_vec::VecEnvCore>()?;
     Ok(())
 }

@@ -341,3 +341,10 @@ pub fn scenario_kind(scenario: &str) -> PyResult<&'static str> {
         "plume"
     })
 }
+
+/// The `k`-th run seed derived from `seed`, as campaigns and the benchmark derive them (a
+/// campaign with `seed = s` flies `derive_seed(s, 0)`, `derive_seed(s, 1)`, ...).
+#[pyfunction]
+pub fn derive_seed(seed: u64, k: u64) -> u64 {
+    plumetrace_env::derive_seed(seed, k)
+}

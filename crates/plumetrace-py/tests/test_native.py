@@ -60,15 +60,15 @@ def test_a_typo_in_a_setting_fails_at_make_naming_the_setting():
     import plumetrace.gym  # noqa: F401
 
     with pytest.raises(plumetrace.PlumetraceError) as e:
-        gym.make("plumetrace/PlumeTracing-v0", scenario="demo", max_turn_dgr=10)
+        gym.make("plumetrace/PlumeTracing-v1", scenario="demo", max_turn_dgr=10)
     text = str(e.value)
-    assert "max_turn_dgr: not a setting of plumetrace/PlumeTracing-v0" in text
+    assert "max_turn_dgr: not a setting of plumetrace/PlumeTracing-v1" in text
     assert "did you mean max_turn_deg?" in text
     assert "decision_period_s" in text  # the settings are listed
     with pytest.raises(plumetrace.PlumetraceError, match="no_such_key"):
-        gym.make("plumetrace/PlumeTracing-v0", scenario="demo", no_such_key=1)
+        gym.make("plumetrace/PlumeTracing-v1", scenario="demo", no_such_key=1)
     # A planner key is still an override, and fine.
-    gym.make("plumetrace/PlumeTracing-v0", scenario="demo", declaration="along_flow")
+    gym.make("plumetrace/PlumeTracing-v1", scenario="demo", declaration="along_flow")
 
 
 def _episode(env, action, seed=2, limit=20000):
@@ -86,21 +86,21 @@ def test_episodes_end_with_a_specific_reason():
     import plumetrace.gym as pg
 
     env = pg.PlumeTracingEnv("demo")
-    term, trunc, info = _episode(env, [0.0, 1.0])  # straight on at full speed
+    term, trunc, info = _episode(env, [0.0, 1.0, -1.0])  # straight on at full speed
     assert term and info["reason"] == "left_op_area"
     short = pg.PlumeTracingEnv("demo", set={"mission.time_limit_s": 30.0})
-    term, trunc, info = _episode(short, [0.0, 0.0])
+    term, trunc, info = _episode(short, [0.0, 0.0, -1.0])
     assert trunc and info["reason"] == "time_limit"
     # An op-area as large as the domain: leaving the domain ends the mission.
     wide = pg.PlumeTracingEnv(
         "demo", set={"mission.op_area": [[0, -150], [520, -150], [520, 150], [0, 150]]}
     )
-    term, trunc, info = _episode(wide, [0.0, 1.0])
+    term, trunc, info = _episode(wide, [0.0, 1.0, -1.0])
     assert term and info["reason"] == "left_domain"
     v = pg.PlumeTracingVecEnv(num_envs=2, scenario="demo", set={"mission.time_limit_s": 30.0})
     v.reset(seed=1)
     for _ in range(40):
-        _, _, term, trunc, info = v.step(np.zeros((2, 2)))
+        _, _, term, trunc, info = v.step(np.zeros((2, 3)) - 1.0)
         if trunc.any():
             assert list(info["reason"]) == ["time_limit", "time_limit"]
             break

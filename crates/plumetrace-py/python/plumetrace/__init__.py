@@ -28,7 +28,7 @@ from ._api import (
     run_columns,
     run_plume,
 )
-from ._plumetrace import Plume, PlumetraceError, __version__
+from ._plumetrace import Plume, PlumetraceError, __version__, derive_seed
 from . import sites
 
 __all__ = [
@@ -36,6 +36,7 @@ __all__ = [
     "PlumetraceError",
     "RunResult",
     "campaign",
+    "derive_seed",
     "merge",
     "planners",
     "presets",
