@@ -46,7 +46,17 @@
 //! `quiet_s` and the midpoint is at least `past_m` up-flow of that point, the leader declares
 //! there and finishes. On the steady plume of a surface outlet the concentration ends at the
 //! outlet, so the most up-flow strong reading is the outlet's along-flow position (less the max
-//! filter's lag); the centre line gives the cross-flow position.
+//! filter's lag); the centre line gives the cross-flow position. That is the `passed_peak` rule;
+//! the default `confirmed` rule ([`declare`]) declares from the along-flow profile the team
+//! sensed, confirmed over a distance.
+//!
+//! **Closing up** (`close_on_fade`): once both leaders' readings have faded below
+//! `quiet_fraction` of the larger leader peak, the scale falls to `scale_min` at
+//! `close_rate_per_s` and stays there, whatever (8) says. The plume narrows towards its outlet:
+//! leaders `d/2` to the sides of it stop reading it some metres (tens at the faster currents)
+//! down-flow of the outlet, and a follower whose depth wanders loses the thin surface plume as
+//! far out, so the open formation's profile ends short of the outlet; closed, the leaders read
+//! on to it.
 //!
 //! **Follower** ([`FormationFollower`]): no position estimate at all. It sends a ranging request
 //! every `ranging_period_s`, alternately to each leader, with its filtered reading piggybacked,
@@ -61,8 +71,11 @@
 //! `use_scale` and a scale heard, (17) with `D^2` inside the root (as (18)):
 //! `d_f = sqrt(d_x^2 + (s_cw d / 2)^2 + D^2)`. Until both ranges are known it holds its heading
 //! at zero speed; when the latest range is older than `stale_s` it holds the formation heading at
-//! the speed the integral has learnt (the leaders' cruise); after `lost_s` without a reply it
-//! finishes (the leaders have stopped, or the link is gone). Depth is held at `depth_m`.
+//! the speed the integral has learnt (the leaders' cruise), after `coast_s` it stops (the
+//! leaders may have stopped), and after `lost_s` without a reply it finishes (the leaders have
+//! stopped, or the link is gone). With `range_filter` the feedback runs on ranges filtered and
+//! predicted to the present ([`ranging`]), and while one leader's range is stale only the fresh
+//! one's common mode (the heading held). Depth is held at `depth_m`.
 //!
 //! Both read chemical samples through eq. (1), `c = s_max - S` for a salinity sensor
 //! (`reading = "freshness"`) or the reading itself (`"concentration"`), and a `filter_window_s`
@@ -1749,7 +1762,14 @@ mod tests {
                 } else {
                     vec![]
                 };
-                let d = f.decide(&snapshot(t, 0, None, Heading::from_deg(270.0), vec![], inbox));
+                let d = f.decide(&snapshot(
+                    t,
+                    0,
+                    None,
+                    Heading::from_deg(270.0),
+                    vec![],
+                    inbox,
+                ));
                 if t > 60.0 {
                     speeds.push(d.command.speed_mps);
                 }
