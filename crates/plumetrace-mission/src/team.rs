@@ -17,7 +17,9 @@
 //!   first declaration over the straight line from the vehicle's start to the first source;
 //! - **scale**: the smallest, largest and last cross-flow scale reported;
 //! - **acoustic losses**: acoustic messages lost (each recipient counts), and delivered;
-//! - **non-finite commands**: commands the world refused.
+//! - **non-finite commands**: commands the world refused;
+//! - **declaration confidence**: the first `declaration_confidence` a planner reported (with its
+//!   declaration), left out of `summary.json` when none was.
 
 use crate::record::{Observer, StepView};
 use plumetrace_core::{PlannerEvent, Telemetry, Vec2, Vec3, VehicleId};
@@ -54,6 +56,10 @@ pub struct TeamSummary {
     pub acoustic_delivered: u64,
     /// Commands refused for a non-finite number.
     pub non_finite_commands: u64,
+    /// The confidence a planner reported with the team's first declaration (telemetry
+    /// `declaration_confidence`), when it reported one.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub declaration_confidence: Option<f64>,
     /// The centroid's cross-flow distance over time: `(t, m)` every second.
     pub centroid_cross_series: Vec<(f64, f64)>,
     /// The scale over time: `(t, vehicle, s_cw)`.
@@ -78,6 +84,7 @@ pub struct TeamStats {
     acoustic_lost: u64,
     acoustic_delivered: u64,
     non_finite: u64,
+    confidence: Option<f64>,
 }
 
 impl TeamStats {
@@ -129,6 +136,7 @@ impl TeamStats {
             acoustic_lost: self.acoustic_lost,
             acoustic_delivered: self.acoustic_delivered,
             non_finite_commands: self.non_finite,
+            declaration_confidence: self.confidence,
             centroid_cross_series: self.cross.clone(),
             scale_series: self.scales.clone(),
         })
@@ -193,11 +201,15 @@ impl Observer for TeamStats {
                     scale_cw,
                     ranges_to,
                     setpoint_m,
+                    declaration_confidence,
                     ..
                 } = tel
                 else {
                     continue;
                 };
+                if self.confidence.is_none() {
+                    self.confidence = declaration_confidence.filter(|c| c.is_finite());
+                }
                 if let Some(s) = scale_cw.filter(|s| s.is_finite()) {
                     self.scales.push((t, k as u32, s));
                 }

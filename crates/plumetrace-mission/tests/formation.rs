@@ -38,6 +38,10 @@ fn the_team_traces_the_freshwater_plume_to_its_outlet_keeping_its_ranges() {
     let median = team.range_error_median_m.unwrap();
     assert!(median < 1.0, "median range error {median}");
     assert_eq!(team.non_finite_commands, 0);
+    let confidence = team
+        .declaration_confidence
+        .expect("the confirmed rule reports one");
+    assert!((0.0..=1.0).contains(&confidence), "{confidence}");
     assert_eq!(team.acoustic_lost, 0, "ideal links lose nothing");
     assert!(team.acoustic_delivered > 100);
     let smax = team.scale_max.unwrap();

@@ -46,7 +46,17 @@
 //! `quiet_s` and the midpoint is at least `past_m` up-flow of that point, the leader declares
 //! there and finishes. On the steady plume of a surface outlet the concentration ends at the
 //! outlet, so the most up-flow strong reading is the outlet's along-flow position (less the max
-//! filter's lag); the centre line gives the cross-flow position.
+//! filter's lag); the centre line gives the cross-flow position. That is the `passed_peak` rule;
+//! the default `confirmed` rule ([`declare`]) declares from the along-flow profile the team
+//! sensed, confirmed over a distance.
+//!
+//! **Closing up** (`close_on_fade`): once both leaders' readings have faded below
+//! `quiet_fraction` of the larger leader peak, the scale falls to `scale_min` at
+//! `close_rate_per_s` and stays there, whatever (8) says. The plume narrows towards its outlet:
+//! leaders `d/2` to the sides of it stop reading it some metres (tens at the faster currents)
+//! down-flow of the outlet, and a follower whose depth wanders loses the thin surface plume as
+//! far out, so the open formation's profile ends short of the outlet; closed, the leaders read
+//! on to it.
 //!
 //! **Follower** ([`FormationFollower`]): no position estimate at all. It sends a ranging request
 //! every `ranging_period_s`, alternately to each leader, with its filtered reading piggybacked,
@@ -61,8 +71,11 @@
 //! `use_scale` and a scale heard, (17) with `D^2` inside the root (as (18)):
 //! `d_f = sqrt(d_x^2 + (s_cw d / 2)^2 + D^2)`. Until both ranges are known it holds its heading
 //! at zero speed; when the latest range is older than `stale_s` it holds the formation heading at
-//! the speed the integral has learnt (the leaders' cruise); after `lost_s` without a reply it
-//! finishes (the leaders have stopped, or the link is gone). Depth is held at `depth_m`.
+//! the speed the integral has learnt (the leaders' cruise), after `coast_s` it stops (the
+//! leaders may have stopped), and after `lost_s` without a reply it finishes (the leaders have
+//! stopped, or the link is gone). With `range_filter` the feedback runs on ranges filtered and
+//! predicted to the present ([`ranging`]), and while one leader's range is stale only the fresh
+//! one's common mode (the heading held). Depth is held at `depth_m`.
 //!
 //! Both read chemical samples through eq. (1), `c = s_max - S` for a salinity sensor
 //! (`reading = "freshness"`) or the reading itself (`"concentration"`), and a `filter_window_s`
@@ -80,6 +93,10 @@ use serde::{Deserialize, Serialize};
 use std::collections::VecDeque;
 
 mod declare;
+mod ranging;
+
+/// Ranges further than this many standard deviations from their prediction are set aside.
+const RANGE_GATE_SIGMAS: f64 = 4.0;
 
 /// Time between the telemetry records of a formation member, s.
 const TELEMETRY_PERIOD_S: f64 = 1.0;
@@ -194,8 +211,8 @@ plumetrace_core::params! {
         min_strong_m: f64 = 3.0, "m", Bounds::non_negative(1000.0);
         /// How far up-flow of the last trace of plume the midpoint must go (`confirmed`).
         confirm_m: f64 = 10.0, "m", Bounds::non_negative(1000.0);
-        /// Declare this fraction of the strongest member's peak-to-edge distance up-flow of its edge (`confirmed`; 0: at the edge).
-        extrapolate: f64 = 0.59, "", Bounds::closed(0.0, 5.0);
+        /// Declare this fraction of the strongest member's peak-to-edge distance up-flow of its edge (`confirmed`; 0: at the edge, chosen on the formation family's tuning seed with `close_on_fade`; 0.59 puts an open formation's declaration on the outlet).
+        extrapolate: f64 = 0.0, "", Bounds::closed(0.0, 5.0);
         /// A reading of at least this fraction of its member's peak marks a strong point.
         significant_fraction: f64 = 0.5, "", Bounds::closed(0.0, 1.0);
         /// Readings below this fraction of their member's peak count as faded.
@@ -210,6 +227,10 @@ plumetrace_core::params! {
         reacquire: bool = false, "", Bounds::Any;
         /// Compensate courses for the measured flow (crab angle).
         flow_compensation: bool = false, "", Bounds::Any;
+        /// When both leaders' readings have faded below `quiet_fraction` of the larger leader peak, close the formation (the scale down to `scale_min` at `close_rate_per_s`) and keep it closed: the plume narrows towards its outlet.
+        close_on_fade: bool = true, "", Bounds::Any;
+        /// How fast the scale falls while the formation closes.
+        close_rate_per_s: f64 = 0.05, "1/s", Bounds::positive(100.0);
         /// How far each position fix moves the leader's own position estimate, which otherwise follows its dead reckoning (1: every fix taken whole, as the navigation estimate does; 0.05 chosen on the formation family's tuning seed, for RTK to 5 m GPS).
         fix_gain: f64 = 0.05, "", Bounds::positive(1.0);
     }
@@ -250,8 +271,16 @@ plumetrace_core::params! {
         heading_measurement_sd_deg: f64 = 10.0, "deg", Bounds::positive(180.0);
         /// A range older than this is stale: hold the formation heading at the learnt speed.
         stale_s: f64 = 10.0, "s", Bounds::positive(3600.0);
-        /// Finish after this long without a reply.
-        lost_s: f64 = 60.0, "s", Bounds::positive(36_000.0);
+        /// Finish after this long without a reply (longer than the deaf windows a modem may have).
+        lost_s: f64 = 120.0, "s", Bounds::positive(36_000.0);
+        /// Without a reply for this long, stop (drift with the current) instead of holding the formation heading at the learnt speed: the leaders may have stopped.
+        coast_s: f64 = 30.0, "s", Bounds::positive(36_000.0);
+        /// Keep station on filtered ranges (range and range rate, predicted to the present) rather than the latest raw ones; after an outage, the fresh range's common mode alone until both are fresh.
+        range_filter: bool = false, "", Bounds::Any;
+        /// Standard deviation of a range, for the filter.
+        range_noise_sd_m: f64 = 1.0, "m", Bounds::positive(1000.0);
+        /// Standard deviation of the range's white acceleration, for the filter.
+        range_accel_sd_mps2: f64 = 0.02, "m/s^2", Bounds::positive(100.0);
         /// How readings become concentrations: eq. (1) for salinity, or as read.
         reading: ReadingModel = ReadingModel::Freshness, "", Bounds::Any;
         /// Salinity upper bound S_max of eq. (1).
@@ -486,6 +515,10 @@ pub struct FormationLeader {
     last_side: f64,
     declared: bool,
     position: FixSmoother,
+    /// Peak readings of this leader and its partner, for the closing.
+    lead_peaks: [f64; 2],
+    /// The formation has closed (`close_on_fade`).
+    closed: bool,
 }
 
 impl FormationLeader {
@@ -518,6 +551,8 @@ impl FormationLeader {
             last_side: 0.0,
             declared: false,
             position: FixSmoother::new(p.fix_gain),
+            lead_peaks: [0.0; 2],
+            closed: false,
             p,
         }
     }
@@ -537,6 +572,22 @@ impl FormationLeader {
                 .scale_max
                 .min(0.95 * 2.0 * (1.0 - r * r).max(0.0).sqrt())
         }
+    }
+
+    /// Closes the formation for good once both leaders' readings (`own`, `partner`) have faded
+    /// below `quiet_fraction` of the larger of their peaks (at least `min_peak`): one leader may
+    /// never have been over the plume.
+    fn update_closing(&mut self, own: f64, partner: Option<f64>) {
+        let Some(q) = partner.filter(|q| q.is_finite()) else {
+            return;
+        };
+        if !self.p.close_on_fade || self.closed || !own.is_finite() {
+            return;
+        }
+        self.lead_peaks[0] = self.lead_peaks[0].max(own);
+        self.lead_peaks[1] = self.lead_peaks[1].max(q);
+        let peak = self.lead_peaks[0].max(self.lead_peaks[1]);
+        self.closed = peak >= self.p.min_peak && own.max(q) < self.p.quiet_fraction * peak;
     }
 
     /// Unit vector to the left of the up-flow direction.
@@ -707,8 +758,11 @@ impl Planner for FormationLeader {
             (FormationSide::Right, Some(q)) => (q.reading, c_own),
             (_, None) => (c_own, c_own),
         };
-        // (8), kept in its bounds; held without the partner or the follower.
-        if let (Some(_), Some(c_c)) = (partner, follower) {
+        self.update_closing(c_own, partner.map(|q| q.reading));
+        // (8), kept in its bounds; held without the partner or the follower; closed on a fade.
+        if self.closed {
+            self.scale = (self.scale - self.p.close_rate_per_s * dt).max(self.p.scale_min);
+        } else if let (Some(_), Some(c_c)) = (partner, follower) {
             let rate = scale_rate(c_left, c_right, c_c, self.p.k_cw);
             if rate.is_finite() {
                 self.scale = (self.scale + rate * dt)
@@ -921,6 +975,8 @@ pub struct FormationFollower {
     heading: HeadingKalman,
     /// Latest range to the left and right leader.
     ranges: [Option<Heard<f64>>; 2],
+    /// The filtered range to the left and right leader.
+    tracks: [ranging::RangeTrack; 2],
     scale: Option<f64>,
     integral: f64,
     last_t_s: Option<f64>,
@@ -938,6 +994,7 @@ impl FormationFollower {
             filter: MaxFilter::new(p.filter_window_s),
             heading: HeadingKalman::new(p.heading_process_sd_deg, p.heading_measurement_sd_deg),
             ranges: [None, None],
+            tracks: [ranging::RangeTrack::default(); 2],
             scale: None,
             integral: 0.0,
             last_t_s: None,
@@ -983,12 +1040,86 @@ impl FormationFollower {
                     value: range_m,
                     t_s: s.time_s,
                 });
+                let n = self.range_noise();
+                self.tracks[side].update(&n, s.time_s, range_m);
                 self.last_reply_s = s.time_s;
                 self.heading.update(s.time_s, sender_heading);
                 if let Some(sc) = scale_cw.filter(|v| v.is_finite() && *v > 0.0) {
                     self.scale = Some(sc);
                 }
             }
+        }
+    }
+}
+
+impl FormationFollower {
+    /// The range filter's settings.
+    fn range_noise(&self) -> ranging::RangeNoise {
+        ranging::RangeNoise {
+            measurement_sd_m: self.p.range_noise_sd_m,
+            accel_sd_mps2: self.p.range_accel_sd_mps2,
+            gate_sigmas: RANGE_GATE_SIGMAS,
+        }
+    }
+
+    /// (14)-(15) on the ranges `l` and `r` to the left and right leader: heading and speed.
+    fn feedback(&mut self, l: f64, r: f64, d_f: f64, psi_f: Heading, dt: f64) -> (Heading, f64) {
+        let eps = 0.5 * (l + r) - d_f;
+        let delta = l - r;
+        let raw = self.p.kp_s * eps + self.p.ki_s * self.integral;
+        // Anti-windup: no integration while clamped in the error's direction.
+        let clamped_high = raw >= self.p.max_speed_mps && eps > 0.0;
+        let clamped_low = raw <= 0.0 && eps < 0.0;
+        if !(clamped_high || clamped_low) {
+            self.integral += eps * dt;
+        }
+        let v = (self.p.kp_s * eps + self.p.ki_s * self.integral).clamp(0.0, self.p.max_speed_mps);
+        let gamma =
+            self.p.gamma_max_deg * std::f64::consts::FRAC_2_PI * (self.p.kp_h * delta).atan();
+        // Too far from the left leader (delta > 0): turn left (anticlockwise).
+        (psi_f.turned_deg(-gamma), v)
+    }
+
+    /// Heading and speed from the ranges at `t`: the feedback while ranges are fresh (with the
+    /// filter, both predicted to `t`, and only the fresh one's common mode while the other is
+    /// stale), the formation heading at the learnt speed while all are stale, and the present
+    /// heading at rest before both leaders have answered.
+    fn station_keeping(
+        &mut self,
+        t: f64,
+        dt: f64,
+        d_f: f64,
+        psi_f: Heading,
+        now: Heading,
+    ) -> (Heading, f64) {
+        let cruise = if t - self.last_reply_s > self.p.coast_s {
+            0.0
+        } else {
+            (self.p.ki_s * self.integral).clamp(0.0, self.p.max_speed_mps)
+        };
+        if self.p.range_filter {
+            let n = self.range_noise();
+            let est = |k: usize| {
+                let tr = &self.tracks[k];
+                tr.range_at(&n, t)
+                    .map(|z| (z, t - tr.last_s() <= self.p.stale_s))
+            };
+            return match (est(0), est(1)) {
+                (Some((l, true)), Some((r, true))) => self.feedback(l, r, d_f, psi_f, dt),
+                (Some((z, true)), Some(_)) | (Some(_), Some((z, true))) => {
+                    self.feedback(z, z, d_f, psi_f, dt)
+                }
+                (Some(_), Some(_)) => (psi_f, cruise),
+                _ => (now, 0.0),
+            };
+        }
+        let fresh = |h: &Option<Heard<f64>>| h.filter(|h| t - h.t_s <= self.p.stale_s);
+        match (self.ranges[0], self.ranges[1]) {
+            (Some(l), Some(r)) if fresh(&Some(l)).is_some() || fresh(&Some(r)).is_some() => {
+                self.feedback(l.value, r.value, d_f, psi_f, dt)
+            }
+            (Some(_), Some(_)) => (psi_f, cruise),
+            _ => (now, 0.0),
         }
     }
 }
@@ -1029,32 +1160,7 @@ impl Planner for FormationFollower {
         }
         let d_f = self.setpoint_m();
         let psi_f = self.heading.estimate().unwrap_or(s.nav.heading);
-        let fresh = |h: &Option<Heard<f64>>| h.filter(|h| t - h.t_s <= self.p.stale_s);
-        let (heading, speed) = match (self.ranges[0], self.ranges[1]) {
-            (Some(l), Some(r)) if fresh(&Some(l)).is_some() || fresh(&Some(r)).is_some() => {
-                let eps = 0.5 * (l.value + r.value) - d_f;
-                let delta = l.value - r.value;
-                let raw = self.p.kp_s * eps + self.p.ki_s * self.integral;
-                // Anti-windup: no integration while clamped in the error's direction.
-                let clamped_high = raw >= self.p.max_speed_mps && eps > 0.0;
-                let clamped_low = raw <= 0.0 && eps < 0.0;
-                if !(clamped_high || clamped_low) {
-                    self.integral += eps * dt;
-                }
-                let v = (self.p.kp_s * eps + self.p.ki_s * self.integral)
-                    .clamp(0.0, self.p.max_speed_mps);
-                let gamma = self.p.gamma_max_deg
-                    * std::f64::consts::FRAC_2_PI
-                    * (self.p.kp_h * delta).atan();
-                // Too far from the left leader (delta > 0): turn left (anticlockwise).
-                (psi_f.turned_deg(-gamma), v)
-            }
-            (Some(_), Some(_)) => (
-                psi_f,
-                (self.p.ki_s * self.integral).clamp(0.0, self.p.max_speed_mps),
-            ),
-            _ => (s.nav.heading, 0.0),
-        };
+        let (heading, speed) = self.station_keeping(t, dt, d_f, psi_f, s.nav.heading);
         let heading = self.rate.filter(heading, dt);
         let speed = if speed.is_finite() { speed } else { 0.0 };
         let status = if t - self.last_reply_s > self.p.lost_s {
@@ -1421,6 +1527,19 @@ mod tests {
             right_leader: 1,
             ..FormationFollowerParams::default()
         };
+        follow_with(p, start_offset, delay_s, noise_m, settle_s, None)
+    }
+
+    /// `follow` with the follower's parameters and a deaf window `[from, to)` in which no reply
+    /// reaches it.
+    fn follow_with(
+        p: FormationFollowerParams,
+        start_offset: Vec2,
+        delay_s: f64,
+        noise_m: f64,
+        settle_s: f64,
+        deaf: Option<(f64, f64)>,
+    ) -> Vec<f64> {
         let d = p.d_m;
         let depth = p.depth_m;
         let mut f = FormationFollower::new(p);
@@ -1437,15 +1556,30 @@ mod tests {
         let dt = 0.1;
         let mut pending: Vec<(f64, Message)> = Vec::new();
         let mut errors = Vec::new();
+        let mut done = false;
         for k in 0..6000 {
             let t = f64::from(k) * dt;
+            let deafened = deaf.is_some_and(|(a, b)| (a..b).contains(&t));
             let inbox: Vec<Message> = pending
                 .iter()
-                .filter(|(at, _)| *at <= t + 1e-9)
+                .filter(|(at, _)| *at <= t + 1e-9 && !deafened)
                 .map(|(_, m)| m.clone())
                 .collect();
             pending.retain(|(at, _)| *at > t + 1e-9);
-            let dec = f.decide(&snapshot(t, 0, None, body.heading, vec![], inbox));
+            let dec = if done {
+                Decision::new(
+                    plumetrace_core::Command {
+                        heading: body.heading,
+                        speed_mps: 0.0,
+                        vertical: VerticalCommand::Depth(depth),
+                    },
+                    PlanStatus::Finished,
+                )
+            } else {
+                f.decide(&snapshot(t, 0, None, body.heading, vec![], inbox))
+            };
+            // A finished planner is not asked again (as in the simulator).
+            done |= dec.status == PlanStatus::Finished;
             assert!(dec.command.is_finite(), "{:?}", dec.command);
             for o in dec.outbox {
                 if let MessageBody::RangeRequest { target, .. } = o.body {
@@ -1502,5 +1636,148 @@ mod tests {
         let e = follow(Vec2::new(8.0, 6.0), 0.01, 0.3, 300.0);
         let m = median(e);
         assert!(m < 1.0, "median range error {m} (10 % of d)");
+    }
+
+    /// The follower with the range filter on or off.
+    fn follower_params(filter: bool) -> FormationFollowerParams {
+        FormationFollowerParams {
+            left_leader: 2,
+            right_leader: 1,
+            range_filter: filter,
+            ..FormationFollowerParams::default()
+        }
+    }
+
+    #[test]
+    fn the_formation_closes_once_both_leaders_readings_fade() {
+        // Own and partner's readings 0.3 (the partner's) and 0.1 (own) for 30 s, then nothing.
+        let run = |close: bool| {
+            let mut l = FormationLeader::new(
+                FormationLeaderParams {
+                    side: FormationSide::Left,
+                    declare: false,
+                    close_on_fade: close,
+                    ..FormationLeaderParams::default()
+                },
+                VehicleId(0),
+                Heading::from_deg(270.0),
+                area(),
+            );
+            let mut scales = Vec::new();
+            for k in 0..600 {
+                let t = f64::from(k) * 0.1;
+                let on = t < 30.0;
+                let inbox = vec![Message {
+                    from: VehicleId(1),
+                    to: Recipient::Broadcast,
+                    link: Link::Radio,
+                    sent_s: t,
+                    body: MessageBody::FormationState {
+                        pos_m: Vec2::new(0.0, 10.0),
+                        reading: if on { 0.3 } else { 0.0 },
+                        scale_cw: l.scale(),
+                    },
+                }];
+                let chem = vec![ChemSample {
+                    time_s: t,
+                    reading: 35.0 - if on { 0.1 } else { 0.0 },
+                }];
+                let pos = Some(Vec2::zeros());
+                l.decide(&snapshot(t, 0, pos, Heading::from_deg(270.0), chem, inbox));
+                scales.push(l.scale());
+            }
+            scales
+        };
+        let closed = run(true);
+        // Faded at 34 s (the 4 s max filter), then 0.05 per second down to 0.3.
+        assert_eq!(closed[300], 1.0, "open while the plume is read");
+        assert!((closed[440] - 0.5).abs() < 0.05, "{}", closed[440]);
+        assert_eq!(closed[599], 0.3);
+        assert_eq!(run(false)[599], 1.0);
+    }
+
+    #[test]
+    fn the_follower_rejoins_after_a_ranging_outage_of_a_minute() {
+        // Deaf from 100 s to 165 s (the family's longest window and the next reply's wait).
+        let run = |now: bool| {
+            let p = if now {
+                follower_params(false)
+            } else {
+                // Before: finished after 60 s without a reply, coasting until then.
+                FormationFollowerParams {
+                    lost_s: 60.0,
+                    coast_s: 60.0,
+                    ..follower_params(false)
+                }
+            };
+            median(follow_with(
+                p,
+                Vec2::new(8.0, 6.0),
+                0.01,
+                0.3,
+                300.0,
+                Some((100.0, 165.0)),
+            ))
+        };
+        let (now, before) = (run(true), run(false));
+        assert!(now < 1.0, "median range error {now} after the outage");
+        assert!(before > 5.0, "the follower gave up before: {before}");
+    }
+
+    #[test]
+    fn the_filtered_follower_rejoins_after_a_ranging_outage_too() {
+        let e = follow_with(
+            follower_params(true),
+            Vec2::new(8.0, 6.0),
+            0.01,
+            0.3,
+            300.0,
+            Some((100.0, 165.0)),
+        );
+        let m = median(e);
+        assert!(m < 1.0, "median range error {m} after the outage");
+    }
+
+    #[test]
+    fn a_stray_range_moves_the_filtered_follower_little() {
+        // Both leaders answer at 10 m for a minute, then one answer is 40 m (a late echo).
+        let run = |filter: bool| {
+            let mut f = FormationFollower::new(follower_params(filter));
+            let mut speeds = Vec::new();
+            for k in 0..700 {
+                let t = f64::from(k) * 0.1;
+                let inbox = if k % 20 == 5 {
+                    let stray = k == 605;
+                    vec![Message {
+                        from: VehicleId(if k % 40 == 5 { 2 } else { 1 }),
+                        to: Recipient::Vehicle(VehicleId(0)),
+                        link: Link::Acoustic,
+                        sent_s: t,
+                        body: MessageBody::RangeReply {
+                            range_m: if stray { 40.0 } else { 10.0 },
+                            sender_heading: Heading::from_deg(270.0),
+                            scale_cw: None,
+                        },
+                    }]
+                } else {
+                    vec![]
+                };
+                let d = f.decide(&snapshot(
+                    t,
+                    0,
+                    None,
+                    Heading::from_deg(270.0),
+                    vec![],
+                    inbox,
+                ));
+                if t > 60.0 {
+                    speeds.push(d.command.speed_mps);
+                }
+            }
+            speeds.into_iter().fold(0.0, f64::max)
+        };
+        let (now, before) = (run(true), run(false));
+        assert!(now < 0.1, "filtered: {now} m/s");
+        assert!(before > 0.9, "raw: {before} m/s");
     }
 }

@@ -20,7 +20,9 @@
 //! offset: it peaks at `x = a` and falls to half its peak at `x = 0.37 a`, short of the outlet.
 //! The declared point is therefore the strongest member's edge moved up-flow by `extrapolate`
 //! times its peak-to-edge distance (0.59 = 0.37 / (1 - 0.37) puts it on the outlet for that
-//! profile), and never down-flow of the team's edge.
+//! profile), and never down-flow of the team's edge. With the formation closing up on a fade
+//! (the leader's `close_on_fade`, the default) the leaders read on to the outlet and the edge is
+//! declared as it is (`extrapolate` 0).
 //!
 //! Its confidence, reported with the declaration (the leader's `formation` telemetry), is the
 //! contrast of the drop times the share of members that saw the plume, `(1 - q / p) n / 3`: `p`
