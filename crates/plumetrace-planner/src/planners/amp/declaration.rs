@@ -182,7 +182,11 @@ mod tests {
             Vec2::new(0.0, 60.0),
         ];
         let field = rule.check(&pts, up);
-        assert_eq!(field, Some(Vec2::new(3.0, 6.0)), "the field rule: the most upflow");
+        assert_eq!(
+            field,
+            Some(Vec2::new(3.0, 6.0)),
+            "the field rule: the most upflow"
+        );
         let placed = rule
             .check_placed(
                 &pts,
