@@ -59,6 +59,7 @@ fn paper() -> AmpParams {
         flow_gate_deg: 180.0,
         nav_drift_mps: 0.0,
         approach_replans: 0,
+        declaration_on_upflow_contact: true,
         track_altitude_m: 0.0,
         declaration_upflow_m: 0.0,
         declaration_across: DeclarationAcross::MostUpflow,
@@ -258,6 +259,46 @@ fn the_field_placement_declares_the_most_upflow_lost_point() {
         declared,
         vec![Vec2::new(195.0, 296.5)],
         "the most upflow (southern) point"
+    );
+}
+
+#[test]
+fn a_track_out_contact_upflow_of_the_lost_points_traces_on_instead_of_declaring() {
+    // Three lost points within 6 m along the flow (North: upflow is South), then a contact during
+    // Track-Out: upflow of them the plume goes on, so Track-In follows it; level with them (or
+    // downflow) the check declares, as at every Track-Out contact in the field rule.
+    let run = |p: AmpParams, contact: (f64, f64)| {
+        let mut a = amp_with(p);
+        a.decide(&snap(0.0, (200.0, 500.0), 0.0, false));
+        let mut events = lose_at(&mut a, &[(200.0, 300.0), (205.0, 298.0)]);
+        events.extend(a.decide(&snap(100.0, (195.0, 296.5), 180.0, true)).events);
+        events.extend(a.decide(&snap(106.0, (195.0, 295.5), 180.0, false)).events);
+        assert_eq!(a.behaviour(), BehaviourKind::TrackOut);
+        events.extend(a.decide(&snap(108.0, contact, 180.0, true)).events);
+        let declared = events
+            .iter()
+            .any(|e| matches!(e, PlannerEvent::Declared { .. }));
+        (declared, a.behaviour())
+    };
+    let upflow = (190.0, 285.0);
+    assert_eq!(
+        run(AmpParams::default(), upflow),
+        (false, BehaviourKind::TrackIn),
+        "upflow of the lost points: traced on"
+    );
+    let field = AmpParams {
+        declaration_on_upflow_contact: true,
+        ..AmpParams::default()
+    };
+    assert_eq!(
+        run(field, upflow),
+        (true, BehaviourKind::Mapping),
+        "the field rule declares"
+    );
+    assert_eq!(
+        run(AmpParams::default(), (190.0, 297.0)),
+        (true, BehaviourKind::Mapping),
+        "downflow of the most upflow lost point: declared"
     );
 }
 

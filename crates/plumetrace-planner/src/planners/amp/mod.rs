@@ -9,7 +9,9 @@
 //!   the wrapped difference between vehicle heading and flow direction, and saves the last detection
 //!   point; after `lambda` seconds without detection it saves that point as a lost point;
 //! - **Track-Out** goes `L_u` upflow and `L_c` across the flow from the most upflow lost point, to the
-//!   side opposite the exit; it ends on detection or arrival, and the declaration check runs;
+//!   side opposite the exit; it ends on detection or arrival, and the declaration check runs
+//!   (not on a contact upflow of every lost point, unless `declaration_on_upflow_contact`: the
+//!   plume goes on there, and Track-In follows it);
 //! - **Reacquire** flies `N_re` Bowties from 10 m upflow of the most upflow lost point down to it,
 //!   then drops the point; with no point left it returns to Find.
 //!
@@ -108,6 +110,8 @@ plumetrace_core::params! {
         declaration_cross_m: f64 = 8.0, "m", Bounds::positive(1000.0);
         /// How far upflow of the most upflow lost point the lost-point rules declare (0: at it, the field rule). The contacts of a bottom source begin only where its chemical has mixed up to the tracing altitude, some metres downflow of it: tracing at 1 m, the most upflow lost point lay a median 1.6-3.4 m downflow of the source on the families' tuning sites.
         declaration_upflow_m: f64 = 2.5, "m", Bounds::non_negative(100.0);
+        /// Whether a contact during Track-Out upflow of the most upflow lost point runs the declaration check (true: the field rule, every Track-Out contact does). Such a contact says the plume goes on upflow: in a strong current a plume's patches far downflow of the source can gather three lost points within declaration_along_m, and the check then declared 150 m from the source.
+        declaration_on_upflow_contact: bool = false, "", Bounds::Any;
         /// Where across the flow the lost-point rules declare: most_upflow (the most upflow lost point, the field rule) or mean (the mean of the three most upflow lost points across the flow).
         declaration_across: DeclarationAcross = DeclarationAcross::Mean, "", Bounds::Any;
         /// Fly the post-declaration mapping pattern (single-source missions).
@@ -425,6 +429,13 @@ impl Memory {
             .iter()
             .map(|l| l.pos)
             .max_by(|a, b| a.dot(&u).total_cmp(&b.dot(&u)))
+    }
+
+    /// `pos` lies upflow of every lost point.
+    fn upflow_of_lost(&self, pos: Vec2) -> bool {
+        let u = self.flow.upflow().unit();
+        self.most_upflow_lost()
+            .is_some_and(|top| pos.dot(&u) > top.dot(&u))
     }
 
     /// Reacquire has searched for `reacquire_timeout_s` since the last detection.
@@ -757,7 +768,10 @@ impl Arbiter<Memory> for Switching {
                 BehaviourKind::Transit | BehaviourKind::Mapping | BehaviourKind::Done
             );
             if p.detected && tracking_allowed && kind != BehaviourKind::TrackIn {
-                if kind == BehaviourKind::TrackOut && self.try_declare(m, p.t_s) {
+                if kind == BehaviourKind::TrackOut
+                    && (m.p.declaration_on_upflow_contact || !m.upflow_of_lost(p.pos_m))
+                    && self.try_declare(m, p.t_s)
+                {
                     continue;
                 }
                 self.enter_track_in(m, p);
