@@ -12,6 +12,7 @@
 #   scripts/fault_table.sh --family-seed S  the coastal sites of campaign seed S (default 3202, the
 #                                           benchmark's test seed of the coastal task)
 #   scripts/fault_table.sh --out FILE       the page (default docs/results/fault-table.md)
+#   scripts/fault_table.sh --table-only     only rewrite the page from the flights in target/fault-table/
 #
 # The faults (flags of `plumetrace frontseat`): 30 s without navigation from 305 s, 0.1 % of the
 # front seat's lines dropped (fault seed = run seed), no current meter (`--no-flow`: the planner
@@ -26,6 +27,7 @@ runs=10
 sites=5
 family_seed=3202
 page="docs/results/fault-table.md"
+table_only=0
 while [ $# -gt 0 ]; do
     case "$1" in
         --bin) bin="$2"; shift 2 ;;
@@ -34,24 +36,26 @@ while [ $# -gt 0 ]; do
         --sites) sites="$2"; shift 2 ;;
         --family-seed) family_seed="$2"; shift 2 ;;
         --out) page="$2"; shift 2 ;;
-        -h|--help) sed -n '2,20p' "$0"; exit 0 ;;
+        --table-only) table_only=1; shift ;;
+        -h|--help) sed -n '2,21p' "$0"; exit 0 ;;
         *) echo "fault_table.sh: unknown argument $1 (see --help)" >&2; exit 2 ;;
     esac
 done
 
-if [ -z "$bin" ]; then
-    cargo build --release --bin plumetrace
-    bin="target/release/plumetrace"
-fi
-bin="$(realpath "$bin")"
 work="target/fault-table"
-rm -rf "$work"
-mkdir -p "$work/sites"
-
-test_flag=()
-if [ "$family_seed" = 3202 ]; then test_flag=(--test-seeds); fi
-"$bin" family examples/families/coastal.family.toml --sample "$sites" --seed "$family_seed" \
-    --out "$work/sites" "${test_flag[@]}" >/dev/null
+if [ "$table_only" -eq 0 ]; then
+    if [ -z "$bin" ]; then
+        cargo build --release --bin plumetrace
+        bin="target/release/plumetrace"
+    fi
+    bin="$(realpath "$bin")"
+    rm -rf "$work"
+    mkdir -p "$work/sites"
+    test_flag=()
+    if [ "$family_seed" = 3202 ]; then test_flag=(--test-seeds); fi
+    "$bin" family examples/families/coastal.family.toml --sample "$sites" --seed "$family_seed" \
+        --out "$work/sites" "${test_flag[@]}" >/dev/null
+fi
 
 # name|fault flags
 faults=(
@@ -95,12 +99,16 @@ scenarios=(demo)
 for k in $(seq 0 $((sites - 1))); do scenarios+=("$work/sites/site-$(printf '%03d' "$k").toml"); done
 
 start=$(date +%s)
+if [ "$table_only" -eq 0 ]; then
 for s in "${scenarios[@]}"; do
     for f in "${faults[@]}"; do
         for seed in $(seq 1 "$runs"); do echo "$s ${f%%|*} $seed"; done
     done
 done | xargs -P "$jobs" -L 1 bash -c 'faults=(); while IFS= read -r l; do faults+=("$l"); done <<< "$FAULTS"; fly_one "$0" "$1" "$2"'
 secs=$(( $(date +%s) - start ))
+echo "$secs" > "$work/seconds"
+fi
+secs="$(cat "$work/seconds" 2>/dev/null || echo "?")"
 
 commit="$(git rev-parse --short=12 HEAD)"
 if ! git diff --quiet HEAD -- crates Cargo.toml Cargo.lock; then
@@ -175,11 +183,11 @@ def site_line(s):
 
 out = []
 out.append("# Results: `fault-table`\n")
-out.append("What ordinary link faults do to the AMP's declaration on a vehicle: the demo and five")
-out.append("coastal-family sites flown over the simulated front seat in lock-step, run seeds 1 to "
-           f"{runs},\neach without a fault and with each of five faults; a cell counts the runs "
-           "declaring within 20 m of\nthe source (the first declaration) and names the others "
-           "(`none`: no declaration before the time limit).\n")
+out.append("The AMP's declaration on a vehicle under ordinary link faults, rehearsed with `frontseat`.\n")
+out.append("The demo and five coastal-family sites are flown over the simulated front seat in lock-step,")
+out.append(f"run seeds 1 to {runs}, each without a fault and with each of five faults; a cell counts the")
+out.append("runs declaring within 20 m of the source (the first declaration) and names the others")
+out.append("(`none`: no declaration before the time limit).\n")
 out.append(f"Produced at commit `{commit}` on {datetime.date.today()} by `scripts/fault_table.sh` "
            f"({cores} cores, {secs} s of wall time).")
 out.append(f"The coastal sites are sites 0 to {int(nsites) - 1} of `plumetrace family "
