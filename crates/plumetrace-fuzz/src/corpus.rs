@@ -117,6 +117,10 @@ pub const CAMPAIGNS: &[(&str, &str)] = &[
         include_str!("../../../examples/campaigns/amp-declaration.toml"),
     ),
     (
+        "amp-vs-lawnmower",
+        include_str!("../../../examples/campaigns/amp-vs-lawnmower.toml"),
+    ),
+    (
         "amp-unbiased-tuning-coastal",
         include_str!("../../../examples/campaigns/amp-unbiased-tuning-coastal.toml"),
     ),
@@ -127,10 +131,6 @@ pub const CAMPAIGNS: &[(&str, &str)] = &[
     (
         "amp-unbiased-tuning-faults",
         include_str!("../../../examples/campaigns/amp-unbiased-tuning-faults.toml"),
-    ),
-    (
-        "amp-vs-lawnmower",
-        include_str!("../../../examples/campaigns/amp-vs-lawnmower.toml"),
     ),
     (
         "moth-comparison",
