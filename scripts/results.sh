@@ -8,8 +8,9 @@
 #
 # Options: --jobs N (worker threads, default: one per core), --bin PATH (a built plumetrace,
 # default: builds the release binary of this checkout), --keep (resume into target/results/NAME
-# instead of starting afresh; the page then says how many runs this call flew). Each page names
-# the commit, the command, the machine and the time.
+# instead of starting afresh; the page then says how many runs this call flew), --test-seeds
+# (passed to `plumetrace campaign`: a campaign that flies a benchmark task's test seeds). Each
+# page names the commit, the command, the machine and the time.
 #
 # Two-sample comparisons: every line `# two-sample: A B` of the campaign file appends to its page
 # the comparison of configurations A and B over the campaign's runs.csv, per scenario
@@ -21,12 +22,14 @@ cd "$(dirname "$0")/.."
 jobs=""
 bin=""
 keep=0
+test_seeds=0
 names=()
 while [ $# -gt 0 ]; do
     case "$1" in
         --jobs) jobs="$2"; shift 2 ;;
         --bin) bin="$2"; shift 2 ;;
         --keep) keep=1; shift ;;
+        --test-seeds) test_seeds=1; shift ;;
         --all)
             for page in docs/results/*.md; do
                 n="$(basename "$page" .md)"
@@ -34,7 +37,7 @@ while [ $# -gt 0 ]; do
             done
             shift ;;
         --index) shift ;;
-        -h|--help) sed -n '2,17p' "$0"; exit 0 ;;
+        -h|--help) sed -n '2,18p' "$0"; exit 0 ;;
         -*) echo "results.sh: unknown option $1 (see --help)" >&2; exit 2 ;;
         *) names+=("$1"); shift ;;
     esac
@@ -117,6 +120,7 @@ for n in "${names[@]}"; do
     if [ "$keep" -eq 0 ]; then rm -rf "$out"; fi
     cmd=("$bin" campaign "$file" --out "$out")
     if [ -n "$jobs" ]; then cmd+=(--jobs "$jobs"); fi
+    if [ "$test_seeds" -eq 1 ]; then cmd+=(--test-seeds); fi
     echo "== $n: ${cmd[*]}" >&2
     start=$(date +%s)
     "${cmd[@]}" 2>&1 | tee "$out.log" >&2
@@ -126,6 +130,7 @@ for n in "${names[@]}"; do
     desc="$(sed -n 's/^description *= *"\(.*\)"$/\1/p' "$file" | head -1)"
     shown="plumetrace campaign $file --out $out"
     if [ -n "$jobs" ]; then shown="$shown --jobs $jobs"; fi
+    if [ "$test_seeds" -eq 1 ]; then shown="$shown --test-seeds"; fi
     page="docs/results/$n.md"
     {
         echo "# Results: \`$n\`"

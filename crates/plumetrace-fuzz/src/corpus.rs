@@ -121,6 +121,18 @@ pub const CAMPAIGNS: &[(&str, &str)] = &[
         include_str!("../../../examples/campaigns/amp-vs-lawnmower.toml"),
     ),
     (
+        "amp-unbiased-tuning-coastal",
+        include_str!("../../../examples/campaigns/amp-unbiased-tuning-coastal.toml"),
+    ),
+    (
+        "amp-unbiased-tuning-duck-like",
+        include_str!("../../../examples/campaigns/amp-unbiased-tuning-duck-like.toml"),
+    ),
+    (
+        "amp-unbiased-tuning-faults",
+        include_str!("../../../examples/campaigns/amp-unbiased-tuning-faults.toml"),
+    ),
+    (
         "moth-comparison",
         include_str!("../../../examples/campaigns/moth-comparison.toml"),
     ),

@@ -7,7 +7,7 @@ use plumetrace_core::{
     SensorSnapshot, Vec2, VehicleId, bearing_between,
 };
 use plumetrace_guidance::OpArea;
-use plumetrace_planner::amp::{FindPattern, LhsUpdate};
+use plumetrace_planner::amp::{DeclarationAcross, FindPattern, LhsUpdate};
 use plumetrace_planner::{Amp, AmpParams, LostPointEviction};
 
 /// Flow towards North at 0.1 m/s: upflow is South.
@@ -59,6 +59,10 @@ fn paper() -> AmpParams {
         flow_gate_deg: 180.0,
         nav_drift_mps: 0.0,
         approach_replans: 0,
+        declaration_on_upflow_contact: true,
+        track_altitude_m: 0.0,
+        declaration_upflow_m: 0.0,
+        declaration_across: DeclarationAcross::MostUpflow,
         ..AmpParams::default()
     }
 }
@@ -225,13 +229,77 @@ fn declares_when_three_lost_points_are_close_along_the_flow_then_maps() {
             }
         })
         .collect();
+    // 2.5 m upflow (South) of the most upflow point, at the three points' mean across the flow.
+    assert_eq!(declared.len(), 1, "{declared:?}");
+    assert!(
+        (declared[0] - Vec2::new(200.0, 294.0)).norm() < 1e-9,
+        "upflow of the most upflow (southern) point, at the mean across: {declared:?}"
+    );
+    assert_eq!(a.declarations(), declared);
+    assert_eq!(a.behaviour(), BehaviourKind::Mapping);
+}
+
+#[test]
+fn the_field_placement_declares_the_most_upflow_lost_point() {
+    let mut a = amp_with(AmpParams {
+        declaration_upflow_m: 0.0,
+        declaration_across: DeclarationAcross::MostUpflow,
+        ..AmpParams::default()
+    });
+    a.decide(&snap(0.0, (200.0, 500.0), 0.0, false));
+    let events = lose_at(&mut a, &[(200.0, 300.0), (205.0, 298.0), (195.0, 296.5)]);
+    let declared: Vec<_> = events
+        .iter()
+        .filter_map(|e| match e {
+            PlannerEvent::Declared { pos_m, .. } => Some(*pos_m),
+            _ => None,
+        })
+        .collect();
     assert_eq!(
         declared,
         vec![Vec2::new(195.0, 296.5)],
         "the most upflow (southern) point"
     );
-    assert_eq!(a.declarations(), declared);
-    assert_eq!(a.behaviour(), BehaviourKind::Mapping);
+}
+
+#[test]
+fn a_track_out_contact_upflow_of_the_lost_points_traces_on_instead_of_declaring() {
+    // Three lost points within 6 m along the flow (North: upflow is South), then a contact during
+    // Track-Out: upflow of them the plume goes on, so Track-In follows it; level with them (or
+    // downflow) the check declares, as at every Track-Out contact in the field rule.
+    let run = |p: AmpParams, contact: (f64, f64)| {
+        let mut a = amp_with(p);
+        a.decide(&snap(0.0, (200.0, 500.0), 0.0, false));
+        let mut events = lose_at(&mut a, &[(200.0, 300.0), (205.0, 298.0)]);
+        events.extend(a.decide(&snap(100.0, (195.0, 296.5), 180.0, true)).events);
+        events.extend(a.decide(&snap(106.0, (195.0, 295.5), 180.0, false)).events);
+        assert_eq!(a.behaviour(), BehaviourKind::TrackOut);
+        events.extend(a.decide(&snap(108.0, contact, 180.0, true)).events);
+        let declared = events
+            .iter()
+            .any(|e| matches!(e, PlannerEvent::Declared { .. }));
+        (declared, a.behaviour())
+    };
+    let upflow = (190.0, 285.0);
+    assert_eq!(
+        run(AmpParams::default(), upflow),
+        (false, BehaviourKind::TrackIn),
+        "upflow of the lost points: traced on"
+    );
+    let field = AmpParams {
+        declaration_on_upflow_contact: true,
+        ..AmpParams::default()
+    };
+    assert_eq!(
+        run(field, upflow),
+        (true, BehaviourKind::Mapping),
+        "the field rule declares"
+    );
+    assert_eq!(
+        run(AmpParams::default(), (190.0, 297.0)),
+        (true, BehaviourKind::Mapping),
+        "downflow of the most upflow lost point: declared"
+    );
 }
 
 #[test]
@@ -714,7 +782,11 @@ fn no_convergence_near_the_source_in_strong_currents() {
     };
     assert_eq!(declared(field), None, "the oldest dropped: no three agree");
     assert_eq!(
-        declared(AmpParams::default()),
+        declared(AmpParams {
+            declaration_upflow_m: 0.0,
+            declaration_across: DeclarationAcross::MostUpflow,
+            ..AmpParams::default()
+        }),
         Some(Vec2::new(200.0, 300.0))
     );
 }
@@ -894,10 +966,7 @@ fn tracing_flies_at_the_track_altitude_and_the_search_at_the_altitude() {
         VerticalCommand::Altitude(a) => a,
         v => panic!("{v:?}"),
     };
-    let mut a = amp_with(AmpParams {
-        track_altitude_m: 1.0,
-        ..AmpParams::default()
-    });
+    let mut a = amp();
     let d = a.decide(&snap(0.0, (200.0, 500.0), 0.0, false));
     assert_eq!(altitude(&d), 2.0);
     let d = a.decide(&snap(1.0, (200.0, 500.0), 170.0, true));
@@ -906,8 +975,12 @@ fn tracing_flies_at_the_track_altitude_and_the_search_at_the_altitude() {
     let d = a.decide(&snap(7.0, (200.0, 495.0), 170.0, false));
     assert_eq!(a.behaviour(), BehaviourKind::TrackOut);
     assert_eq!(altitude(&d), 1.0);
-    // At 0 (the default) the whole mission flies at altitude_m.
-    let mut a = amp();
+    assert_eq!(AmpParams::default().track_altitude_m, 1.0, "the default");
+    // At 0 (the field behaviour) the whole mission flies at altitude_m.
+    let mut a = amp_with(AmpParams {
+        track_altitude_m: 0.0,
+        ..AmpParams::default()
+    });
     a.decide(&snap(0.0, (200.0, 500.0), 0.0, false));
     let d = a.decide(&snap(1.0, (200.0, 500.0), 170.0, true));
     assert_eq!(a.behaviour(), BehaviourKind::TrackIn);

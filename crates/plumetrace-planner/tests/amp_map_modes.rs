@@ -8,7 +8,7 @@ use plumetrace_core::{
     Planner, PlannerEvent, SensorSnapshot, Telemetry, Vec2, VehicleId,
 };
 use plumetrace_guidance::OpArea;
-use plumetrace_planner::amp::MapDeclaration;
+use plumetrace_planner::amp::{DeclarationAcross, MapDeclaration};
 use plumetrace_planner::{Amp, AmpParams, MapKeys};
 
 /// Flow towards North at 0.1 m/s: upflow is South.
@@ -52,6 +52,9 @@ fn amp(mode: MapDeclaration, map_can_declare: bool) -> Amp {
             map_estimate_radius_m: 0.0,
             ..AmpParams::default().map
         },
+        // The lost-point rule declares the most upflow lost point itself (the field placement).
+        declaration_upflow_m: 0.0,
+        declaration_across: DeclarationAcross::MostUpflow,
         ..AmpParams::default()
     };
     let area = OpArea::rectangle(0.0, 400.0, 0.0, 1000.0).unwrap();

@@ -9,11 +9,15 @@
 //!   the wrapped difference between vehicle heading and flow direction, and saves the last detection
 //!   point; after `lambda` seconds without detection it saves that point as a lost point;
 //! - **Track-Out** goes `L_u` upflow and `L_c` across the flow from the most upflow lost point, to the
-//!   side opposite the exit; it ends on detection or arrival, and the declaration check runs;
+//!   side opposite the exit; it ends on detection or arrival, and the declaration check runs
+//!   (not on a contact upflow of every lost point, unless `declaration_on_upflow_contact`: the
+//!   plume goes on there, and Track-In follows it);
 //! - **Reacquire** flies `N_re` Bowties from 10 m upflow of the most upflow lost point down to it,
 //!   then drops the point; with no point left it returns to Find.
 //!
-//! Declaration ([`DeclarationRule`]; with `map_declaration`, also or instead the
+//! Declaration ([`DeclarationRule`], placed by [`Placement`]: by default `declaration_upflow_m`
+//! upflow of the most upflow lost point and at the three points' mean across the flow, where the
+//! field rule declared the most upflow point itself; with `map_declaration`, also or instead the
 //! source-likelihood map's rule of [`crate::estimate::tracker`]) leads to post-declaration mapping ([`MappingParams`]) and the
 //! end of the mission. In a multi-source mission the area is split into subregions searched in
 //! turn; a subregion ends on timeout (source-free), on a declaration, or when the plume is traced
@@ -38,7 +42,8 @@ mod mapping;
 
 pub use bowtie::{Bowtie, centres as bowtie_centres};
 pub use declaration::{
-    ALONG_AND_CROSS_FLOW, ALONG_FLOW, DeclarationChoice, DeclarationRule, UPFLOW_EDGE,
+    ALONG_AND_CROSS_FLOW, ALONG_FLOW, DeclarationAcross, DeclarationChoice, DeclarationRule,
+    Placement, UPFLOW_EDGE,
 };
 pub use find::{candidates as find_candidates, reflect as find_reflect};
 pub use mapping::MappingParams;
@@ -63,8 +68,8 @@ plumetrace_core::params! {
     pub struct AmpParams {
         include autopilot: AutopilotKeys = AutopilotKeys::default();
         include map: MapKeys = MapKeys { map_mass: 0.7, map_hold_s: 300.0, map_estimate_radius_m: 10.0, map_mixing_length_m: 0.12, map_dilution_m: 30.0, ..MapKeys::default() };
-        /// Altitude flown while tracing the plume (Track-In, Track-Out, Reacquire; 0: altitude_m). A bottom source's chemical reaches a vehicle at altitude z only some way downflow, a distance that grows as z^2 with how weakly the water mixes vertically: lower, the contacts begin nearer the source whatever the mixing.
-        track_altitude_m: f64 = 0.0, "m", Bounds::non_negative(1000.0);
+        /// Altitude flown while tracing the plume (Track-In, Track-Out, Reacquire; 0: altitude_m, as in the field). A bottom source's chemical reaches a vehicle at altitude z only some way downflow, a distance that grows as z^2 with how weakly the water mixes vertically: lower, the contacts begin nearer the source whatever the mixing.
+        track_altitude_m: f64 = 1.0, "m", Bounds::non_negative(1000.0);
         /// lambda: time without detection that ends Track-In.
         lambda_s: f64 = 5.0, "s", Bounds::positive(3600.0);
         /// beta: Track-In offset from upflow.
@@ -103,6 +108,12 @@ plumetrace_core::params! {
         declaration_along_m: f64 = 6.0, "m", Bounds::positive(1000.0);
         /// Crossflow spread bound of the along_and_cross_flow rule.
         declaration_cross_m: f64 = 8.0, "m", Bounds::positive(1000.0);
+        /// How far upflow of the most upflow lost point the lost-point rules declare (0: at it, the field rule). The contacts of a bottom source begin only where its chemical has mixed up to the tracing altitude, some metres downflow of it: tracing at 1 m, the most upflow lost point lay a median 1.6-3.4 m downflow of the source on the families' tuning sites.
+        declaration_upflow_m: f64 = 2.5, "m", Bounds::non_negative(100.0);
+        /// Whether a contact during Track-Out upflow of the most upflow lost point runs the declaration check (true: the field rule, every Track-Out contact does). Such a contact says the plume goes on upflow: in a strong current a plume's patches far downflow of the source can gather three lost points within declaration_along_m, and the check then declared 150 m from the source.
+        declaration_on_upflow_contact: bool = false, "", Bounds::Any;
+        /// Where across the flow the lost-point rules declare: most_upflow (the most upflow lost point, the field rule) or mean (the mean of the three most upflow lost points across the flow).
+        declaration_across: DeclarationAcross = DeclarationAcross::Mean, "", Bounds::Any;
         /// Fly the post-declaration mapping pattern (single-source missions).
         mapping: bool = true, "", Bounds::Any;
         /// Mapping lines.
@@ -218,6 +229,14 @@ impl AmpParams {
         }
     }
 
+    /// Where the lost-point rules put the declared source.
+    pub fn placement(&self) -> Placement {
+        Placement {
+            upflow_m: self.declaration_upflow_m,
+            across: self.declaration_across,
+        }
+    }
+
     /// The mapping pattern, if one is flown.
     pub fn mapping_params(&self) -> Option<MappingParams> {
         self.mapping.then_some(MappingParams {
@@ -273,7 +292,7 @@ impl PlannerParams for AmpParams {
     const RULES: &'static [RuleDoc] = &[
         RuleDoc {
             rule: declaration::ALONG_FLOW,
-            doc: "the three most upflow lost points lie within declaration_along_m of each other along the flow: the most upflow one (the field rule)",
+            doc: "the three most upflow lost points lie within declaration_along_m of each other along the flow: declaration_upflow_m upflow of the most upflow one, across the flow as declaration_across says (with 0 and most_upflow: the most upflow one, the field rule)",
         },
         RuleDoc {
             rule: declaration::ALONG_AND_CROSS_FLOW,
@@ -410,6 +429,13 @@ impl Memory {
             .iter()
             .map(|l| l.pos)
             .max_by(|a, b| a.dot(&u).total_cmp(&b.dot(&u)))
+    }
+
+    /// `pos` lies upflow of every lost point.
+    fn upflow_of_lost(&self, pos: Vec2) -> bool {
+        let u = self.flow.upflow().unit();
+        self.most_upflow_lost()
+            .is_some_and(|top| pos.dot(&u) > top.dot(&u))
     }
 
     /// Reacquire has searched for `reacquire_timeout_s` since the last detection.
@@ -632,7 +658,7 @@ impl Switching {
             return false;
         }
         let rule = m.p.declaration_rule();
-        match rule.check(&m.lost_positions(), m.flow.upflow()) {
+        match rule.check_placed(&m.lost_positions(), m.flow.upflow(), m.p.placement()) {
             Some(at) => {
                 let refined = match (m.p.map_declaration, m.map.as_mut()) {
                     (MapDeclaration::Refine, Some(tracker)) => {
@@ -742,7 +768,10 @@ impl Arbiter<Memory> for Switching {
                 BehaviourKind::Transit | BehaviourKind::Mapping | BehaviourKind::Done
             );
             if p.detected && tracking_allowed && kind != BehaviourKind::TrackIn {
-                if kind == BehaviourKind::TrackOut && self.try_declare(m, p.t_s) {
+                if kind == BehaviourKind::TrackOut
+                    && (m.p.declaration_on_upflow_contact || !m.upflow_of_lost(p.pos_m))
+                    && self.try_declare(m, p.t_s)
+                {
                     continue;
                 }
                 self.enter_track_in(m, p);
