@@ -75,38 +75,35 @@ fn duck_st_map_declaration_declares_every_seed_within_a_few_metres() {
 
 #[test]
 #[ignore = "about a minute in release mode; run with --ignored"]
-fn duck_st_declares_in_most_seeds_with_errors_mostly_along_the_flow() {
+fn duck_st_declares_in_most_seeds_without_an_along_flow_bias() {
+    // The default declaration (traced at 1 m, placed upflow of the lost points at their mean
+    // across the flow) has no systematic along-flow error: over these 20 seeds every run
+    // declares, the median error is under 5 m and the median signed along-flow error near 0
+    // (the paper's rule, at the most upflow lost point, lay a median 6-10 m downflow).
     let results = run_seeds("duck-2003-st", 20);
     let declared: Vec<_> = results
         .iter()
         .filter_map(|r| r.1.first_declaration.as_ref())
         .collect();
-    let mut errors: Vec<f64> = declared.iter().map(|d| d.error_m).collect();
-    errors.sort_by(f64::total_cmp);
-    let median = if errors.is_empty() {
-        f64::NAN
-    } else {
-        errors[errors.len() / 2]
+    let median_of = |mut v: Vec<f64>| {
+        v.sort_by(f64::total_cmp);
+        v.get(v.len() / 2).copied().unwrap_or(f64::NAN)
     };
-    let along_dominant = declared
-        .iter()
-        .filter(|d| d.error_along_m.abs() > d.error_cross_m.abs())
-        .count();
+    let median = median_of(declared.iter().map(|d| d.error_m).collect());
+    let along = median_of(declared.iter().map(|d| d.error_along_m).collect());
     eprintln!(
-        "declared {}/20, errors {errors:?}, median {median:.1} m, along-dominant {along_dominant}",
+        "declared {}/20, median error {median:.1} m, median signed along-flow error {along:.1} m",
         declared.len()
     );
     assert!(
-        declared.len() >= 16,
+        declared.len() >= 18,
         "declared in {} of 20 seeds",
         declared.len()
     );
-    assert!(median < 20.0, "median error {median} m");
+    assert!(median < 8.0, "median error {median} m");
     assert!(
-        2 * along_dominant > declared.len(),
-        "the error is mostly across the flow in {} of {}",
-        declared.len() - along_dominant,
-        declared.len()
+        along.abs() < 3.0,
+        "median signed along-flow error {along} m"
     );
 }
 

@@ -42,7 +42,7 @@ class RunResult:
         vehicles: vehicle names, by index.
         warnings: what ``plumetrace check`` would warn about.
         verdict: whether the mission located the source, in the words of ``plumetrace run``'s
-            line (``located: declared 8.2 m from the source (success radius 50 m)``, ``NOT
+            line (``located: declared 6.3 m from the source (success radius 50 m)``, ``NOT
             located: ...``; the radius is the scenario's ``mission.success_radius_m``).
         metrics: the run's metrics as a campaign's ``runs.csv`` records them (its metric
             columns, see :func:`run_columns`; ``success`` within the scenario's success radius), missing
