@@ -43,13 +43,24 @@ impl Target {
     }
 }
 
-/// The scenario a NetCDF input is read by: the example site with its currents file replaced.
+/// The name the example site's seabed is written under beside a NetCDF input (a `fuzz` name,
+/// as every file beside an input has).
+pub const NETCDF_SEABED: &str = "fuzz-seabed.nc";
+
+/// The scenario a NetCDF input is read by: the example site with its currents file replaced,
+/// over its own seabed written as [`NETCDF_SEABED`].
 pub fn netcdf_scenario() -> String {
-    include_str!("../../../examples/sites/site.toml").replacen(
-        "file = \"currents.nc\"",
-        &format!("file = \"{}\"", Target::Netcdf.file_name()),
-        1,
-    )
+    include_str!("../../../examples/sites/site.toml")
+        .replacen(
+            "file = \"currents.nc\"",
+            &format!("file = \"{}\"", Target::Netcdf.file_name()),
+            1,
+        )
+        .replacen(
+            "file = \"seabed.nc\"",
+            &format!("file = \"{NETCDF_SEABED}\""),
+            1,
+        )
 }
 
 /// The NetCDF seeds: the example site's currents (CDF-1, shorts, fill values, longitude and
@@ -351,6 +362,17 @@ pub fn campaign_side_files() -> Vec<(&'static str, &'static str)> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_netcdf_scenario_reads_the_input_over_the_fuzz_named_seabed() {
+        let text = netcdf_scenario();
+        assert!(text.contains(&format!("file = \"{}\"", Target::Netcdf.file_name())));
+        assert!(
+            text.contains(&format!("file = \"{NETCDF_SEABED}\"")),
+            "{text}"
+        );
+        assert!(!text.contains("\"currents.nc\"") && !text.contains("\"seabed.nc\""));
+    }
 
     #[test]
     fn every_example_family_is_a_seed() {

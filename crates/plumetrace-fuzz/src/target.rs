@@ -265,12 +265,19 @@ fn onboard(input: &Input, path: &Path) -> Result<String, Stop> {
     Ok(format!("onboard: {} checked", o.planner.kind().name()))
 }
 
-/// The example site's scenario over the input as its currents: read and sampled as `check`
-/// does, then the flow queried over the domain (every velocity finite).
+/// The example site's scenario over the input as its currents (over the site's own seabed):
+/// read and sampled as `check` does, then the flow queried over the domain (every velocity
+/// finite).
 fn netcdf(path: &Path) -> Result<String, Stop> {
     let scenario = path.with_file_name("fuzz-currents.toml");
     let text = crate::corpus::netcdf_scenario();
     std::fs::write(&scenario, &text).map_err(rejected)?;
+    // The site's seabed, which its scenario reads beside the currents (not the input).
+    std::fs::write(
+        path.with_file_name(crate::corpus::NETCDF_SEABED),
+        include_bytes!("../../../examples/sites/seabed.nc"),
+    )
+    .map_err(rejected)?;
     let origin = Origin::File(scenario.clone());
     let cfg = plumetrace_scenario::parse(&text, &origin).map_err(rejected)?;
     let built = plumetrace_scenario::build(&cfg, &origin, None).map_err(rejected)?;
