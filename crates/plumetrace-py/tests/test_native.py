@@ -159,7 +159,8 @@ def test_a_result_without_its_record_says_why_it_cannot_be_saved(tmp_path):
 
 def test_the_namespace_holds_only_the_api():
     public = {n for n in dir(plumetrace) if not n.startswith("_")}
-    assert public <= set(plumetrace.__all__) | {"gym", "dask"}, public - set(plumetrace.__all__)
+    modules = {"gym", "dask", "sites", "sb3"}
+    assert public <= set(plumetrace.__all__) | modules, public - set(plumetrace.__all__)
     for n in ("np", "os", "csv", "json", "Dict", "annotations"):
         assert not hasattr(plumetrace, n), n
     for n in plumetrace.__all__:
