@@ -15,10 +15,9 @@
 //! value takes the shallowest water depth of the grid.
 
 use crate::flow::cf::{
-    axes, check_cover_points, clamp_to, err, expand, length_scale, locate, native_spacing,
+    EvenGrid, axes, check_cover_points, clamp_to, err, expand, length_scale, locate,
 };
 use crate::{EnvError, Rect};
-use plumetrace_core::Vec2;
 use plumetrace_core::geo::LocalFrame;
 use plumetrace_netcdf::{NcFile, Var, nearest};
 use std::path::Path;
@@ -323,50 +322,25 @@ fn sample(
         (Some((px, xs)), Some((py, ys))) => ((*px, xs.as_slice()), (*py, ys.as_slice())),
         _ => return Err(err(path, "the bathymetry has no horizontal grid")),
     };
-    let frame = match (a.geographic, &o.frame) {
-        (false, _) => None,
-        (true, Some(f)) => Some(f),
-        (true, None) => {
-            return Err(err(
-                path,
-                "the bathymetry is on a longitude/latitude grid: give the site's origin \
-                 ([origin] lat_deg and lon_deg) to place it in the local frame",
-            ));
-        }
-    };
-    let to_file = |x: f64, y: f64| -> (f64, f64) {
-        match frame {
-            None => (x, y),
-            Some(f) => {
-                let (lat, mut lon) = f.to_geographic(Vec2::new(x, y));
-                let (lo, hi) = (xs[0].min(xs[xs.len() - 1]), xs[0].max(xs[xs.len() - 1]));
-                if lon < lo && lon + 360.0 <= hi {
-                    lon += 360.0;
-                } else if lon > hi && lon - 360.0 >= lo {
-                    lon -= 360.0;
-                }
-                (lon, lat)
-            }
-        }
-    };
-    let area = o.area;
-    let spacing = o
-        .spacing_m
-        .unwrap_or_else(|| native_spacing(xs, ys, frame))
-        .max(area.width_m() / (MAX_NODES_PER_SIDE - 1) as f64)
-        .max(area.height_m() / (MAX_NODES_PER_SIDE - 1) as f64);
-    let nx = ((area.width_m() / spacing).ceil() as usize + 1).max(2);
-    let ny = ((area.height_m() / spacing).ceil() as usize + 1).max(2);
-    let (dx, dy) = (
-        area.width_m() / (nx - 1) as f64,
-        area.height_m() / (ny - 1) as f64,
-    );
+    let g = EvenGrid::new(
+        xs,
+        ys,
+        a.geographic,
+        o.frame.as_ref(),
+        o.spacing_m,
+        o.area,
+        "the bathymetry is on a longitude/latitude grid: give the site's origin \
+         ([origin] lat_deg and lon_deg) to place it in the local frame",
+        path,
+    )?;
+    let to_file = |x: f64, y: f64| g.to_file(x, y);
+    let (area, spacing, nx, ny, dx, dy) = (o.area, g.spacing, g.nx, g.ny, g.dx, g.dy);
     check_cover_points(
         "the bathymetry's",
         o.must_cover,
         xs,
         ys,
-        frame.is_some(),
+        g.geographic(),
         spacing,
         &to_file,
         path,

@@ -815,54 +815,26 @@ fn resample(
         (Some((_, xs)), Some((_, ys))) => (xs.as_slice(), ys.as_slice()),
         _ => return Err(err(path, "the currents have no horizontal grid")),
     };
-    let frame = match (axes.geographic, &o.frame) {
-        (false, _) => None,
-        (true, Some(f)) => Some(f),
-        (true, None) => {
-            return Err(err(
-                path,
-                "the currents are on a longitude/latitude grid: give the site's origin \
-                 ([origin] lat_deg and lon_deg) to place them in the local frame",
-            ));
-        }
-    };
-    // Where a local position is in the file's coordinates (longitudes wrapped to its range).
-    let to_file = |x: f64, y: f64| -> (f64, f64) {
-        match frame {
-            None => (x, y),
-            Some(f) => {
-                let (lat, mut lon) = f.to_geographic(Vec2::new(x, y));
-                let (lo, hi) = (xs[0].min(xs[xs.len() - 1]), xs[0].max(xs[xs.len() - 1]));
-                if lon < lo && lon + 360.0 <= hi {
-                    lon += 360.0;
-                } else if lon > hi && lon - 360.0 >= lo {
-                    lon -= 360.0;
-                }
-                (lon, lat)
-            }
-        }
-    };
-    let spacing = match o.spacing_m {
-        Some(s) => s,
-        None => native_spacing(xs, ys, frame),
-    };
-    let area = o.area;
-    let spacing = spacing
-        .max(area.width_m() / (MAX_NODES_PER_SIDE - 1) as f64)
-        .max(area.height_m() / (MAX_NODES_PER_SIDE - 1) as f64);
-    let nx = ((area.width_m() / spacing).ceil() as usize + 1).max(2);
-    let ny = ((area.height_m() / spacing).ceil() as usize + 1).max(2);
-    let (dx, dy) = (
-        area.width_m() / (nx - 1) as f64,
-        area.height_m() / (ny - 1) as f64,
-    );
+    let g = EvenGrid::new(
+        xs,
+        ys,
+        axes.geographic,
+        o.frame.as_ref(),
+        o.spacing_m,
+        o.area,
+        "the currents are on a longitude/latitude grid: give the site's origin \
+         ([origin] lat_deg and lon_deg) to place them in the local frame",
+        path,
+    )?;
+    let to_file = |x: f64, y: f64| g.to_file(x, y);
+    let (area, spacing, nx, ny, dx, dy) = (o.area, g.spacing, g.nx, g.ny, g.dx, g.dy);
     let reach = expand(&o.must_cover, dx.max(dy));
     check_cover_points(
         "the currents'",
         o.must_cover,
         xs,
         ys,
-        frame.is_some(),
+        g.geographic(),
         spacing,
         &to_file,
         path,
@@ -915,6 +887,79 @@ fn resample(
         ny,
         frames,
     ))
+}
+
+/// An even grid in the local frame over `area` for a file's horizontal axes `xs`, `ys`: the
+/// frame that places a longitude/latitude grid (none for a projected one), the spacing (the
+/// file's own unless one is given, at most [`MAX_NODES_PER_SIDE`] nodes a side) and the nodes.
+pub(crate) struct EvenGrid<'a> {
+    xs: &'a [f64],
+    frame: Option<&'a LocalFrame>,
+    /// The spacing asked for or the file's, widened to at most the nodes a side allows.
+    pub(crate) spacing: f64,
+    pub(crate) nx: usize,
+    pub(crate) ny: usize,
+    pub(crate) dx: f64,
+    pub(crate) dy: f64,
+}
+
+impl<'a> EvenGrid<'a> {
+    /// The grid; `on_lon_lat` is the message for a longitude/latitude grid without an origin.
+    #[allow(clippy::too_many_arguments)]
+    pub(crate) fn new(
+        xs: &'a [f64],
+        ys: &'a [f64],
+        geographic: bool,
+        frame: Option<&'a LocalFrame>,
+        spacing_m: Option<f64>,
+        area: Rect,
+        on_lon_lat: &str,
+        path: &Path,
+    ) -> Result<Self, EnvError> {
+        let frame = match (geographic, frame) {
+            (false, _) => None,
+            (true, Some(f)) => Some(f),
+            (true, None) => return Err(err(path, on_lon_lat)),
+        };
+        let spacing = spacing_m
+            .unwrap_or_else(|| native_spacing(xs, ys, frame))
+            .max(area.width_m() / (MAX_NODES_PER_SIDE - 1) as f64)
+            .max(area.height_m() / (MAX_NODES_PER_SIDE - 1) as f64);
+        let nx = ((area.width_m() / spacing).ceil() as usize + 1).max(2);
+        let ny = ((area.height_m() / spacing).ceil() as usize + 1).max(2);
+        Ok(EvenGrid {
+            xs,
+            frame,
+            spacing,
+            nx,
+            ny,
+            dx: area.width_m() / (nx - 1) as f64,
+            dy: area.height_m() / (ny - 1) as f64,
+        })
+    }
+
+    /// Whether the grid is placed by the site's origin (longitude and latitude).
+    pub(crate) fn geographic(&self) -> bool {
+        self.frame.is_some()
+    }
+
+    /// Where a local position is in the file's coordinates (longitudes wrapped to its range).
+    pub(crate) fn to_file(&self, x: f64, y: f64) -> (f64, f64) {
+        match self.frame {
+            None => (x, y),
+            Some(f) => {
+                let xs = self.xs;
+                let (lat, mut lon) = f.to_geographic(Vec2::new(x, y));
+                let (lo, hi) = (xs[0].min(xs[xs.len() - 1]), xs[0].max(xs[xs.len() - 1]));
+                if lon < lo && lon + 360.0 <= hi {
+                    lon += 360.0;
+                } else if lon > hi && lon - 360.0 >= lo {
+                    lon -= 360.0;
+                }
+                (lon, lat)
+            }
+        }
+    }
 }
 
 /// Whether every point of the op-area `r`'s edge (every `spacing`, and its corners) lies in the
