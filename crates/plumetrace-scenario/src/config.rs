@@ -452,6 +452,10 @@ pub enum ChemModel {
     Voltage,
     /// Salinity over a freshwater plume (ppt), with half-normal noise.
     Salinity,
+    /// The same salinity probe read as its contrast: the medium's salinity less the reading
+    /// (ppt below the ambient, 0 outside the plume), a concentration for the single-vehicle
+    /// planners.
+    SalinityDeficit,
 }
 
 /// `[vehicles.dynamics]`
@@ -513,7 +517,7 @@ pub struct ChemSensorConfig {
     /// Detection threshold, V: passed to the vehicle's planner as its `threshold_v` (the
     /// threshold belongs to the planner; this key is kept for older scenario files).
     pub threshold_v: Option<f64>,
-    /// What it measures: "voltage" (default) or "salinity".
+    /// What it measures: "voltage" (default), "salinity" or "salinity_deficit".
     pub model: Option<ChemModel>,
     /// Salinity: the medium's salinity, ppt (35).
     pub medium_salinity_ppt: Option<f64>,

@@ -805,3 +805,47 @@ fn a_key_that_is_not_bare_is_quoted_in_the_error_path() {
     let e = error_of(&text);
     assert!(e.contains("planners.\"a b\": invalid type"), "{e}");
 }
+
+/// `model = "salinity_deficit"` is the salinity probe read as its contrast below the medium:
+/// the same keys, the deficit flag set; a typo of it names the models, and the salinity keys on
+/// a voltage sensor name both salinity models.
+#[test]
+fn a_salinity_deficit_sensor_builds_and_its_mistakes_name_themselves() {
+    let base = find_preset("soares-freshwater").unwrap().toml;
+    let deficit = base.replacen(
+        "[vehicles.chem_sensor]\nmodel = \"salinity\"",
+        "[vehicles.chem_sensor]\nmodel = \"salinity_deficit\"\nmedium_salinity_ppt = 31.5\nnoise_sd_ppt = 0.05",
+        1,
+    );
+    let origin = Origin::File("scenario.toml".into());
+    let built = build(&parse(&deficit, &origin).unwrap(), &origin, None).unwrap();
+    let s = built.vehicles[0].chem_sensor.salinity.unwrap();
+    assert!(
+        s.deficit && s.medium_ppt == 31.5 && s.noise_sd_ppt == 0.05,
+        "{s:?}"
+    );
+    let leader = built.vehicles[1].chem_sensor.salinity.unwrap();
+    assert!(!leader.deficit && leader.medium_ppt == 35.0, "{leader:?}");
+
+    let typo = error_of(&base.replacen("model = \"salinity\"", "model = \"salinity_defict\"", 1));
+    assert!(
+        typo.contains("vehicles[0].chem_sensor.model")
+            && typo.contains("did you mean `salinity_deficit`"),
+        "{typo}"
+    );
+    let voltage = error_of(&base.replacen(
+        "[vehicles.chem_sensor]\nmodel = \"salinity\"",
+        "[vehicles.chem_sensor]\nmedium_salinity_ppt = 34.0",
+        1,
+    ));
+    assert!(
+        voltage.contains("vehicles[0].chem_sensor.medium_salinity_ppt")
+            && voltage.contains("model = \"salinity\" or \"salinity_deficit\""),
+        "{voltage}"
+    );
+    let negative = error_of(&deficit.replace("noise_sd_ppt = 0.05", "noise_sd_ppt = -0.05"));
+    assert!(
+        negative.contains("vehicles[0].chem_sensor.noise_sd_ppt"),
+        "{negative}"
+    );
+}

@@ -60,6 +60,12 @@ pub struct ChemSensorParams {
 /// dilutes the medium, `S = S_medium (1 - f)`, and the probe reports `S + |n|` with `n` normal
 /// of standard deviation `noise_sd_ppt` (half-normal noise), saturated at `S_medium`: fresh
 /// water never raises the salinity, so no reading exceeds the medium's.
+///
+/// With `deficit` the probe reports the salinity contrast instead, `S_medium - (S + |n|)`
+/// (the same probe's reading below the ambient, `S_medium f` less the noise, in `[0, S_medium]`):
+/// the scalar a formation leader computes from the salinity by eq. (1), and a concentration that
+/// grows into the plume for planners that trace one (a CTD-carrying AUV whose planner is told the
+/// ambient salinity).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct SalinityParams {
     /// Salinity of the medium, ppt.
@@ -68,6 +74,9 @@ pub struct SalinityParams {
     pub fresh_density_kgpm3: f64,
     /// Noise (the scale of the half-normal), ppt.
     pub noise_sd_ppt: f64,
+    /// Report the deficit below the medium's salinity instead of the salinity.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub deficit: bool,
 }
 
 impl Default for SalinityParams {
@@ -77,6 +86,7 @@ impl Default for SalinityParams {
             medium_ppt: 35.0,
             fresh_density_kgpm3: 998.2,
             noise_sd_ppt: 0.1,
+            deficit: false,
         }
     }
 }
@@ -149,12 +159,17 @@ impl ChemSensor {
             let n: f64 = StandardNormal.sample(rng);
             let reading =
                 (s.medium_ppt * (1.0 - fresh) + s.noise_sd_ppt * n.abs()).clamp(0.0, s.medium_ppt);
+            let reading = if reading.is_finite() {
+                reading
+            } else {
+                s.medium_ppt
+            };
             return ChemSample {
                 time_s: t_s,
-                reading: if reading.is_finite() {
-                    reading
+                reading: if s.deficit {
+                    s.medium_ppt - reading
                 } else {
-                    s.medium_ppt
+                    reading
                 },
             };
         }
@@ -460,6 +475,44 @@ mod tests {
         let want =
             34.9 + 0.1 * ((2.0 / std::f64::consts::PI).sqrt() * (1.0 - (-0.5f64).exp()) + 0.3173);
         assert!((mean_below - want).abs() < 0.002, "{mean_below} vs {want}");
+    }
+
+    #[test]
+    fn salinity_deficit_is_the_same_probe_read_below_the_medium() {
+        // The same stream through a salinity probe and its deficit twin: every deficit reading
+        // is the medium less the salinity reading, zero outside the plume, never negative.
+        let probe = |deficit| {
+            ChemSensor::new(ChemSensorParams {
+                salinity: Some(SalinityParams {
+                    medium_ppt: 32.0,
+                    deficit,
+                    ..SalinityParams::default()
+                }),
+                ..ChemSensorParams::default()
+            })
+        };
+        let (mut s, mut d) = (probe(false), probe(true));
+        let (mut rs, mut rd) = (
+            stream_rng(3, StreamId::Sensor(0, 1)),
+            stream_rng(3, StreamId::Sensor(0, 1)),
+        );
+        for k in 0..2000 {
+            let c = [0.0, 0.5, 3.0, 2000.0][k % 4];
+            let t = f64::from(k as u32);
+            let (a, b) = (
+                s.sample(c, t, &mut rs).reading,
+                d.sample(c, t, &mut rd).reading,
+            );
+            assert!((a + b - 32.0).abs() < 1e-12, "{a} + {b}");
+            assert!((0.0..=32.0).contains(&b), "{b}");
+            if c == 0.0 {
+                assert_eq!(b, 0.0);
+            }
+            if c == 2000.0 {
+                // Pure fresh water: the whole contrast, less the half-normal noise.
+                assert!(b > 31.0, "{b}");
+            }
+        }
     }
 
     #[test]

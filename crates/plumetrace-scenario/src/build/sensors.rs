@@ -49,15 +49,17 @@ pub(super) fn chem_sensor(c: &ChemSensorConfig, key: &str) -> Result<ChemSensorP
     Ok(chem_sensor)
 }
 
-/// The salinity probe of a chemical sensor, if its model is "salinity"; the salinity keys
-/// without it are an error (they would be ignored).
+/// The salinity probe of a chemical sensor, if its model is "salinity" or "salinity_deficit";
+/// the salinity keys without it are an error (they would be ignored).
 fn salinity(c: &ChemSensorConfig, key: &str) -> Result<Option<SalinityParams>, Invalid> {
     let d = SalinityParams::default();
-    match c.model.unwrap_or(ChemModel::Voltage) {
-        ChemModel::Salinity => Ok(Some(SalinityParams {
+    let model = c.model.unwrap_or(ChemModel::Voltage);
+    match model {
+        ChemModel::Salinity | ChemModel::SalinityDeficit => Ok(Some(SalinityParams {
             medium_ppt: c.medium_salinity_ppt.unwrap_or(d.medium_ppt),
             fresh_density_kgpm3: c.fresh_density_kgpm3.unwrap_or(d.fresh_density_kgpm3),
             noise_sd_ppt: c.noise_sd_ppt.unwrap_or(d.noise_sd_ppt),
+            deficit: model == ChemModel::SalinityDeficit,
         })),
         ChemModel::Voltage => {
             let given = [
@@ -68,7 +70,7 @@ fn salinity(c: &ChemSensorConfig, key: &str) -> Result<Option<SalinityParams>, I
             match given.iter().find(|(_, v)| v.is_some()) {
                 Some((name, _)) => Err(Invalid::new(
                     format!("{key}.{name}"),
-                    "only a salinity sensor has it (set model = \"salinity\")",
+                    "only a salinity sensor has it (set model = \"salinity\" or \"salinity_deficit\")",
                 )),
                 None => Ok(None),
             }
