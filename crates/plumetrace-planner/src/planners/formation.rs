@@ -714,7 +714,7 @@ impl FormationLeader {
                     d.strong = Some((along, mid + up * (along - mid.dot(&up))));
                 }
             }
-            if c >= self.p.quiet_fraction * d.peaks[k] && d.peaks[k] >= self.p.min_peak {
+            if declare::reads_on(c, d.peaks[k], self.p.min_peak, self.p.quiet_fraction) {
                 faded = false;
             }
         }
@@ -1300,6 +1300,22 @@ mod tests {
         }
     }
 
+    /// The partner leader's radio state at `t`, 10 m to the north: its filtered `reading` and
+    /// scale.
+    fn partner_state(t: f64, reading: f64, scale_cw: f64) -> Message {
+        Message {
+            from: VehicleId(1),
+            to: Recipient::Broadcast,
+            link: Link::Radio,
+            sent_s: t,
+            body: MessageBody::FormationState {
+                pos_m: Vec2::new(0.0, 10.0),
+                reading,
+                scale_cw,
+            },
+        }
+    }
+
     fn leader(side: FormationSide, id: u32) -> FormationLeader {
         FormationLeader::new(
             FormationLeaderParams {
@@ -1471,17 +1487,7 @@ mod tests {
         for k in 0..100 {
             let t = f64::from(k) * 0.1;
             let inbox = vec![
-                Message {
-                    from: VehicleId(1),
-                    to: Recipient::Broadcast,
-                    link: Link::Radio,
-                    sent_s: t,
-                    body: MessageBody::FormationState {
-                        pos_m: Vec2::new(0.0, 10.0),
-                        reading: 0.3,
-                        scale_cw: l.scale(),
-                    },
-                },
+                partner_state(t, 0.3, l.scale()),
                 Message {
                     from: VehicleId(2),
                     to: Recipient::Broadcast,
@@ -1667,17 +1673,7 @@ mod tests {
             for k in 0..600 {
                 let t = f64::from(k) * 0.1;
                 let on = t < 30.0;
-                let inbox = vec![Message {
-                    from: VehicleId(1),
-                    to: Recipient::Broadcast,
-                    link: Link::Radio,
-                    sent_s: t,
-                    body: MessageBody::FormationState {
-                        pos_m: Vec2::new(0.0, 10.0),
-                        reading: if on { 0.3 } else { 0.0 },
-                        scale_cw: l.scale(),
-                    },
-                }];
+                let inbox = vec![partner_state(t, if on { 0.3 } else { 0.0 }, l.scale())];
                 let chem = vec![ChemSample {
                     time_s: t,
                     reading: 35.0 - if on { 0.1 } else { 0.0 },

@@ -86,7 +86,7 @@ impl Profile {
             let bin = (along / r.bin_m).floor() as i64;
             let e = self.bins[k].entry(bin).or_insert(c);
             *e = e.max(c);
-            if self.peaks[k] >= r.min_peak && c >= r.quiet_fraction * self.peaks[k] {
+            if reads_on(c, self.peaks[k], r.min_peak, r.quiet_fraction) {
                 faded = false;
             }
         }
@@ -152,6 +152,13 @@ impl Profile {
 /// The point on the centre line through `mid` at along-flow coordinate `along` (axis `up`).
 pub(super) fn on_centre_line(mid: Vec2, up: Vec2, along: f64) -> Vec2 {
     mid + up * (along - mid.dot(&up))
+}
+
+/// Whether a member reading `c` against its `peak` still reads the plume: its peak counts (at
+/// least `min_peak`) and `c` has not faded below `quiet_fraction` of it. Both declaration rules
+/// wait until no member does.
+pub(super) fn reads_on(c: f64, peak: f64, min_peak: f64, quiet_fraction: f64) -> bool {
+    peak >= min_peak && c >= quiet_fraction * peak
 }
 
 #[cfg(test)]
