@@ -12,7 +12,7 @@ cd "$(dirname "$0")/.."
 bin=""
 jobs=$(nproc)
 sites=200
-tuning_sites=40
+tuning_sites=20
 while [ $# -gt 0 ]; do
     case "$1" in
         --bin) bin="$2"; shift 2 ;;
@@ -29,7 +29,7 @@ fi
 started=$(date +%s)
 work=target/results/formation-comparison
 rm -rf "$work"
-mkdir -p "$work/planners" "$work/rows"
+mkdir -p "$work/planners"
 
 # The single AUV's planners, scaled to a basin of 30-60 m (their defaults are for sites of
 # hundreds of metres at 1.5-2 m/s): 0.5 m/s (the AUV's top speed is 1 m/s, its turns 10 deg/s, a
@@ -75,49 +75,22 @@ depths="0.5 0.2"
 
 # twin SITE_DIR NAME PLANNER DEPTH THRESHOLD: the single-AUV twins of every site in SITE_DIR.
 twin() {
-    local dir="$1" name="$2" planner="$3" depth="$4" thr="$5" f
-    local alt
-    mkdir -p "$work/twins/$name"
+    local dir="$1" name="$2" planner="$3" depth="$4" thr="$5"
     { cat "$work/planners/$planner.toml"; echo "threshold_v = $thr"; } > "$work/planners/$name.toml"
-    for f in "$dir"/site-*.toml; do
-        python3 scripts/formation_single.py "$f" "$work/twins/$name/$(basename "$f")" \
-            --planner "$work/planners/$name.toml" --depth "$depth"
-    done
+    python3 scripts/formation_single.py "$dir"/site-*.toml --out "$work/twins/$name" \
+        --planner "$work/planners/$name.toml" --depth "$depth"
 }
 
-# Every run: `plumetrace run FILE --out DIR --no-snapshot-log`, then its row (the first
-# declaration, each vehicle's path up to it, the site's drawn values) into rows/NAME/, and the
-# run's directory removed.
-cat > "$work/row.py" <<'PY'
-import csv, json, math, sys
-site, d = sys.argv[1:3]
-s = json.load(open(d + "/summary.json"))
-first = s.get("first_declaration")
-until = first["t_s"] if first else math.inf
-path, last = dict(), dict()
-for r in csv.DictReader(open(d + "/trajectory.csv")):
-    if float(r["t_s"]) > until:
-        continue
-    v, p = r["vehicle"], (float(r["true_x_m"]), float(r["true_y_m"]))
-    if v in last:
-        path[v] = path.get(v, 0.0) + math.dist(last[v], p)
-    last[v] = p
-drawn = dict()
-for line in open(site):
-    if line.startswith("#   ") and " = " in line:
-        k, _, v = line[4:].strip().partition(" = ")
-        drawn[k] = v
-print(json.dumps({"site": site, "outcome": s["outcome"], "first": first,
-                  "paths": [path.get(str(v["id"]), 0.0) for v in s["vehicles"]],
-                  "drawn": drawn}))
-PY
+# Every run: `plumetrace run FILE --out DIR --no-snapshot-log`, keeping its summary.json (and the
+# team's trajectory.csv: the team flies on after its first declaration, and its path is counted
+# up to it; a single AUV's mission ends at its declaration).
 fly() {
-    local name="$1" dir="$2"
-    mkdir -p "$work/rows/$name" "$work/flown/$name"
+    local name="$1" dir="$2" keep="$3"
+    mkdir -p "$work/flown/$name"
     ls "$dir"/site-*.toml | xargs -P "$jobs" -I{} sh -c \
-        'f="$1"; n=$(basename "$f" .toml); d="$3/flown/$4/$n"
+        'f="$1"; d="$3/flown/$4/$(basename "$f" .toml)"
          "$2" run "$f" --out "$d" --no-snapshot-log >/dev/null &&
-         python3 "$3/row.py" "$f" "$d" > "$3/rows/$4/$n.json" && rm -rf "$d"' _ {} "$bin" "$work" "$name"
+         find "$d" -type f ! -name summary.json ! -name "$5" -delete' _ {} "$bin" "$work" "$name" "$keep"
 }
 
 # The tuning seed: the threshold at the team's depth.
@@ -125,17 +98,17 @@ fly() {
 for planner in amp moth map; do
     for thr in 0.01 0.02 0.05 0.1; do
         twin "$work/tuning-sites" "tuning-$planner-$thr" "$planner" 0.5 "$thr"
-        fly "tuning-$planner-$thr" "$work/twins/tuning-$planner-$thr"
+        fly "tuning-$planner-$thr" "$work/twins/tuning-$planner-$thr" summary.json
     done
 done
 
 # The test seed: the team as drawn, and each planner at each depth.
 "$bin" family examples/families/formation.family.toml --sample "$sites" --seed 3102 --out "$work/sites" >/dev/null
-fly formation "$work/sites"
+fly formation "$work/sites" trajectory.csv
 for depth in $depths; do
     for planner in amp moth map; do
         twin "$work/sites" "$planner-$depth" "$planner" "$depth" "$threshold"
-        fly "$planner-$depth" "$work/twins/$planner-$depth"
+        fly "$planner-$depth" "$work/twins/$planner-$depth" summary.json
     done
 done
 
@@ -147,11 +120,43 @@ cpu="$(sed -n 's/^model name[[:space:]]*: //p' /proc/cpuinfo | head -1)"
 wall=$(( $(date +%s) - started ))
 python3 - "$work" "$commit" "$sites" "$tuning_sites" "$threshold" "$(nproc) cores, $cpu" "$wall" "$jobs" \
     > docs/results/formation-comparison.md.tmp <<'PY'
-import datetime, glob, json, os, statistics, sys
+import csv, datetime, glob, json, math, os, statistics, sys
 
 work, commit, sites, tuning_sites, threshold, machine, wall, jobs = sys.argv[1:9]
+def drawn_of(site):
+    out = dict()
+    for line in open(site):
+        if line.startswith("#   ") and " = " in line:
+            k, _, v = line[4:].strip().partition(" = ")
+            out[k] = v
+    return out
+def paths_until(d, s, until):
+    """Each vehicle's path up to `until`: the summary's when the mission ended by then, else
+    summed from the trajectory."""
+    if s["ended"]["t_s"] <= until or not os.path.exists(d + "/trajectory.csv"):
+        return [v["path_length_m"] for v in s["vehicles"]]
+    path, last = dict(), dict()
+    for r in csv.DictReader(open(d + "/trajectory.csv")):
+        if float(r["t_s"]) > until:
+            break
+        v, p = r["vehicle"], (float(r["true_x_m"]), float(r["true_y_m"]))
+        if v in last:
+            path[v] = path.get(v, 0.0) + math.dist(last[v], p)
+        last[v] = p
+    return [path.get(str(v["id"]), 0.0) for v in s["vehicles"]]
+cache = dict()
 def rows(name):
-    return [json.load(open(f)) for f in sorted(glob.glob(f"{work}/rows/{name}/*.json"))]
+    if name not in cache:
+        out = []
+        for d in sorted(glob.glob(f"{work}/flown/{name}/site-*")):
+            s = json.load(open(d + "/summary.json"))
+            first = s.get("first_declaration")
+            site = f"{work}/sites/{os.path.basename(d)}.toml"
+            out.append({"first": first, "outcome": s["outcome"],
+                        "paths": paths_until(d, s, first["t_s"] if first else math.inf),
+                        "drawn": drawn_of(site) if os.path.exists(site) else dict()})
+        cache[name] = out
+    return cache[name]
 def p90(xs):
     xs = sorted(xs)
     return xs[max(0, -(-9 * len(xs) // 10) - 1)] if xs else None

@@ -8,13 +8,17 @@ the follower's dynamics, the AUV's default navigation and a salinity probe
 read as its contrast (`model = "salinity_deficit"`, the site's medium salinity), flying the
 planner table in `--planner` (a TOML file, copied as `[planners.single]`).
 
-    scripts/formation_single.py SITE.toml OUT.toml --planner amp.toml --depth 0.5
+    scripts/formation_single.py SITE.toml --out TWIN.toml --planner amp.toml --depth 0.5
+    scripts/formation_single.py DIR/site-*.toml --out TWINS/ --planner amp.toml --depth 0.5
+
+(several sites: OUT is a directory, each twin named as its site).
 
 Only the standard library: the site is read with tomllib and the twin written by a small TOML
 writer for the tables, arrays of tables, numbers, strings, booleans and arrays a site holds.
 """
 
 import argparse
+import os
 import sys
 import tomllib
 
@@ -88,30 +92,42 @@ def single(site, planner, depth_m):
     return twin
 
 
+def write_twin(path, out, planner, depth):
+    with open(path, "rb") as f:
+        twin = single(tomllib.load(f), planner, depth)
+    with open(path) as f:
+        head = [line for line in f if line.startswith("#")]
+    lines = []
+    body(twin, "", lines)
+    with open(out, "w") as f:
+        f.write(f"# The single-AUV twin of {path} (scripts/formation_single.py, "
+                f"{depth} m down, planner {planner.get('kind', '?')}); the site as drawn:\n")
+        f.writelines(head[2:])
+        f.write("\n".join(lines) + "\n")
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("site")
-    ap.add_argument("out")
+    ap.add_argument("sites", nargs="+")
+    ap.add_argument("--out", required=True, help="the twin's file, or a directory for several sites")
     ap.add_argument("--planner", required=True, help="TOML file of the planner table")
     ap.add_argument("--depth", type=float, default=0.5, help="depth below the surface, m")
     a = ap.parse_args()
     try:
-        with open(a.site, "rb") as f:
-            site = tomllib.load(f)
         with open(a.planner, "rb") as f:
             planner = tomllib.load(f)
-        twin = single(site, planner, a.depth)
-    except (OSError, tomllib.TOMLDecodeError, ValueError, KeyError) as e:
-        sys.exit(f"formation_single.py: {a.site}: {e}")
-    with open(a.site) as f:
-        head = [line for line in f if line.startswith("#")]
-    out = []
-    body(twin, "", out)
-    with open(a.out, "w") as f:
-        f.write(f"# The single-AUV twin of {a.site} (scripts/formation_single.py, "
-                f"{a.depth} m down, planner {planner.get('kind', '?')}); the site as drawn:\n")
-        f.writelines(head[2:])
-        f.write("\n".join(out) + "\n")
+    except (OSError, tomllib.TOMLDecodeError) as e:
+        sys.exit(f"formation_single.py: --planner {a.planner}: {e}")
+    if len(a.sites) > 1 or os.path.isdir(a.out):
+        os.makedirs(a.out, exist_ok=True)
+        outs = [os.path.join(a.out, os.path.basename(p)) for p in a.sites]
+    else:
+        outs = [a.out]
+    for path, out in zip(a.sites, outs):
+        try:
+            write_twin(path, out, planner, a.depth)
+        except (OSError, tomllib.TOMLDecodeError, ValueError, KeyError) as e:
+            sys.exit(f"formation_single.py: {path}: {e}")
 
 
 if __name__ == "__main__":
