@@ -231,6 +231,8 @@ plumetrace_core::params! {
         close_on_fade: bool = true, "", Bounds::Any;
         /// How fast the scale falls while the formation closes.
         close_rate_per_s: f64 = 0.05, "1/s", Bounds::positive(100.0);
+        /// With close_on_fade, open a closed formation again when a leader's reading comes back to `quiet_fraction` of the larger leader peak it closed on (the fade was a gap in an intermittent plume, not the plume narrowing past the leaders); it closes again on the next fade.
+        reopen_on_return: bool = false, "", Bounds::Any;
         /// How far each position fix moves the leader's own position estimate, which otherwise follows its dead reckoning (1: every fix taken whole, as the navigation estimate does; 0.05 chosen on the formation family's tuning seed, for RTK to 5 m GPS).
         fix_gain: f64 = 0.05, "", Bounds::positive(1.0);
     }
@@ -574,14 +576,21 @@ impl FormationLeader {
         }
     }
 
-    /// Closes the formation for good once both leaders' readings (`own`, `partner`) have faded
-    /// below `quiet_fraction` of the larger of their peaks (at least `min_peak`): one leader may
-    /// never have been over the plume.
+    /// Closes the formation once both leaders' readings (`own`, `partner`) have faded below
+    /// `quiet_fraction` of the larger of their peaks (at least `min_peak`): one leader may never
+    /// have been over the plume. It stays closed, unless `reopen_on_return` and a reading comes
+    /// back to that fraction of the peaks it closed on.
     fn update_closing(&mut self, own: f64, partner: Option<f64>) {
         let Some(q) = partner.filter(|q| q.is_finite()) else {
             return;
         };
-        if !self.p.close_on_fade || self.closed || !own.is_finite() {
+        if !self.p.close_on_fade || !own.is_finite() {
+            return;
+        }
+        if self.closed {
+            // The peaks it closed on, unchanged while it is closed.
+            let peak = self.lead_peaks[0].max(self.lead_peaks[1]);
+            self.closed = !(self.p.reopen_on_return && own.max(q) >= self.p.quiet_fraction * peak);
             return;
         }
         self.lead_peaks[0] = self.lead_peaks[0].max(own);
@@ -1690,6 +1699,46 @@ mod tests {
         assert!((closed[440] - 0.5).abs() < 0.05, "{}", closed[440]);
         assert_eq!(closed[599], 0.3);
         assert_eq!(run(false)[599], 1.0);
+    }
+
+    #[test]
+    fn a_closed_formation_reopens_when_the_plume_comes_back_with_reopen_on_return() {
+        // Read for 30 s, a gap of 15 s, read again for 7 s, then nothing.
+        let run = |reopen: bool| {
+            let mut l = FormationLeader::new(
+                FormationLeaderParams {
+                    side: FormationSide::Left,
+                    declare: false,
+                    reopen_on_return: reopen,
+                    ..FormationLeaderParams::default()
+                },
+                VehicleId(0),
+                Heading::from_deg(270.0),
+                area(),
+            );
+            let mut scales = Vec::new();
+            for k in 0..800 {
+                let t = f64::from(k) * 0.1;
+                let on = t < 30.0 || (45.0..52.0).contains(&t);
+                let inbox = vec![partner_state(t, if on { 0.3 } else { 0.0 }, l.scale())];
+                let chem = vec![ChemSample {
+                    time_s: t,
+                    reading: 35.0 - if on { 0.1 } else { 0.0 },
+                }];
+                let pos = Some(Vec2::zeros());
+                l.decide(&snapshot(t, 0, pos, Heading::from_deg(270.0), chem, inbox));
+                scales.push(l.scale());
+            }
+            scales
+        };
+        // Closing from 34 s; at 45 s the plume is back: the scale is held (no follower) where
+        // it was, 1 - 0.05 x 11 = 0.45, and falls again from the next fade (56 s).
+        let reopened = run(true);
+        assert!((reopened[500] - 0.45).abs() < 0.02, "{}", reopened[500]);
+        assert!((reopened[550] - 0.45).abs() < 0.02, "{}", reopened[550]);
+        assert_eq!(reopened[799], 0.3);
+        let kept = run(false);
+        assert_eq!(kept[500], 0.3, "closed for good without the key");
     }
 
     #[test]
