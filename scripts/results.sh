@@ -158,9 +158,11 @@ done
     echo
     echo "A campaign's page is written whole by \`scripts/results.sh NAME\` (\`--all\` for every one),"
     echo "from a campaign anyone can run again; each names the commit, the command and the machine"
-    echo "that produced it. \`scripts/gridworld.sh\` writes the grid-world page the same way. The other"
-    echo "pages are records of measurements no script regenerates (timings, and campaigns flown at older"
-    echo "code to choose a default), each table with its commit and command."
+    echo "that produced it. \`scripts/gridworld.sh\` writes the grid-world page the same way, and"
+    echo "\`scripts/formation_acceptance.sh\` and \`scripts/formation_comparison.sh\` the formation"
+    echo "acceptance and comparison pages. The other pages are records of measurements no script"
+    echo "regenerates (timings, and campaigns flown at older code to choose a default), each table with"
+    echo "its commit and command."
     echo
     echo "| page | what it measures |"
     echo "| --- | --- |"
