@@ -14,9 +14,7 @@
 //! zero); elsewhere a node outside the grid takes the nearest edge value, and land or a missing
 //! value takes the shallowest water depth of the grid.
 
-use crate::flow::cf::{
-    EvenGrid, axes, check_cover_points, clamp_to, err, expand, length_scale, locate,
-};
+use crate::flow::cf::{axes, bilinear, err, expand, length_scale, place};
 use crate::{EnvError, Rect};
 use plumetrace_core::geo::LocalFrame;
 use plumetrace_netcdf::{NcFile, Var, nearest};
@@ -318,33 +316,22 @@ fn sample(
     o: &SeabedOptions,
     path: &Path,
 ) -> Result<Seabed, EnvError> {
-    let ((px, xs), (py, ys)) = match (&a.x, &a.y) {
-        (Some((px, xs)), Some((py, ys))) => ((*px, xs.as_slice()), (*py, ys.as_slice())),
+    let (px, py) = match (&a.x, &a.y) {
+        (Some((px, _)), Some((py, _))) => (*px, *py),
         _ => return Err(err(path, "the bathymetry has no horizontal grid")),
     };
-    let g = EvenGrid::new(
-        xs,
-        ys,
-        a.geographic,
+    let (g, cells) = place(
+        a,
         o.frame.as_ref(),
         o.spacing_m,
         o.area,
+        o.must_cover,
+        "the bathymetry's",
         "the bathymetry is on a longitude/latitude grid: give the site's origin \
          ([origin] lat_deg and lon_deg) to place it in the local frame",
         path,
     )?;
-    let to_file = |x: f64, y: f64| g.to_file(x, y);
-    let (area, spacing, nx, ny, dx, dy) = (o.area, g.spacing, g.nx, g.ny, g.dx, g.dy);
-    check_cover_points(
-        "the bathymetry's",
-        o.must_cover,
-        xs,
-        ys,
-        g.geographic(),
-        spacing,
-        &to_file,
-        path,
-    )?;
+    let (area, nx, ny, dx, dy) = (o.area, g.nx, g.ny, g.dx, g.dy);
     let shape = file.shape(var);
     let mut strides = vec![1; shape.len()];
     for k in (0..shape.len().saturating_sub(1)).rev() {
@@ -352,46 +339,40 @@ fn sample(
     }
     let at = |i: usize, j: usize| depths[i * strides[px] + j * strides[py]];
     let reach = expand(&o.must_cover, dx.max(dy));
+    let n = a.len_xy();
     let mut out = Vec::with_capacity(nx * ny);
     let mut dry = Vec::new();
-    for j in 0..ny {
-        for i in 0..nx {
-            let (x, y) = (area.x_min_m + i as f64 * dx, area.y_min_m + j as f64 * dy);
-            let (fx, fy) = to_file(x, y);
-            let (ci, tx) = locate(xs, clamp_to(xs, fx)).unwrap_or((0, 0.0));
-            let (cj, ty) = locate(ys, clamp_to(ys, fy)).unwrap_or((0, 0.0));
-            let (i1, j1) = ((ci + 1).min(xs.len() - 1), (cj + 1).min(ys.len() - 1));
-            let g = |a: usize, b: usize, w: f64| if w == 0.0 { 0.0 } else { w * at(a, b) };
-            let d = g(ci, cj, (1.0 - tx) * (1.0 - ty))
-                + g(i1, cj, tx * (1.0 - ty))
-                + g(ci, j1, (1.0 - tx) * ty)
-                + g(i1, j1, tx * ty);
-            if !(d.is_finite() && d > 0.0) {
-                if reach.contains_xy(x, y) {
-                    return Err(err(
-                        path,
-                        if d.is_nan() {
-                            format!(
-                                "variable {}: a missing value (_FillValue or missing_value) at \
-                                 ({x:.1}, {y:.1}) m, where the op-area needs the seabed",
-                                var.name
-                            )
-                        } else {
-                            format!(
-                                "variable {}: the seabed is at or above the surface (depth \
-                                 {d:.2} m: land) at ({x:.1}, {y:.1}) m, inside the op-area; \
-                                 check the sign (a depth is positive down, an elevation \
-                                 negative below sea level: attribute positive = \"up\" or \
-                                 \"down\" says which)",
-                                var.name
-                            )
-                        },
-                    ));
-                }
-                dry.push(out.len());
+    for (k, &cell) in cells.iter().enumerate() {
+        let (x, y) = (
+            area.x_min_m + (k % nx) as f64 * dx,
+            area.y_min_m + (k / nx) as f64 * dy,
+        );
+        let d = bilinear(cell, n, at);
+        if !(d.is_finite() && d > 0.0) {
+            if reach.contains_xy(x, y) {
+                return Err(err(
+                    path,
+                    if d.is_nan() {
+                        format!(
+                            "variable {}: a missing value (_FillValue or missing_value) at \
+                             ({x:.1}, {y:.1}) m, where the op-area needs the seabed",
+                            var.name
+                        )
+                    } else {
+                        format!(
+                            "variable {}: the seabed is at or above the surface (depth \
+                             {d:.2} m: land) at ({x:.1}, {y:.1}) m, inside the op-area; \
+                             check the sign (a depth is positive down, an elevation \
+                             negative below sea level: attribute positive = \"up\" or \
+                             \"down\" says which)",
+                            var.name
+                        )
+                    },
+                ));
             }
-            out.push(d);
+            dry.push(out.len());
         }
+        out.push(d);
     }
     let shallowest = out
         .iter()

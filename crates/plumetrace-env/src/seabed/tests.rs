@@ -319,3 +319,51 @@ fn from_depths_refuses_what_is_not_water() {
     assert!(Seabed::from_depths(area, 1, 2, &[1.0, 2.0]).is_err());
     assert!(Seabed::from_depths(area, 2, 2, &[1.0]).is_err());
 }
+
+/// The 5 % slope of [`projected`] on a curvilinear grid: projected 2-D x and y turned 20° about
+/// (200, 100) m, 9 x 9 nodes 60 m apart (ROMS's `h` on `x_rho` and `y_rho`).
+fn turned_slope() -> Dataset {
+    let mut d = Dataset::default();
+    let eta = d.dim("eta_rho", 9);
+    let xi = d.dim("xi_rho", 9);
+    let (s, c) = 20f64.to_radians().sin_cos();
+    let (mut xs, mut ys, mut h) = (vec![], vec![], vec![]);
+    for j in 0..9 {
+        for i in 0..9 {
+            let (a, b) = (60.0 * i as f64 - 240.0, 60.0 * j as f64 - 240.0);
+            let (x, y) = (200.0 + c * a - s * b, 100.0 + s * a + c * b);
+            xs.push(x);
+            ys.push(y);
+            h.push(30.0 - 0.05 * x);
+        }
+    }
+    d.var("x_rho", &[eta, xi], xs)
+        .attr("standard_name", "projection_x_coordinate")
+        .attr("units", "m");
+    d.var("y_rho", &[eta, xi], ys)
+        .attr("standard_name", "projection_y_coordinate")
+        .attr("units", "m");
+    d.var("h", &[eta, xi], h)
+        .attr("units", "m")
+        .attr("coordinates", "x_rho y_rho");
+    d
+}
+
+#[test]
+fn a_curvilinear_bathymetry_samples_the_slope_it_holds() {
+    let s = read("turned-slope.nc", &turned_slope(), &options()).unwrap();
+    let flat = read("slope-again.nc", &projected(), &options()).unwrap();
+    // A plane is reproduced exactly by bilinear cells (to rounding), turned or not.
+    for (x, y) in [(50.0, 50.0), (200.0, 100.0), (333.0, 140.0), (120.0, 75.0)] {
+        let (a, b) = (s.depth_at(x, y), flat.depth_at(x, y));
+        assert!((a - b).abs() < 1e-9, "({x}, {y}): {a} against {b}");
+    }
+    let mut o = options();
+    o.must_cover = rect(0.0, 400.0, -200.0, 150.0);
+    let e = read("turned-short.nc", &turned_slope(), &o).unwrap_err();
+    assert!(
+        e.contains("the bathymetry's curvilinear grid (x_rho and y_rho: x ")
+            && e.contains("does not cover the op-area"),
+        "{e}"
+    );
+}
