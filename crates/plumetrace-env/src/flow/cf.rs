@@ -93,6 +93,16 @@ pub(crate) struct Axes {
     pub(crate) geographic: bool,
     /// A curvilinear grid's 2-D coordinates (then `x` and `y` hold node indices).
     pub(crate) curvi: Option<curvilinear::Curvilinear>,
+    /// Terrain-following levels (then `depth` holds the level coordinate).
+    pub(crate) sigma: Option<sigma::Sigma>,
+}
+
+/// Where in the vertical a field is read: a level and the weight towards the next, or a depth
+/// in terrain-following levels (found column by column).
+#[derive(Debug, Clone, Copy)]
+enum Levels<'a> {
+    Fixed((usize, f64)),
+    Sigma(&'a sigma::Sigma, f64),
 }
 
 /// A located error in the file.
@@ -240,13 +250,17 @@ fn dim_kind(
     Ok(match coord {
         Some(c) => {
             let sn = c.text("standard_name").unwrap_or("");
+            if sigma::is_known(sn) {
+                return Ok(Axis::Depth);
+            }
             if sn.contains("sigma") || sn.contains("s_coordinate") {
                 return Err(err(
                     path,
                     format!(
-                        "dimension {}: variable {} is a terrain-following level \
-                         (standard_name {sn}); sigma and s levels are not read: \
-                         interpolate the file to depth levels first",
+                        "dimension {}: variable {} is a terrain-following level of \
+                         standard_name {sn}, which is not read (ocean_sigma_coordinate, \
+                         ocean_s_coordinate_g1 and ocean_s_coordinate_g2 are): interpolate the \
+                         file to depth levels first",
                         dim.name, c.name
                     ),
                 ));
@@ -284,6 +298,7 @@ pub(crate) fn axes(file: &NcFile, u: &Var, path: &Path) -> Result<Axes, EnvError
         ..Axes::default()
     };
     let mut kinds = Vec::new();
+    let mut sigma_level = None;
     for (pos, &d) in u.dims.iter().enumerate() {
         let dim = &file.dims[d];
         if let Some(c) = &a.curvi
@@ -335,6 +350,10 @@ pub(crate) fn axes(file: &NcFile, u: &Var, path: &Path) -> Result<Axes, EnvError
                     finite(vals)?.iter().map(|&t| tu.to_epoch_s(t)).collect(),
                 ));
             }
+            Axis::Depth if sigma::is_known(c.text("standard_name").unwrap_or("")) => {
+                a.depth = Some((pos, finite(vals)?));
+                sigma_level = Some(c);
+            }
             Axis::Depth => {
                 let up = c
                     .text("positive")
@@ -375,6 +394,14 @@ pub(crate) fn axes(file: &NcFile, u: &Var, path: &Path) -> Result<Axes, EnvError
                     .join(", ")
             ),
         ));
+    }
+    if let (Some(level), Some((px, _)), Some((py, _))) = (sigma_level, &a.x, &a.y) {
+        let roles = sigma::Roles {
+            time: a.time.as_ref().map(|(p, _)| u.dims[*p]),
+            x: u.dims[*px],
+            y: u.dims[*py],
+        };
+        a.sigma = Some(sigma::Sigma::read(file, level, u, &roles, path)?);
     }
     for (name, axis) in [
         ("x", &a.x),
@@ -483,7 +510,14 @@ impl Field {
     }
 
     /// The value at time index `t`, depth `d` (level and weight towards the next), node `(i, j)`.
-    fn at(&self, axes: &Axes, t: usize, d: (usize, f64), i: usize, j: usize) -> f64 {
+    fn at(&self, axes: &Axes, t: usize, d: Levels, i: usize, j: usize) -> f64 {
+        let d = match d {
+            Levels::Fixed(d) => d,
+            Levels::Sigma(s, z) => match s.weight(z, t, i, j) {
+                Some(d) => d,
+                None => return f64::NAN,
+            },
+        };
         let mut base = 0;
         if let Some((p, _)) = axes.time {
             base += t * self.strides[p];
@@ -546,13 +580,25 @@ fn velocity_scale(units: &str) -> Option<f64> {
 }
 
 /// The level at or above `depth_m` and the weight towards the next level.
-fn depth_weight(axes: &Axes, o: &CfOptions, path: &Path) -> Result<(usize, f64), EnvError> {
+fn depth_weight<'a>(axes: &'a Axes, o: &CfOptions, path: &Path) -> Result<Levels<'a>, EnvError> {
     let Some((_, levels)) = &axes.depth else {
-        return Ok((0, 0.0));
+        return Ok(Levels::Fixed((0, 0.0)));
     };
     let n = levels.len();
+    if let Some(s) = &axes.sigma {
+        return match o.depth_m {
+            Some(z) => Ok(Levels::Sigma(s, z)),
+            None => Err(err(
+                path,
+                format!(
+                    "the currents have {n} terrain-following levels: give the depth to sample \
+                     at (flow.netcdf.depth_m, or [domain] depth_m and a source height)"
+                ),
+            )),
+        };
+    }
     if n == 1 {
-        return Ok((0, 0.0));
+        return Ok(Levels::Fixed((0, 0.0)));
     }
     let (shallow, deep) = if levels[0] < levels[n - 1] {
         (0, n - 1)
@@ -579,16 +625,16 @@ fn depth_weight(axes: &Axes, o: &CfOptions, path: &Path) -> Result<(usize, f64),
         ));
     }
     if z <= levels[shallow] {
-        return Ok((shallow, 0.0));
+        return Ok(Levels::Fixed((shallow, 0.0)));
     }
     for k in 0..n - 1 {
         let (a, b) = (levels[k], levels[k + 1]);
         if (a.min(b)..=a.max(b)).contains(&z) {
             let w = (z - a) / (b - a);
-            return Ok(if w >= 1.0 { (k + 1, 0.0) } else { (k, w) });
+            return Ok(Levels::Fixed(if w >= 1.0 { (k + 1, 0.0) } else { (k, w) }));
         }
     }
-    Ok((shallow, 0.0))
+    Ok(Levels::Fixed((shallow, 0.0)))
 }
 
 /// The frames' times relative to the start, and the range of frames kept.
@@ -811,7 +857,7 @@ fn resample(
     v: &Field,
     times: &[f64],
     keep: std::ops::Range<usize>,
-    d: (usize, f64),
+    d: Levels,
     o: &CfOptions,
     path: &Path,
 ) -> Result<GriddedFlow, EnvError> {
@@ -1103,6 +1149,7 @@ pub(crate) fn native_spacing(xs: &[f64], ys: &[f64], frame: Option<&LocalFrame>)
 }
 
 mod curvilinear;
+mod sigma;
 
 #[cfg(test)]
 mod tests;

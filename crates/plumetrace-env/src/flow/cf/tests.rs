@@ -495,3 +495,202 @@ fn a_curvilinear_grid_that_misses_the_op_area_or_folds_or_has_holes_is_located()
         "{e}"
     );
 }
+
+/// A projected 5 x 3 grid 50 m apart over two frames on four terrain-following levels of
+/// `standard_name` (`ocean_sigma_coordinate` or `ocean_s_coordinate_g1`/`g2`), the water `h =
+/// 20 + 0.02 x` m deep (`h0` at node 0 when given) under a surface `eta = 0.5` then `-0.3` m,
+/// with `formula_terms` as given (`None`: all of them). The eastward velocity is 0.01 s-1 times
+/// its level's depth below the surface plus 0.001 s-1 times x, so at 5 m it is `0.05 + 0.001 x`.
+fn terrain_following(standard_name: &str, formula_terms: Option<&str>, h0: Option<f64>) -> Dataset {
+    let mut d = Dataset::default();
+    let t = d.record_dim("time", 2);
+    let k = d.dim("s_rho", 4);
+    let y = d.dim("y", 3);
+    let x = d.dim("x", 5);
+    let one = d.dim("one", 1);
+    let (xs, ys) = ([0.0, 50.0, 100.0, 150.0, 200.0], [0.0, 50.0, 100.0]);
+    let s = [-0.875, -0.625, -0.375, -0.125];
+    let c: Vec<f64> = s.iter().map(|v: &f64| -v * v).collect();
+    let (hc, etas) = (4.0, [0.5, -0.3]);
+    let h = |i: usize| match (i, h0) {
+        (0, Some(h)) => h,
+        _ => 20.0 + 0.02 * xs[i],
+    };
+    d.var("time", &[t], vec![0.0, 100.0])
+        .attr("units", "seconds since 2026-03-01 00:00:00");
+    d.var("x", &[x], xs.to_vec())
+        .attr("standard_name", "projection_x_coordinate")
+        .attr("units", "m");
+    d.var("y", &[y], ys.to_vec())
+        .attr("standard_name", "projection_y_coordinate")
+        .attr("units", "m");
+    let sigma = standard_name == "ocean_sigma_coordinate";
+    let all = if sigma {
+        "sigma: s_rho eta: zeta depth: h"
+    } else {
+        "s: s_rho C: Cs_r eta: zeta depth: h depth_c: hc"
+    };
+    d.var("s_rho", &[k], s.to_vec())
+        .attr("standard_name", standard_name)
+        .attr("positive", "up")
+        .attr("formula_terms", formula_terms.unwrap_or(all));
+    d.var("Cs_r", &[k], c.clone());
+    d.var("hc", &[], vec![hc]).attr("units", "m");
+    let mut hv = Vec::new();
+    let mut zeta = Vec::new();
+    for _ in 0..3 {
+        for i in 0..5 {
+            hv.push(h(i));
+        }
+    }
+    for e in etas {
+        zeta.extend([e; 15]);
+    }
+    // The ROMS layout: h on (y, x), zeta on (time, one, y, x).
+    d.var("h", &[y, x], hv).attr("units", "m");
+    d.var("zeta", &[t, one, y, x], zeta).attr("units", "m");
+    let (mut u, mut v) = (Vec::new(), Vec::new());
+    for eta in etas {
+        for kk in 0..4 {
+            for _ in 0..3 {
+                for (i, xx) in xs.iter().enumerate() {
+                    let h = h(i);
+                    // Depth below the surface, eta - z, from the CF formulas.
+                    let z = match standard_name {
+                        "ocean_sigma_coordinate" => eta + s[kk] * (h + eta),
+                        "ocean_s_coordinate_g1" => {
+                            let big = hc * s[kk] + (h - hc) * c[kk];
+                            big + eta * (1.0 + big / h)
+                        }
+                        _ => {
+                            let big = (hc * s[kk] + h * c[kk]) / (hc + h);
+                            eta + (eta + h) * big
+                        }
+                    };
+                    u.push(0.01 * (eta - z) + 0.001 * xx);
+                    v.push(0.1);
+                }
+            }
+        }
+    }
+    d.var("u", &[t, k, y, x], u)
+        .attr("standard_name", "sea_water_x_velocity")
+        .attr("units", "m s-1");
+    d.var("v", &[t, k, y, x], v)
+        .attr("standard_name", "sea_water_y_velocity")
+        .attr("units", "m s-1");
+    d
+}
+
+#[test]
+fn terrain_following_levels_give_each_column_its_depths() {
+    let mut o = options();
+    o.depth_m = Some(5.0);
+    for sn in [
+        "ocean_sigma_coordinate",
+        "ocean_s_coordinate_g1",
+        "ocean_s_coordinate_g2",
+    ] {
+        let mut f = read(&format!("{sn}.nc"), &terrain_following(sn, None, None), &o).unwrap();
+        let mut rng = stream_rng(1, StreamId::Flow);
+        for t in [0.0, 50.0, 100.0] {
+            f.advance(t, 1.0, &mut rng).unwrap();
+            for (x, y) in [(0.0, 0.0), (35.0, 80.0), (200.0, 100.0), (123.0, 45.0)] {
+                let w = f.velocity(Vec2::new(x, y));
+                let want = 0.05 + 0.001 * x;
+                assert!((w.x - want).abs() < 1e-12, "{sn} t {t} ({x}, {y}): {w:?}");
+                assert!((w.y - 0.1).abs() < 1e-12, "{sn}");
+            }
+        }
+    }
+    // Shallower than the layer inside the op-area's reach: a missing value, located.
+    let e = read(
+        "shallow.nc",
+        &terrain_following("ocean_s_coordinate_g2", None, Some(4.0)),
+        &o,
+    )
+    .unwrap_err();
+    assert!(
+        e.contains("missing value") && e.contains("at (0.0, 0.0) m"),
+        "{e}"
+    );
+    o.depth_m = None;
+    let e = read(
+        "no-depth.nc",
+        &terrain_following("ocean_sigma_coordinate", None, None),
+        &o,
+    )
+    .unwrap_err();
+    assert!(
+        e.contains("4 terrain-following levels") && e.contains("flow.netcdf.depth_m"),
+        "{e}"
+    );
+}
+
+#[test]
+fn a_missing_or_misnamed_formula_term_is_located() {
+    let mut o = options();
+    o.depth_m = Some(5.0);
+    let sn = "ocean_s_coordinate_g2";
+    let e = read(
+        "terms.nc",
+        &terrain_following(sn, Some("s: s_rho C: Cs_r eta: zeta depth: h"), None),
+        &o,
+    )
+    .unwrap_err();
+    assert!(
+        e.contains(
+            "terms.nc: variable s_rho (standard_name ocean_s_coordinate_g2): attribute \
+             formula_terms = \"s: s_rho C: Cs_r eta: zeta depth: h\" lacks the term depth_c; \
+             its levels' depths need s, C, eta, depth, depth_c"
+        ),
+        "{e}"
+    );
+    let e = read(
+        "misnamed.nc",
+        &terrain_following(
+            sn,
+            Some("s: s_rho C: Cs_w eta: zeta depth: h depth_c: hc"),
+            None,
+        ),
+        &o,
+    )
+    .unwrap_err();
+    assert!(
+        e.contains(
+            "formula term C names variable \"Cs_w\", which the file does not have; did \
+             you mean \"Cs_r\"?"
+        ),
+        "{e}"
+    );
+    let e = read(
+        "garbled.nc",
+        &terrain_following(sn, Some("s s_rho"), None),
+        &o,
+    )
+    .unwrap_err();
+    assert!(e.contains("is not a list of `term: variable` pairs"), "{e}");
+    // A term on dimensions of its own (a staggered grid): h at u points is one node short.
+    let mut d = terrain_following(
+        sn,
+        Some("s: s_rho C: Cs_r eta: zeta depth: h_u depth_c: hc"),
+        None,
+    );
+    let xi_u = d.dim("xi_u", 4);
+    d.var("h_u", &[2, xi_u], vec![20.0; 12]).attr("units", "m");
+    let e = read("stagger.nc", &d, &o).unwrap_err();
+    assert!(
+        e.contains(
+            "variable h_u (formula term depth): its dimension xi_u is not one of variable u's \
+             time and horizontal dimensions (a staggered grid?"
+        ),
+        "{e}"
+    );
+    let mut d = terrain_following("ocean_s_coordinate", None, None);
+    d.var("unused", &[], vec![0.0]);
+    let e = read("old-s.nc", &d, &o).unwrap_err();
+    assert!(
+        e.contains("standard_name ocean_s_coordinate, which is not read") && e.contains("g2"),
+        "{e}"
+    );
+}
