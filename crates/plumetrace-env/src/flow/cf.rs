@@ -5,8 +5,9 @@
 //! (`eastward_sea_water_velocity` and `northward_sea_water_velocity`, or `sea_water_x_velocity`
 //! and `sea_water_y_velocity` on a projected grid) or named by the caller. Their dimensions are
 //! recognised by their coordinate variables: longitude and latitude (degrees) or projected `x`
-//! and `y` (metres or kilometres), depth (a level axis, interpolated linearly to the asked
-//! depth), time (CF `units = "<unit> since <date>"`, frames kept from the mission's start to its
+//! and `y` (metres or kilometres), or 2-D longitude and latitude arrays of a curvilinear grid
+//! ([`curvilinear`]), depth (a level axis, interpolated linearly to the asked depth, or
+//! terrain-following levels placed column by column, [`sigma`]), time (CF `units = "<unit> since <date>"`, frames kept from the mission's start to its
 //! end). Values are unpacked (`scale_factor`, `add_offset`), converted to m/s from their
 //! `units` (m s-1, cm s-1, mm s-1, knots), and `_FillValue` / `missing_value` are missing.
 //!
