@@ -14,6 +14,7 @@
 //! zero); elsewhere a node outside the grid takes the nearest edge value, and land or a missing
 //! value takes the shallowest water depth of the grid.
 
+use crate::flow::cell_weight;
 use crate::flow::cf::{axes, bilinear, err, expand, length_scale, place};
 use crate::{EnvError, Rect};
 use plumetrace_core::geo::LocalFrame;
@@ -122,14 +123,9 @@ impl Seabed {
     /// value beyond the grid. Never below 0 nor above the surface.
     #[inline]
     pub fn height_at(&self, x: f64, y: f64) -> f64 {
-        let fx = ((x - self.x0) / self.dx).clamp(0.0, (self.nx - 1) as f64);
-        let fy = ((y - self.y0) / self.dy).clamp(0.0, (self.ny - 1) as f64);
-        // A NaN position lands on node 0 (`as` saturates), so no query panics.
-        let i = (fx as usize).min(self.nx - 2);
-        let j = (fy as usize).min(self.ny - 2);
-        let (tx, ty) = (fx - i as f64, fy - j as f64);
-        let tx = if tx.is_finite() { tx } else { 0.0 };
-        let ty = if ty.is_finite() { ty } else { 0.0 };
+        // The flow grid's cell lookup (a NaN position lands on node 0, so no query panics).
+        let (i, tx) = cell_weight((x - self.x0) / self.dx, self.nx);
+        let (j, ty) = cell_weight((y - self.y0) / self.dy, self.ny);
         let h = |a: usize, b: usize| self.height[b * self.nx + a];
         let south = h(i, j) + tx * (h(i + 1, j) - h(i, j));
         let north = h(i, j + 1) + tx * (h(i + 1, j + 1) - h(i, j + 1));

@@ -215,13 +215,20 @@ fn roms_currents() -> Vec<u8> {
     let s = d.dim("s_rho", ns);
     let eta = d.dim("eta_rho", ne);
     let xi = d.dim("xi_rho", nxi);
-    d.var("ocean_time", &[t], (0..nt).map(|k| 3600.0 * k as f64).collect())
-        .attr("units", "seconds since 2026-06-01 00:00:00");
+    d.var(
+        "ocean_time",
+        &[t],
+        (0..nt).map(|k| 3600.0 * k as f64).collect(),
+    )
+    .attr("units", "seconds since 2026-06-01 00:00:00");
     let sv = [-0.875, -0.625, -0.375, -0.125];
     d.var("s_rho", &[s], sv.to_vec())
         .attr("standard_name", "ocean_s_coordinate_g2")
         .attr("positive", "up")
-        .attr("formula_terms", "s: s_rho C: Cs_r eta: zeta depth: h depth_c: hc");
+        .attr(
+            "formula_terms",
+            "s: s_rho C: Cs_r eta: zeta depth: h depth_c: hc",
+        );
     d.var("Cs_r", &[s], sv.iter().map(|v| -v * v).collect());
     d.var("hc", &[], vec![5.0]).attr("units", "meter");
     let (sn, cs) = 15f64.to_radians().sin_cos();
@@ -257,7 +264,9 @@ fn roms_currents() -> Vec<u8> {
         d.var(
             name,
             &[t, s, eta, xi],
-            (0..n).map(|k| base + 0.01 * ((k / n2) % ns) as f64).collect(),
+            (0..n)
+                .map(|k| base + 0.01 * ((k / n2) % ns) as f64)
+                .collect(),
         )
         .of_type(NcType::Float)
         .attr("standard_name", sn)

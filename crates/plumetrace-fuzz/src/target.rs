@@ -313,7 +313,9 @@ fn seabed(path: &Path) -> Result<String, Stop> {
     let cfg = plumetrace_scenario::parse(&text, &origin).map_err(rejected)?;
     let built = plumetrace_scenario::build(&cfg, &origin, None).map_err(rejected)?;
     let Some(seabed) = built.env.seabed() else {
-        return Err(Stop::Nonfinite("the site's scenario built no seabed".into()));
+        return Err(Stop::Nonfinite(
+            "the site's scenario built no seabed".into(),
+        ));
     };
     let top = seabed.surface_m();
     for k in 0..=20 {

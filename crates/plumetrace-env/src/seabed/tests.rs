@@ -367,3 +367,49 @@ fn a_curvilinear_bathymetry_samples_the_slope_it_holds() {
         "{e}"
     );
 }
+
+#[test]
+fn the_shared_cell_lookup_gives_the_heights_of_the_seabed_s_own_bit_for_bit() {
+    // The lookup the seabed had before it shared the flow grid's.
+    fn own(s: &Seabed, x: f64, y: f64) -> f64 {
+        let fx = ((x - s.x0) / s.dx).clamp(0.0, (s.nx - 1) as f64);
+        let fy = ((y - s.y0) / s.dy).clamp(0.0, (s.ny - 1) as f64);
+        let i = (fx as usize).min(s.nx - 2);
+        let j = (fy as usize).min(s.ny - 2);
+        let (tx, ty) = (fx - i as f64, fy - j as f64);
+        let tx = if tx.is_finite() { tx } else { 0.0 };
+        let ty = if ty.is_finite() { ty } else { 0.0 };
+        let h = |a: usize, b: usize| s.height[b * s.nx + a];
+        let south = h(i, j) + tx * (h(i + 1, j) - h(i, j));
+        let north = h(i, j + 1) + tx * (h(i + 1, j + 1) - h(i, j + 1));
+        south + ty * (north - south)
+    }
+    let mut o = options();
+    o.spacing_m = Some(37.0);
+    let s = read("lookup.nc", &projected(), &o).unwrap();
+    let mut rng = stream_rng(3, StreamId::Flow);
+    use rand::Rng;
+    let mut points: Vec<(f64, f64)> = (0..20_000)
+        .map(|_| {
+            (
+                rng.random_range(-50.0..450.0),
+                rng.random_range(-50.0..250.0),
+            )
+        })
+        .collect();
+    points.extend([
+        (f64::NAN, 10.0),
+        (10.0, f64::NAN),
+        (f64::INFINITY, f64::NEG_INFINITY),
+        (-0.0, 0.0),
+        (400.0, 200.0),
+        (0.0, 0.0),
+    ]);
+    for (x, y) in points {
+        assert_eq!(
+            s.height_at(x, y).to_bits(),
+            own(&s, x, y).to_bits(),
+            "({x}, {y})"
+        );
+    }
+}
