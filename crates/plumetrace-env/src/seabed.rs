@@ -177,7 +177,27 @@ impl Seabed {
             }
         }
         let depths = read_depths(&file, var, is_depth, path)?;
-        sample(&file, var, &a, &depths, o, path)
+        let (px, py) = match (&a.x, &a.y) {
+            (Some((px, _)), Some((py, _))) => (*px, *py),
+            _ => return Err(err(path, "the bathymetry has no horizontal grid")),
+        };
+        let shape = file.shape(var);
+        let mut strides = vec![1; shape.len()];
+        for k in (0..shape.len().saturating_sub(1)).rev() {
+            strides[k] = strides[k + 1] * shape[k + 1];
+        }
+        let at = |i: usize, j: usize| depths[i * strides[px] + j * strides[py]];
+        sample(&format!("variable {}", var.name), &a, &at, o, path)
+    }
+
+    /// Reads a seabed from a bathymetry file: a GeoTIFF (by its first bytes, see [`geotiff`])
+    /// or else a CF NetCDF classic file ([`Seabed::from_netcdf`]).
+    pub fn from_file(path: &Path, o: &SeabedOptions) -> Result<Self, EnvError> {
+        if geotiff::is_tiff(path) {
+            geotiff::read(path, o)
+        } else {
+            Self::from_netcdf(path, o)
+        }
     }
 }
 
@@ -304,18 +324,15 @@ fn read_depths(
 }
 
 /// The depths sampled onto an even grid over the simulated area.
+/// `what` names the depths in a message (`variable h`); `at(i, j)` is the water depth at the
+/// file's node `(i, j)` (positive down, NaN where missing).
 fn sample(
-    file: &NcFile,
-    var: &Var,
+    what: &str,
     a: &crate::flow::cf::Axes,
-    depths: &[f64],
+    at: &dyn Fn(usize, usize) -> f64,
     o: &SeabedOptions,
     path: &Path,
 ) -> Result<Seabed, EnvError> {
-    let (px, py) = match (&a.x, &a.y) {
-        (Some((px, _)), Some((py, _))) => (*px, *py),
-        _ => return Err(err(path, "the bathymetry has no horizontal grid")),
-    };
     let (g, cells) = place(
         a,
         o.frame.as_ref(),
@@ -328,12 +345,6 @@ fn sample(
         path,
     )?;
     let (area, nx, ny, dx, dy) = (o.area, g.nx, g.ny, g.dx, g.dy);
-    let shape = file.shape(var);
-    let mut strides = vec![1; shape.len()];
-    for k in (0..shape.len().saturating_sub(1)).rev() {
-        strides[k] = strides[k + 1] * shape[k + 1];
-    }
-    let at = |i: usize, j: usize| depths[i * strides[px] + j * strides[py]];
     let reach = expand(&o.must_cover, dx.max(dy));
     let n = a.len_xy();
     let mut out = Vec::with_capacity(nx * ny);
@@ -350,18 +361,16 @@ fn sample(
                     path,
                     if d.is_nan() {
                         format!(
-                            "variable {}: a missing value (_FillValue or missing_value) at \
-                             ({x:.1}, {y:.1}) m, where the op-area needs the seabed",
-                            var.name
+                            "{what}: a missing value (_FillValue or missing_value) at \
+                             ({x:.1}, {y:.1}) m, where the op-area needs the seabed"
                         )
                     } else {
                         format!(
-                            "variable {}: the seabed is at or above the surface (depth \
+                            "{what}: the seabed is at or above the surface (depth \
                              {d:.2} m: land) at ({x:.1}, {y:.1}) m, inside the op-area; \
                              check the sign (a depth is positive down, an elevation \
                              negative below sea level: attribute positive = \"up\" or \
-                             \"down\" says which)",
-                            var.name
+                             \"down\" says which)"
                         )
                     },
                 ));
@@ -380,6 +389,8 @@ fn sample(
     }
     Seabed::from_depths(area, nx, ny, &out).map_err(|e| err(path, e.to_string()))
 }
+
+mod geotiff;
 
 #[cfg(test)]
 mod tests;
