@@ -89,8 +89,8 @@ pub fn seabed_scenario() -> String {
 
 /// The bathymetry seeds: the example site's seabed (CDF-1, GEBCO-style elevations on longitude
 /// and latitude), a projected grid of depths (CDF-2, shorts packed with a scale, a fill value on
-/// land far from the op-area) and a curvilinear grid (2-D longitude and latitude turned 15°, as
-/// ROMS writes `h` on `lon_rho` and `lat_rho`), all covering the site's op-area.
+/// land far from the op-area), a curvilinear grid (2-D longitude and latitude turned 15°, as
+/// ROMS writes `h` on `lon_rho` and `lat_rho`) and a GeoTIFF, all covering the site's op-area.
 pub fn seabed_seeds() -> Vec<(&'static str, Vec<u8>)> {
     use plumetrace_netcdf::{Dataset, NcType};
     // The projected grid: x -100..620 m, y -250..250 m, 40 m apart; depths 10 m to 18 m east.
@@ -152,7 +152,43 @@ pub fn seabed_seeds() -> Vec<(&'static str, Vec<u8>)> {
         ),
         ("projected-seabed", p.to_bytes().unwrap_or_default()),
         ("curvilinear-seabed", c.to_bytes().unwrap_or_default()),
+        ("geotiff-seabed", geotiff_seabed()),
     ]
+}
+
+/// The site's seabed as a GeoTIFF (GEBCO-style elevations on WGS 84, 0.0005° pixels from
+/// 4.153 W, 50.3535 N; GeoKeys, tiepoint, pixel scale and GDAL's no-data tag), as the tiff
+/// crate writes it.
+fn geotiff_seabed() -> Vec<u8> {
+    use tiff::encoder::{TiffEncoder, colortype::Gray32Float};
+    use tiff::tags::Tag;
+    let (w, h) = (24u32, 14u32);
+    let data: Vec<f32> = (0..w * h)
+        .map(|k| -10.0 - 0.3 * (k % w) as f32 - if k == 0 { 9989.0 } else { 0.0 })
+        .collect();
+    let mut out = std::io::Cursor::new(Vec::new());
+    let write = |out: &mut std::io::Cursor<Vec<u8>>| -> tiff::TiffResult<()> {
+        let mut enc = TiffEncoder::new(out)?;
+        let mut image = enc.new_image::<Gray32Float>(w, h)?;
+        let e = image.encoder();
+        e.write_tag(Tag::ModelPixelScaleTag, &[0.0005f64, 0.0005, 0.0][..])?;
+        e.write_tag(
+            Tag::ModelTiepointTag,
+            &[0.0f64, 0.0, 0.0, -4.153, 50.3535, 0.0][..],
+        )?;
+        e.write_tag(
+            Tag::GeoKeyDirectoryTag,
+            &[
+                1u16, 1, 0, 3, 1024, 0, 1, 2, 1025, 0, 1, 1, 2048, 0, 1, 4326,
+            ][..],
+        )?;
+        e.write_tag(Tag::Unknown(42113), "-9999")?;
+        image.write_data(&data)
+    };
+    match write(&mut out) {
+        Ok(()) => out.into_inner(),
+        Err(_) => Vec::new(),
+    }
 }
 
 /// The NetCDF seeds: the example site's currents (CDF-1, shorts, fill values, longitude and
