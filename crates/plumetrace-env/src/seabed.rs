@@ -1,4 +1,5 @@
-//! The seabed: its height over the simulated area, from a bathymetry grid in a CF NetCDF file.
+//! The seabed: its height over the simulated area, from a bathymetry grid in a CF NetCDF file
+//! (rectilinear or curvilinear) or a GeoTIFF on longitude and latitude ([`geotiff`]).
 //!
 //! Heights are measured from a datum, the deepest point of the seabed over the simulated area
 //! (so the seabed is at `z >= 0` everywhere and `z = 0` at its deepest), and the surface is at
