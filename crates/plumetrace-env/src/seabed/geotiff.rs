@@ -26,6 +26,8 @@ const MODEL_PROJECTED: u16 = 1;
 const MODEL_GEOGRAPHIC: u16 = 2;
 /// WGS 84.
 const EPSG_WGS84: u16 = 4326;
+/// A GeoKey value saying the frame is described by other keys.
+const USER_DEFINED: u16 = 32767;
 /// GDAL's no-data tag.
 const GDAL_NODATA: u16 = 42113;
 
@@ -68,7 +70,14 @@ pub(crate) fn read(path: &Path, o: &SeabedOptions) -> Result<Seabed, EnvError> {
         ));
     }
     let bytes = std::fs::read(path).map_err(|e| err(path, e.to_string()))?;
-    let bad = |e: tiff::TiffError| err(path, format!("the GeoTIFF could not be read: {e}"));
+    let bad = |e: tiff::TiffError| {
+        let hint = if matches!(e, tiff::TiffError::IoError(_)) {
+            " (the file ends before its data do: cut short?)"
+        } else {
+            ""
+        };
+        err(path, format!("the GeoTIFF could not be read: {e}{hint}"))
+    };
     let mut dec = Decoder::new(Cursor::new(bytes)).map_err(bad)?;
     let (w, h) = dec.dimensions().map_err(bad)?;
     let (w, h) = (w as usize, h as usize);
@@ -112,6 +121,7 @@ pub(crate) fn read(path: &Path, o: &SeabedOptions) -> Result<Seabed, EnvError> {
         || (key(MODEL_TYPE).is_none() && key(PROJECTED_CS_TYPE).is_some());
     if projected {
         let code = key(PROJECTED_CS_TYPE)
+            .filter(|c| *c != USER_DEFINED)
             .map(|c| format!("EPSG:{c}"))
             .unwrap_or_else(|| "a user-defined projection".into());
         return Err(err(
@@ -131,7 +141,7 @@ pub(crate) fn read(path: &Path, o: &SeabedOptions) -> Result<Seabed, EnvError> {
             ),
         ));
     }
-    if let Some(code) = key(GEOGRAPHIC_TYPE).filter(|c| *c != EPSG_WGS84 && *c != 32767) {
+    if let Some(code) = key(GEOGRAPHIC_TYPE).filter(|c| *c != EPSG_WGS84 && *c != USER_DEFINED) {
         return Err(err(
             path,
             format!(
