@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
-# Fuzzes plumetrace's scenario, campaign, family and onboard files with the plumetrace-fuzz harness
-# (crates/plumetrace-fuzz): mutated presets and example campaigns are checked as `plumetrace
-# check` does, accepted scenarios are run briefly, campaigns are resolved and checked, and every
-# input is classified (accepted, rejected_located, or a finding: rejected_unlocated, panic,
+# Fuzzes plumetrace's scenario, campaign, family and onboard files, and the NetCDF currents and
+# bathymetry readers, with the plumetrace-fuzz harness (crates/plumetrace-fuzz): mutated presets
+# and example campaigns are checked as `plumetrace check` does, accepted scenarios are run
+# briefly, campaigns are resolved and checked, mutated currents and bathymetry files are read by
+# the example site's scenario (every 16th input, the two in turn), and every input is classified (accepted, rejected_located, or a finding: rejected_unlocated, panic,
 # nonfinite_output, hang, abort). Inputs run in child processes limited to 2 GB of address space
 # (prlimit) and 30 s each; findings are written to OUT/findings/<class>/<index>.toml with the
 # message in <index>.txt. The last line of output is a JSON report; exit status 1 if anything

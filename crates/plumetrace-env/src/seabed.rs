@@ -1,4 +1,5 @@
-//! The seabed: its height over the simulated area, from a bathymetry grid in a CF NetCDF file.
+//! The seabed: its height over the simulated area, from a bathymetry grid in a CF NetCDF file
+//! (rectilinear or curvilinear) or a GeoTIFF on longitude and latitude ([`geotiff`]).
 //!
 //! Heights are measured from a datum, the deepest point of the seabed over the simulated area
 //! (so the seabed is at `z >= 0` everywhere and `z = 0` at its deepest), and the surface is at
@@ -14,9 +15,8 @@
 //! zero); elsewhere a node outside the grid takes the nearest edge value, and land or a missing
 //! value takes the shallowest water depth of the grid.
 
-use crate::flow::cf::{
-    EvenGrid, axes, check_cover_points, clamp_to, err, expand, length_scale, locate,
-};
+use crate::flow::cell_weight;
+use crate::flow::cf::{axes, bilinear, err, expand, length_scale, place};
 use crate::{EnvError, Rect};
 use plumetrace_core::geo::LocalFrame;
 use plumetrace_netcdf::{NcFile, Var, nearest};
@@ -124,14 +124,9 @@ impl Seabed {
     /// value beyond the grid. Never below 0 nor above the surface.
     #[inline]
     pub fn height_at(&self, x: f64, y: f64) -> f64 {
-        let fx = ((x - self.x0) / self.dx).clamp(0.0, (self.nx - 1) as f64);
-        let fy = ((y - self.y0) / self.dy).clamp(0.0, (self.ny - 1) as f64);
-        // A NaN position lands on node 0 (`as` saturates), so no query panics.
-        let i = (fx as usize).min(self.nx - 2);
-        let j = (fy as usize).min(self.ny - 2);
-        let (tx, ty) = (fx - i as f64, fy - j as f64);
-        let tx = if tx.is_finite() { tx } else { 0.0 };
-        let ty = if ty.is_finite() { ty } else { 0.0 };
+        // The flow grid's cell lookup (a NaN position lands on node 0, so no query panics).
+        let (i, tx) = cell_weight((x - self.x0) / self.dx, self.nx);
+        let (j, ty) = cell_weight((y - self.y0) / self.dy, self.ny);
         let h = |a: usize, b: usize| self.height[b * self.nx + a];
         let south = h(i, j) + tx * (h(i + 1, j) - h(i, j));
         let north = h(i, j + 1) + tx * (h(i + 1, j + 1) - h(i, j + 1));
@@ -183,7 +178,27 @@ impl Seabed {
             }
         }
         let depths = read_depths(&file, var, is_depth, path)?;
-        sample(&file, var, &a, &depths, o, path)
+        let (px, py) = match (&a.x, &a.y) {
+            (Some((px, _)), Some((py, _))) => (*px, *py),
+            _ => return Err(err(path, "the bathymetry has no horizontal grid")),
+        };
+        let shape = file.shape(var);
+        let mut strides = vec![1; shape.len()];
+        for k in (0..shape.len().saturating_sub(1)).rev() {
+            strides[k] = strides[k + 1] * shape[k + 1];
+        }
+        let at = |i: usize, j: usize| depths[i * strides[px] + j * strides[py]];
+        sample(&format!("variable {}", var.name), &a, &at, o, path)
+    }
+
+    /// Reads a seabed from a bathymetry file: a GeoTIFF (by its first bytes, see [`geotiff`])
+    /// or else a CF NetCDF classic file ([`Seabed::from_netcdf`]).
+    pub fn from_file(path: &Path, o: &SeabedOptions) -> Result<Self, EnvError> {
+        if geotiff::is_tiff(path) {
+            geotiff::read(path, o)
+        } else {
+            Self::from_netcdf(path, o)
+        }
     }
 }
 
@@ -310,88 +325,60 @@ fn read_depths(
 }
 
 /// The depths sampled onto an even grid over the simulated area.
+/// `what` names the depths in a message (`variable h`); `at(i, j)` is the water depth at the
+/// file's node `(i, j)` (positive down, NaN where missing).
 fn sample(
-    file: &NcFile,
-    var: &Var,
+    what: &str,
     a: &crate::flow::cf::Axes,
-    depths: &[f64],
+    at: &dyn Fn(usize, usize) -> f64,
     o: &SeabedOptions,
     path: &Path,
 ) -> Result<Seabed, EnvError> {
-    let ((px, xs), (py, ys)) = match (&a.x, &a.y) {
-        (Some((px, xs)), Some((py, ys))) => ((*px, xs.as_slice()), (*py, ys.as_slice())),
-        _ => return Err(err(path, "the bathymetry has no horizontal grid")),
-    };
-    let g = EvenGrid::new(
-        xs,
-        ys,
-        a.geographic,
+    let (g, cells) = place(
+        a,
         o.frame.as_ref(),
         o.spacing_m,
         o.area,
+        o.must_cover,
+        "the bathymetry's",
         "the bathymetry is on a longitude/latitude grid: give the site's origin \
          ([origin] lat_deg and lon_deg) to place it in the local frame",
         path,
     )?;
-    let to_file = |x: f64, y: f64| g.to_file(x, y);
-    let (area, spacing, nx, ny, dx, dy) = (o.area, g.spacing, g.nx, g.ny, g.dx, g.dy);
-    check_cover_points(
-        "the bathymetry's",
-        o.must_cover,
-        xs,
-        ys,
-        g.geographic(),
-        spacing,
-        &to_file,
-        path,
-    )?;
-    let shape = file.shape(var);
-    let mut strides = vec![1; shape.len()];
-    for k in (0..shape.len().saturating_sub(1)).rev() {
-        strides[k] = strides[k + 1] * shape[k + 1];
-    }
-    let at = |i: usize, j: usize| depths[i * strides[px] + j * strides[py]];
+    let (area, nx, ny, dx, dy) = (o.area, g.nx, g.ny, g.dx, g.dy);
     let reach = expand(&o.must_cover, dx.max(dy));
+    let n = a.len_xy();
     let mut out = Vec::with_capacity(nx * ny);
     let mut dry = Vec::new();
-    for j in 0..ny {
-        for i in 0..nx {
-            let (x, y) = (area.x_min_m + i as f64 * dx, area.y_min_m + j as f64 * dy);
-            let (fx, fy) = to_file(x, y);
-            let (ci, tx) = locate(xs, clamp_to(xs, fx)).unwrap_or((0, 0.0));
-            let (cj, ty) = locate(ys, clamp_to(ys, fy)).unwrap_or((0, 0.0));
-            let (i1, j1) = ((ci + 1).min(xs.len() - 1), (cj + 1).min(ys.len() - 1));
-            let g = |a: usize, b: usize, w: f64| if w == 0.0 { 0.0 } else { w * at(a, b) };
-            let d = g(ci, cj, (1.0 - tx) * (1.0 - ty))
-                + g(i1, cj, tx * (1.0 - ty))
-                + g(ci, j1, (1.0 - tx) * ty)
-                + g(i1, j1, tx * ty);
-            if !(d.is_finite() && d > 0.0) {
-                if reach.contains_xy(x, y) {
-                    return Err(err(
-                        path,
-                        if d.is_nan() {
-                            format!(
-                                "variable {}: a missing value (_FillValue or missing_value) at \
-                                 ({x:.1}, {y:.1}) m, where the op-area needs the seabed",
-                                var.name
-                            )
-                        } else {
-                            format!(
-                                "variable {}: the seabed is at or above the surface (depth \
-                                 {d:.2} m: land) at ({x:.1}, {y:.1}) m, inside the op-area; \
-                                 check the sign (a depth is positive down, an elevation \
-                                 negative below sea level: attribute positive = \"up\" or \
-                                 \"down\" says which)",
-                                var.name
-                            )
-                        },
-                    ));
-                }
-                dry.push(out.len());
+    for (k, &cell) in cells.iter().enumerate() {
+        let (x, y) = (
+            area.x_min_m + (k % nx) as f64 * dx,
+            area.y_min_m + (k / nx) as f64 * dy,
+        );
+        let d = bilinear(cell, n, at);
+        if !(d.is_finite() && d > 0.0) {
+            if reach.contains_xy(x, y) {
+                return Err(err(
+                    path,
+                    if d.is_nan() {
+                        format!(
+                            "{what}: a missing value (_FillValue or missing_value) at \
+                             ({x:.1}, {y:.1}) m, where the op-area needs the seabed"
+                        )
+                    } else {
+                        format!(
+                            "{what}: the seabed is at or above the surface (depth \
+                             {d:.2} m: land) at ({x:.1}, {y:.1}) m, inside the op-area; \
+                             check the sign (a depth is positive down, an elevation \
+                             negative below sea level: attribute positive = \"up\" or \
+                             \"down\" says which)"
+                        )
+                    },
+                ));
             }
-            out.push(d);
+            dry.push(out.len());
         }
+        out.push(d);
     }
     let shallowest = out
         .iter()
@@ -403,6 +390,8 @@ fn sample(
     }
     Seabed::from_depths(area, nx, ny, &out).map_err(|e| err(path, e.to_string()))
 }
+
+mod geotiff;
 
 #[cfg(test)]
 mod tests;

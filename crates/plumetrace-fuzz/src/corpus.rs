@@ -17,6 +17,9 @@ pub enum Target {
     /// A CF NetCDF currents file, read by the example site's scenario as `check` does, and its
     /// flow queried.
     Netcdf,
+    /// A CF NetCDF bathymetry file, read by the example site's scenario as `check` does, and its
+    /// seabed queried.
+    Seabed,
 }
 
 impl Target {
@@ -28,6 +31,7 @@ impl Target {
             Target::Family => "fuzz.family.toml",
             Target::Onboard => "fuzz.onboard.toml",
             Target::Netcdf => "fuzz.nc",
+            Target::Seabed => "fuzz-bathymetry.nc",
         }
     }
 
@@ -39,6 +43,7 @@ impl Target {
             Target::Family => "family",
             Target::Onboard => "onboard",
             Target::Netcdf => "netcdf",
+            Target::Seabed => "seabed",
         }
     }
 }
@@ -63,9 +68,133 @@ pub fn netcdf_scenario() -> String {
         )
 }
 
+/// The name the example site's currents are written under beside a bathymetry input.
+pub const SEABED_CURRENTS: &str = "fuzz-currents.nc";
+
+/// The scenario a bathymetry input is read by: the example site with its seabed file replaced,
+/// under its own currents written as [`SEABED_CURRENTS`].
+pub fn seabed_scenario() -> String {
+    include_str!("../../../examples/sites/site.toml")
+        .replacen(
+            "file = \"currents.nc\"",
+            &format!("file = \"{SEABED_CURRENTS}\""),
+            1,
+        )
+        .replacen(
+            "file = \"seabed.nc\"",
+            &format!("file = \"{}\"", Target::Seabed.file_name()),
+            1,
+        )
+}
+
+/// The bathymetry seeds: the example site's seabed (CDF-1, GEBCO-style elevations on longitude
+/// and latitude), a projected grid of depths (CDF-2, shorts packed with a scale, a fill value on
+/// land far from the op-area), a curvilinear grid (2-D longitude and latitude turned 15°, as
+/// ROMS writes `h` on `lon_rho` and `lat_rho`) and a GeoTIFF, all covering the site's op-area.
+pub fn seabed_seeds() -> Vec<(&'static str, Vec<u8>)> {
+    use plumetrace_netcdf::{Dataset, NcType};
+    // The projected grid: x -100..620 m, y -250..250 m, 40 m apart; depths 10 m to 18 m east.
+    let mut p = Dataset::default();
+    let (ny, nx) = (14usize, 19usize);
+    let y = p.dim("y", ny);
+    let x = p.dim("x", nx);
+    let xs: Vec<f64> = (0..nx).map(|k| -100.0 + 40.0 * k as f64).collect();
+    let ys: Vec<f64> = (0..ny).map(|k| -260.0 + 40.0 * k as f64).collect();
+    p.var("y", &[y], ys.clone())
+        .attr("standard_name", "projection_y_coordinate")
+        .attr("units", "m");
+    p.var("x", &[x], xs.clone())
+        .attr("standard_name", "projection_x_coordinate")
+        .attr("units", "m");
+    let mut depth: Vec<f64> = Vec::new();
+    for _ in &ys {
+        for xx in &xs {
+            depth.push(((10.0 + 8.0 * (xx + 100.0) / 720.0) * 100.0).round());
+        }
+    }
+    depth[0] = -1.0;
+    p.var("depth", &[y, x], depth)
+        .of_type(NcType::Short)
+        .attr("standard_name", "sea_floor_depth_below_sea_surface")
+        .attr("units", "m")
+        .attr("scale_factor", 0.01)
+        .attr("_FillValue", -1i16);
+    // The curvilinear grid, about the site's origin (50.35 N, 4.15 W).
+    let mut c = Dataset::default();
+    let (ne, nxi) = (16usize, 24usize);
+    let eta = c.dim("eta_rho", ne);
+    let xi = c.dim("xi_rho", nxi);
+    let (sn, cs) = 15f64.to_radians().sin_cos();
+    let (mut lon, mut lat, mut h) = (Vec::new(), Vec::new(), Vec::new());
+    for j in 0..ne {
+        for i in 0..nxi {
+            let (a, b) = (40.0 * i as f64 - 460.0, 40.0 * j as f64 - 300.0);
+            let (east, north) = (260.0 + cs * a - sn * b, sn * a + cs * b);
+            lon.push(-4.15 + east / 71_090.0);
+            lat.push(50.35 + north / 111_200.0);
+            h.push(10.0 + 0.015 * (east + 100.0));
+        }
+    }
+    c.var("lon_rho", &[eta, xi], lon)
+        .attr("standard_name", "longitude")
+        .attr("units", "degree_east");
+    c.var("lat_rho", &[eta, xi], lat)
+        .attr("standard_name", "latitude")
+        .attr("units", "degree_north");
+    c.var("h", &[eta, xi], h)
+        .of_type(NcType::Float)
+        .attr("units", "meter")
+        .attr("coordinates", "lon_rho lat_rho");
+    vec![
+        (
+            "site-seabed",
+            include_bytes!("../../../examples/sites/seabed.nc").to_vec(),
+        ),
+        ("projected-seabed", p.to_bytes().unwrap_or_default()),
+        ("curvilinear-seabed", c.to_bytes().unwrap_or_default()),
+        ("geotiff-seabed", geotiff_seabed()),
+    ]
+}
+
+/// The site's seabed as a GeoTIFF (GEBCO-style elevations on WGS 84, 0.0005° pixels from
+/// 4.153 W, 50.3535 N; GeoKeys, tiepoint, pixel scale and GDAL's no-data tag), as the tiff
+/// crate writes it.
+fn geotiff_seabed() -> Vec<u8> {
+    use tiff::encoder::{TiffEncoder, colortype::Gray32Float};
+    use tiff::tags::Tag;
+    let (w, h) = (24u32, 14u32);
+    let data: Vec<f32> = (0..w * h)
+        .map(|k| -10.0 - 0.3 * (k % w) as f32 - if k == 0 { 9989.0 } else { 0.0 })
+        .collect();
+    let mut out = std::io::Cursor::new(Vec::new());
+    let write = |out: &mut std::io::Cursor<Vec<u8>>| -> tiff::TiffResult<()> {
+        let mut enc = TiffEncoder::new(out)?;
+        let mut image = enc.new_image::<Gray32Float>(w, h)?;
+        let e = image.encoder();
+        e.write_tag(Tag::ModelPixelScaleTag, &[0.0005f64, 0.0005, 0.0][..])?;
+        e.write_tag(
+            Tag::ModelTiepointTag,
+            &[0.0f64, 0.0, 0.0, -4.153, 50.3535, 0.0][..],
+        )?;
+        e.write_tag(
+            Tag::GeoKeyDirectoryTag,
+            &[
+                1u16, 1, 0, 3, 1024, 0, 1, 2, 1025, 0, 1, 1, 2048, 0, 1, 4326,
+            ][..],
+        )?;
+        e.write_tag(Tag::Unknown(42113), "-9999")?;
+        image.write_data(&data)
+    };
+    match write(&mut out) {
+        Ok(()) => out.into_inner(),
+        Err(_) => Vec::new(),
+    }
+}
+
 /// The NetCDF seeds: the example site's currents (CDF-1, shorts, fill values, longitude and
-/// latitude, depth levels, a record dimension) and the same site on a projected grid (CDF-2,
-/// doubles, no depth), written by the codec.
+/// latitude, depth levels, a record dimension), the same site on a projected grid (CDF-2,
+/// doubles, no depth) and as ROMS writes it (curvilinear, terrain-following levels), the last
+/// two written by the codec.
 pub fn netcdf_seeds() -> Vec<(&'static str, Vec<u8>)> {
     use plumetrace_netcdf::{Dataset, NcType};
     let mut d = Dataset::default();
@@ -107,7 +236,80 @@ pub fn netcdf_seeds() -> Vec<(&'static str, Vec<u8>)> {
             include_bytes!("../../../examples/sites/currents.nc").to_vec(),
         ),
         ("projected", d.to_bytes().unwrap_or_default()),
+        ("roms-currents", roms_currents()),
     ]
+}
+
+/// The site's currents as ROMS writes them: `u_eastward` and `v_northward` on a curvilinear
+/// grid (2-D `lon_rho` and `lat_rho`, turned 15°) and four `ocean_s_coordinate_g2` levels with
+/// `Cs_r`, `zeta`, `h` and `hc`, hourly frames from midnight.
+fn roms_currents() -> Vec<u8> {
+    use plumetrace_netcdf::{Dataset, NcType};
+    let mut d = Dataset::default();
+    let (nt, ns, ne, nxi) = (7usize, 4usize, 12usize, 18usize);
+    let t = d.record_dim("ocean_time", nt);
+    let s = d.dim("s_rho", ns);
+    let eta = d.dim("eta_rho", ne);
+    let xi = d.dim("xi_rho", nxi);
+    d.var(
+        "ocean_time",
+        &[t],
+        (0..nt).map(|k| 3600.0 * k as f64).collect(),
+    )
+    .attr("units", "seconds since 2026-06-01 00:00:00");
+    let sv = [-0.875, -0.625, -0.375, -0.125];
+    d.var("s_rho", &[s], sv.to_vec())
+        .attr("standard_name", "ocean_s_coordinate_g2")
+        .attr("positive", "up")
+        .attr(
+            "formula_terms",
+            "s: s_rho C: Cs_r eta: zeta depth: h depth_c: hc",
+        );
+    d.var("Cs_r", &[s], sv.iter().map(|v| -v * v).collect());
+    d.var("hc", &[], vec![5.0]).attr("units", "meter");
+    let (sn, cs) = 15f64.to_radians().sin_cos();
+    let (mut lon, mut lat, mut h) = (Vec::new(), Vec::new(), Vec::new());
+    for j in 0..ne {
+        for i in 0..nxi {
+            let (a, b) = (55.0 * i as f64 - 470.0, 55.0 * j as f64 - 300.0);
+            let (east, north) = (260.0 + cs * a - sn * b, sn * a + cs * b);
+            lon.push(-4.15 + east / 71_090.0);
+            lat.push(50.35 + north / 111_200.0);
+            h.push(12.0 + 0.012 * (east + 100.0));
+        }
+    }
+    let n2 = ne * nxi;
+    d.var("lon_rho", &[eta, xi], lon)
+        .attr("standard_name", "longitude")
+        .attr("units", "degree_east");
+    d.var("lat_rho", &[eta, xi], lat)
+        .attr("standard_name", "latitude")
+        .attr("units", "degree_north");
+    d.var("h", &[eta, xi], h).attr("units", "meter");
+    let zeta: Vec<f64> = (0..nt * n2)
+        .map(|k| 0.8 * (k / n2) as f64 / nt as f64 - 0.4)
+        .collect();
+    d.var("zeta", &[t, eta, xi], zeta)
+        .of_type(NcType::Float)
+        .attr("units", "meter");
+    let n = nt * ns * n2;
+    for (name, sn, base) in [
+        ("u_eastward", "eastward_sea_water_velocity", 0.2),
+        ("v_northward", "northward_sea_water_velocity", 0.02),
+    ] {
+        d.var(
+            name,
+            &[t, s, eta, xi],
+            (0..n)
+                .map(|k| base + 0.01 * ((k / n2) % ns) as f64)
+                .collect(),
+        )
+        .of_type(NcType::Float)
+        .attr("standard_name", sn)
+        .attr("units", "meter second-1")
+        .attr("coordinates", "lon_rho lat_rho s_rho ocean_time");
+    }
+    d.to_bytes().unwrap_or_default()
 }
 
 /// One seed of the corpus.

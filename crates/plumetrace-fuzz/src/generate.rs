@@ -59,13 +59,23 @@ const CAMPAIGN_SHARE: f64 = 0.5;
 const RAW_SHARE: f64 = 0.2;
 
 /// Every this many indices, the last is a NetCDF input (the others are drawn as before it was
-/// added).
+/// added): currents and bathymetry in turn (index 15 currents, 31 bathymetry, 47 currents, ...).
 pub const NETCDF_EVERY: u64 = 16;
 
-/// A NetCDF input: a seed file with one to three raw mutations or overwritten header words.
-fn netcdf_input(seed: u64, index: u64) -> Input {
-    let mut rng = input_rng(seed ^ 0x6e65_7463_6466, index);
-    let seeds = crate::corpus::netcdf_seeds();
+/// A NetCDF input (currents or bathymetry, `target`): a seed file with one to three raw
+/// mutations or overwritten header words.
+fn netcdf_input(seed: u64, index: u64, target: Target) -> Input {
+    let (mut rng, seeds) = if target == Target::Seabed {
+        (
+            input_rng(seed ^ 0x7365_6162_6564, index),
+            crate::corpus::seabed_seeds(),
+        )
+    } else {
+        (
+            input_rng(seed ^ 0x6e65_7463_6466, index),
+            crate::corpus::netcdf_seeds(),
+        )
+    };
     let (corpus, mut bytes) = seeds[rng.random_range(0..seeds.len())].clone();
     let mut mutations = Vec::new();
     for _ in 0..rng.random_range(1..=3) {
@@ -100,7 +110,7 @@ fn netcdf_input(seed: u64, index: u64) -> Input {
         index,
         seed,
         corpus,
-        target: Target::Netcdf,
+        target,
         mutations,
         bytes,
     }
@@ -109,7 +119,12 @@ fn netcdf_input(seed: u64, index: u64) -> Input {
 /// The input at `index` of the pass seeded with `seed`.
 pub fn generate(seed: u64, index: u64) -> Input {
     if index % NETCDF_EVERY == NETCDF_EVERY - 1 {
-        return netcdf_input(seed, index);
+        let target = if (index / NETCDF_EVERY) % 2 == 1 {
+            Target::Seabed
+        } else {
+            Target::Netcdf
+        };
+        return netcdf_input(seed, index, target);
     }
     let mut rng = input_rng(seed, index);
     let all = seeds();
@@ -260,7 +275,7 @@ mod tests {
             assert!(!input.mutations.is_empty());
             targets.insert(input.target);
             seen.extend(input.mutations.iter().map(|m| m.kind));
-            if seen.len() == Kind::ALL.len() && targets.len() == 5 {
+            if seen.len() == Kind::ALL.len() && targets.len() == 6 {
                 break;
             }
         }
@@ -272,8 +287,8 @@ mod tests {
         assert!(missing.is_empty(), "never produced: {missing:?}");
         assert_eq!(
             targets.len(),
-            5,
-            "scenarios, campaigns, families, onboard files and NetCDF currents"
+            6,
+            "scenarios, campaigns, families, onboard files, NetCDF currents and bathymetry"
         );
     }
 }

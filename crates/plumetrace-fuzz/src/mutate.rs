@@ -829,7 +829,7 @@ fn polygon_target(
             ]
         }
         // A family has no polygon of its own; a NetCDF input is not a table.
-        Target::Family | Target::Netcdf => return None,
+        Target::Family | Target::Netcdf | Target::Seabed => return None,
         Target::Onboard => {
             let m = root.get_mut("mission")?.as_table_mut()?;
             m.insert("op_area".into(), points_value(&square));

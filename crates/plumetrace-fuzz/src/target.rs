@@ -125,7 +125,7 @@ impl Workdir {
             Target::Campaign => self.campaign.join(target.file_name()),
             Target::Family => self.families.join(target.file_name()),
             Target::Onboard => self.scenario.join(target.file_name()),
-            Target::Netcdf => self.scenario.join(target.file_name()),
+            Target::Netcdf | Target::Seabed => self.scenario.join(target.file_name()),
         }
     }
 
@@ -197,6 +197,7 @@ pub fn run(input: &Input, wd: &Workdir, timeout_s: f64) -> anyhow::Result<Outcom
         Target::Family => family(input, &path, deadline),
         Target::Onboard => onboard(input, &path),
         Target::Netcdf => netcdf(&path),
+        Target::Seabed => seabed(&path),
     }));
     let secs = start.elapsed().as_secs_f64();
     let (class, message) = match result {
@@ -292,6 +293,41 @@ fn netcdf(path: &Path) -> Result<String, Stop> {
         }
     }
     Ok("netcdf: currents read and sampled".into())
+}
+
+/// The example site's scenario over the input as its bathymetry (under the site's own
+/// currents): read and sampled as `check` does (its variable, units, sign, land and coverage of
+/// the op-area), then the seabed queried over the domain (every height finite, between the
+/// datum and the surface).
+fn seabed(path: &Path) -> Result<String, Stop> {
+    let scenario = path.with_file_name("fuzz-bathymetry.toml");
+    let text = crate::corpus::seabed_scenario();
+    std::fs::write(&scenario, &text).map_err(rejected)?;
+    // The site's currents, which its scenario reads beside the seabed (not the input).
+    std::fs::write(
+        path.with_file_name(crate::corpus::SEABED_CURRENTS),
+        include_bytes!("../../../examples/sites/currents.nc"),
+    )
+    .map_err(rejected)?;
+    let origin = Origin::File(scenario.clone());
+    let cfg = plumetrace_scenario::parse(&text, &origin).map_err(rejected)?;
+    let built = plumetrace_scenario::build(&cfg, &origin, None).map_err(rejected)?;
+    let Some(seabed) = built.env.seabed() else {
+        return Err(Stop::Nonfinite(
+            "the site's scenario built no seabed".into(),
+        ));
+    };
+    let top = seabed.surface_m();
+    for k in 0..=20 {
+        let (x, y) = (-50.0 + 30.0 * f64::from(k), -160.0 + 16.0 * f64::from(k));
+        let h = seabed.height_at(x, y);
+        if !(h.is_finite() && (0.0..=top).contains(&h) && top.is_finite()) {
+            return Err(Stop::Nonfinite(format!(
+                "seabed height at ({x}, {y}) m: {h} (surface {top})"
+            )));
+        }
+    }
+    Ok("seabed: bathymetry read and sampled".into())
 }
 
 /// Sites drawn and checked per family input.
@@ -603,6 +639,29 @@ mod tests {
         )?;
         assert_eq!(o.class, Class::Accepted, "{}", o.message);
         assert!(o.message.contains("= 80 runs"), "{}", o.message);
+        Ok(())
+    }
+
+    #[test]
+    fn every_netcdf_and_seabed_seed_is_accepted_and_a_cut_one_is_located() -> anyhow::Result<()> {
+        install_panic_hook();
+        let wd = Workdir::new()?;
+        let seeds = [
+            (Target::Netcdf, crate::corpus::netcdf_seeds()),
+            (Target::Seabed, crate::corpus::seabed_seeds()),
+        ];
+        for (target, list) in seeds {
+            for (name, bytes) in list {
+                let mut i = unmutated(target, "");
+                i.bytes = bytes.clone();
+                let o = run(&i, &wd, 60.0)?;
+                assert_eq!(o.class, Class::Accepted, "{name}: {}", o.message);
+                i.bytes.truncate(bytes.len() / 2);
+                let o = run(&i, &wd, 60.0)?;
+                assert_eq!(o.class, Class::RejectedLocated, "{name}: {}", o.message);
+                assert!(o.message.contains(target.file_name()), "{}", o.message);
+            }
+        }
         Ok(())
     }
 

@@ -5,8 +5,9 @@
 //! (`eastward_sea_water_velocity` and `northward_sea_water_velocity`, or `sea_water_x_velocity`
 //! and `sea_water_y_velocity` on a projected grid) or named by the caller. Their dimensions are
 //! recognised by their coordinate variables: longitude and latitude (degrees) or projected `x`
-//! and `y` (metres or kilometres), depth (a level axis, interpolated linearly to the asked
-//! depth), time (CF `units = "<unit> since <date>"`, frames kept from the mission's start to its
+//! and `y` (metres or kilometres), or 2-D longitude and latitude arrays of a curvilinear grid
+//! ([`curvilinear`]), depth (a level axis, interpolated linearly to the asked depth, or
+//! terrain-following levels placed column by column, [`sigma`]), time (CF `units = "<unit> since <date>"`, frames kept from the mission's start to its
 //! end). Values are unpacked (`scale_factor`, `add_offset`), converted to m/s from their
 //! `units` (m s-1, cm s-1, mm s-1, knots), and `_FillValue` / `missing_value` are missing.
 //!
@@ -91,6 +92,18 @@ pub(crate) struct Axes {
     pub(crate) x: Option<(usize, Vec<f64>)>,
     pub(crate) y: Option<(usize, Vec<f64>)>,
     pub(crate) geographic: bool,
+    /// A curvilinear grid's 2-D coordinates (then `x` and `y` hold node indices).
+    pub(crate) curvi: Option<curvilinear::Curvilinear>,
+    /// Terrain-following levels (then `depth` holds the level coordinate).
+    pub(crate) sigma: Option<sigma::Sigma>,
+}
+
+/// Where in the vertical a field is read: a level and the weight towards the next, or a depth
+/// in terrain-following levels (found column by column).
+#[derive(Debug, Clone, Copy)]
+enum Levels<'a> {
+    Fixed((usize, f64)),
+    Sigma(&'a sigma::Sigma, f64),
 }
 
 /// A located error in the file.
@@ -238,13 +251,17 @@ fn dim_kind(
     Ok(match coord {
         Some(c) => {
             let sn = c.text("standard_name").unwrap_or("");
+            if sigma::is_known(sn) {
+                return Ok(Axis::Depth);
+            }
             if sn.contains("sigma") || sn.contains("s_coordinate") {
                 return Err(err(
                     path,
                     format!(
-                        "dimension {}: variable {} is a terrain-following level \
-                         (standard_name {sn}); sigma and s levels are not read: \
-                         interpolate the file to depth levels first",
+                        "dimension {}: variable {} is a terrain-following level of \
+                         standard_name {sn}, which is not read (ocean_sigma_coordinate, \
+                         ocean_s_coordinate_g1 and ocean_s_coordinate_g2 are): interpolate the \
+                         file to depth levels first",
                         dim.name, c.name
                     ),
                 ));
@@ -263,30 +280,13 @@ fn dim_kind(
         }
         None if dim.len == 1 => Axis::Single,
         None => {
-            let curvilinear = u
-                .text("coordinates")
-                .map(|s| {
-                    s.split_whitespace()
-                        .any(|n| file.var(n).is_some_and(|c| c.dims.len() == 2))
-                })
-                .unwrap_or(false);
             return Err(err(
                 path,
-                if curvilinear {
-                    format!(
-                        "variable {}: its grid is curvilinear (2-D longitude and latitude \
-                         in attribute coordinates = {:?}), which is not read; regrid it to \
-                         a rectilinear grid first (e.g. `cdo remapbil`)",
-                        u.name,
-                        u.text("coordinates").unwrap_or("")
-                    )
-                } else {
-                    format!(
-                        "dimension {} of variable {} has no coordinate variable (a 1-D \
-                         variable of the same name)",
-                        dim.name, u.name
-                    )
-                },
+                format!(
+                    "dimension {} of variable {} has no coordinate variable (a 1-D variable of \
+                     the same name), and no 2-D longitude and latitude span it",
+                    dim.name, u.name
+                ),
             ));
         }
     })
@@ -294,10 +294,30 @@ fn dim_kind(
 
 /// The velocity's axes, from the coordinate variables of its dimensions.
 pub(crate) fn axes(file: &NcFile, u: &Var, path: &Path) -> Result<Axes, EnvError> {
-    let mut a = Axes::default();
+    let mut a = Axes {
+        curvi: curvilinear::find(file, u, path)?,
+        ..Axes::default()
+    };
     let mut kinds = Vec::new();
+    let mut sigma_level = None;
     for (pos, &d) in u.dims.iter().enumerate() {
         let dim = &file.dims[d];
+        if let Some(c) = &a.curvi
+            && c.dims.contains(&d)
+        {
+            // Node indices stand for the coordinates; the grid holds the rest.
+            let (is_x, geo) = (d == c.dims[1], c.geographic);
+            kinds.push(match (is_x, geo) {
+                (true, true) => Axis::Lon,
+                (false, true) => Axis::Lat,
+                (true, false) => Axis::X,
+                (false, false) => Axis::Y,
+            });
+            a.geographic = geo;
+            let idx = (0..dim.len).map(|k| k as f64).collect();
+            *(if is_x { &mut a.x } else { &mut a.y }) = Some((pos, idx));
+            continue;
+        }
         let coord = file
             .var(&dim.name)
             .filter(|c| c.dims.len() == 1 && c.dims[0] == d);
@@ -330,6 +350,10 @@ pub(crate) fn axes(file: &NcFile, u: &Var, path: &Path) -> Result<Axes, EnvError
                     pos,
                     finite(vals)?.iter().map(|&t| tu.to_epoch_s(t)).collect(),
                 ));
+            }
+            Axis::Depth if sigma::is_known(c.text("standard_name").unwrap_or("")) => {
+                a.depth = Some((pos, finite(vals)?));
+                sigma_level = Some(c);
             }
             Axis::Depth => {
                 let up = c
@@ -371,6 +395,14 @@ pub(crate) fn axes(file: &NcFile, u: &Var, path: &Path) -> Result<Axes, EnvError
                     .join(", ")
             ),
         ));
+    }
+    if let (Some(level), Some((px, _)), Some((py, _))) = (sigma_level, &a.x, &a.y) {
+        let roles = sigma::Roles {
+            time: a.time.as_ref().map(|(p, _)| u.dims[*p]),
+            x: u.dims[*px],
+            y: u.dims[*py],
+        };
+        a.sigma = Some(sigma::Sigma::read(file, level, u, &roles, path)?);
     }
     for (name, axis) in [
         ("x", &a.x),
@@ -479,7 +511,14 @@ impl Field {
     }
 
     /// The value at time index `t`, depth `d` (level and weight towards the next), node `(i, j)`.
-    fn at(&self, axes: &Axes, t: usize, d: (usize, f64), i: usize, j: usize) -> f64 {
+    fn at(&self, axes: &Axes, t: usize, d: Levels, i: usize, j: usize) -> f64 {
+        let d = match d {
+            Levels::Fixed(d) => d,
+            Levels::Sigma(s, z) => match s.weight(z, t, i, j) {
+                Some(d) => d,
+                None => return f64::NAN,
+            },
+        };
         let mut base = 0;
         if let Some((p, _)) = axes.time {
             base += t * self.strides[p];
@@ -542,13 +581,25 @@ fn velocity_scale(units: &str) -> Option<f64> {
 }
 
 /// The level at or above `depth_m` and the weight towards the next level.
-fn depth_weight(axes: &Axes, o: &CfOptions, path: &Path) -> Result<(usize, f64), EnvError> {
+fn depth_weight<'a>(axes: &'a Axes, o: &CfOptions, path: &Path) -> Result<Levels<'a>, EnvError> {
     let Some((_, levels)) = &axes.depth else {
-        return Ok((0, 0.0));
+        return Ok(Levels::Fixed((0, 0.0)));
     };
     let n = levels.len();
+    if let Some(s) = &axes.sigma {
+        return match o.depth_m {
+            Some(z) => Ok(Levels::Sigma(s, z)),
+            None => Err(err(
+                path,
+                format!(
+                    "the currents have {n} terrain-following levels: give the depth to sample \
+                     at (flow.netcdf.depth_m, or [domain] depth_m and a source height)"
+                ),
+            )),
+        };
+    }
     if n == 1 {
-        return Ok((0, 0.0));
+        return Ok(Levels::Fixed((0, 0.0)));
     }
     let (shallow, deep) = if levels[0] < levels[n - 1] {
         (0, n - 1)
@@ -575,16 +626,16 @@ fn depth_weight(axes: &Axes, o: &CfOptions, path: &Path) -> Result<(usize, f64),
         ));
     }
     if z <= levels[shallow] {
-        return Ok((shallow, 0.0));
+        return Ok(Levels::Fixed((shallow, 0.0)));
     }
     for k in 0..n - 1 {
         let (a, b) = (levels[k], levels[k + 1]);
         if (a.min(b)..=a.max(b)).contains(&z) {
             let w = (z - a) / (b - a);
-            return Ok(if w >= 1.0 { (k + 1, 0.0) } else { (k, w) });
+            return Ok(Levels::Fixed(if w >= 1.0 { (k + 1, 0.0) } else { (k, w) }));
         }
     }
-    Ok((shallow, 0.0))
+    Ok(Levels::Fixed((shallow, 0.0)))
 }
 
 /// The frames' times relative to the start, and the range of frames kept.
@@ -649,7 +700,7 @@ fn sample(
         (Some((_, xs)), Some((_, ys))) => (xs, ys),
         _ => return Err(err(path, "the currents have no horizontal grid")),
     };
-    let node_for_node = !axes.geographic && o.spacing_m.is_none();
+    let node_for_node = !axes.geographic && o.spacing_m.is_none() && axes.curvi.is_none();
     if let (true, Some((x0, dx)), Some((y0, dy))) = (node_for_node, even(xs), even(ys)) {
         let (nx, ny) = (xs.len(), ys.len());
         check_cover(
@@ -807,70 +858,44 @@ fn resample(
     v: &Field,
     times: &[f64],
     keep: std::ops::Range<usize>,
-    d: (usize, f64),
+    d: Levels,
     o: &CfOptions,
     path: &Path,
 ) -> Result<GriddedFlow, EnvError> {
-    let (xs, ys) = match (&axes.x, &axes.y) {
-        (Some((_, xs)), Some((_, ys))) => (xs.as_slice(), ys.as_slice()),
-        _ => return Err(err(path, "the currents have no horizontal grid")),
-    };
-    let g = EvenGrid::new(
-        xs,
-        ys,
-        axes.geographic,
+    let (g, cells) = place(
+        axes,
         o.frame.as_ref(),
         o.spacing_m,
         o.area,
+        o.must_cover,
+        "the currents'",
         "the currents are on a longitude/latitude grid: give the site's origin \
          ([origin] lat_deg and lon_deg) to place them in the local frame",
         path,
     )?;
-    let to_file = |x: f64, y: f64| g.to_file(x, y);
-    let (area, spacing, nx, ny, dx, dy) = (o.area, g.spacing, g.nx, g.ny, g.dx, g.dy);
+    let (area, nx, ny, dx, dy) = (o.area, g.nx, g.ny, g.dx, g.dy);
     let reach = expand(&o.must_cover, dx.max(dy));
-    check_cover_points(
-        "the currents'",
-        o.must_cover,
-        xs,
-        ys,
-        g.geographic(),
-        spacing,
-        &to_file,
-        path,
-    )?;
-    // Each node's cell in the file, found once for every frame (outside the op-area a node
-    // beyond the grid takes its nearest edge).
-    let mut cells = Vec::with_capacity(nx * ny);
-    for j in 0..ny {
-        for i in 0..nx {
-            let (x, y) = (area.x_min_m + i as f64 * dx, area.y_min_m + j as f64 * dy);
-            let (fx, fy) = to_file(x, y);
-            let a = locate(xs, clamp_to(xs, fx)).unwrap_or((0, 0.0));
-            let b = locate(ys, clamp_to(ys, fy)).unwrap_or((0, 0.0));
-            let cell = (a, b);
-            cells.push((cell, reach.contains_xy(x, y), x, y));
-        }
-    }
+    let n = axes.len_xy();
     let mut frames = Vec::new();
     for t in keep {
         let (mut fu, mut fv) = (vec![0.0; nx * ny], vec![0.0; nx * ny]);
-        for (k, &(((i, tx), (j, ty)), in_reach, x, y)) in cells.iter().enumerate() {
-            let bil = |f: &Field| {
-                let (i1, j1) = ((i + 1).min(xs.len() - 1), (j + 1).min(ys.len() - 1));
-                let g = |a: usize, b: usize, w: f64| {
-                    if w == 0.0 {
-                        0.0
-                    } else {
-                        w * f.at(axes, t, d, a, b)
-                    }
-                };
-                g(i, j, (1.0 - tx) * (1.0 - ty))
-                    + g(i1, j, tx * (1.0 - ty))
-                    + g(i, j1, (1.0 - tx) * ty)
-                    + g(i1, j1, tx * ty)
-            };
-            fill_or_fail(&mut fu[k], &mut fv[k], bil(u), bil(v), in_reach, x, y, path)?;
+        for (k, &cell) in cells.iter().enumerate() {
+            let (x, y) = (
+                area.x_min_m + (k % nx) as f64 * dx,
+                area.y_min_m + (k / nx) as f64 * dy,
+            );
+            let a = bilinear(cell, n, |i, j| u.at(axes, t, d, i, j));
+            let b = bilinear(cell, n, |i, j| v.at(axes, t, d, i, j));
+            fill_or_fail(
+                &mut fu[k],
+                &mut fv[k],
+                a,
+                b,
+                reach.contains_xy(x, y),
+                x,
+                y,
+                path,
+            )?;
         }
         frames.push(Frame {
             t_s: times[t],
@@ -889,11 +914,99 @@ fn resample(
     ))
 }
 
+/// A node's place in the file's grid: `((i, weight towards i + 1), (j, weight towards j + 1))`.
+pub(crate) type Cell = ((usize, f64), (usize, f64));
+
+/// The value at `cell` of a field on an `n = (nx, ny)` grid read by `at(i, j)`: bilinear, a
+/// node of zero weight not read (so a missing value there does not spread).
+pub(crate) fn bilinear(
+    ((i, tx), (j, ty)): Cell,
+    n: (usize, usize),
+    at: impl Fn(usize, usize) -> f64,
+) -> f64 {
+    let (i1, j1) = ((i + 1).min(n.0 - 1), (j + 1).min(n.1 - 1));
+    let g = |a: usize, b: usize, w: f64| if w == 0.0 { 0.0 } else { w * at(a, b) };
+    g(i, j, (1.0 - tx) * (1.0 - ty))
+        + g(i1, j, tx * (1.0 - ty))
+        + g(i, j1, (1.0 - tx) * ty)
+        + g(i1, j1, tx * ty)
+}
+
+impl Axes {
+    /// Nodes along the horizontal axes, `(x, y)`.
+    pub(crate) fn len_xy(&self) -> (usize, usize) {
+        let n = |a: &Option<(usize, Vec<f64>)>| a.as_ref().map_or(1, |(_, v)| v.len());
+        (n(&self.x), n(&self.y))
+    }
+}
+
+/// The even grid over `area` and each of its nodes' cell in the file (row by row from the
+/// south), once the op-area `must_cover` is found inside the file's grid. `what` names the
+/// grid's owner in a message (`the currents'`); `on_lon_lat` is the message for a
+/// longitude/latitude grid without an origin. Outside the grid a node takes its nearest edge.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn place<'a>(
+    axes: &Axes,
+    frame: Option<&'a LocalFrame>,
+    spacing_m: Option<f64>,
+    area: Rect,
+    must_cover: Rect,
+    what: &str,
+    on_lon_lat: &str,
+    path: &Path,
+) -> Result<(EvenGrid<'a>, Vec<Cell>), EnvError> {
+    let (xs, ys) = match (&axes.x, &axes.y) {
+        (Some((_, xs)), Some((_, ys))) => (xs.as_slice(), ys.as_slice()),
+        _ => return Err(err(path, format!("{what} file has no horizontal grid"))),
+    };
+    if let Some(c) = &axes.curvi {
+        return curvilinear::place(
+            c, frame, spacing_m, area, must_cover, what, on_lon_lat, path,
+        );
+    }
+    let g = EvenGrid::new(
+        xs,
+        ys,
+        axes.geographic,
+        frame,
+        spacing_m,
+        area,
+        on_lon_lat,
+        path,
+    )?;
+    let to_file = |x: f64, y: f64| g.to_file(x, y);
+    check_cover_points(
+        what,
+        must_cover,
+        xs,
+        ys,
+        g.geographic(),
+        g.spacing,
+        &to_file,
+        path,
+    )?;
+    let mut cells = Vec::with_capacity(g.nx * g.ny);
+    for j in 0..g.ny {
+        for i in 0..g.nx {
+            let (x, y) = (
+                area.x_min_m + i as f64 * g.dx,
+                area.y_min_m + j as f64 * g.dy,
+            );
+            let (fx, fy) = to_file(x, y);
+            let a = locate(xs, clamp_to(xs, fx)).unwrap_or((0, 0.0));
+            let b = locate(ys, clamp_to(ys, fy)).unwrap_or((0, 0.0));
+            cells.push((a, b));
+        }
+    }
+    Ok((g, cells))
+}
+
 /// An even grid in the local frame over `area` for a file's horizontal axes `xs`, `ys`: the
 /// frame that places a longitude/latitude grid (none for a projected one), the spacing (the
 /// file's own unless one is given, at most [`MAX_NODES_PER_SIDE`] nodes a side) and the nodes.
 pub(crate) struct EvenGrid<'a> {
-    xs: &'a [f64],
+    /// The file's longitude range (for wrapping), lowest first.
+    lon_range: (f64, f64),
     frame: Option<&'a LocalFrame>,
     /// The spacing asked for or the file's, widened to at most the nodes a side allows.
     pub(crate) spacing: f64,
@@ -907,8 +1020,8 @@ impl<'a> EvenGrid<'a> {
     /// The grid; `on_lon_lat` is the message for a longitude/latitude grid without an origin.
     #[allow(clippy::too_many_arguments)]
     pub(crate) fn new(
-        xs: &'a [f64],
-        ys: &'a [f64],
+        xs: &[f64],
+        ys: &[f64],
         geographic: bool,
         frame: Option<&'a LocalFrame>,
         spacing_m: Option<f64>,
@@ -928,7 +1041,7 @@ impl<'a> EvenGrid<'a> {
         let nx = ((area.width_m() / spacing).ceil() as usize + 1).max(2);
         let ny = ((area.height_m() / spacing).ceil() as usize + 1).max(2);
         Ok(EvenGrid {
-            xs,
+            lon_range: (xs[0].min(xs[xs.len() - 1]), xs[0].max(xs[xs.len() - 1])),
             frame,
             spacing,
             nx,
@@ -948,9 +1061,8 @@ impl<'a> EvenGrid<'a> {
         match self.frame {
             None => (x, y),
             Some(f) => {
-                let xs = self.xs;
                 let (lat, mut lon) = f.to_geographic(Vec2::new(x, y));
-                let (lo, hi) = (xs[0].min(xs[xs.len() - 1]), xs[0].max(xs[xs.len() - 1]));
+                let (lo, hi) = self.lon_range;
                 if lon < lo && lon + 360.0 <= hi {
                     lon += 360.0;
                 } else if lon > hi && lon - 360.0 >= lo {
@@ -975,19 +1087,7 @@ pub(crate) fn check_cover_points(
     to_file: &dyn Fn(f64, f64) -> (f64, f64),
     path: &Path,
 ) -> Result<(), EnvError> {
-    let steps = |len: f64| ((len / spacing).ceil() as usize).clamp(1, MAX_NODES_PER_SIDE);
-    let (nx, ny) = (steps(r.width_m()), steps(r.height_m()));
-    let mut edge = Vec::new();
-    for k in 0..=nx {
-        let x = r.x_min_m + r.width_m() * k as f64 / nx as f64;
-        edge.push((x, r.y_min_m));
-        edge.push((x, r.y_max_m));
-    }
-    for k in 0..=ny {
-        let y = r.y_min_m + r.height_m() * k as f64 / ny as f64;
-        edge.push((r.x_min_m, y));
-        edge.push((r.x_max_m, y));
-    }
+    let edge = edge_points(r, spacing);
     let (nx_name, ny_name) = if geographic {
         ("lon", "lat")
     } else {
@@ -1011,6 +1111,24 @@ pub(crate) fn check_cover_points(
     Ok(())
 }
 
+/// Points along the edge of `r`, every `spacing` or closer, and its corners.
+pub(crate) fn edge_points(r: Rect, spacing: f64) -> Vec<(f64, f64)> {
+    let steps = |len: f64| ((len / spacing).ceil() as usize).clamp(1, MAX_NODES_PER_SIDE);
+    let (nx, ny) = (steps(r.width_m()), steps(r.height_m()));
+    let mut edge = Vec::new();
+    for k in 0..=nx {
+        let x = r.x_min_m + r.width_m() * k as f64 / nx as f64;
+        edge.push((x, r.y_min_m));
+        edge.push((x, r.y_max_m));
+    }
+    for k in 0..=ny {
+        let y = r.y_min_m + r.height_m() * k as f64 / ny as f64;
+        edge.push((r.x_min_m, y));
+        edge.push((r.x_max_m, y));
+    }
+    edge
+}
+
 /// The file's smallest node spacing in metres (near the origin for a geographic grid).
 pub(crate) fn native_spacing(xs: &[f64], ys: &[f64], frame: Option<&LocalFrame>) -> f64 {
     let step = |a: &[f64]| {
@@ -1030,6 +1148,9 @@ pub(crate) fn native_spacing(xs: &[f64], ys: &[f64], frame: Option<&LocalFrame>)
     };
     if s.is_finite() && s > 0.0 { s } else { 1.0 }
 }
+
+mod curvilinear;
+mod sigma;
 
 #[cfg(test)]
 mod tests;

@@ -134,10 +134,16 @@ impl FlowField for FlowModel {
 /// libm call is needed in the filament hot path.
 #[inline(always)]
 pub(crate) fn axis_weight(pos: f64, origin: f64, inv_step: f64, n: usize) -> (usize, f64) {
+    cell_weight((pos - origin) * inv_step, n)
+}
+
+/// [`axis_weight`] of a position already in node units, `f = (pos - origin) / step` (the seabed
+/// divides where the flow multiplies by the inverse step; each keeps its own arithmetic).
+#[inline(always)]
+pub(crate) fn cell_weight(f: f64, n: usize) -> (usize, f64) {
     if n < 2 {
         return (0, 0.0);
     }
-    let f = (pos - origin) * inv_step;
     // `f > 0.0` is false for NaN, which therefore maps to 0.
     let f = if f > 0.0 { f } else { 0.0 };
     let last = (n - 1) as f64;

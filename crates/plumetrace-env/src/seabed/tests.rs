@@ -319,3 +319,251 @@ fn from_depths_refuses_what_is_not_water() {
     assert!(Seabed::from_depths(area, 1, 2, &[1.0, 2.0]).is_err());
     assert!(Seabed::from_depths(area, 2, 2, &[1.0]).is_err());
 }
+
+/// The 5 % slope of [`projected`] on a curvilinear grid: projected 2-D x and y turned 20° about
+/// (200, 100) m, 9 x 9 nodes 60 m apart (ROMS's `h` on `x_rho` and `y_rho`).
+fn turned_slope() -> Dataset {
+    let mut d = Dataset::default();
+    let eta = d.dim("eta_rho", 9);
+    let xi = d.dim("xi_rho", 9);
+    let (s, c) = 20f64.to_radians().sin_cos();
+    let (mut xs, mut ys, mut h) = (vec![], vec![], vec![]);
+    for j in 0..9 {
+        for i in 0..9 {
+            let (a, b) = (60.0 * i as f64 - 240.0, 60.0 * j as f64 - 240.0);
+            let (x, y) = (200.0 + c * a - s * b, 100.0 + s * a + c * b);
+            xs.push(x);
+            ys.push(y);
+            h.push(30.0 - 0.05 * x);
+        }
+    }
+    d.var("x_rho", &[eta, xi], xs)
+        .attr("standard_name", "projection_x_coordinate")
+        .attr("units", "m");
+    d.var("y_rho", &[eta, xi], ys)
+        .attr("standard_name", "projection_y_coordinate")
+        .attr("units", "m");
+    d.var("h", &[eta, xi], h)
+        .attr("units", "m")
+        .attr("coordinates", "x_rho y_rho");
+    d
+}
+
+#[test]
+fn a_curvilinear_bathymetry_samples_the_slope_it_holds() {
+    let s = read("turned-slope.nc", &turned_slope(), &options()).unwrap();
+    let flat = read("slope-again.nc", &projected(), &options()).unwrap();
+    // A plane is reproduced exactly by bilinear cells (to rounding), turned or not.
+    for (x, y) in [(50.0, 50.0), (200.0, 100.0), (333.0, 140.0), (120.0, 75.0)] {
+        let (a, b) = (s.depth_at(x, y), flat.depth_at(x, y));
+        assert!((a - b).abs() < 1e-9, "({x}, {y}): {a} against {b}");
+    }
+    let mut o = options();
+    o.must_cover = rect(0.0, 400.0, -200.0, 150.0);
+    let e = read("turned-short.nc", &turned_slope(), &o).unwrap_err();
+    assert!(
+        e.contains("the bathymetry's curvilinear grid (x_rho and y_rho: x ")
+            && e.contains("does not cover the op-area"),
+        "{e}"
+    );
+}
+
+#[test]
+fn the_shared_cell_lookup_gives_the_heights_of_the_seabed_s_own_bit_for_bit() {
+    // The lookup the seabed had before it shared the flow grid's.
+    fn own(s: &Seabed, x: f64, y: f64) -> f64 {
+        let fx = ((x - s.x0) / s.dx).clamp(0.0, (s.nx - 1) as f64);
+        let fy = ((y - s.y0) / s.dy).clamp(0.0, (s.ny - 1) as f64);
+        let i = (fx as usize).min(s.nx - 2);
+        let j = (fy as usize).min(s.ny - 2);
+        let (tx, ty) = (fx - i as f64, fy - j as f64);
+        let tx = if tx.is_finite() { tx } else { 0.0 };
+        let ty = if ty.is_finite() { ty } else { 0.0 };
+        let h = |a: usize, b: usize| s.height[b * s.nx + a];
+        let south = h(i, j) + tx * (h(i + 1, j) - h(i, j));
+        let north = h(i, j + 1) + tx * (h(i + 1, j + 1) - h(i, j + 1));
+        south + ty * (north - south)
+    }
+    let mut o = options();
+    o.spacing_m = Some(37.0);
+    let s = read("lookup.nc", &projected(), &o).unwrap();
+    let mut rng = stream_rng(3, StreamId::Flow);
+    use rand::Rng;
+    let mut points: Vec<(f64, f64)> = (0..20_000)
+        .map(|_| {
+            (
+                rng.random_range(-50.0..450.0),
+                rng.random_range(-50.0..250.0),
+            )
+        })
+        .collect();
+    points.extend([
+        (f64::NAN, 10.0),
+        (10.0, f64::NAN),
+        (f64::INFINITY, f64::NEG_INFINITY),
+        (-0.0, 0.0),
+        (400.0, 200.0),
+        (0.0, 0.0),
+    ]);
+    for (x, y) in points {
+        assert_eq!(
+            s.height_at(x, y).to_bits(),
+            own(&s, x, y).to_bits(),
+            "({x}, {y})"
+        );
+    }
+}
+
+/// A GeoTIFF of `w` x `h` float pixels 0.005° a side from (4.03 W, 50.02 N), tagged with the
+/// GeoKeys `keys` (id, value), holding `value(lon, lat)` at each pixel's centre, with GDAL's
+/// no-data tag `-9999`: written with the TIFF crate's encoder, GeoTIFF tags by number.
+fn geotiff(w: usize, h: usize, keys: &[(u16, u16)], value: impl Fn(f64, f64) -> f64) -> Vec<u8> {
+    use tiff::encoder::{TiffEncoder, colortype::Gray32Float};
+    use tiff::tags::Tag;
+    let mut data = Vec::new();
+    for j in 0..h {
+        for i in 0..w {
+            let (lon, lat) = geotiff_node(i, j);
+            data.push(value(lon, lat) as f32);
+        }
+    }
+    let mut dir: Vec<u16> = vec![1, 1, 0, keys.len() as u16];
+    for (k, v) in keys {
+        dir.extend([*k, 0, 1, *v]);
+    }
+    let mut out = Cursor::new(Vec::new());
+    let mut enc = TiffEncoder::new(&mut out).unwrap();
+    let mut image = enc.new_image::<Gray32Float>(w as u32, h as u32).unwrap();
+    let e = image.encoder();
+    e.write_tag(Tag::ModelPixelScaleTag, &[0.005f64, 0.005, 0.0][..])
+        .unwrap();
+    e.write_tag(
+        Tag::ModelTiepointTag,
+        &[0.0f64, 0.0, 0.0, -4.03, 50.02, 0.0][..],
+    )
+    .unwrap();
+    e.write_tag(Tag::GeoKeyDirectoryTag, &dir[..]).unwrap();
+    e.write_tag(Tag::Unknown(42113), "-9999").unwrap();
+    image.write_data(&data).unwrap();
+    out.into_inner()
+}
+
+use std::io::Cursor;
+
+/// The centre of pixel `(i, j)`, as a GeoTIFF reader computes it.
+fn geotiff_node(i: usize, j: usize) -> (f64, f64) {
+    (
+        -4.03 + (i as f64 + 0.5) * 0.005,
+        50.02 - (j as f64 + 0.5) * 0.005,
+    )
+}
+
+const WGS84: &[(u16, u16)] = &[(1024, 2), (1025, 1), (2048, 4326)];
+
+fn geo_options() -> SeabedOptions {
+    SeabedOptions {
+        frame: Some(
+            LocalFrame::new(Origin {
+                lat_deg: 50.0,
+                lon_deg: -4.0,
+            })
+            .unwrap(),
+        ),
+        area: rect(-1000.0, 1000.0, -1000.0, 1000.0),
+        must_cover: rect(-500.0, 500.0, -500.0, 500.0),
+        spacing_m: Some(100.0),
+        variable: None,
+    }
+}
+
+/// GEBCO-style elevation: -20 m at 4.03 W falling 1 m per 0.001° eastward.
+fn east_slope(lon: f64, _lat: f64) -> f64 {
+    -20.0 - 1000.0 * (lon + 4.03)
+}
+
+#[test]
+fn a_geotiff_reads_as_the_same_grid_in_netcdf_bit_for_bit() {
+    let (w, h) = (13, 9);
+    let tif = tmp("slope.tif", &geotiff(w, h, WGS84, east_slope));
+    let from_tiff = Seabed::from_file(&tif, &geo_options()).unwrap();
+    let mut d = Dataset::default();
+    let la = d.dim("lat", h);
+    let lo = d.dim("lon", w);
+    d.var("lat", &[la], (0..h).map(|j| geotiff_node(0, j).1).collect())
+        .attr("units", "degrees_north");
+    d.var("lon", &[lo], (0..w).map(|i| geotiff_node(i, 0).0).collect())
+        .attr("units", "degrees_east");
+    let mut z = Vec::new();
+    for j in 0..h {
+        for i in 0..w {
+            let (lon, lat) = geotiff_node(i, j);
+            z.push(f64::from(east_slope(lon, lat) as f32));
+        }
+    }
+    d.var("elevation", &[la, lo], z)
+        .attr("standard_name", "height_above_mean_sea_level")
+        .attr("units", "m");
+    let from_nc = read("slope.nc", &d, &geo_options()).unwrap();
+    assert_eq!(from_tiff, from_nc);
+    // 20 m deep at 4.03 W, 80 m at 3.97 W: about 40 m deep at the origin.
+    assert!((from_tiff.depth_at(0.0, 0.0) - 50.0).abs() < 0.5);
+    // Positive values are depths; no-data far from the op-area takes the shallowest water.
+    let depths = geotiff(w, h, WGS84, |lon, lat| {
+        if lat > 50.015 {
+            -9999.0
+        } else {
+            -east_slope(lon, lat)
+        }
+    });
+    let s = Seabed::from_file(&tmp("depths.tif", &depths), &geo_options()).unwrap();
+    assert_eq!(s.depth_at(0.0, 0.0), from_tiff.depth_at(0.0, 0.0));
+}
+
+#[test]
+fn a_geotiff_in_another_frame_or_cut_short_is_located() {
+    let o = geo_options();
+    let utm = tmp(
+        "utm.tif",
+        &geotiff(13, 9, &[(1024, 1), (3072, 32630)], east_slope),
+    );
+    let e = Seabed::from_file(&utm, &o).unwrap_err().to_string();
+    assert!(
+        e.contains(
+            "utm.tif: the GeoTIFF is in a projected frame (EPSG:32630); only longitude \
+             and latitude on WGS 84 (EPSG:4326) is read"
+        ) && e.contains("gdal_translate -of netCDF IN.tif OUT.nc"),
+        "{e}"
+    );
+    let nad = tmp(
+        "nad27.tif",
+        &geotiff(13, 9, &[(1024, 2), (2048, 4267)], east_slope),
+    );
+    let e = Seabed::from_file(&nad, &o).unwrap_err().to_string();
+    assert!(e.contains("geographic frame EPSG:4267"), "{e}");
+    let bare = tmp("bare.tif", &geotiff(13, 9, &[], east_slope));
+    let e = Seabed::from_file(&bare, &o).unwrap_err().to_string();
+    assert!(e.contains("no GeoKeys saying its frame"), "{e}");
+    let whole = geotiff(13, 9, WGS84, east_slope);
+    let cut = tmp("cut.tif", &whole[..whole.len() / 2]);
+    let e = Seabed::from_file(&cut, &o).unwrap_err().to_string();
+    assert!(
+        e.contains("cut.tif: the GeoTIFF could not be read: "),
+        "{e}"
+    );
+    let mut small = o.clone();
+    small.must_cover = rect(-500.0, 2500.0, -500.0, 500.0);
+    small.area = rect(-1000.0, 3000.0, -1000.0, 1000.0);
+    let e = Seabed::from_file(&tmp("small.tif", &whole), &small)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("the bathymetry's grid (lon ") && e.contains("does not cover"),
+        "{e}"
+    );
+    let mut named = o;
+    named.variable = Some("elevation".into());
+    let e = Seabed::from_file(&tmp("named.tif", &whole), &named)
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("a GeoTIFF holds one band"), "{e}");
+}

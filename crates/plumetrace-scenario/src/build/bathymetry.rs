@@ -53,7 +53,7 @@ pub(super) fn seabed(
         spacing_m: b.spacing_m,
         variable: b.variable.clone(),
     };
-    let seabed = Seabed::from_netcdf(&base_dir.join(&b.file), &o)
+    let seabed = Seabed::from_file(&base_dir.join(&b.file), &o)
         .map_err(|e| Invalid::new(format!("{KEY}.file"), e.to_string()))?;
     Ok(Some(Arc::new(seabed)))
 }
