@@ -289,7 +289,8 @@ mod tests {
             for (t, v) in late {
                 assert!(
                     (v.norm() - 0.3).abs() < 0.08
-                        && Heading::of_vector(*v).is_some_and(|h| h.diff_deg(Heading::from_deg(45.0)).abs() < 15.0),
+                        && Heading::of_vector(*v)
+                            .is_some_and(|h| h.diff_deg(Heading::from_deg(45.0)).abs() < 15.0),
                     "{label}: {v:?} at {t} s"
                 );
             }
@@ -326,7 +327,9 @@ mod tests {
         assert_eq!(f.add(61.0, &nav(f64::INFINITY)), None);
         let mut last = None;
         for k in 1..=20 {
-            last = f.add(60.0 + f64::from(k), &nav(100.0 + 0.2 * f64::from(k))).or(last);
+            last = f
+                .add(60.0 + f64::from(k), &nav(100.0 + 0.2 * f64::from(k)))
+                .or(last);
         }
         let v = last.expect("a sample after the gap");
         assert!((v.x - 0.2).abs() < 1e-9 && v.y.abs() < 1e-9, "{v:?}");
