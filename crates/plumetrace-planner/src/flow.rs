@@ -160,9 +160,8 @@ impl TrackFlow {
     pub fn add(&mut self, t_s: f64, nav: &NavEstimate) -> Option<Vec2> {
         let pos = nav.pos_m?;
         let water = nav.heading.unit() * nav.speed_mps;
-        if !(t_s.is_finite() && pos.x.is_finite() && pos.y.is_finite())
-            || !(water.x.is_finite() && water.y.is_finite())
-        {
+        let finite = [t_s, pos.x, pos.y, water.x, water.y];
+        if !finite.iter().all(|v| v.is_finite()) {
             return None;
         }
         let fixed = nav
