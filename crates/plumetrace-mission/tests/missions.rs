@@ -186,6 +186,16 @@ fn bad_planner_settings_are_rejected_with_the_file_and_key_path() {
         e.contains("planner.nre") && e.contains("unknown field"),
         "{e}"
     );
+    // Keys that are each within bounds but contradict each other.
+    let text = load_preset_text("demo")
+        .replace("kind = \"amp\"", "kind = \"amp\"\ntrack_flow_min_mps = 4.0");
+    let e = setup_error(&text);
+    assert!(
+        e.contains("scenario.toml")
+            && e.contains("planner.track_flow_min_mps")
+            && e.contains("must be below track_flow_max_mps (3), not 4"),
+        "{e}"
+    );
     // The older name of `kind`: the error names the key as written.
     let text = load_preset_text("demo").replace("kind = \"amp\"", "strategy = \"butterfly\"");
     let e = setup_error(&text);

@@ -55,7 +55,7 @@ use crate::flow::{FlowEstimate, TrackFlow, TrackFlowParams};
 use crate::planners::{BuildContext, PlannerParams};
 use crate::shared_keys::{AutopilotKeys, MapKeys};
 use behaviours::{Find, Reacquire, TrackIn, TrackOut};
-use plumetrace_core::params::{Bounds, Choice, ParamError};
+use plumetrace_core::params::{Bounds, Choice, ParamError, Params};
 use plumetrace_core::{
     BehaviourKind, Decision, DeclarationKind, Heading, PlanStatus, Planner, PlannerEvent,
     RegionEvent, RuleDoc, SensorSnapshot, Telemetry, Vec2, VerticalCommand, wrap_deg_360,
@@ -313,6 +313,21 @@ impl PlannerParams for AmpParams {
             doc: "with map_declaration: the source map's most likely cell (the posterior mean within map_estimate_radius_m of it) once map_mass lies within map_radius_m of it for map_hold_s",
         },
     ];
+
+    fn validate(&self, prefix: &str) -> Result<(), ParamError> {
+        self.check_bounds(prefix)?;
+        if self.track_flow_min_mps >= self.track_flow_max_mps {
+            return Err(ParamError::at(
+                prefix,
+                "track_flow_min_mps",
+                format!(
+                    "must be below track_flow_max_mps ({}), not {}: no sample of the current from the track would be used",
+                    self.track_flow_max_mps, self.track_flow_min_mps
+                ),
+            ));
+        }
+        Ok(())
+    }
 
     fn detection_threshold_v(&self) -> Option<f64> {
         Some(self.autopilot.threshold_v)
