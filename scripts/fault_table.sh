@@ -16,8 +16,9 @@
 #
 # The faults (flags of `plumetrace frontseat`): 30 s without navigation from 305 s, 0.1 % of the
 # front seat's lines dropped (fault seed = run seed), no current meter (`--no-flow`: the planner
-# keeps the prior flow), a 10 s front-seat restart at 300 s, and the Iver remote helm with depths
-# in feet (remote helm 4, on a pseudo-terminal). Work files go to target/fault-table/.
+# estimates the current from its track, from the prior on), a 10 s front-seat restart at 300 s,
+# and the Iver remote helm with depths in feet (remote helm 4, on a pseudo-terminal). Work files
+# go to target/fault-table/.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 

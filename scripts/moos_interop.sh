@@ -19,11 +19,7 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
-if ! command -v MOOSDB >/dev/null 2>&1; then
-    echo "moos_interop: skipped: no MOOSDB on the PATH (install MOOS-IvP or core-moos to run it)"
-    exit 0
-fi
-
+# The arguments first: a mistyped one is named even where the run would be skipped.
 BIN=""
 KEEP=0
 while [ $# -gt 0 ]; do
@@ -33,6 +29,11 @@ while [ $# -gt 0 ]; do
         *) echo "moos_interop: unknown argument '$1' (expected --bin PATH or --keep)" >&2; exit 2 ;;
     esac
 done
+
+if ! command -v MOOSDB >/dev/null 2>&1; then
+    echo "moos_interop: skipped: no MOOSDB on the PATH (install MOOS-IvP or core-moos to run it)"
+    exit 0
+fi
 
 if ! command -v python3 >/dev/null 2>&1; then
     echo "moos_interop: FAIL: python3 is needed for the simulated vehicle (scripts/moos_vehicle.py)"

@@ -481,3 +481,28 @@ fn check_says_how_the_flow_grid_steps() {
     let out = check(&coarse);
     assert!(out.contains("flow sub-steps per step"), "{out}");
 }
+
+#[test]
+fn the_moos_script_names_an_unknown_argument_before_it_skips() {
+    // No MOOSDB on this PATH: the run would be skipped, but a mistyped argument is named first.
+    let script = concat!(env!("CARGO_MANIFEST_DIR"), "/../../scripts/moos_interop.sh");
+    let run = |args: &[&str]| {
+        std::process::Command::new("bash")
+            .arg(script)
+            .args(args)
+            .env("PATH", "/usr/bin:/bin")
+            .output()
+            .unwrap()
+    };
+    let typo = run(&["--bni", "x"]);
+    assert_eq!(typo.status.code(), Some(2));
+    let err = String::from_utf8(typo.stderr).unwrap();
+    assert!(
+        err.contains("moos_interop: unknown argument '--bni' (expected --bin PATH or --keep)"),
+        "{err}"
+    );
+    let fine = run(&["--keep"]);
+    assert_eq!(fine.status.code(), Some(0));
+    let out = String::from_utf8(fine.stdout).unwrap();
+    assert!(out.contains("skipped: no MOOSDB on the PATH"), "{out}");
+}

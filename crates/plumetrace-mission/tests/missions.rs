@@ -186,6 +186,16 @@ fn bad_planner_settings_are_rejected_with_the_file_and_key_path() {
         e.contains("planner.nre") && e.contains("unknown field"),
         "{e}"
     );
+    // Keys that are each within bounds but contradict each other.
+    let text = load_preset_text("demo")
+        .replace("kind = \"amp\"", "kind = \"amp\"\ntrack_flow_min_mps = 4.0");
+    let e = setup_error(&text);
+    assert!(
+        e.contains("scenario.toml")
+            && e.contains("planner.track_flow_min_mps")
+            && e.contains("must be below track_flow_max_mps (3), not 4"),
+        "{e}"
+    );
     // The older name of `kind`: the error names the key as written.
     let text = load_preset_text("demo").replace("kind = \"amp\"", "strategy = \"butterfly\"");
     let e = setup_error(&text);
@@ -710,4 +720,63 @@ fn dropping_unreachable_filaments_changes_no_reading() {
     let (a, b) = (fly(with), fly(without));
     assert!(a.2.contains("detection"), "the mission met the plume");
     assert!(a == b, "the missions differ");
+}
+
+/// The AMP on a vehicle whose current meter never reaches the planner (as over a front-seat link
+/// without one): every snapshot's flow reading is taken out.
+struct WithoutCurrentMeter(plumetrace_planner::Amp);
+
+impl plumetrace_core::Planner for WithoutCurrentMeter {
+    fn decide(&mut self, s: &plumetrace_core::SensorSnapshot) -> plumetrace_core::Decision {
+        let mut s = s.clone();
+        s.flow = None;
+        self.0.decide(&s)
+    }
+}
+
+/// The demo without a current meter, the planner given `prior_deg` as the prior flow direction:
+/// the first declaration's error, m, with the flow estimated from the track over
+/// `track_flow_window_s` windows (0: the prior alone).
+fn demo_without_current_meter(seed: u64, track_flow_window_s: f64, prior_deg: f64) -> Option<f64> {
+    let setup = MissionSetup::new(shortened("demo", 3500.0, 2400.0, seed)).unwrap();
+    let area = plumetrace_guidance::OpArea::new(vec![
+        plumetrace_core::Vec2::new(60.0, -80.0),
+        plumetrace_core::Vec2::new(460.0, -80.0),
+        plumetrace_core::Vec2::new(460.0, 80.0),
+        plumetrace_core::Vec2::new(60.0, 80.0),
+    ])
+    .unwrap();
+    let p = plumetrace_planner::AmpParams {
+        mapping_lines: 3,
+        mapping_length_m: 60.0,
+        track_flow_window_s,
+        ..plumetrace_planner::AmpParams::default()
+    };
+    let amp = plumetrace_planner::Amp::new(
+        p,
+        area,
+        Vec::new(),
+        plumetrace_core::Heading::from_deg(prior_deg),
+    )
+    .trusting_prior();
+    let mut m = Mission::new(setup, MissionOptions::default()).unwrap();
+    m.replace_planner(0, Box::new(WithoutCurrentMeter(amp)))
+        .unwrap();
+    m.run(&mut |_, _| {}).unwrap();
+    let run = m.finish().unwrap();
+    run.summary.first_declaration.map(|d| d.error_m)
+}
+
+#[test]
+fn without_a_current_meter_the_amp_reads_the_current_from_its_track() {
+    // The prior 45 degrees off the demo's eastward current: from the track, every run declares
+    // within 10 m; on the prior alone, runs 2-4 declare 34-226 m away.
+    let mut prior_alone_missed = 0;
+    for seed in 1..=4 {
+        let track = demo_without_current_meter(seed, 60.0, 135.0);
+        assert!(track.is_some_and(|e| e < 10.0), "seed {seed}: {track:?}");
+        let prior = demo_without_current_meter(seed, 0.0, 135.0);
+        prior_alone_missed += usize::from(prior.is_none_or(|e| e > 20.0));
+    }
+    assert!(prior_alone_missed >= 2, "{prior_alone_missed}");
 }

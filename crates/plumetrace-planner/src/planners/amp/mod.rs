@@ -51,11 +51,11 @@ pub use mapping::MappingParams;
 use crate::behaviour::{Arbiter, Behaviour, EventLog, GoTo, Idle, Legs, LineParams, Percept};
 use crate::behaviour::{Proposal, Reached};
 use crate::estimate::MapTracker;
-use crate::flow::FlowEstimate;
+use crate::flow::{FlowEstimate, TrackFlow, TrackFlowParams};
 use crate::planners::{BuildContext, PlannerParams};
 use crate::shared_keys::{AutopilotKeys, MapKeys};
 use behaviours::{Find, Reacquire, TrackIn, TrackOut};
-use plumetrace_core::params::{Bounds, Choice, ParamError};
+use plumetrace_core::params::{Bounds, Choice, ParamError, Params};
 use plumetrace_core::{
     BehaviourKind, Decision, DeclarationKind, Heading, PlanStatus, Planner, PlannerEvent,
     RegionEvent, RuleDoc, SensorSnapshot, Telemetry, Vec2, VerticalCommand, wrap_deg_360,
@@ -146,6 +146,12 @@ plumetrace_core::params! {
         flow_gate_deg: f64 = 90.0, "deg", Bounds::closed(1.0, 180.0);
         /// How long implausible flow readings must persist to be believed.
         flow_gate_persist_s: f64 = 1800.0, "s", Bounds::non_negative(1e6);
+        /// Without a current meter (no flow reading yet), the current is estimated from the vehicle's own track, one sample per this window: the drift of the navigation positions against the water track (heading and water speed) plus the jumps at position fixes spread over the time since the fix before; the samples go through the flow estimate (flow_average_s, flow_gate_deg from the prior) as a meter's readings would (0: the prior direction alone).
+        track_flow_window_s: f64 = 60.0, "s", Bounds::non_negative(3600.0);
+        /// A track sample of the current slower than this is not used (it carries no direction: before the first fix of a vehicle that dead-reckons through the water alone, the track shows no current).
+        track_flow_min_mps: f64 = 0.05, "m/s", Bounds::non_negative(10.0);
+        /// A track sample of the current faster than this is not used (a bad fix).
+        track_flow_max_mps: f64 = 3.0, "m/s", Bounds::positive(10.0);
         /// Navigation error growth assumed between fixes: the cage acts this much earlier per second since the last fix (0: at the op-area's edge, as in the field).
         nav_drift_mps: f64 = 0.02, "m/s", Bounds::non_negative(10.0);
         /// The most the cage's area is shrunk by for the navigation error.
@@ -307,6 +313,21 @@ impl PlannerParams for AmpParams {
             doc: "with map_declaration: the source map's most likely cell (the posterior mean within map_estimate_radius_m of it) once map_mass lies within map_radius_m of it for map_hold_s",
         },
     ];
+
+    fn validate(&self, prefix: &str) -> Result<(), ParamError> {
+        self.check_bounds(prefix)?;
+        if self.track_flow_min_mps >= self.track_flow_max_mps {
+            return Err(ParamError::at(
+                prefix,
+                "track_flow_min_mps",
+                format!(
+                    "must be below track_flow_max_mps ({}), not {}: no sample of the current from the track would be used",
+                    self.track_flow_max_mps, self.track_flow_min_mps
+                ),
+            ));
+        }
+        Ok(())
+    }
 
     fn detection_threshold_v(&self) -> Option<f64> {
         Some(self.autopilot.threshold_v)
@@ -799,6 +820,8 @@ pub struct Amp {
     started: bool,
     last_steer: Steer,
     reported_estimate: Option<Vec2>,
+    /// The current from the track, until a current meter reports (`None`: not estimated).
+    track_flow: Option<TrackFlow>,
 }
 
 impl Amp {
@@ -816,6 +839,13 @@ impl Amp {
     /// (when it does not fit, the planner has none: the registry's build refuses such keys).
     pub fn new(p: AmpParams, area: OpArea, regions: Vec<OpArea>, prior_flow: Heading) -> Self {
         let map = p.map_tracker(&area).unwrap_or(None);
+        let track_flow = (p.track_flow_window_s > 0.0).then(|| {
+            TrackFlow::new(TrackFlowParams {
+                window_s: p.track_flow_window_s,
+                min_mps: p.track_flow_min_mps,
+                max_mps: p.track_flow_max_mps,
+            })
+        });
         let regions = if regions.is_empty() {
             vec![area.clone()]
         } else {
@@ -865,6 +895,7 @@ impl Amp {
             in_contact: false,
             started: false,
             reported_estimate: None,
+            track_flow,
         }
     }
 
@@ -972,7 +1003,11 @@ impl Planner for Amp {
     fn decide(&mut self, s: &SensorSnapshot) -> Decision {
         let t = s.time_s;
         if let Some(f) = s.flow {
+            // A current meter reports: its readings alone from now on.
+            self.track_flow = None;
             self.m.flow.add(f.time_s, f.velocity_mps);
+        } else if let Some(v) = self.track_flow.as_mut().and_then(|e| e.add(t, &s.nav)) {
+            self.m.flow.add(t, v);
         }
         let Some(pos) = s.nav.pos_m else {
             // Without a position estimate the AMP can only hold its course (the registry refuses
