@@ -8,7 +8,7 @@ use crate::planner::{ErrorSlot, PyPlanner};
 use plumetrace_campaign::benchmark::{
     BenchmarkOptions, Given, Task, TaskDone, TaskSet, Watch, plan, run_benchmark,
 };
-use plumetrace_campaign::{ExternalError, ExternalPlanners};
+use plumetrace_campaign::{CampaignReport, ExternalError, ExternalPlanners};
 use plumetrace_core::Planner;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
@@ -80,7 +80,14 @@ impl ExternalPlanners for PyFactory {
 struct Heard {
     progress: Option<Py<PyAny>>,
     task: Mutex<String>,
-    reports: Mutex<Vec<(String, u64, u64, u64, u64, f64)>>,
+    reports: Mutex<Vec<Flown>>,
+}
+
+/// One task's report: its name, what its campaign did, the wall time of its runs.
+struct Flown {
+    task: String,
+    report: CampaignReport,
+    wall_s: f64,
 }
 
 impl Watch for Heard {
@@ -101,14 +108,11 @@ impl Watch for Heard {
 
     fn task_done(&self, d: &TaskDone<'_>) {
         if let Ok(mut r) = self.reports.lock() {
-            r.push((
-                d.task.name.clone(),
-                d.report.planned,
-                d.report.skipped,
-                d.report.ran,
-                d.report.failed,
-                d.wall_s,
-            ));
+            r.push(Flown {
+                task: d.task.name.clone(),
+                report: d.report.clone(),
+                wall_s: d.wall_s,
+            });
         }
     }
 }
@@ -190,16 +194,14 @@ pub fn benchmark<'py>(
     d.set_item("board", board.to_json())?;
     d.set_item("notes", plan.notes.clone())?;
     let reports = PyList::empty(py);
-    for (task, planned, skipped, ran, failed, wall_s) in
-        heard.reports.into_inner().unwrap_or_default()
-    {
+    for f in heard.reports.into_inner().unwrap_or_default() {
         let r = PyDict::new(py);
-        r.set_item("task", task)?;
-        r.set_item("planned", planned)?;
-        r.set_item("skipped", skipped)?;
-        r.set_item("ran", ran)?;
-        r.set_item("failed", failed)?;
-        r.set_item("wall_s", wall_s)?;
+        r.set_item("task", f.task)?;
+        r.set_item("planned", f.report.planned)?;
+        r.set_item("skipped", f.report.skipped)?;
+        r.set_item("ran", f.report.ran)?;
+        r.set_item("failed", f.report.failed)?;
+        r.set_item("wall_s", f.wall_s)?;
         reports.append(r)?;
     }
     d.set_item("tasks", reports)?;
