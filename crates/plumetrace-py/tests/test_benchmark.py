@@ -106,6 +106,9 @@ def test_benchmark_errors_name_what_is_wrong(tmp_path):
                        match=r"task 'freshwater-team' is not flown by 'Northward': its planners "
                              r"are formation \(a team"):
         plumetrace.benchmark(Northward, tmp_path / "a", tasks="freshwater-team")
+    with pytest.raises(plumetrace.PlumetraceError,
+                       match=r"has no name of its own: give it one with name="):
+        plumetrace.benchmark(lambda scenario, seed: Northward(scenario, seed), tmp_path / "a")
     assert not (tmp_path / "a").exists()
     # A directory holding another planner's benchmark is refused before anything is written.
     plumetrace.benchmark(Northward, tmp_path / "b", tasks="coastal", seeds_per_task=1,

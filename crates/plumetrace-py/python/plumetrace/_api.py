@@ -329,9 +329,10 @@ def benchmark(
     elif callable(planner):
         factory = _planner_factory(planner)
         factory_name = name or getattr(planner, "__name__", None)
-        if not factory_name:
+        if not factory_name or factory_name == "<lambda>":
             raise PlumetraceError(
-                f"the planner {planner!r} has no __name__: give it one with name="
+                f"the planner {planner!r} has no name of its own: give it one with name= "
+                "(it names the planner's rows in the leaderboard)"
             )
     else:
         raise PlumetraceError(
