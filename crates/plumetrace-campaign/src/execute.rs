@@ -329,9 +329,12 @@ fn fly_in_turn(
             seed,
             message: e.message,
         };
-        let scenario = match &c.scenarios[key.scenario].origin {
-            plumetrace_scenario::Origin::File(p) => p.display().to_string(),
-            plumetrace_scenario::Origin::Preset(n) => n.clone(),
+        // A family's file (not its base scenario's): the planner builds the run's site from it.
+        let entry = &c.scenarios[key.scenario];
+        let scenario = match (&entry.family, &entry.origin) {
+            (Some(f), _) => f.path.display().to_string(),
+            (None, plumetrace_scenario::Origin::File(p)) => p.display().to_string(),
+            (None, plumetrace_scenario::Origin::Preset(n)) => n.clone(),
         };
         let planner = ext.make(config, &scenario, seed).map_err(failed)?;
         let row = run_one(c, key, out, &mut None, false, Some(planner));

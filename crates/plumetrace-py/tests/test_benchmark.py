@@ -19,7 +19,7 @@ class Northward:
 
     def __init__(self, scenario, seed):
         Northward.made += 1
-        self.scenario, self.seed = scenario, seed
+        Northward.last = (scenario, seed)
 
     def decide(self, s):
         if s["time_s"] >= 120.0 and s["nav"]["pos_m"] is not None:
@@ -65,6 +65,8 @@ def test_a_python_planner_flies_the_test_seeds_as_run_flies_them_and_resumes(tmp
     results = plumetrace.benchmark(Northward, out, tasks="coastal", seeds_per_task=2,
                                    progress=False)
     assert Northward.made == 2
+    # Made for the task's family file (where its sites are drawn), not the family's base preset.
+    assert Northward.last[0] == str(out / "tasks" / "coastal.family.toml")
     entry = results["coastal"]["Northward"]
     assert entry["runs"] == 2 and entry["failed"] == 0
     rows = list(csv.DictReader((out / "coastal" / "runs.csv").open()))

@@ -409,4 +409,77 @@ mod tests {
             std::fs::read_to_string(dir.path().join("tasks/coastal.campaign.toml")).unwrap();
         assert_eq!(before, after);
     }
+
+    /// Records what each run's planner was made for; its planner stops at once.
+    struct Recorder {
+        seen: std::sync::Mutex<Vec<(String, u64)>>,
+    }
+
+    struct Stop;
+
+    impl plumetrace_core::Planner for Stop {
+        fn decide(&mut self, s: &plumetrace_core::SensorSnapshot) -> plumetrace_core::Decision {
+            plumetrace_core::Decision::new(
+                plumetrace_core::Command {
+                    heading: s.nav.heading,
+                    speed_mps: 0.0,
+                    vertical: plumetrace_core::VerticalCommand::Altitude(3.0),
+                },
+                plumetrace_core::PlanStatus::Finished,
+            )
+        }
+    }
+
+    impl ExternalPlanners for Recorder {
+        fn flies(&self, config: &str) -> bool {
+            config == "mine"
+        }
+        fn make(
+            &self,
+            _config: &str,
+            scenario: &str,
+            seed: u64,
+        ) -> Result<Box<dyn plumetrace_core::Planner>, crate::ExternalError> {
+            self.seen.lock().unwrap().push((scenario.to_string(), seed));
+            Ok(Box::new(Stop))
+        }
+        fn check(&self) -> Result<(), crate::ExternalError> {
+            Ok(())
+        }
+    }
+
+    #[test]
+    fn an_external_planner_is_made_for_each_test_seed_with_the_tasks_family_file() {
+        let set = TaskSet::builtin().unwrap();
+        let dir = tempfile::tempdir().unwrap();
+        let p = plan(
+            &set,
+            &["coastal".into(), "kelp".into()],
+            &[Given::external("mine")],
+        )
+        .unwrap();
+        let rec = Recorder {
+            seen: std::sync::Mutex::new(Vec::new()),
+        };
+        let opts = BenchmarkOptions {
+            seeds_per_task: Some(2),
+            jobs: Some(1),
+        };
+        let board = run_benchmark(&set, &p, dir.path(), opts, Some(&rec), &Quiet).unwrap();
+        let seen = rec.seen.into_inner().unwrap();
+        let family = dir.path().join("tasks").join("coastal.family.toml");
+        let d = plumetrace_env::derive_seed;
+        assert_eq!(
+            seen,
+            [
+                (family.display().to_string(), d(3202, 0)),
+                (family.display().to_string(), d(3202, 1)),
+                ("li-zhang-kelp".to_string(), d(3222, 0)),
+                ("li-zhang-kelp".to_string(), d(3222, 1)),
+            ]
+        );
+        assert_eq!(board.tasks.len(), 2);
+        assert_eq!(board.tasks[0].entries[0].planner, "mine");
+        assert_eq!(board.tasks[0].entries[0].runs, 2);
+    }
 }
