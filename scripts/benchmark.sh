@@ -10,8 +10,10 @@
 #
 # Options: --jobs N (worker threads, default: one per core), --bin PATH (a built plumetrace,
 # default: builds the release binary of this checkout), --seeds-per-task N, --keep (resume into
-# target/benchmark instead of starting afresh), --ppo FILE (the learned baseline's row,
-# target/ppo/ppo.md from scripts/ppo_baseline.sh, added unranked to the coastal table).
+# target/benchmark instead of starting afresh), --ppo FILE (the learned baseline, added unranked
+# to the coastal table: a trained policy, ppo_coastal.zip from scripts/ppo_baseline.sh, flown
+# here on the task's test seeds by `scripts/ppo_baseline.sh --evaluate FILE` into target/ppo-eval;
+# or the row such a call wrote, its ppo.md beside its ppo.json).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -29,10 +31,19 @@ while [ $# -gt 0 ]; do
         --keep) keep=1; shift ;;
         --smoke) smoke=1; shift ;;
         --ppo) ppo="$2"; shift 2 ;;
-        -h|--help) sed -n '2,15p' "$0"; exit 0 ;;
+        -h|--help) sed -n '2,17p' "$0"; exit 0 ;;
         *) echo "benchmark.sh: unknown argument $1 (see --help)" >&2; exit 2 ;;
     esac
 done
+
+case "$ppo" in
+    ""|*.md|*.zip) ;;
+    *) echo "benchmark.sh: --ppo $ppo: give the policy (.zip) or its row (ppo.md)" >&2; exit 2 ;;
+esac
+if [ -n "$ppo" ] && [ ! -f "$ppo" ]; then
+    echo "benchmark.sh: --ppo $ppo: no such file" >&2
+    exit 2
+fi
 
 if [ -z "$bin" ]; then
     cargo build --release --bin plumetrace
@@ -123,11 +134,21 @@ mkdir -p "$images"
     echo
     sed -n 's/^\([a-z0-9_-]*\): \([0-9]*\) planners x \([0-9]*\) test seeds: \([0-9]*\) runs.* in \([0-9.]*\) s$/- `\1`: \2 planners x \3 test seeds, \4 runs, \5 s/p' "$log"
 } > "$page.tmp"
+ppo_given="$(basename "$ppo")"
+if [ "${ppo%.zip}" != "$ppo" ]; then
+    # The policy flies the coastal task's test seeds (as many as the table's) through Python.
+    ppo_seeds="$(sed -n 's/^- `coastal`: [0-9]* planners x \([0-9]*\) test seeds.*/\1/p' "$page.tmp")"
+    policy="$(cd "$(dirname "$ppo")" && pwd)/$(basename "$ppo")"
+    echo "== scripts/ppo_baseline.sh --evaluate $policy --test-seeds $ppo_seeds" >&2
+    bash scripts/ppo_baseline.sh --evaluate "$policy" --test-seeds "$ppo_seeds" \
+        --out target/ppo-eval >&2
+    ppo="target/ppo-eval/ppo.md"
+fi
 if [ -n "$ppo" ]; then
     # The learned baseline flew apart (through Python): its row joins the coastal table unranked.
     ppo_json="$(dirname "$ppo")/ppo.json"
     steps="$(sed -n 's/^ *"timesteps": \([0-9]*\),$/\1/p' "$ppo_json")"
-    note="\`ppo\` (unranked): the learned baseline, PPO trained for $steps environment steps on the task's tuning seeds by \`scripts/ppo_baseline.sh\` and flown on the same test seeds through the Python planner seam ([the benchmark](../benchmark.md#a-learned-baseline-ppo))."
+    note="\`ppo\` (unranked): the learned baseline, PPO trained for $steps environment steps on the task's tuning seeds by \`scripts/ppo_baseline.sh\` and flown on the same test seeds by \`plumetrace.benchmark\` through the Python planner seam (\`scripts/benchmark.sh --ppo $ppo_given\`; [the benchmark](../benchmark.md#a-learned-baseline-ppo))."
     awk -v row="$(cat "$ppo")" -v note="$note" '
         /^### `coastal`/ { c = 1 }
         /^### / && !/`coastal`/ { c = 0 }

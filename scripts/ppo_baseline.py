@@ -1,9 +1,10 @@
 """The learned baseline: PPO (Stable-Baselines3) trained through the vectorised Gymnasium
 environment on the tuning seeds of one benchmark task (coastal), then flown on the task's test
-seeds through the Python planner seam (plumetrace.gym.PolicyPlanner) and summarised with the
-leaderboard's columns.
+seeds by plumetrace.benchmark through the Python planner seam (plumetrace.gym.PolicyPlanner): the
+benchmark's own loop and leaderboard, so its row has the leaderboard's columns and numbers.
 
     python scripts/ppo_baseline.py [--timesteps 200000] [--envs 4] [--test-seeds 100] [--out DIR]
+    python scripts/ppo_baseline.py --evaluate POLICY.zip [--test-seeds 100] [--out DIR]
 
 Run it through scripts/ppo_baseline.sh, which makes the environment (torch, stable-baselines3)
 and installs the package. Training never sees a test seed: every training episode flies one of
@@ -11,9 +12,10 @@ the task's tuning seeds (the vectorised environment's `seeds`), and the two sets
 """
 
 import argparse
+import csv
 import json
-import math
 import pathlib
+import shutil
 import sys
 import time
 import tomllib
@@ -34,22 +36,6 @@ torch.set_num_threads(1)
 # The policy decides every 5 s (the environment's default is 1 s): episodes of the task's
 # 7200 s are at most 1,440 decisions, within reach of PPO's discounting.
 SETTINGS = {"decision_period_s": 5.0}
-
-
-def wilson(k, n, z=1.959964):
-    """Wilson 95 % interval of k successes in n runs."""
-    if n == 0:
-        return [0.0, 1.0]
-    p = k / n
-    d = 1 + z * z / n
-    c = (p + z * z / (2 * n)) / d
-    h = z * math.sqrt(p * (1 - p) / n + z * z / (4 * n * n)) / d
-    return [max(0.0, c - h), min(1.0, c + h)]
-
-
-def quantile(xs, q):
-    """The q-quantile, None without values (as the leaderboard's JSON has null)."""
-    return float(np.quantile(np.asarray(xs), q)) if xs else None
 
 
 class Progress(BaseCallback):
@@ -99,51 +85,26 @@ def train(task, scenario, args, path):
     return model, took, tuning
 
 
-def evaluate(model, task, scenario, tests):
-    """Flies the policy on each test seed through the planner seam; returns the rows."""
+def evaluate(model, task, n_test, out):
+    """Flies the policy on the task's first `n_test` test seeds with plumetrace.benchmark (into
+    out/benchmark, afresh: its runs are the policy's); returns its leaderboard entry with the
+    runs' outcomes counted."""
     def policy(obs):
         return model.predict(obs, deterministic=True)[0]
 
-    rows = []
-    for seed in tests:
-        planner = pg.PolicyPlanner(policy, scenario, seed,
-                                   success_radius_m=task["success_radius_m"], **SETTINGS)
-        r = plumetrace.run(scenario, seed=seed, planner=planner, trajectory=False,
-                           outputs=False)
-        if r.summary["success_radius_m"] != task["success_radius_m"]:
-            sys.exit("ppo_baseline.py: the scenario's success radius is not the task's")
-        rows.append({"outcome": r.outcome, **r.metrics})
-    return rows
+    def ppo(scenario, seed):
+        return pg.PolicyPlanner(policy, scenario, seed,
+                                success_radius_m=task["success_radius_m"], **SETTINGS)
 
-
-def entry(rows):
-    """The leaderboard's columns for the rows."""
-    n = len(rows)
-    ok = sum(1 for r in rows if r["success"])
-    declared = [r for r in rows if r["declared"]]
-    err = [r["error_m"] for r in declared if r["error_m"] is not None]
-    return {
-        "planner": "ppo",
-        "runs": n,
-        "successes": ok,
-        "success_rate": ok / n if n else 0.0,
-        "success_ci95": wilson(ok, n),
-        "sources_located": sum(r["sources_located"] for r in rows),
-        "sources": sum(r["sources"] for r in rows),
-        "error_median_m": quantile(err, 0.5),
-        "error_p90_m": quantile(err, 0.9),
-        "along_median_m": quantile([abs(r["error_along_m"]) for r in declared], 0.5),
-        "along_signed_median_m": quantile([r["error_along_m"] for r in declared], 0.5),
-        "cross_median_m": quantile([abs(r["error_cross_m"]) for r in declared], 0.5),
-        "declaration_median_s": quantile([r["declaration_s"] for r in declared], 0.5),
-        "path_length_median_m": quantile([r["path_length_m"] for r in rows], 0.5),
-        "false_declarations": sum(1 for r in declared if not r["success"]),
-        "collisions": sum(1 for r in rows if r["outcome"] == "collided"),
-        "cage_aborts": sum(1 for r in rows if r["outcome"] == "aborted"),
-        "failed": sum(1 for r in rows if r["outcome"] == "error"),
-        "outcomes": {o: sum(1 for r in rows if r["outcome"] == o)
-                     for o in sorted({r["outcome"] for r in rows})},
-    }
+    bench = out / "benchmark"
+    shutil.rmtree(bench, ignore_errors=True)
+    results = plumetrace.benchmark(ppo, bench, tasks=task["name"], seeds_per_task=n_test,
+                                   progress=False)
+    e = dict(results[task["name"]]["ppo"])
+    with (bench / task["name"] / "runs.csv").open() as f:
+        outcomes = [r["outcome"] for r in csv.DictReader(f)]
+    e["outcomes"] = {o: outcomes.count(o) for o in sorted(set(outcomes))}
+    return e
 
 
 def markdown_row(e):
@@ -176,7 +137,7 @@ def main():
     n_test = args.test_seeds if args.test_seeds is not None else task["seeds"]
     if not 1 <= n_test <= task["test_seeds"]:
         sys.exit(f"ppo_baseline.py: --test-seeds {n_test} is outside 1..={task['test_seeds']}")
-    tests = [plumetrace.derive_seed(task["test_seed"], k) for k in range(n_test)]
+    tests = [plumetrace.derive_seed(task["test_seed"], k) for k in range(task["test_seeds"])]
     out = pathlib.Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
 
@@ -195,10 +156,11 @@ def main():
               flush=True)
 
     start = time.perf_counter()
-    rows = evaluate(model, task, scenario, tests)
+    e = evaluate(model, task, n_test, out)
     flown = time.perf_counter() - start
-    e = entry(rows)
-    e.update({"task": args.task, "task_set": version, "timesteps": args.timesteps,
+    # A saved policy knows how many steps it was trained for.
+    timesteps = int(model.num_timesteps) if args.evaluate else args.timesteps
+    e.update({"task": args.task, "task_set": version, "timesteps": timesteps,
               "envs": args.envs, "seed": args.seed, "train_s": round(took, 1),
               "test_s": round(flown, 1), **{k: v for k, v in SETTINGS.items()}})
     (out / "ppo.json").write_text(json.dumps(e, indent=2) + "\n")

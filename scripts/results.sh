@@ -16,6 +16,9 @@
 # the comparison of configurations A and B over the campaign's runs.csv, per scenario
 # (scripts/two_sample.sh: Fisher's exact test for the rates, Kolmogorov-Smirnov and Mann-Whitney U
 # for the errors and times; it makes a virtual environment with scipy on first use).
+# Lines `# beside the benchmark: TEXT` of a campaign file (joined) say, under the page's
+# description, what it measures that the benchmark's leaderboard (docs/results/benchmark.md)
+# does not, where the two report the same planners.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -37,7 +40,7 @@ while [ $# -gt 0 ]; do
             done
             shift ;;
         --index) shift ;;
-        -h|--help) sed -n '2,18p' "$0"; exit 0 ;;
+        -h|--help) sed -n '2,21p' "$0"; exit 0 ;;
         -*) echo "results.sh: unknown option $1 (see --help)" >&2; exit 2 ;;
         *) names+=("$1"); shift ;;
     esac
@@ -136,6 +139,8 @@ for n in "${names[@]}"; do
         echo "# Results: \`$n\`"
         echo
         if [ -n "$desc" ]; then echo "${desc^}."; echo; fi
+        beside="$(sed -n 's/^# beside the benchmark: //p' "$file" | paste -sd ' ' -)"
+        if [ -n "$beside" ]; then echo "**Beside the benchmark.** $beside"; echo; fi
         echo "Produced at commit \`$commit\` on $(date -u +%Y-%m-%d) by \`scripts/results.sh $n\`,"
         echo "which ran (release build, $cores cores, $cpu; ${secs} s of wall time$resumed):"
         echo

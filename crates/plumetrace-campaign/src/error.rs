@@ -41,6 +41,16 @@ pub enum CampaignError {
         /// What is wrong.
         message: String,
     },
+    /// A planner from outside the registry could not be made, or failed during a run.
+    #[error("configuration '{config}', run seed {seed}: {message}")]
+    External {
+        /// The configuration it flies.
+        config: String,
+        /// The run's seed.
+        seed: u64,
+        /// What went wrong.
+        message: String,
+    },
     /// A chart could not be drawn.
     #[error("drawing {what}: {message}")]
     Chart {

@@ -5,6 +5,7 @@ use crate::error::{CampaignError, RunError};
 use crate::example::{EXAMPLES_DIR, ExampleRun};
 use crate::runs::{Appender, RUNS_FILE, RunRow, row_key};
 use crate::spec::{Campaign, RunKey, Shard};
+use plumetrace_core::Planner;
 use plumetrace_env::Environment;
 use plumetrace_mission::{Mission, MissionOptions, MissionRun, MissionSetup, fly_shared};
 use rayon::prelude::*;
@@ -69,6 +70,35 @@ pub struct CampaignReport {
     pub failed: u64,
     /// A partial row left by a killed process was cut off.
     pub cut_partial_line: bool,
+}
+
+/// Planners from outside the registry (written in Python, say), flown by the configurations
+/// they name: every run of such a configuration gets a fresh planner for its first vehicle,
+/// made before its first step, in place of the configuration's planner table. A campaign with
+/// them runs one run at a time, on the calling thread, and shares nothing between runs (the
+/// results are the same bits as sharing's: see [`Share`]).
+pub trait ExternalPlanners {
+    /// Whether the configuration called `config` is flown by one of them.
+    fn flies(&self, config: &str) -> bool;
+    /// A fresh planner for a run of `config` on `scenario` (the campaign's scenario: its file's
+    /// path, or a preset's name) with run seed `seed`.
+    fn make(
+        &self,
+        config: &str,
+        scenario: &str,
+        seed: u64,
+    ) -> Result<Box<dyn Planner>, ExternalError>;
+    /// Asked after each of their runs: an error (the planner failed during the run) stops the
+    /// campaign, and that run is not recorded (a later call flies it again).
+    fn check(&self) -> Result<(), ExternalError>;
+}
+
+/// Why a planner from outside the registry could not be made or failed in a run.
+#[derive(Debug, thiserror::Error)]
+#[error("{message}")]
+pub struct ExternalError {
+    /// What went wrong, in the planner's own words.
+    pub message: String,
 }
 
 /// Checks or records that `out` belongs to this campaign.
@@ -151,6 +181,18 @@ pub fn run_campaign(
     opts: RunOptions,
     progress: &(dyn Fn(u64, u64) + Sync),
 ) -> Result<CampaignReport, CampaignError> {
+    run_campaign_with(c, out, opts, None, progress)
+}
+
+/// [`run_campaign`], with planners from outside the registry flying the configurations they
+/// name (one run at a time; `opts.jobs` and `opts.share` then have no effect).
+pub fn run_campaign_with(
+    c: &Campaign,
+    out: &Path,
+    opts: RunOptions,
+    external: Option<&dyn ExternalPlanners>,
+    progress: &(dyn Fn(u64, u64) + Sync),
+) -> Result<CampaignReport, CampaignError> {
     claim_dir(c, out)?;
     let runs_path = out.join(RUNS_FILE);
     let (appender, existing) = Appender::open(&runs_path)?;
@@ -183,35 +225,35 @@ pub fn run_campaign(
         Share::Nothing => todo.iter().map(|k| vec![*k]).collect(),
         Share::Plume | Share::SpinUp => share_groups(c, &todo),
     };
+    // Each row is appended the moment its run ends, so an interrupted group keeps the rows of
+    // the runs that ended before it.
+    let emit = |row: RunRow| {
+        if stop.load(Ordering::Relaxed) {
+            return;
+        }
+        if row.outcome == crate::runs::RunOutcome::ERROR {
+            failed.fetch_add(1, Ordering::Relaxed);
+        }
+        let written = appender
+            .lock()
+            .map_err(|_| CampaignError::io(&runs_path, "a worker panicked while writing"))
+            .and_then(|mut a| a.append(&row));
+        if let Err(e) = written {
+            stop.store(true, Ordering::Relaxed);
+            if let Ok(mut slot) = first_error.lock() {
+                slot.get_or_insert(e);
+            }
+            return;
+        }
+        progress(finished.fetch_add(1, Ordering::Relaxed) + 1, total);
+    };
     let work = || {
         groups.par_iter().for_each(|group| {
-            // Each row is appended the moment its run ends, so an interrupted group keeps the
-            // rows of the runs that ended before it.
-            let mut emit = |row: RunRow| {
-                if stop.load(Ordering::Relaxed) {
-                    return;
-                }
-                if row.outcome == crate::runs::RunOutcome::ERROR {
-                    failed.fetch_add(1, Ordering::Relaxed);
-                }
-                let written = appender
-                    .lock()
-                    .map_err(|_| CampaignError::io(&runs_path, "a worker panicked while writing"))
-                    .and_then(|mut a| a.append(&row));
-                if let Err(e) = written {
-                    stop.store(true, Ordering::Relaxed);
-                    if let Ok(mut slot) = first_error.lock() {
-                        slot.get_or_insert(e);
-                    }
-                    return;
-                }
-                progress(finished.fetch_add(1, Ordering::Relaxed) + 1, total);
-            };
             if stop.load(Ordering::Relaxed) {
                 return;
             }
             match opts.share {
-                Share::Plume if group.len() > 1 => run_shared(c, group, out, &mut emit),
+                Share::Plume if group.len() > 1 => run_shared(c, group, out, &mut |r| emit(r)),
                 _ => {
                     let mut shared: Option<Environment> = None;
                     for (i, key) in group.iter().enumerate() {
@@ -219,19 +261,20 @@ pub fn run_campaign(
                             return;
                         }
                         let more = i + 1 < group.len();
-                        emit(run_one(c, key, out, &mut shared, more));
+                        emit(run_one(c, key, out, &mut shared, more, None));
                     }
                 }
             }
         });
     };
-    match opts.jobs {
-        Some(n) => rayon::ThreadPoolBuilder::new()
-            .num_threads(n.max(1))
-            .build()
-            .map_err(|e| CampaignError::io(out, e))?
-            .install(work),
-        None => work(),
+    if let Some(ext) = external {
+        if let Err(e) = fly_in_turn(c, &todo, out, ext, &|| stop.load(Ordering::Relaxed), &emit)
+            && let Ok(mut slot) = first_error.lock()
+        {
+            slot.get_or_insert(e);
+        }
+    } else {
+        run_in_pool(opts.jobs, out, work)?;
     }
     if let Some(e) = first_error.into_inner().ok().flatten() {
         return Err(e);
@@ -241,6 +284,64 @@ pub fn run_campaign(
     drop(appender);
     crate::finish::finish_dir(c, out)?;
     Ok(report)
+}
+
+/// Runs `work` on `jobs` threads (None: the global pool's).
+fn run_in_pool(
+    jobs: Option<usize>,
+    out: &Path,
+    work: impl FnOnce() + Send,
+) -> Result<(), CampaignError> {
+    match jobs {
+        Some(n) => rayon::ThreadPoolBuilder::new()
+            .num_threads(n.max(1))
+            .build()
+            .map_err(|e| CampaignError::io(out, e))?
+            .install(work),
+        None => work(),
+    }
+    Ok(())
+}
+
+/// Flies `todo` one run at a time on this thread, the configurations of `ext` with its
+/// planners. A planner that cannot be made, or that failed during its run, stops here with the
+/// run unrecorded.
+fn fly_in_turn(
+    c: &Campaign,
+    todo: &[RunKey],
+    out: &Path,
+    ext: &dyn ExternalPlanners,
+    stopped: &dyn Fn() -> bool,
+    emit: &dyn Fn(RunRow),
+) -> Result<(), CampaignError> {
+    for key in todo {
+        if stopped() {
+            break;
+        }
+        let config = &c.configs[key.config].name;
+        if !ext.flies(config) {
+            emit(run_one(c, key, out, &mut None, false, None));
+            continue;
+        }
+        let seed = c.run_seed(key);
+        let failed = |e: ExternalError| CampaignError::External {
+            config: config.clone(),
+            seed,
+            message: e.message,
+        };
+        // A family's file (not its base scenario's): the planner builds the run's site from it.
+        let entry = &c.scenarios[key.scenario];
+        let scenario = match (&entry.family, &entry.origin) {
+            (Some(f), _) => f.path.display().to_string(),
+            (None, plumetrace_scenario::Origin::File(p)) => p.display().to_string(),
+            (None, plumetrace_scenario::Origin::Preset(n)) => n.clone(),
+        };
+        let planner = ext.make(config, &scenario, seed).map_err(failed)?;
+        let row = run_one(c, key, out, &mut None, false, Some(planner));
+        ext.check().map_err(failed)?;
+        emit(row);
+    }
+    Ok(())
 }
 
 /// The runs that can share one environment (its spin-up, or the whole world): runs of the same
@@ -302,13 +403,15 @@ fn env_fingerprint(mut t: toml::Table) -> String {
 
 /// Flies one run and makes its row; never panics (a panic inside becomes outcome `error`).
 /// `shared` holds a spun-up environment of an earlier run of the same spin-up group, or
-/// receives this run's when `more` runs of the group follow.
+/// receives this run's when `more` runs of the group follow. `planner` replaces the first
+/// vehicle's.
 fn run_one(
     c: &Campaign,
     key: &RunKey,
     out: &Path,
     shared: &mut Option<Environment>,
     more: bool,
+    planner: Option<Box<dyn Planner>>,
 ) -> RunRow {
     let attempt = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
         let (mut setup, options) = prepare(c, key)?;
@@ -322,6 +425,9 @@ fn run_one(
             }
         }
         let mut mission = Mission::new(setup, options)?;
+        if let Some(p) = planner {
+            mission.replace_planner(0, p)?;
+        }
         mission.run(&mut |_, _| {})?;
         let run = mission.finish()?;
         row_of(c, key, out, run)
@@ -387,7 +493,7 @@ fn run_shared(c: &Campaign, group: &[RunKey], out: &Path, emit: &mut dyn FnMut(R
     }));
     if attempt.is_err() {
         for (key, _) in group.iter().zip(&written).filter(|(_, w)| !**w) {
-            emit(run_one(c, key, out, &mut None, false));
+            emit(run_one(c, key, out, &mut None, false, None));
         }
     }
 }

@@ -38,7 +38,10 @@ pub mod spec;
 pub mod stats;
 
 pub use error::CampaignError;
-pub use execute::{CampaignReport, RunOptions, Share, run_campaign};
+pub use execute::{
+    CampaignReport, ExternalError, ExternalPlanners, RunOptions, Share, run_campaign,
+    run_campaign_with,
+};
 pub use merge::{MergeReport, merge};
 pub use runs::{RUNS_FILE, RunRow};
 pub use spec::{Campaign, RunKey, Shard, TestSeeds};

@@ -5,6 +5,7 @@
 //! (missions, plume steps, campaigns, environment steps) runs with the interpreter detached, so
 //! other Python threads go on meanwhile.
 
+mod benchmark;
 mod campaign;
 mod error;
 mod gym;
@@ -32,6 +33,7 @@ fn _plumetrace(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(run::derive_seed, m)?)?;
     m.add_function(wrap_pyfunction!(plume::_plume_from_state, m)?)?;
     m.add_class::<run::RunRecord>()?;
+    m.add_function(wrap_pyfunction!(benchmark::benchmark, m)?)?;
     m.add_function(wrap_pyfunction!(campaign::campaign, m)?)?;
     m.add_function(wrap_pyfunction!(campaign::merge, m)?)?;
     m.add_function(wrap_pyfunction!(campaign::run_columns, m)?)?;

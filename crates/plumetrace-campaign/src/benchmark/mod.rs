@@ -11,6 +11,9 @@
 //! ([`TaskSet::test_seed_use`]): tune on the tuning seeds, read the test seeds once.
 
 pub mod board;
+pub mod run;
+
+pub use run::{BenchmarkOptions, Given, Plan, Quiet, TaskDone, Watch, plan, run_benchmark};
 
 use crate::error::CampaignError;
 use crate::spec::{Campaign, CampaignFile, ConfigFile};
@@ -112,6 +115,37 @@ pub enum BenchmarkError {
         given: u64,
         /// Its test seeds.
         max: u64,
+    },
+    /// The output directory holds something other than a benchmark.
+    #[error("{dir}: {what}; give a new, empty or benchmark output directory")]
+    NotABenchmark {
+        /// The directory.
+        dir: String,
+        /// What it is or holds.
+        what: String,
+    },
+    /// The output directory holds a task flown by other entrants.
+    #[error(
+        "{dir}: holds task '{task}' flown by {had}; this call enters {now}: give another output \
+         directory (or the same planners, to resume)"
+    )]
+    OtherEntrants {
+        /// The directory.
+        dir: String,
+        /// The task.
+        task: String,
+        /// Who flew it there.
+        had: String,
+        /// Who this call enters.
+        now: String,
+    },
+    /// An error flying one task.
+    #[error("benchmark task '{task}': {error}")]
+    InTask {
+        /// The task.
+        task: String,
+        /// What went wrong.
+        error: Box<BenchmarkError>,
     },
     /// A campaign error (a planner file, a group that does not build, the output directory).
     #[error(transparent)]

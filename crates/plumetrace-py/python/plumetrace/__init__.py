@@ -19,6 +19,7 @@ Submodules: ``plumetrace.gym`` (a Gymnasium environment, needs gymnasium) and
 
 from ._api import (
     RunResult,
+    benchmark,
     campaign,
     merge,
     planners,
@@ -35,6 +36,7 @@ __all__ = [
     "Plume",
     "PlumetraceError",
     "RunResult",
+    "benchmark",
     "campaign",
     "derive_seed",
     "merge",

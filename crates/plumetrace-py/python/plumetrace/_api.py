@@ -246,6 +246,140 @@ def campaign(
             bar.close()
 
 
+def _planner_factory(planner: Any) -> Callable[[str, int], Any]:
+    """``planner(scenario, seed)`` when it takes two arguments, else ``planner()``: a fresh
+    planner object per run. A class without ``decide`` is refused before anything flies."""
+    import inspect
+
+    what = getattr(planner, "__name__", type(planner).__name__)
+    if isinstance(planner, type) and not callable(getattr(planner, "decide", None)):
+        raise PlumetraceError(
+            f"the planner class {what} has no decide(snapshot) method: a Python planner "
+            "answers decide(snapshot) with a command dict (see plumetrace.run)"
+        )
+    try:
+        sig = inspect.signature(planner)
+    except (TypeError, ValueError):
+        return lambda scenario, seed: planner(scenario, seed)
+    try:
+        sig.bind("scenario", 0)
+        return lambda scenario, seed: planner(scenario, seed)
+    except TypeError:
+        pass
+    try:
+        sig.bind()
+        return lambda scenario, seed: planner()
+    except TypeError:
+        raise PlumetraceError(
+            f"the planner {what}{sig} cannot be made for a run: it is called as "
+            f"{what}(scenario, seed) or {what}()"
+        ) from None
+
+
+def benchmark(
+    planner: Union[None, str, Sequence[str], Any] = None,
+    out: Optional[PathLike] = None,
+    *,
+    name: Optional[str] = None,
+    tasks: Union[None, str, Sequence[str]] = None,
+    seeds_per_task: Optional[int] = None,
+    jobs: Optional[int] = None,
+    progress: Union[bool, Callable[[str, int, int], None]] = True,
+) -> Dict[str, Dict[str, Dict[str, Any]]]:
+    """Flies the benchmark's tasks on their test seeds, as ``plumetrace benchmark`` does (the
+    same loop: the same runs, the same numbers), and writes the leaderboard into ``out``.
+
+    Args:
+        planner: a registered planner's name (``"amp"``) or a list of names, flown at their
+            defaults in parallel; or a planner written in Python: a class (or any callable)
+            called as ``planner(scenario, seed)`` for each run (``planner()`` when it takes no
+            arguments) and returning an object with ``decide(snapshot)`` (the seam of
+            :func:`run`, and of ``plumetrace.gym.PolicyPlanner``). ``scenario`` is the task's
+            scenario (a family file's path, or a preset's name) and ``seed`` the run seed; the
+            planner flies the first vehicle. Python planners fly one run at a time. Default:
+            every task's own planners.
+        out: the output directory (a campaign directory per task, ``leaderboard.md``,
+            ``leaderboard.json``); running again into it resumes.
+        name: the Python planner's name in the tables (default: its ``__name__``).
+        tasks: task names (default: every task an entrant enters; a Python planner enters
+            every task but the team's).
+        seeds_per_task: test seeds per task, the first ones (default: each task's ``seeds``).
+        jobs: worker threads for registered planners (default one per core); results do not
+            depend on it.
+        progress: True for a tqdm bar per task (when tqdm is installed), or a callable
+            ``progress(task, done, total)``.
+
+    Returns:
+        ``results[task][planner]``: one dict per task and planner, the leaderboard's entry
+        (the keys of ``leaderboard.json``'s entries: ``runs``, ``successes``, ``success_rate``,
+        ``success_ci95``, ``error_median_m``, ...; ``None`` where it has ``null``), tasks in the
+        task set's order and planners best first.
+    """
+    if out is None:
+        raise PlumetraceError("benchmark needs out=: the directory the results go to")
+    names: List[str] = []
+    factory = None
+    factory_name = None
+    if isinstance(planner, str):
+        names = [planner]
+    elif planner is None:
+        names = []
+    elif isinstance(planner, (list, tuple)) and all(isinstance(p, str) for p in planner):
+        names = list(planner)
+    elif callable(planner):
+        factory = _planner_factory(planner)
+        factory_name = name or getattr(planner, "__name__", None)
+        if not factory_name or factory_name == "<lambda>":
+            raise PlumetraceError(
+                f"the planner {planner!r} has no name of its own: give it one with name= "
+                "(it names the planner's rows in the leaderboard)"
+            )
+    else:
+        raise PlumetraceError(
+            f"planner={planner!r}: give a registered planner's name, a list of names, or a "
+            "Python planner class"
+        )
+    if isinstance(tasks, str):
+        tasks = [tasks]
+    bar: List[Any] = [None, ""]
+    callback: Optional[Callable[[str, int, int], None]] = None
+    if callable(progress):
+        callback = progress
+    elif progress:
+
+        def callback(task: str, done: int, total: int) -> None:
+            if bar[1] != task:
+                if bar[0] is not None:
+                    bar[0].close()
+                bar[0] = _tqdm(total, "runs", task)
+                bar[1] = task
+            if bar[0] is not None:
+                bar[0].update(done - bar[0].n)
+
+    try:
+        r = _plumetrace.benchmark(
+            os.fspath(out),
+            names=names,
+            factory=factory,
+            factory_name=factory_name,
+            tasks=list(tasks or []),
+            seeds_per_task=seeds_per_task,
+            jobs=jobs,
+            progress=callback,
+        )
+    finally:
+        if bar[0] is not None:
+            bar[0].close()
+    for note in r["notes"]:
+        import warnings
+
+        warnings.warn(note, stacklevel=2)
+    board = json.loads(r["board"])
+    return {
+        t["task"]["name"]: {e["planner"]: e for e in t["entries"]} for t in board["tasks"]
+    }
+
+
 def merge(dirs: Sequence[PathLike], out: PathLike) -> Dict[str, Any]:
     """Merges shard directories of one campaign into ``out`` (``plumetrace merge``)."""
     return dict(_plumetrace.merge([os.fspath(d) for d in dirs], os.fspath(out)))

@@ -45,6 +45,16 @@ def campaign(
     progress: Optional[Callable[[int, int], Any]] = None,
 ) -> Dict[str, Any]: ...
 def merge(dirs: Sequence[str], out: str) -> Dict[str, Any]: ...
+def benchmark(
+    out: str,
+    names: Sequence[str] = ...,
+    factory: Optional[Callable[[str, int], Any]] = None,
+    factory_name: Optional[str] = None,
+    tasks: Sequence[str] = ...,
+    seeds_per_task: Optional[int] = None,
+    jobs: Optional[int] = None,
+    progress: Optional[Callable[[str, int, int], Any]] = None,
+) -> Dict[str, Any]: ...
 def run_columns() -> List[Tuple[str, str, str, str]]: ...
 
 class Plume:
