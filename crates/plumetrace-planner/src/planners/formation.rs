@@ -1663,35 +1663,49 @@ mod tests {
         }
     }
 
+    /// The left leader's formation scale at each 0.1 s step of `steps`, with `params` (its side
+    /// and `declare = false` set here), where it and its partner read the plume while `on(t)`
+    /// (its own reading 0.1, the partner's 0.3) and nothing otherwise.
+    fn left_leader_scales(
+        params: FormationLeaderParams,
+        steps: u32,
+        on: impl Fn(f64) -> bool,
+    ) -> Vec<f64> {
+        let mut l = FormationLeader::new(
+            FormationLeaderParams {
+                side: FormationSide::Left,
+                declare: false,
+                ..params
+            },
+            VehicleId(0),
+            Heading::from_deg(270.0),
+            area(),
+        );
+        let mut scales = Vec::new();
+        for k in 0..steps {
+            let t = f64::from(k) * 0.1;
+            let on = on(t);
+            let inbox = vec![partner_state(t, if on { 0.3 } else { 0.0 }, l.scale())];
+            let chem = vec![ChemSample {
+                time_s: t,
+                reading: 35.0 - if on { 0.1 } else { 0.0 },
+            }];
+            let pos = Some(Vec2::zeros());
+            l.decide(&snapshot(t, 0, pos, Heading::from_deg(270.0), chem, inbox));
+            scales.push(l.scale());
+        }
+        scales
+    }
+
     #[test]
     fn the_formation_closes_once_both_leaders_readings_fade() {
         // Own and partner's readings 0.3 (the partner's) and 0.1 (own) for 30 s, then nothing.
         let run = |close: bool| {
-            let mut l = FormationLeader::new(
-                FormationLeaderParams {
-                    side: FormationSide::Left,
-                    declare: false,
-                    close_on_fade: close,
-                    ..FormationLeaderParams::default()
-                },
-                VehicleId(0),
-                Heading::from_deg(270.0),
-                area(),
-            );
-            let mut scales = Vec::new();
-            for k in 0..600 {
-                let t = f64::from(k) * 0.1;
-                let on = t < 30.0;
-                let inbox = vec![partner_state(t, if on { 0.3 } else { 0.0 }, l.scale())];
-                let chem = vec![ChemSample {
-                    time_s: t,
-                    reading: 35.0 - if on { 0.1 } else { 0.0 },
-                }];
-                let pos = Some(Vec2::zeros());
-                l.decide(&snapshot(t, 0, pos, Heading::from_deg(270.0), chem, inbox));
-                scales.push(l.scale());
-            }
-            scales
+            let p = FormationLeaderParams {
+                close_on_fade: close,
+                ..FormationLeaderParams::default()
+            };
+            left_leader_scales(p, 600, |t| t < 30.0)
         };
         let closed = run(true);
         // Faded at 34 s (the 4 s max filter), then 0.05 per second down to 0.3.
@@ -1705,31 +1719,11 @@ mod tests {
     fn a_closed_formation_reopens_when_the_plume_comes_back_with_reopen_on_return() {
         // Read for 30 s, a gap of 15 s, read again for 7 s, then nothing.
         let run = |reopen: bool| {
-            let mut l = FormationLeader::new(
-                FormationLeaderParams {
-                    side: FormationSide::Left,
-                    declare: false,
-                    reopen_on_return: reopen,
-                    ..FormationLeaderParams::default()
-                },
-                VehicleId(0),
-                Heading::from_deg(270.0),
-                area(),
-            );
-            let mut scales = Vec::new();
-            for k in 0..800 {
-                let t = f64::from(k) * 0.1;
-                let on = t < 30.0 || (45.0..52.0).contains(&t);
-                let inbox = vec![partner_state(t, if on { 0.3 } else { 0.0 }, l.scale())];
-                let chem = vec![ChemSample {
-                    time_s: t,
-                    reading: 35.0 - if on { 0.1 } else { 0.0 },
-                }];
-                let pos = Some(Vec2::zeros());
-                l.decide(&snapshot(t, 0, pos, Heading::from_deg(270.0), chem, inbox));
-                scales.push(l.scale());
-            }
-            scales
+            let p = FormationLeaderParams {
+                reopen_on_return: reopen,
+                ..FormationLeaderParams::default()
+            };
+            left_leader_scales(p, 800, |t| t < 30.0 || (45.0..52.0).contains(&t))
         };
         // Closing from 34 s; at 45 s the plume is back: the scale is held (no follower) where
         // it was, 1 - 0.05 x 11 = 0.45, and falls again from the next fade (56 s).
