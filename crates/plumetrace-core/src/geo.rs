@@ -4,11 +4,13 @@
 //! ellipsoid, computed with GeographicLib's geodesics (`geographiclib-rs`): a point's east and
 //! north are its geodesic distance from the origin times the sine and cosine of the azimuth
 //! there. Distances from the origin and bearings at it are exact; over a few kilometres the
-//! frame differs from a flat tangent plane by millimetres.
+//! frame differs from a flat tangent plane by millimetres. [`tm`] holds the transverse Mercator
+//! (and UTM) that projected bathymetry and currents are placed by.
 
 use crate::Vec2;
 use geographiclib_rs::{DirectGeodesic, Geodesic, InverseGeodesic};
 use serde::{Deserialize, Serialize};
+pub use tm::{ProjectionError, TmParams, TransverseMercator};
 
 /// The origin of the local frame (where `x = y = 0`).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -76,6 +78,8 @@ impl LocalFrame {
             .direct(self.origin.lat_deg, self.origin.lon_deg, azi1, s12)
     }
 }
+
+pub mod tm;
 
 #[cfg(test)]
 mod tests {
