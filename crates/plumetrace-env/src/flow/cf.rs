@@ -23,7 +23,7 @@
 use super::gridded::{Frame, GriddedFlow};
 use crate::{EnvError, Rect};
 use plumetrace_core::Vec2;
-use plumetrace_core::geo::LocalFrame;
+use plumetrace_core::geo::{LocalFrame, TransverseMercator};
 use plumetrace_netcdf::time::TimeUnits;
 use plumetrace_netcdf::{NcFile, Var, nearest};
 use std::path::Path;
@@ -92,6 +92,10 @@ pub(crate) struct Axes {
     pub(crate) x: Option<(usize, Vec<f64>)>,
     pub(crate) y: Option<(usize, Vec<f64>)>,
     pub(crate) geographic: bool,
+    /// The projection of a projected grid in a mapped frame (a UTM GeoTIFF, a CF
+    /// `transverse_mercator` grid mapping): `x` and `y` hold eastings and northings, placed
+    /// through the site's origin; `None` for a grid in the local frame itself.
+    pub(crate) projection: Option<TransverseMercator>,
     /// A curvilinear grid's 2-D coordinates (then `x` and `y` hold node indices).
     pub(crate) curvi: Option<curvilinear::Curvilinear>,
     /// Terrain-following levels (then `depth` holds the level coordinate).
@@ -700,7 +704,10 @@ fn sample(
         (Some((_, xs)), Some((_, ys))) => (xs, ys),
         _ => return Err(err(path, "the currents have no horizontal grid")),
     };
-    let node_for_node = !axes.geographic && o.spacing_m.is_none() && axes.curvi.is_none();
+    let node_for_node = !axes.geographic
+        && axes.projection.is_none()
+        && o.spacing_m.is_none()
+        && axes.curvi.is_none();
     if let (true, Some((x0, dx)), Some((y0, dy))) = (node_for_node, even(xs), even(ys)) {
         let (nx, ny) = (xs.len(), ys.len());
         check_cover(
@@ -964,23 +971,29 @@ pub(crate) fn place<'a>(
             c, frame, spacing_m, area, must_cover, what, on_lon_lat, path,
         );
     }
-    let g = EvenGrid::new(
+    if let Some(tm) = &axes.projection {
+        check_projected_origin(tm, frame, what, path)?;
+    }
+    let mut g = EvenGrid::new(
         xs,
         ys,
-        axes.geographic,
+        axes.geographic || axes.projection.is_some(),
         frame,
         spacing_m,
         area,
         on_lon_lat,
         path,
     )?;
+    if let Some(tm) = &axes.projection {
+        g.set_projection(tm.clone(), xs, ys, spacing_m, area);
+    }
     let to_file = |x: f64, y: f64| g.to_file(x, y);
     check_cover_points(
         what,
         must_cover,
         xs,
         ys,
-        g.geographic(),
+        g.axis_names(),
         g.spacing,
         &to_file,
         path,
@@ -1001,13 +1014,50 @@ pub(crate) fn place<'a>(
     Ok((g, cells))
 }
 
+/// Whether the site's origin can place a grid in the projection `tm`: an origin is given, and
+/// the projection takes it (a UTM zone's latitudes, its central meridian near enough).
+fn check_projected_origin(
+    tm: &TransverseMercator,
+    frame: Option<&LocalFrame>,
+    what: &str,
+    path: &Path,
+) -> Result<(), EnvError> {
+    let Some(f) = frame else {
+        return Err(err(
+            path,
+            format!(
+                "{what} grid is projected ({}): give the site's origin ([origin] lat_deg and \
+                 lon_deg) to place it in the local frame",
+                tm.name()
+            ),
+        ));
+    };
+    let o = f.origin();
+    tm.forward(o.lat_deg, o.lon_deg).map(|_| ()).map_err(|e| {
+        err(
+            path,
+            format!(
+                "{what} grid is projected ({}), which cannot place the site's origin ({}, {}): \
+                 {e}; reproject it to longitude and latitude (`gdalwarp -t_srs EPSG:4326`) or \
+                 to the site's own UTM zone",
+                tm.name(),
+                o.lat_deg,
+                o.lon_deg
+            ),
+        )
+    })
+}
+
 /// An even grid in the local frame over `area` for a file's horizontal axes `xs`, `ys`: the
-/// frame that places a longitude/latitude grid (none for a projected one), the spacing (the
-/// file's own unless one is given, at most [`MAX_NODES_PER_SIDE`] nodes a side) and the nodes.
+/// frame that places a longitude/latitude or mapped grid (none for one in the local frame), the
+/// spacing (the file's own unless one is given, at most [`MAX_NODES_PER_SIDE`] nodes a side)
+/// and the nodes.
 pub(crate) struct EvenGrid<'a> {
     /// The file's longitude range (for wrapping), lowest first.
     lon_range: (f64, f64),
     frame: Option<&'a LocalFrame>,
+    /// The projection of a mapped grid (eastings and northings from latitude and longitude).
+    projection: Option<TransverseMercator>,
     /// The spacing asked for or the file's, widened to at most the nodes a side allows.
     pub(crate) spacing: f64,
     pub(crate) nx: usize,
@@ -1043,6 +1093,7 @@ impl<'a> EvenGrid<'a> {
         Ok(EvenGrid {
             lon_range: (xs[0].min(xs[xs.len() - 1]), xs[0].max(xs[xs.len() - 1])),
             frame,
+            projection: None,
             spacing,
             nx,
             ny,
@@ -1051,17 +1102,47 @@ impl<'a> EvenGrid<'a> {
         })
     }
 
-    /// Whether the grid is placed by the site's origin (longitude and latitude).
-    pub(crate) fn geographic(&self) -> bool {
-        self.frame.is_some()
+    /// Makes the grid a mapped one: its file coordinates are eastings and northings of `tm`,
+    /// and its own spacing is in metres (before [`EvenGrid::new`] took it as degrees).
+    fn set_projection(
+        &mut self,
+        tm: TransverseMercator,
+        xs: &[f64],
+        ys: &[f64],
+        spacing_m: Option<f64>,
+        area: Rect,
+    ) {
+        self.projection = Some(tm);
+        if spacing_m.is_none() {
+            self.spacing = native_spacing(xs, ys, None)
+                .max(area.width_m() / (MAX_NODES_PER_SIDE - 1) as f64)
+                .max(area.height_m() / (MAX_NODES_PER_SIDE - 1) as f64);
+            self.nx = ((area.width_m() / self.spacing).ceil() as usize + 1).max(2);
+            self.ny = ((area.height_m() / self.spacing).ceil() as usize + 1).max(2);
+            self.dx = area.width_m() / (self.nx - 1) as f64;
+            self.dy = area.height_m() / (self.ny - 1) as f64;
+        }
     }
 
-    /// Where a local position is in the file's coordinates (longitudes wrapped to its range).
+    /// The names of the file's horizontal coordinates in a message.
+    pub(crate) fn axis_names(&self) -> (&'static str, &'static str) {
+        match (self.frame, &self.projection) {
+            (_, Some(_)) => ("easting", "northing"),
+            (Some(_), None) => ("lon", "lat"),
+            (None, None) => ("x", "y"),
+        }
+    }
+
+    /// Where a local position is in the file's coordinates (longitudes wrapped to its range;
+    /// a mapped grid's eastings and northings, NaN where the projection does not reach).
     pub(crate) fn to_file(&self, x: f64, y: f64) -> (f64, f64) {
         match self.frame {
             None => (x, y),
             Some(f) => {
                 let (lat, mut lon) = f.to_geographic(Vec2::new(x, y));
+                if let Some(tm) = &self.projection {
+                    return tm.forward(lat, lon).unwrap_or((f64::NAN, f64::NAN));
+                }
                 let (lo, hi) = self.lon_range;
                 if lon < lo && lon + 360.0 <= hi {
                     lon += 360.0;
@@ -1082,17 +1163,12 @@ pub(crate) fn check_cover_points(
     r: Rect,
     xs: &[f64],
     ys: &[f64],
-    geographic: bool,
+    (nx_name, ny_name): (&str, &str),
     spacing: f64,
     to_file: &dyn Fn(f64, f64) -> (f64, f64),
     path: &Path,
 ) -> Result<(), EnvError> {
     let edge = edge_points(r, spacing);
-    let (nx_name, ny_name) = if geographic {
-        ("lon", "lat")
-    } else {
-        ("x", "y")
-    };
     let range = |a: &[f64]| (a[0].min(a[a.len() - 1]), a[0].max(a[a.len() - 1]));
     for (x, y) in edge {
         let (fx, fy) = to_file(x, y);

@@ -1,16 +1,21 @@
-//! Bathymetry from a single-band GeoTIFF on longitude and latitude (WGS 84, EPSG:4326), placed
-//! by its ModelTiepoint and ModelPixelScale tags, as GEBCO and EMODnet deliver their grids.
+//! Bathymetry from a single-band GeoTIFF on longitude and latitude (WGS 84, EPSG:4326), as
+//! GEBCO and EMODnet deliver their grids, or in WGS 84 / UTM (EPSG:32601 to 32660 north, 32701
+//! to 32760 south), as surveys do; placed by its ModelTiepoint and ModelPixelScale tags.
 //!
 //! The raster's frame comes from its GeoKeys: a geographic model (`GTModelTypeGeoKey` 2) in WGS
-//! 84 is read; a projected one (UTM and the rest), a rotated raster (ModelTransformation) or
-//! another datum is refused with the conversion to use. Pixels are areas (their centres are the
-//! nodes) unless `GTRasterTypeGeoKey` says points. GDAL's no-data tag marks missing values. The
+//! 84 is read, and a projected one (`GTModelTypeGeoKey` 1) whose `ProjectedCSTypeGeoKey` is a
+//! WGS 84 / UTM zone, in metres, is read through the core's transverse Mercator (each node of
+//! the local grid placed in latitude and longitude by the site's origin, then in the zone);
+//! another projection, a rotated raster (ModelTransformation) or another datum is refused with
+//! the conversion to use. Pixels are areas (their centres are the nodes) unless
+//! `GTRasterTypeGeoKey` says points. GDAL's no-data tag marks missing values. The
 //! values' sign says what they are: a raster with any value below zero holds elevations (as
 //! GEBCO's: negative below sea level), one with none holds depths (positive down).
 
 use super::{Seabed, SeabedOptions, sample};
 use crate::EnvError;
 use crate::flow::cf::{Axes, err};
+use plumetrace_core::geo::TransverseMercator;
 use std::io::{Cursor, Read};
 use std::path::Path;
 use tiff::decoder::{Decoder, DecodingResult};
@@ -21,6 +26,9 @@ const MODEL_TYPE: u16 = 1024;
 const RASTER_TYPE: u16 = 1025;
 const GEOGRAPHIC_TYPE: u16 = 2048;
 const PROJECTED_CS_TYPE: u16 = 3072;
+const PROJ_LINEAR_UNITS: u16 = 3076;
+/// `ProjLinearUnitsGeoKey`'s metre.
+const LINEAR_METER: u16 = 9001;
 /// `GTModelTypeGeoKey` values.
 const MODEL_PROJECTED: u16 = 1;
 const MODEL_GEOGRAPHIC: u16 = 2;
@@ -119,20 +127,19 @@ pub(crate) fn read(path: &Path, o: &SeabedOptions) -> Result<Seabed, EnvError> {
     let key = |id: u16| keys.iter().find(|(k, _)| *k == id).map(|(_, v)| *v);
     let projected = key(MODEL_TYPE) == Some(MODEL_PROJECTED)
         || (key(MODEL_TYPE).is_none() && key(PROJECTED_CS_TYPE).is_some());
-    if projected {
-        let code = key(PROJECTED_CS_TYPE)
-            .filter(|c| *c != USER_DEFINED)
-            .map(|c| format!("EPSG:{c}"))
-            .unwrap_or_else(|| "a user-defined projection".into());
-        return Err(err(
+    let projection = if projected {
+        Some(utm_zone(
+            key(PROJECTED_CS_TYPE),
+            key(PROJ_LINEAR_UNITS),
             path,
-            format!(
-                "the GeoTIFF is in a projected frame ({code}); only longitude and latitude on \
-                 WGS 84 (EPSG:4326) is read: {CONVERT}"
-            ),
-        ));
-    }
-    if key(MODEL_TYPE) != Some(MODEL_GEOGRAPHIC) && key(GEOGRAPHIC_TYPE).is_none() {
+        )?)
+    } else {
+        None
+    };
+    if projection.is_none()
+        && key(MODEL_TYPE) != Some(MODEL_GEOGRAPHIC)
+        && key(GEOGRAPHIC_TYPE).is_none()
+    {
         return Err(err(
             path,
             format!(
@@ -141,7 +148,9 @@ pub(crate) fn read(path: &Path, o: &SeabedOptions) -> Result<Seabed, EnvError> {
             ),
         ));
     }
-    if let Some(code) = key(GEOGRAPHIC_TYPE).filter(|c| *c != EPSG_WGS84 && *c != USER_DEFINED) {
+    if let Some(code) = key(GEOGRAPHIC_TYPE)
+        .filter(|c| projection.is_none() && *c != EPSG_WGS84 && *c != USER_DEFINED)
+    {
         return Err(err(
             path,
             format!(
@@ -220,11 +229,56 @@ pub(crate) fn read(path: &Path, o: &SeabedOptions) -> Result<Seabed, EnvError> {
     let axes = Axes {
         x: Some((1, xs)),
         y: Some((0, ys)),
-        geographic: true,
+        geographic: projection.is_none(),
+        projection,
         ..Axes::default()
     };
     let at = |i: usize, j: usize| depths[j * w + i];
     sample("the GeoTIFF", &axes, &at, o, path)
+}
+
+/// The UTM zone of a projected GeoTIFF, from its `ProjectedCSTypeGeoKey` (`code`) and
+/// `ProjLinearUnitsGeoKey` (`units`); any other projection is refused, its code named.
+fn utm_zone(
+    code: Option<u16>,
+    units: Option<u16>,
+    path: &Path,
+) -> Result<TransverseMercator, EnvError> {
+    let named = code
+        .filter(|c| *c != USER_DEFINED)
+        .map(|c| format!("ProjectedCSTypeGeoKey = {c}, EPSG:{c}"))
+        .unwrap_or_else(|| "a user-defined projection".into());
+    let tm = match code.and_then(|c| TransverseMercator::utm_from_epsg(u32::from(c))) {
+        Some(Ok(tm)) => tm,
+        Some(Err(e)) => {
+            return Err(err(
+                path,
+                format!("the GeoTIFF is in a projected frame ({named}): {e}; {CONVERT}"),
+            ));
+        }
+        None => {
+            return Err(err(
+                path,
+                format!(
+                    "the GeoTIFF is in a projected frame ({named}); only longitude and latitude \
+                     on WGS 84 (EPSG:4326) and WGS 84 / UTM (EPSG:32601 to 32660, 32701 to \
+                     32760) are read: {CONVERT}, or to the site's UTM zone (`gdalwarp -t_srs \
+                     EPSG:326NN`)"
+                ),
+            ));
+        }
+    };
+    match units {
+        None | Some(LINEAR_METER) => Ok(tm),
+        Some(u) => Err(err(
+            path,
+            format!(
+                "the GeoTIFF is in {} with ProjLinearUnitsGeoKey = {u}; UTM is read in metres \
+                 ({LINEAR_METER}): {CONVERT}",
+                tm.name()
+            ),
+        )),
+    }
 }
 
 /// The raster's values as numbers.
@@ -243,3 +297,6 @@ fn numbers(r: DecodingResult) -> Vec<f64> {
         DecodingResult::I64(v) => v.into_iter().map(|x| x as f64).collect(),
     }
 }
+
+#[cfg(test)]
+mod tests;

@@ -524,13 +524,13 @@ fn a_geotiff_in_another_frame_or_cut_short_is_located() {
     let o = geo_options();
     let utm = tmp(
         "utm.tif",
-        &geotiff(13, 9, &[(1024, 1), (3072, 32630)], east_slope),
+        &geotiff(13, 9, &[(1024, 1), (3072, 27700)], east_slope),
     );
     let e = Seabed::from_file(&utm, &o).unwrap_err().to_string();
     assert!(
         e.contains(
-            "utm.tif: the GeoTIFF is in a projected frame (EPSG:32630); only longitude \
-             and latitude on WGS 84 (EPSG:4326) is read"
+            "utm.tif: the GeoTIFF is in a projected frame (ProjectedCSTypeGeoKey = 27700, \
+             EPSG:27700); only longitude and latitude on WGS 84 (EPSG:4326) and WGS 84 / UTM"
         ) && e.contains("gdal_translate -of netCDF IN.tif OUT.nc"),
         "{e}"
     );
