@@ -337,6 +337,12 @@ impl TransverseMercator {
         Ok(tm)
     }
 
+    /// The projection named `name` in messages.
+    pub fn named(mut self, name: &str) -> Self {
+        self.name = name.to_string();
+        self
+    }
+
     /// The projection's name in messages (`UTM zone 18N`).
     pub fn name(&self) -> &str {
         &self.name

@@ -139,7 +139,14 @@ impl GriddedFlow {
         let uf = Field::read(&file, u, path)?;
         let vf = Field::read(&file, v, path)?;
         let (times, keep) = frames_kept(&axes, o, path)?;
-        sample(&axes, &uf, &vf, &times, keep, o, path)
+        // Velocities along a mapped grid's axes are turned to east and north at the origin.
+        let along_grid = ["sea_water_x_velocity", "x_sea_water_velocity"]
+            .contains(&u.text("standard_name").unwrap_or("").trim());
+        let turn = match (&axes.projection, o.frame.as_ref()) {
+            (Some(tm), Some(f)) if along_grid => mapping::grid_turn(tm, f),
+            _ => None,
+        };
+        sample(&axes, &uf, &vf, &times, keep, turn, o, path)
     }
 }
 
@@ -399,6 +406,9 @@ pub(crate) fn axes(file: &NcFile, u: &Var, path: &Path) -> Result<Axes, EnvError
                     .join(", ")
             ),
         ));
+    }
+    if !a.geographic && a.curvi.is_none() {
+        a.projection = mapping::read(file, u, path)?;
     }
     if let (Some(level), Some((px, _)), Some((py, _))) = (sigma_level, &a.x, &a.y) {
         let roles = sigma::Roles {
@@ -689,13 +699,16 @@ fn even(vals: &[f64]) -> Option<(f64, f64)> {
         .then_some((v[0], step))
 }
 
-/// Builds the flow: node for node on an even projected grid, else resampled.
+/// Builds the flow: node for node on an even projected grid, else resampled (velocities turned
+/// by `turn`, a sine and cosine, when along a mapped grid's axes).
+#[allow(clippy::too_many_arguments)]
 fn sample(
     axes: &Axes,
     u: &Field,
     v: &Field,
     times: &[f64],
     keep: std::ops::Range<usize>,
+    turn: Option<(f64, f64)>,
     o: &CfOptions,
     path: &Path,
 ) -> Result<GriddedFlow, EnvError> {
@@ -754,7 +767,7 @@ fn sample(
             x0, dx, nx, y0, dy, ny, frames,
         ));
     }
-    resample(axes, u, v, times, keep, d, o, path)
+    resample(axes, u, v, times, keep, d, turn, o, path)
 }
 
 /// A missing value: an error within reach of the op-area, else still water.
@@ -866,6 +879,7 @@ fn resample(
     times: &[f64],
     keep: std::ops::Range<usize>,
     d: Levels,
+    turn: Option<(f64, f64)>,
     o: &CfOptions,
     path: &Path,
 ) -> Result<GriddedFlow, EnvError> {
@@ -893,6 +907,7 @@ fn resample(
             );
             let a = bilinear(cell, n, |i, j| u.at(axes, t, d, i, j));
             let b = bilinear(cell, n, |i, j| v.at(axes, t, d, i, j));
+            let (a, b) = turn.map_or((a, b), |r| mapping::turn((a, b), r));
             fill_or_fail(
                 &mut fu[k],
                 &mut fv[k],
@@ -1226,6 +1241,7 @@ pub(crate) fn native_spacing(xs: &[f64], ys: &[f64], frame: Option<&LocalFrame>)
 }
 
 mod curvilinear;
+mod mapping;
 mod sigma;
 
 #[cfg(test)]
