@@ -22,7 +22,7 @@ packages() {
     case "$1" in
         fuzzy) echo "scikit-fuzzy==0.5.0 numpy scipy networkx packaging" ;;
         netcdf) echo "numpy scipy xarray" ;;
-        package) echo "numpy maturin==1.16.0 gymnasium==1.4.0 pytest>=7 pandas pyarrow tqdm dask[distributed] matplotlib" ;;
+        package) echo "numpy maturin==1.16.0 gymnasium==1.4.0 pytest>=7 pandas pyarrow tqdm dask[distributed] matplotlib xarray scipy" ;;
         ppo) echo "$PPO_NO_DEPS $PPO_DEPS" ;;
         *) return 1 ;;
     esac
