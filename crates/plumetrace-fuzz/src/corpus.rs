@@ -90,7 +90,8 @@ pub fn seabed_scenario() -> String {
 /// The bathymetry seeds: the example site's seabed (CDF-1, GEBCO-style elevations on longitude
 /// and latitude), a projected grid of depths (CDF-2, shorts packed with a scale, a fill value on
 /// land far from the op-area), a curvilinear grid (2-D longitude and latitude turned 15°, as
-/// ROMS writes `h` on `lon_rho` and `lat_rho`) and a GeoTIFF, all covering the site's op-area.
+/// ROMS writes `h` on `lon_rho` and `lat_rho`) and two GeoTIFFs (longitude and latitude; UTM
+/// zone 30N), all covering the site's op-area.
 pub fn seabed_seeds() -> Vec<(&'static str, Vec<u8>)> {
     use plumetrace_netcdf::{Dataset, NcType};
     // The projected grid: x -100..620 m, y -250..250 m, 40 m apart; depths 10 m to 18 m east.
@@ -153,7 +154,54 @@ pub fn seabed_seeds() -> Vec<(&'static str, Vec<u8>)> {
         ("projected-seabed", p.to_bytes().unwrap_or_default()),
         ("curvilinear-seabed", c.to_bytes().unwrap_or_default()),
         ("geotiff-seabed", geotiff_seabed()),
+        ("utm-geotiff-seabed", utm_geotiff_seabed()),
     ]
+}
+
+/// The site's seabed as a survey's GeoTIFF in WGS 84 / UTM zone 30N (EPSG:32630): depths
+/// (positive) on 20 m pixels from 200 m west and 300 m north of the site's origin, pixels as
+/// points, metres named by ProjLinearUnitsGeoKey.
+fn utm_geotiff_seabed() -> Vec<u8> {
+    use plumetrace_core::geo::TransverseMercator;
+    use tiff::encoder::{TiffEncoder, colortype::Gray32Float};
+    use tiff::tags::Tag;
+    let Some((e0, n0)) = TransverseMercator::utm(30, true)
+        .ok()
+        .and_then(|tm| tm.forward(50.35, -4.15).ok())
+    else {
+        return Vec::new();
+    };
+    let (w, h) = (48u32, 31u32);
+    let data: Vec<f32> = (0..w * h).map(|k| 10.0 + 0.3 * (k % w) as f32).collect();
+    let mut out = std::io::Cursor::new(Vec::new());
+    let write = |out: &mut std::io::Cursor<Vec<u8>>| -> tiff::TiffResult<()> {
+        let mut enc = TiffEncoder::new(out)?;
+        let mut image = enc.new_image::<Gray32Float>(w, h)?;
+        let e = image.encoder();
+        e.write_tag(Tag::ModelPixelScaleTag, &[20.0f64, 20.0, 0.0][..])?;
+        e.write_tag(
+            Tag::ModelTiepointTag,
+            &[
+                0.0f64,
+                0.0,
+                0.0,
+                (e0 - 200.0).round(),
+                (n0 + 300.0).round(),
+                0.0,
+            ][..],
+        )?;
+        e.write_tag(
+            Tag::GeoKeyDirectoryTag,
+            &[
+                1u16, 1, 0, 4, 1024, 0, 1, 1, 1025, 0, 1, 2, 3072, 0, 1, 32630, 3076, 0, 1, 9001,
+            ][..],
+        )?;
+        image.write_data(&data)
+    };
+    match write(&mut out) {
+        Ok(()) => out.into_inner(),
+        Err(_) => Vec::new(),
+    }
 }
 
 /// The site's seabed as a GeoTIFF (GEBCO-style elevations on WGS 84, 0.0005° pixels from
