@@ -124,41 +124,8 @@ pub(crate) fn read(path: &Path, o: &SeabedOptions) -> Result<Seabed, EnvError> {
         Some(_) => geokeys(&dec.get_tag_u16_vec(Tag::GeoKeyDirectoryTag).map_err(bad)?),
         None => Vec::new(),
     };
+    let projection = frame(&keys, path)?;
     let key = |id: u16| keys.iter().find(|(k, _)| *k == id).map(|(_, v)| *v);
-    let projected = key(MODEL_TYPE) == Some(MODEL_PROJECTED)
-        || (key(MODEL_TYPE).is_none() && key(PROJECTED_CS_TYPE).is_some());
-    let projection = if projected {
-        Some(utm_zone(
-            key(PROJECTED_CS_TYPE),
-            key(PROJ_LINEAR_UNITS),
-            path,
-        )?)
-    } else {
-        None
-    };
-    if projection.is_none()
-        && key(MODEL_TYPE) != Some(MODEL_GEOGRAPHIC)
-        && key(GEOGRAPHIC_TYPE).is_none()
-    {
-        return Err(err(
-            path,
-            format!(
-                "the GeoTIFF has no GeoKeys saying its frame (GTModelTypeGeoKey); a bathymetry \
-                 GeoTIFF is on longitude and latitude, WGS 84 (EPSG:4326): {CONVERT}"
-            ),
-        ));
-    }
-    if let Some(code) = key(GEOGRAPHIC_TYPE)
-        .filter(|c| projection.is_none() && *c != EPSG_WGS84 && *c != USER_DEFINED)
-    {
-        return Err(err(
-            path,
-            format!(
-                "the GeoTIFF is on the geographic frame EPSG:{code}; only WGS 84 (EPSG:4326) is \
-                 read: {CONVERT}"
-            ),
-        ));
-    }
     let tag = |dec: &mut Decoder<Cursor<Vec<u8>>>, t: Tag, name: &str, n: usize| match dec
         .find_tag(t)
         .map_err(bad)?
@@ -235,6 +202,47 @@ pub(crate) fn read(path: &Path, o: &SeabedOptions) -> Result<Seabed, EnvError> {
     };
     let at = |i: usize, j: usize| depths[j * w + i];
     sample("the GeoTIFF", &axes, &at, o, path)
+}
+
+/// The raster's frame from its GeoKeys: `None` for longitude and latitude on WGS 84, the
+/// zone's projection for WGS 84 / UTM; an error naming any other frame.
+fn frame(keys: &[(u16, u16)], path: &Path) -> Result<Option<TransverseMercator>, EnvError> {
+    let key = |id: u16| keys.iter().find(|(k, _)| *k == id).map(|(_, v)| *v);
+    let projected = key(MODEL_TYPE) == Some(MODEL_PROJECTED)
+        || (key(MODEL_TYPE).is_none() && key(PROJECTED_CS_TYPE).is_some());
+    let projection = if projected {
+        Some(utm_zone(
+            key(PROJECTED_CS_TYPE),
+            key(PROJ_LINEAR_UNITS),
+            path,
+        )?)
+    } else {
+        None
+    };
+    if projection.is_none()
+        && key(MODEL_TYPE) != Some(MODEL_GEOGRAPHIC)
+        && key(GEOGRAPHIC_TYPE).is_none()
+    {
+        return Err(err(
+            path,
+            format!(
+                "the GeoTIFF has no GeoKeys saying its frame (GTModelTypeGeoKey); a bathymetry \
+                 GeoTIFF is on longitude and latitude, WGS 84 (EPSG:4326): {CONVERT}"
+            ),
+        ));
+    }
+    if let Some(code) = key(GEOGRAPHIC_TYPE)
+        .filter(|c| projection.is_none() && *c != EPSG_WGS84 && *c != USER_DEFINED)
+    {
+        return Err(err(
+            path,
+            format!(
+                "the GeoTIFF is on the geographic frame EPSG:{code}; only WGS 84 (EPSG:4326) is \
+                 read: {CONVERT}"
+            ),
+        ));
+    }
+    Ok(projection)
 }
 
 /// The UTM zone of a projected GeoTIFF, from its `ProjectedCSTypeGeoKey` (`code`) and
