@@ -23,7 +23,7 @@
 use super::gridded::{Frame, GriddedFlow};
 use crate::{EnvError, Rect};
 use plumetrace_core::Vec2;
-use plumetrace_core::geo::{LocalFrame, TransverseMercator};
+use plumetrace_core::geo::{LocalFrame, ProjectionError, TransverseMercator};
 use plumetrace_netcdf::time::TimeUnits;
 use plumetrace_netcdf::{NcFile, Var, nearest};
 use std::path::Path;
@@ -1049,12 +1049,18 @@ fn check_projected_origin(
     };
     let o = f.origin();
     tm.forward(o.lat_deg, o.lon_deg).map(|_| ()).map_err(|e| {
+        // Beyond UTM's latitudes no zone helps.
+        let or_zone = if matches!(e, ProjectionError::Latitude { .. }) {
+            ""
+        } else {
+            " or to the site's own UTM zone"
+        };
         err(
             path,
             format!(
                 "{what} grid is projected ({}), which cannot place the site's origin ({}, {}): \
-                 {e}; reproject it to longitude and latitude (`gdalwarp -t_srs EPSG:4326`) or \
-                 to the site's own UTM zone",
+                 {e}; reproject it to longitude and latitude (`gdalwarp -t_srs \
+                 EPSG:4326`){or_zone}",
                 tm.name(),
                 o.lat_deg,
                 o.lon_deg

@@ -256,6 +256,16 @@ fn utm_zone(
         .filter(|c| *c != USER_DEFINED)
         .map(|c| format!("ProjectedCSTypeGeoKey = {c}, EPSG:{c}"))
         .unwrap_or_else(|| "a user-defined projection".into());
+    if let Some(c @ (32661 | 32761)) = code {
+        let pole = if c == 32661 { "North" } else { "South" };
+        return Err(err(
+            path,
+            format!(
+                "the GeoTIFF is in a projected frame ({named}): WGS 84 / UPS {pole}, the polar \
+                 stereographic beyond UTM's latitudes, which is not read; {CONVERT}"
+            ),
+        ));
+    }
     let tm = match code.and_then(|c| TransverseMercator::utm_from_epsg(u32::from(c))) {
         Some(Ok(tm)) => tm,
         Some(Err(e)) => {

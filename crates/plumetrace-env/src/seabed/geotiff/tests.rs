@@ -121,7 +121,12 @@ fn slope_error(lat: f64, lon: f64, code: u16, point: bool) -> f64 {
 #[test]
 fn a_utm_geotiff_reads_back_as_the_seabed_it_was_written_from() {
     // Off Plymouth in zone 30N, 1 deg west of its central meridian; off Sydney in zone 56S.
-    for (lat, lon, code) in [(50.0, -4.0, 32630), (-33.9, 151.3, 32756)] {
+    // And off Plymouth in the next zone west, 29N, 5 deg from its central meridian.
+    for (lat, lon, code) in [
+        (50.0, -4.0, 32630),
+        (-33.9, 151.3, 32756),
+        (50.0, -4.0, 32629),
+    ] {
         for point in [false, true] {
             let worst = slope_error(lat, lon, code, point);
             eprintln!("EPSG:{code} pixel-is-point {point}: worst {worst:.2e} m");
@@ -157,7 +162,7 @@ fn projections_other_than_utm_and_places_outside_the_zone_are_refused() {
     let user = write("user.tif", &[(1024, 1), (3072, 32767)]);
     assert!(read(&user, &options(f.clone())).contains("(a user-defined projection)"));
     // The codes either side of the series are not zones.
-    for (code, zone) in [(32600, 0), (32661, 61), (32700, 0), (32799, 99)] {
+    for (code, zone) in [(32600, 0), (32700, 0), (32799, 99)] {
         let p = write(&format!("zone{code}.tif"), &[(1024, 1), (3072, code)]);
         let e = read(&p, &options(f.clone()));
         assert!(
@@ -168,6 +173,12 @@ fn projections_other_than_utm_and_places_outside_the_zone_are_refused() {
             "{e}"
         );
     }
+    // The poles' codes next to the series are UPS.
+    let ups = write("ups.tif", &[(1024, 1), (3072, 32661)]);
+    assert!(read(&ups, &options(f.clone())).contains(
+        "(ProjectedCSTypeGeoKey = 32661, EPSG:32661): WGS 84 / UPS North, the polar stereographic \
+         beyond UTM's latitudes, which is not read; reproject it"
+    ));
     // Feet are refused.
     let feet = write("feet.tif", &[(1024, 1), (3072, 32630), (3076, 9002)]);
     assert!(
@@ -181,8 +192,8 @@ fn projections_other_than_utm_and_places_outside_the_zone_are_refused() {
         e.contains(
             "the bathymetry's grid is projected (UTM zone 30N), which cannot place the site's \
              origin (85, -4): latitude 85 deg is outside UTM zone 30N's limits (-80.5 to 84.5 \
-             deg)"
-        ),
+             deg); reproject it to longitude and latitude (`gdalwarp -t_srs EPSG:4326`)"
+        ) && !e.contains("own UTM zone"),
         "{e}"
     );
     let e = read(&utm, &options(frame(50.0, 40.0)));
