@@ -11,8 +11,11 @@
 //! end). Values are unpacked (`scale_factor`, `add_offset`), converted to m/s from their
 //! `units` (m s-1, cm s-1, mm s-1, knots), and `_FillValue` / `missing_value` are missing.
 //!
-//! A projected grid that is evenly spaced is used node for node (so a file holding the same
-//! numbers as a CSV grid gives the same flow, bit for bit); otherwise the field is resampled,
+//! A projected grid in a `transverse_mercator` grid mapping (UTM and the rest, [`mapping`])
+//! holds eastings and northings and is placed through the site's origin as a longitude/latitude
+//! grid is. A projected grid without one is in the local frame: evenly spaced, it is used node
+//! for node (so a file holding the same numbers as a CSV grid gives the same flow, bit for
+//! bit); otherwise the field is resampled,
 //! bilinearly, onto an even grid in the local frame over the simulated area, each node placed in
 //! latitude and longitude through the site's origin. The op-area must lie inside the file's grid
 //! and may touch no missing value; elsewhere in the simulated area a node outside the grid takes
