@@ -478,6 +478,8 @@ pub struct DynamicsConfig {
     pub dvl_beam_angle_deg: Option<f64>,
     /// The forward altimeter's range ahead along the heading, m (0: none).
     pub look_ahead_m: Option<f64>,
+    /// The lowest altitude the altitude hold aims at over a seabed grid, m.
+    pub min_altitude_m: Option<f64>,
 }
 
 /// `[vehicles.nav]`

@@ -447,6 +447,12 @@ pub const LIMITS: &[Limit] = &[
         "a forward altimeter reads tens of metres ahead",
     ),
     num(
+        "vehicles[].dynamics.min_altitude_m",
+        0.0,
+        100.0,
+        "a minimum altitude of 100 m is no altitude hold",
+    ),
+    num(
         "vehicles[].nav.fix_interval_s",
         0.01,
         LONG,

@@ -244,6 +244,11 @@ fn altitude_hold_s_seabed_sensors_are_bounded() {
             "vehicles[1].dynamics.look_ahead_m: must be >= 0.0 and <= 100.0 (a forward altimeter \
              reads tens of metres ahead), got -1.0",
         ),
+        (
+            "[vehicles.dynamics]\nmin_altitude_m = -0.5",
+            "vehicles[1].dynamics.min_altitude_m: must be >= 0.0 and <= 100.0 (a minimum \
+             altitude of 100 m is no altitude hold), got -0.5",
+        ),
     ] {
         let e = error_of(&demo_with_vehicles(extra));
         assert!(e.contains(want), "{extra:?}: {e}");
@@ -646,7 +651,7 @@ fn keys_with_no_effect_in_this_kind_of_run_are_warned_of() {
             format!("{demo}\n[vehicles.dynamics]\nlook_ahead_m = 20.0\n"),
             vec![
                 "vehicles[0].dynamics.look_ahead_m: has no effect over a flat seabed: altitude \
-                 hold looks at the seabed's slope only over a [bathymetry] grid",
+                 hold uses its seabed sensors and minimum altitude only over a [bathymetry] grid",
             ],
         ),
         (demo.to_string(), vec![]),

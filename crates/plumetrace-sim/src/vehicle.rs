@@ -37,6 +37,10 @@ pub struct VehicleParams {
     /// Horizontal range ahead of the forward altimeter, along the heading, m (10 for the field
     /// AUV; 0: none). Over a seabed that is not flat, altitude hold clears the seabed it sees.
     pub look_ahead_m: f64,
+    /// Over a seabed that is not flat, the lowest altitude the altitude hold aims at, m (0.3
+    /// for the field AUV: its altitude error is clipped there, about two sd below an altitude
+    /// of 1 m; a commanded altitude below it is aimed at as it is).
+    pub min_altitude_m: f64,
 }
 
 impl VehicleParams {
@@ -52,6 +56,7 @@ impl VehicleParams {
             altitude_error_time_s: 60.0,
             dvl_beam_angle_deg: 30.0,
             look_ahead_m: 10.0,
+            min_altitude_m: 0.3,
         }
     }
 
@@ -67,6 +72,7 @@ impl VehicleParams {
             altitude_error_time_s: 1.0,
             dvl_beam_angle_deg: 0.0,
             look_ahead_m: 0.0,
+            min_altitude_m: 0.0,
         }
     }
 
@@ -88,7 +94,8 @@ impl VehicleParams {
                 ),
             ));
         }
-        require_non_negative("look_ahead_m", self.look_ahead_m)
+        require_non_negative("look_ahead_m", self.look_ahead_m)?;
+        require_non_negative("min_altitude_m", self.min_altitude_m)
     }
 }
 
@@ -220,7 +227,10 @@ impl Vehicle {
                 let target_z = match (p.kind, command.vertical) {
                     (VehicleKind::Auv, VerticalCommand::Altitude(alt)) if alt.is_finite() => {
                         let ground = water + flow_mps;
-                        seabed_ahead(&p, s, ground, floor, height_at) + alt + s.altitude_error_m
+                        // The error never takes the aim closer to the seabed than the vehicle's
+                        // minimum altitude (nor below the commanded altitude, if lower).
+                        let aim = (alt + s.altitude_error_m).max(p.min_altitude_m.min(alt));
+                        seabed_ahead(&p, s, ground, floor, height_at) + aim
                     }
                     _ => target_z,
                 };
@@ -445,6 +455,38 @@ mod tests {
         assert!(w > 0.3 && w < 0.4, "{w}");
         let w = worst(blind, 90.0);
         assert!(w > 0.9 && w < 1.0, "{w}");
+    }
+
+    /// Over a seabed grid the altitude error never takes the aim below `min_altitude_m`: a
+    /// 1 m sd error at 1 m, for an hour over a flat grid, never brings the vehicle below 0.3 m;
+    /// without the minimum it reaches the seabed.
+    #[test]
+    fn the_altitude_error_stops_at_the_minimum_altitude() {
+        let lowest = |min_altitude_m: f64| {
+            let params = VehicleParams {
+                altitude_error_sd_m: 1.0,
+                min_altitude_m,
+                ..VehicleParams::auv()
+            };
+            let mut v = Vehicle::new(VehicleId(0), params, Vec2::zeros(), 1.0, Heading::NORTH);
+            let mut rng = stream_rng(2, StreamId::Vehicle(0));
+            let mut low = f64::INFINITY;
+            for _ in 0..36_000 {
+                v.step_over(
+                    &cmd(0.0, 2.0, 1.0),
+                    Vec2::zeros(),
+                    Some(20.0),
+                    Some(&|_| 0.0),
+                    0.1,
+                    &mut rng,
+                );
+                low = low.min(v.state.z_m);
+            }
+            low
+        };
+        let low = lowest(0.3);
+        assert!((0.3..0.31).contains(&low), "{low}");
+        assert!(lowest(0.0) < 0.01);
     }
 
     #[test]
