@@ -333,8 +333,9 @@ fn ridge() -> Vec<u8> {
     d.to_bytes().unwrap()
 }
 
-#[test]
-fn a_vehicle_that_meets_a_ridge_hits_the_bottom_and_the_summary_says_so() {
+/// The demo, shortened, over [`ridge`], its AUV's `[vehicles.dynamics]` given: its events and
+/// summary.
+fn over_the_ridge(dynamics: &str) -> (String, serde_json::Value) {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
     std::fs::write(d.join("ridge.nc"), ridge()).unwrap();
@@ -342,6 +343,11 @@ fn a_vehicle_that_meets_a_ridge_hits_the_bottom_and_the_summary_says_so() {
         .replacen(
             "depth_m = 8.0\n",
             "\n[bathymetry]\nfile = \"ridge.nc\"\n",
+            1,
+        )
+        .replacen(
+            "[mission]",
+            &format!("[vehicles.dynamics]\n{dynamics}\n\n[mission]"),
             1,
         )
         .replacen("time_limit_s = 2400.0", "time_limit_s = 300.0", 1)
@@ -352,12 +358,20 @@ fn a_vehicle_that_meets_a_ridge_hits_the_bottom_and_the_summary_says_so() {
     let out = d.join("run");
     run_ok(&["run", s.to_str().unwrap(), "--out", out.to_str().unwrap()]);
     let events = std::fs::read_to_string(out.join("events.jsonl")).unwrap();
+    let summary =
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    (events, summary)
+}
+
+#[test]
+fn a_vehicle_that_meets_a_ridge_hits_the_bottom_and_the_summary_says_so() {
+    // Blind to the seabed ahead (no DVL slope, no forward altimeter), the altitude hold lags the
+    // wall.
+    let (events, summary) = over_the_ridge("dvl_beam_angle_deg = 0.0\nlook_ahead_m = 0.0");
     assert!(
         events.contains("\"event\":\"incident\",\"what\":\"hit_bottom\""),
         "{events}"
     );
-    let summary: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
     assert_eq!(summary["outcome"], "collided");
     let v = &summary["vehicles"][0];
     assert_eq!(v["status"], "collided");
@@ -369,4 +383,12 @@ fn a_vehicle_that_meets_a_ridge_hits_the_bottom_and_the_summary_says_so() {
         (ended - t).abs() < 1e-9,
         "the mission ends there: {ended} {t}"
     );
+}
+
+#[test]
+fn the_field_auv_sees_the_ridge_ahead_and_climbs_it() {
+    let (events, summary) = over_the_ridge("");
+    assert!(!events.contains("hit_bottom"), "{events}");
+    assert_ne!(summary["outcome"], "collided");
+    assert!(summary["vehicles"][0].get("hit_bottom_s").is_none());
 }

@@ -474,6 +474,12 @@ pub struct DynamicsConfig {
     pub altitude_error_sd_m: Option<f64>,
     /// Altitude-keeping error correlation time, s.
     pub altitude_error_time_s: Option<f64>,
+    /// The DVL's beams' angle from the vertical, deg (0: altitude hold sees no slope).
+    pub dvl_beam_angle_deg: Option<f64>,
+    /// The forward altimeter's range ahead along the heading, m (0: none).
+    pub look_ahead_m: Option<f64>,
+    /// The lowest altitude the altitude hold aims at over a seabed grid, m.
+    pub min_altitude_m: Option<f64>,
 }
 
 /// `[vehicles.nav]`

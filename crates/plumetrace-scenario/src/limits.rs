@@ -435,6 +435,24 @@ pub const LIMITS: &[Limit] = &[
         "a correlation time of a day at most",
     ),
     num(
+        "vehicles[].dynamics.dvl_beam_angle_deg",
+        0.0,
+        60.0,
+        "a beam further than 60 deg from the vertical grazes the seabed",
+    ),
+    num(
+        "vehicles[].dynamics.look_ahead_m",
+        0.0,
+        100.0,
+        "a forward altimeter reads tens of metres ahead",
+    ),
+    num(
+        "vehicles[].dynamics.min_altitude_m",
+        0.0,
+        100.0,
+        "a minimum altitude of 100 m is no altitude hold",
+    ),
+    num(
         "vehicles[].nav.fix_interval_s",
         0.01,
         LONG,

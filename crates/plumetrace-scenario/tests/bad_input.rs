@@ -232,6 +232,36 @@ fn bad_vehicle_settings_are_rejected_with_their_key_path() {
 }
 
 #[test]
+fn altitude_hold_s_seabed_sensors_are_bounded() {
+    for (extra, want) in [
+        (
+            "[vehicles.dynamics]\ndvl_beam_angle_deg = 75.0",
+            "vehicles[1].dynamics.dvl_beam_angle_deg: must be >= 0.0 and <= 60.0 (a beam further \
+             than 60 deg from the vertical grazes the seabed), got 75.0",
+        ),
+        (
+            "[vehicles.dynamics]\nlook_ahead_m = -1.0",
+            "vehicles[1].dynamics.look_ahead_m: must be >= 0.0 and <= 100.0 (a forward altimeter \
+             reads tens of metres ahead), got -1.0",
+        ),
+        (
+            "[vehicles.dynamics]\nmin_altitude_m = -0.5",
+            "vehicles[1].dynamics.min_altitude_m: must be >= 0.0 and <= 100.0 (a minimum \
+             altitude of 100 m is no altitude hold), got -0.5",
+        ),
+    ] {
+        let e = error_of(&demo_with_vehicles(extra));
+        assert!(e.contains(want), "{extra:?}: {e}");
+    }
+    assert_eq!(
+        error_of(&demo_with_vehicles(
+            "[vehicles.dynamics]\ndvl_beam_angle_deg = 20.0\nlook_ahead_m = 0.0"
+        )),
+        "accepted"
+    );
+}
+
+#[test]
 fn planner_tables_are_wired_to_vehicles_with_key_paths() {
     let mt = find_preset("duck-2003-mt").unwrap().toml;
     assert_eq!(error_of(mt), "accepted");
@@ -615,6 +645,13 @@ fn keys_with_no_effect_in_this_kind_of_run_are_warned_of() {
             vec![
                 "comms: has no effect on a plume run (a scenario without [mission]): no vehicle \
                  sends messages",
+            ],
+        ),
+        (
+            format!("{demo}\n[vehicles.dynamics]\nlook_ahead_m = 20.0\n"),
+            vec![
+                "vehicles[0].dynamics.look_ahead_m: has no effect over a flat seabed: altitude \
+                 hold uses its seabed sensors and minimum altitude only over a [bathymetry] grid",
             ],
         ),
         (demo.to_string(), vec![]),

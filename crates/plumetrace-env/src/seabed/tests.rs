@@ -110,25 +110,9 @@ fn gebco(land_at: Option<usize>) -> Dataset {
     d
 }
 
-fn site() -> SeabedOptions {
-    SeabedOptions {
-        frame: Some(
-            LocalFrame::new(Origin {
-                lat_deg: 50.0,
-                lon_deg: -4.0,
-            })
-            .unwrap(),
-        ),
-        area: rect(-1000.0, 1000.0, -1000.0, 1000.0),
-        must_cover: rect(-500.0, 500.0, -500.0, 500.0),
-        spacing_m: Some(100.0),
-        variable: None,
-    }
-}
-
 #[test]
 fn a_gebco_elevation_on_longitude_and_latitude_is_read_as_depth() {
-    let s = read("gebco.nc", &gebco(None), &site()).unwrap();
+    let s = read("gebco.nc", &gebco(None), &geo_options()).unwrap();
     // -40 m at lon -4.04, one metre shallower each 0.02 deg east: -38 m at the origin.
     assert!(
         (s.depth_at(0.0, 0.0) - 38.0).abs() < 0.01,
@@ -136,9 +120,9 @@ fn a_gebco_elevation_on_longitude_and_latitude_is_read_as_depth() {
         s.depth_at(0.0, 0.0)
     );
     // Land (elevation > 0) outside the op-area takes the shallowest water.
-    let s = read("land-out.nc", &gebco(Some(0)), &site()).unwrap();
+    let s = read("land-out.nc", &gebco(Some(0)), &geo_options()).unwrap();
     assert!(s.depth_at(-1000.0, -1000.0) > 0.0);
-    let e = read("land-in.nc", &gebco(Some(7)), &site()).unwrap_err();
+    let e = read("land-in.nc", &gebco(Some(7)), &geo_options()).unwrap_err();
     assert!(
         e.contains("variable elevation: the seabed is at or above the surface")
             && e.contains("inside the op-area")
@@ -208,7 +192,7 @@ fn the_errors_name_the_variable_attribute_or_dimension_and_suggest() {
         "{e}"
     );
     // Longitude and latitude without an origin.
-    let mut o = site();
+    let mut o = geo_options();
     o.frame = None;
     let e = read("origin.nc", &gebco(None), &o).unwrap_err();
     assert!(
@@ -460,6 +444,8 @@ fn geotiff_node(i: usize, j: usize) -> (f64, f64) {
 
 const WGS84: &[(u16, u16)] = &[(1024, 2), (1025, 1), (2048, 4326)];
 
+/// A site at (50 N, 4 W): a 2 km domain around the origin, its inner kilometre the op-area,
+/// 100 m nodes (the GEBCO-style NetCDF grids and the GeoTIFFs alike).
 fn geo_options() -> SeabedOptions {
     SeabedOptions {
         frame: Some(

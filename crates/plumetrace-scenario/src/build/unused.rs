@@ -59,5 +59,23 @@ pub(super) fn unused_keys(cfg: &ScenarioConfig, mission: bool) -> Vec<Warning> {
             }
         }
     }
+    if cfg.bathymetry.is_none() {
+        for (i, v) in cfg.vehicles.iter().enumerate() {
+            let d = &v.dynamics;
+            for (key, given) in [
+                ("dvl_beam_angle_deg", d.dvl_beam_angle_deg.is_some()),
+                ("look_ahead_m", d.look_ahead_m.is_some()),
+                ("min_altitude_m", d.min_altitude_m.is_some()),
+            ] {
+                if given {
+                    out.push(Warning::new(
+                        format!("vehicles[{i}].dynamics.{key}"),
+                        "has no effect over a flat seabed: altitude hold uses its seabed \
+                         sensors and minimum altitude only over a [bathymetry] grid",
+                    ));
+                }
+            }
+        }
+    }
     out
 }

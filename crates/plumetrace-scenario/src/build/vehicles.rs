@@ -191,6 +191,9 @@ fn dynamics(v: &VehicleConfig, key: &str) -> Result<VehicleParams, Invalid> {
         altitude_error_time_s: dy
             .altitude_error_time_s
             .unwrap_or(base.altitude_error_time_s),
+        dvl_beam_angle_deg: dy.dvl_beam_angle_deg.unwrap_or(base.dvl_beam_angle_deg),
+        look_ahead_m: dy.look_ahead_m.unwrap_or(base.look_ahead_m),
+        min_altitude_m: dy.min_altitude_m.unwrap_or(base.min_altitude_m),
     };
     params
         .validate()
