@@ -358,12 +358,12 @@ fn a_patch_whose_plume_goes_on_upflow_is_traced_on_not_declared() {
     assert_eq!(a.behaviour(), BehaviourKind::TrackOut);
     let (at, goals) = a.confirming().expect("a confirming Track-Out");
     assert!((at - Vec2::new(200.0, 294.0)).norm() < 1e-9, "{at:?}");
-    // Three legs, a third of 50 m upflow each, 20 m to either side of the axis in turn.
+    // Three legs, a third of 60 m upflow each, 30 m to either side of the axis in turn.
     assert_eq!(goals.len(), 3, "{goals:?}");
     for (k, g) in goals.iter().enumerate() {
         let up = 294.0 - g.y;
-        assert!((up - 50.0 * (k + 1) as f64 / 3.0).abs() < 1e-9, "{goals:?}");
-        assert!(((g.x - 200.0).abs() - 20.0).abs() < 1e-9, "{goals:?}");
+        assert!((up - 60.0 * (k + 1) as f64 / 3.0).abs() < 1e-9, "{goals:?}");
+        assert!(((g.x - 200.0).abs() - 30.0).abs() < 1e-9, "{goals:?}");
     }
     assert!(
         (goals[0].x - 200.0) * (goals[1].x - 200.0) < 0.0,

@@ -11,7 +11,9 @@
 //! - **Track-Out** goes `L_u` upflow and `L_c` across the flow from the most upflow lost point, to the
 //!   side opposite the exit; it ends on detection or arrival, and the declaration check runs
 //!   (not on a contact upflow of every lost point, unless `declaration_on_upflow_contact`: the
-//!   plume goes on there, and Track-In follows it);
+//!   plume goes on there, and Track-In follows it); when the check holds, a confirming Track-Out
+//!   first zigzags `declaration_confirm_m` upflow of the point, and a contact there resumes
+//!   Track-In instead of declaring;
 //! - **Reacquire** flies `N_re` Bowties from 10 m upflow of the most upflow lost point down to it,
 //!   then drops the point; with no point left it returns to Find.
 //!
@@ -112,10 +114,10 @@ plumetrace_core::params! {
         declaration_upflow_m: f64 = 2.5, "m", Bounds::non_negative(100.0);
         /// Whether a contact during Track-Out upflow of the most upflow lost point runs the declaration check (true: the field rule, every Track-Out contact does). Such a contact says the plume goes on upflow: in a strong current a plume's patches far downflow of the source can gather three lost points within declaration_along_m, and the check then declared 150 m from the source.
         declaration_on_upflow_contact: bool = false, "", Bounds::Any;
-        /// Before a lost-point rule declares, a confirming Track-Out flies from where the vehicle is to this far upflow of the point to declare (clipped to the op-area pattern_margin_m inside it); a contact on the way more than declaration_along_m upflow of the point says the plume goes on there, and Track-In follows it instead of declaring (0: declare at once, the field rule). Far downflow of a source the plume breaks into patches, and the upflow ends of one patch, drifting with the current, can gather three lost points within declaration_along_m: on the families' tuning sites the check then declared 120-460 m downflow of the source, with the next patch upflow beyond Track-Out's reach.
-        declaration_confirm_m: f64 = 50.0, "m", Bounds::non_negative(1000.0);
-        /// How far to each side of the flow axis through the point to declare the confirming Track-Out zigzags: three legs, a third of declaration_confirm_m upflow each, from the side away from the vehicle to the other and back (0: straight upflow). Far downflow the plume meanders across the flow and the instantaneous plume is narrow: a straight leg up its mean axis can pass between patches.
-        declaration_confirm_width_m: f64 = 20.0, "m", Bounds::non_negative(1000.0);
+        /// Before a lost-point rule declares, a confirming Track-Out flies from where the vehicle is to this far upflow of the point to declare (each leg clipped to the op-area pattern_margin_m inside it); a contact on the way more than declaration_along_m upflow of the point says the plume goes on there, and Track-In follows it instead of declaring (0: declare at once, the field rule). Far downflow of a source the plume breaks into patches, and the upflow ends of one patch can gather three lost points within declaration_along_m: on the families' tuning sites the check then declared 125-534 m downflow of the source (4 of 900 sites), with the plume going on beyond Track-Out's reach; the confirming leg costs a median 100 s before each declaration.
+        declaration_confirm_m: f64 = 60.0, "m", Bounds::non_negative(1000.0);
+        /// How far to each side of the flow axis through the point to declare the confirming Track-Out zigzags: three legs, each a third of declaration_confirm_m further upflow, first to the side away from the vehicle, then across to the other and back (0: one leg straight upflow). Far downflow the instantaneous plume is narrow and meanders across the flow: straight up its axis a leg found the plume beyond the patch on 2 of the 4 tuning sites, zigzagging on 3.
+        declaration_confirm_width_m: f64 = 30.0, "m", Bounds::non_negative(1000.0);
         /// Where across the flow the lost-point rules declare: most_upflow (the most upflow lost point, the field rule) or mean (the mean of the three most upflow lost points across the flow).
         declaration_across: DeclarationAcross = DeclarationAcross::Mean, "", Bounds::Any;
         /// Fly the post-declaration mapping pattern (single-source missions).
@@ -302,7 +304,7 @@ impl PlannerParams for AmpParams {
     const RULES: &'static [RuleDoc] = &[
         RuleDoc {
             rule: declaration::ALONG_FLOW,
-            doc: "the three most upflow lost points lie within declaration_along_m of each other along the flow: declaration_upflow_m upflow of the most upflow one, across the flow as declaration_across says (with 0 and most_upflow: the most upflow one, the field rule)",
+            doc: "the three most upflow lost points lie within declaration_along_m of each other along the flow: declaration_upflow_m upflow of the most upflow one, across the flow as declaration_across says (with 0 and most_upflow: the most upflow one, the field rule), once a confirming Track-Out declaration_confirm_m upflow of it met no plume (0: at once, the field rule)",
         },
         RuleDoc {
             rule: declaration::ALONG_AND_CROSS_FLOW,
