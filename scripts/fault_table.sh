@@ -9,6 +9,7 @@
 #   scripts/fault_table.sh --jobs N         rehearsals at once (default: the number of cores)
 #   scripts/fault_table.sh --runs N         run seeds 1..N (default 10)
 #   scripts/fault_table.sh --sites N        coastal sites 0..N-1 (default 5)
+#   scripts/fault_table.sh --site K         only coastal site K (no demo), e.g. with --out elsewhere
 #   scripts/fault_table.sh --family-seed S  the coastal sites of campaign seed S (default 3202, the
 #                                           benchmark's test seed of the coastal task)
 #   scripts/fault_table.sh --out FILE       the page (default docs/results/fault-table.md)
@@ -29,16 +30,18 @@ sites=5
 family_seed=3202
 page="docs/results/fault-table.md"
 table_only=0
+only_site=""
 while [ $# -gt 0 ]; do
     case "$1" in
         --bin) bin="$2"; shift 2 ;;
         --jobs) jobs="$2"; shift 2 ;;
         --runs) runs="$2"; shift 2 ;;
         --sites) sites="$2"; shift 2 ;;
+        --site) only_site="$2"; shift 2 ;;
         --family-seed) family_seed="$2"; shift 2 ;;
         --out) page="$2"; shift 2 ;;
         --table-only) table_only=1; shift ;;
-        -h|--help) sed -n '2,21p' "$0"; exit 0 ;;
+        -h|--help) sed -n '2,22p' "$0"; exit 0 ;;
         *) echo "fault_table.sh: unknown argument $1 (see --help)" >&2; exit 2 ;;
     esac
 done
@@ -54,6 +57,7 @@ if [ "$table_only" -eq 0 ]; then
     mkdir -p "$work/sites"
     test_flag=()
     if [ "$family_seed" = 3202 ]; then test_flag=(--test-seeds); fi
+    if [ -n "$only_site" ] && [ "$sites" -le "$only_site" ]; then sites=$((only_site + 1)); fi
     "$bin" family examples/families/coastal.family.toml --sample "$sites" --seed "$family_seed" \
         --out "$work/sites" "${test_flag[@]}" >/dev/null
 fi
@@ -96,8 +100,12 @@ export -f fly_one
 export bin work
 export FAULTS="$(printf '%s\n' "${faults[@]}")"
 
-scenarios=(demo)
-for k in $(seq 0 $((sites - 1))); do scenarios+=("$work/sites/site-$(printf '%03d' "$k").toml"); done
+if [ -n "$only_site" ]; then
+    scenarios=("$work/sites/site-$(printf '%03d' "$only_site").toml")
+else
+    scenarios=(demo)
+    for k in $(seq 0 $((sites - 1))); do scenarios+=("$work/sites/site-$(printf '%03d' "$k").toml"); done
+fi
 
 start=$(date +%s)
 if [ "$table_only" -eq 0 ]; then
@@ -185,13 +193,18 @@ def site_line(s):
 out = []
 out.append("# Results: `fault-table`\n")
 out.append("The AMP's declaration on a vehicle under ordinary link faults, rehearsed with `frontseat`.\n")
-out.append("The demo and five coastal-family sites are flown over the simulated front seat in lock-step,")
+out.append(("The demo and five coastal-family sites are" if "demo" in scenarios
+            else "Coastal-family sites only (`--site`) are")
+           + " flown over the simulated front seat in lock-step,")
 out.append(f"run seeds 1 to {runs}, each without a fault and with each of five faults; a cell counts the")
 out.append("runs declaring within 20 m of the source (the first declaration) and names the others")
 out.append("(`none`: no declaration before the time limit).\n")
 out.append(f"Produced at commit `{commit}` on {datetime.date.today()} by `scripts/fault_table.sh` "
            f"({cores} cores, {secs} s of wall time).")
-out.append(f"The coastal sites are sites 0 to {int(nsites) - 1} of `plumetrace family "
+site_names = [os.path.basename(s).removesuffix(".toml") for s in scenarios if s != "demo"]
+site_range = (f"sites 0 to {int(nsites) - 1}" if "demo" in scenarios
+              else ", ".join(site_names))
+out.append(f"The coastal sites are {site_range} of `plumetrace family "
            f"examples/families/coastal.family.toml --seed {family_seed}`"
            + (" (the coastal task's test seed)" if family_seed == "3202" else "") + ".")
 out.append("Each rehearsal is")

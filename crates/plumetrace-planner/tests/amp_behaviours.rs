@@ -210,6 +210,18 @@ fn lose_at(a: &mut Amp, points: &[(f64, f64)]) -> Vec<PlannerEvent> {
         t += 10.0;
         events.extend(a.decide(&snap(t, (goal.x, goal.y), 180.0, false)).events);
         t += 1.0;
+        events.extend(confirm_clean(a, &mut t));
+    }
+    events
+}
+
+/// Flies a confirming Track-Out, if one began, to its goal without a contact.
+fn confirm_clean(a: &mut Amp, t: &mut f64) -> Vec<PlannerEvent> {
+    let goals = a.confirming().map(|(_, g)| g.to_vec()).unwrap_or_default();
+    let mut events = Vec::new();
+    for goal in goals {
+        *t += 20.0;
+        events.extend(a.decide(&snap(*t, (goal.x, goal.y), 180.0, false)).events);
     }
     events
 }
@@ -275,6 +287,7 @@ fn a_track_out_contact_upflow_of_the_lost_points_traces_on_instead_of_declaring(
         events.extend(a.decide(&snap(106.0, (195.0, 295.5), 180.0, false)).events);
         assert_eq!(a.behaviour(), BehaviourKind::TrackOut);
         events.extend(a.decide(&snap(108.0, contact, 180.0, true)).events);
+        events.extend(confirm_clean(&mut a, &mut 110.0));
         let declared = events
             .iter()
             .any(|e| matches!(e, PlannerEvent::Declared { .. }));
@@ -286,8 +299,11 @@ fn a_track_out_contact_upflow_of_the_lost_points_traces_on_instead_of_declaring(
         (false, BehaviourKind::TrackIn),
         "upflow of the lost points: traced on"
     );
+    // (The field rule flies no confirming Track-Out: by default the contact, more than
+    // declaration_along_m upflow of the point, would itself hold the declaration back.)
     let field = AmpParams {
         declaration_on_upflow_contact: true,
+        declaration_confirm_m: 0.0,
         ..AmpParams::default()
     };
     assert_eq!(
@@ -300,6 +316,79 @@ fn a_track_out_contact_upflow_of_the_lost_points_traces_on_instead_of_declaring(
         (true, BehaviourKind::Mapping),
         "downflow of the most upflow lost point: declared"
     );
+}
+
+#[test]
+fn a_patch_whose_plume_goes_on_upflow_is_traced_on_not_declared() {
+    // Three lost points within 6 m along the flow (North: upflow is South), as the upflow ends of
+    // one patch far downflow of a source leave them. At the Track-Out's arrival the field check
+    // declares at once; by default a confirming Track-Out first flies upflow of the point, and
+    // chemical there (the next patch) is traced on instead.
+    let patch = [(200.0, 300.0), (205.0, 298.0), (195.0, 296.5)];
+    let declared = |events: &[PlannerEvent]| {
+        events
+            .iter()
+            .any(|e| matches!(e, PlannerEvent::Declared { .. }))
+    };
+    let fly = |p: AmpParams| {
+        let mut a = amp_with(p);
+        a.decide(&snap(0.0, (200.0, 500.0), 0.0, false));
+        let mut events = Vec::new();
+        let mut t = 10.0;
+        for &(x, y) in &patch {
+            events.extend(a.decide(&snap(t, (x, y), 180.0, true)).events);
+            t += 6.0;
+            events.extend(a.decide(&snap(t, (x, y - 1.0), 180.0, false)).events);
+            let goal = a.track_out_goal().unwrap();
+            t += 10.0;
+            events.extend(a.decide(&snap(t, (goal.x, goal.y), 180.0, false)).events);
+            t += 1.0;
+        }
+        (a, events, t)
+    };
+    let (a, events, _) = fly(AmpParams {
+        declaration_confirm_m: 0.0,
+        ..AmpParams::default()
+    });
+    assert!(declared(&events), "the field check declares the patch");
+    assert!((a.declarations()[0] - Vec2::new(200.0, 294.0)).norm() < 1e-9);
+
+    let (mut a, events, t) = fly(AmpParams::default());
+    assert!(!declared(&events), "held back for the confirming leg");
+    assert_eq!(a.behaviour(), BehaviourKind::TrackOut);
+    let (at, goals) = a.confirming().expect("a confirming Track-Out");
+    assert!((at - Vec2::new(200.0, 294.0)).norm() < 1e-9, "{at:?}");
+    // Three legs, a third of 60 m upflow each, 30 m to either side of the axis in turn.
+    assert_eq!(goals.len(), 3, "{goals:?}");
+    for (k, g) in goals.iter().enumerate() {
+        let up = 294.0 - g.y;
+        assert!((up - 60.0 * (k + 1) as f64 / 3.0).abs() < 1e-9, "{goals:?}");
+        assert!(((g.x - 200.0).abs() - 30.0).abs() < 1e-9, "{goals:?}");
+    }
+    assert!(
+        (goals[0].x - 200.0) * (goals[1].x - 200.0) < 0.0,
+        "zigzag: {goals:?}"
+    );
+    // Chemical within declaration_along_m of the point: still the patch; the leg flies on.
+    let near = a.decide(&snap(t, (200.0, 290.0), 180.0, true)).events;
+    assert!(!declared(&near));
+    assert_eq!(a.behaviour(), BehaviourKind::TrackOut);
+    assert!(a.confirming().is_some());
+    // 20 m upflow: the plume goes on; Track-In follows it, nothing is declared.
+    let upflow = a
+        .decide(&snap(t + 10.0, (200.0, 274.0), 180.0, true))
+        .events;
+    assert!(!declared(&upflow));
+    assert_eq!(a.behaviour(), BehaviourKind::TrackIn);
+    assert_eq!(a.confirming(), None);
+    assert!(a.declarations().is_empty());
+
+    // Nothing on the way: the point is declared where the field check would have.
+    let (mut a, _, mut t) = fly(AmpParams::default());
+    let events = confirm_clean(&mut a, &mut t);
+    assert!(declared(&events));
+    assert!((a.declarations()[0] - Vec2::new(200.0, 294.0)).norm() < 1e-9);
+    assert_eq!(a.behaviour(), BehaviourKind::Mapping);
 }
 
 #[test]
@@ -819,6 +908,7 @@ fn a_lost_point_that_never_agrees_ages_out() {
                 events.extend(a.decide(&snap(t, (goal.x, goal.y), 180.0, false)).events);
             }
             t += 1.0;
+            events.extend(confirm_clean(&mut a, &mut t));
         }
         events
             .iter()

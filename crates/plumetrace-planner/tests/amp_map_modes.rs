@@ -55,6 +55,8 @@ fn amp(mode: MapDeclaration, map_can_declare: bool) -> Amp {
         // The lost-point rule declares the most upflow lost point itself (the field placement).
         declaration_upflow_m: 0.0,
         declaration_across: DeclarationAcross::MostUpflow,
+        // At the check's own time (the confirming Track-Out has its own test).
+        declaration_confirm_m: 0.0,
         ..AmpParams::default()
     };
     let area = OpArea::rectangle(0.0, 400.0, 0.0, 1000.0).unwrap();

@@ -356,3 +356,38 @@ impl Behaviour<Memory, AmpDone> for Reacquire {
         }
     }
 }
+
+/// The confirming Track-Out before a declaration: go-tos through the legs' ends upflow of the
+/// point to declare (`declaration_confirm_m`, zigzagging `declaration_confirm_width_m` across
+/// the flow); the switching logic watches its contacts.
+#[derive(Debug, Clone)]
+pub(super) struct ConfirmLeg {
+    goals: Vec<GoToPoint>,
+    k: usize,
+}
+
+impl ConfirmLeg {
+    /// The legs through `goals`, in order.
+    pub(super) fn new(goals: Vec<GoToPoint>) -> Self {
+        ConfirmLeg { goals, k: 0 }
+    }
+}
+
+impl Behaviour<Memory, AmpDone> for ConfirmLeg {
+    fn kind(&self) -> BehaviourKind {
+        BehaviourKind::TrackOut
+    }
+
+    fn propose(&mut self, p: &Percept, m: &mut Memory) -> Proposal<AmpDone> {
+        if let Some(at) = m.upflow_edge(p.pos_m) {
+            return Proposal::Done(AmpDone::AtEdge { at });
+        }
+        while let Some(goal) = self.goals.get(self.k) {
+            match goal.update(p.pos_m) {
+                ModeStatus::Running(s) => return Proposal::Steer(s),
+                ModeStatus::Done(_) => self.k += 1,
+            }
+        }
+        Proposal::Done(AmpDone::Reached)
+    }
+}

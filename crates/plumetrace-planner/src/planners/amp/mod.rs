@@ -11,7 +11,9 @@
 //! - **Track-Out** goes `L_u` upflow and `L_c` across the flow from the most upflow lost point, to the
 //!   side opposite the exit; it ends on detection or arrival, and the declaration check runs
 //!   (not on a contact upflow of every lost point, unless `declaration_on_upflow_contact`: the
-//!   plume goes on there, and Track-In follows it);
+//!   plume goes on there, and Track-In follows it); when the check holds, a confirming Track-Out
+//!   first zigzags `declaration_confirm_m` upflow of the point, and a contact there resumes
+//!   Track-In instead of declaring;
 //! - **Reacquire** flies `N_re` Bowties from 10 m upflow of the most upflow lost point down to it,
 //!   then drops the point; with no point left it returns to Find.
 //!
@@ -54,7 +56,7 @@ use crate::estimate::MapTracker;
 use crate::flow::{FlowEstimate, TrackFlow, TrackFlowParams};
 use crate::planners::{BuildContext, PlannerParams};
 use crate::shared_keys::{AutopilotKeys, MapKeys};
-use behaviours::{Find, Reacquire, TrackIn, TrackOut};
+use behaviours::{ConfirmLeg, Find, Reacquire, TrackIn, TrackOut};
 use plumetrace_core::params::{Bounds, Choice, ParamError, Params};
 use plumetrace_core::{
     BehaviourKind, Decision, DeclarationKind, Heading, PlanStatus, Planner, PlannerEvent,
@@ -112,6 +114,10 @@ plumetrace_core::params! {
         declaration_upflow_m: f64 = 2.5, "m", Bounds::non_negative(100.0);
         /// Whether a contact during Track-Out upflow of the most upflow lost point runs the declaration check (true: the field rule, every Track-Out contact does). Such a contact says the plume goes on upflow: in a strong current a plume's patches far downflow of the source can gather three lost points within declaration_along_m, and the check then declared 150 m from the source.
         declaration_on_upflow_contact: bool = false, "", Bounds::Any;
+        /// Before a lost-point rule declares, a confirming Track-Out flies from where the vehicle is to this far upflow of the point to declare (each leg clipped to the op-area pattern_margin_m inside it); a contact on the way more than declaration_along_m upflow of the point says the plume goes on there, and Track-In follows it instead of declaring (0: declare at once, the field rule). Far downflow of a source the plume breaks into patches, and the upflow ends of one patch can gather three lost points within declaration_along_m: on the families' tuning sites the check then declared 125-534 m downflow of the source (4 of 900 sites), with the plume going on beyond Track-Out's reach; the confirming leg costs a median 100 s before each declaration.
+        declaration_confirm_m: f64 = 60.0, "m", Bounds::non_negative(1000.0);
+        /// How far to each side of the flow axis through the point to declare the confirming Track-Out zigzags: three legs, each a third of declaration_confirm_m further upflow, first to the side away from the vehicle, then across to the other and back (0: one leg straight upflow). Far downflow the instantaneous plume is narrow and meanders across the flow: straight up its axis a leg found the plume beyond the patch on 2 of the 4 tuning sites, zigzagging on 3.
+        declaration_confirm_width_m: f64 = 30.0, "m", Bounds::non_negative(1000.0);
         /// Where across the flow the lost-point rules declare: most_upflow (the most upflow lost point, the field rule) or mean (the mean of the three most upflow lost points across the flow).
         declaration_across: DeclarationAcross = DeclarationAcross::Mean, "", Bounds::Any;
         /// Fly the post-declaration mapping pattern (single-source missions).
@@ -298,7 +304,7 @@ impl PlannerParams for AmpParams {
     const RULES: &'static [RuleDoc] = &[
         RuleDoc {
             rule: declaration::ALONG_FLOW,
-            doc: "the three most upflow lost points lie within declaration_along_m of each other along the flow: declaration_upflow_m upflow of the most upflow one, across the flow as declaration_across says (with 0 and most_upflow: the most upflow one, the field rule)",
+            doc: "the three most upflow lost points lie within declaration_along_m of each other along the flow: declaration_upflow_m upflow of the most upflow one, across the flow as declaration_across says (with 0 and most_upflow: the most upflow one, the field rule), once a confirming Track-Out declaration_confirm_m upflow of it met no plume (0: at once, the field rule)",
         },
         RuleDoc {
             rule: declaration::ALONG_AND_CROSS_FLOW,
@@ -400,6 +406,18 @@ struct LostPoint {
     flow: Heading,
 }
 
+/// A declaration held back while the confirming Track-Out flies upflow of it
+/// (`declaration_confirm_m`).
+#[derive(Debug, Clone, PartialEq)]
+struct Confirm {
+    /// The point to declare.
+    at: Vec2,
+    /// The rule that placed it.
+    rule: DeclarationKind,
+    /// The confirming legs' ends, in order.
+    goals: Vec<Vec2>,
+}
+
 /// What the AMP's behaviours share: parameters, areas, the flow estimate, LHS, the lost points
 /// and the events of the current decision.
 #[derive(Debug, Clone)]
@@ -414,6 +432,8 @@ struct Memory {
     last_detection: Option<(f64, Vec2)>,
     lost: Vec<LostPoint>,
     declared: Vec<Vec2>,
+    /// A declaration awaiting its confirming Track-Out.
+    confirm: Option<Confirm>,
     flow: FlowEstimate,
     events: Vec<PlannerEvent>,
     /// When Reacquire began after the last detection.
@@ -457,6 +477,40 @@ impl Memory {
         let u = self.flow.upflow().unit();
         self.most_upflow_lost()
             .is_some_and(|top| pos.dot(&u) > top.dot(&u))
+    }
+
+    /// The ends of the confirming Track-Out's legs before declaring `at` with the vehicle at
+    /// `pos` (none: `declaration_confirm_m` is 0, or no leg lies inside the op-area).
+    fn confirm_goals(&self, at: Vec2, pos: Vec2) -> Vec<Vec2> {
+        let (length, width) = (
+            self.p.declaration_confirm_m,
+            self.p.declaration_confirm_width_m,
+        );
+        if length <= 0.0 {
+            return Vec::new();
+        }
+        let up = self.flow.upflow();
+        let (u, c) = (up.unit(), up.turned_deg(90.0).unit());
+        // First to the side away from the vehicle.
+        let mut side = if (pos - at).dot(&c) > 0.0 { -1.0 } else { 1.0 };
+        let mut goals = Vec::new();
+        for k in 1..=3 {
+            let goal = at + u * (length * f64::from(k) / 3.0) + c * (width * side);
+            side = -side;
+            if width <= 0.0 && k < 3 {
+                continue;
+            }
+            if let Some((_, end)) = self.pattern_line(at, goal) {
+                goals.push(end);
+            }
+        }
+        goals
+    }
+
+    /// `pos` lies more than `declaration_along_m` upflow of `point`.
+    fn upflow_of_point(&self, pos: Vec2, point: Vec2) -> bool {
+        let u = self.flow.upflow().unit();
+        (pos - point).dot(&u) > self.p.declaration_along_m
     }
 
     /// Reacquire has searched for `reacquire_timeout_s` since the last detection.
@@ -587,6 +641,7 @@ impl Switching {
         m.region_started_s = t;
         m.lost.clear();
         m.last_detection = None;
+        m.confirm = None;
         m.log(PlannerEvent::Region {
             index: k,
             what: RegionEvent::Started,
@@ -646,6 +701,7 @@ impl Switching {
         what: RegionEvent,
         t: f64,
     ) {
+        m.confirm = None;
         m.declared.push(at);
         m.log(PlannerEvent::Declared { pos_m: at, rule });
         if m.multi_region() {
@@ -673,8 +729,38 @@ impl Switching {
         }
     }
 
-    /// Runs the declaration check; true when a source was declared.
-    fn try_declare(&mut self, m: &mut Memory, t: f64) -> bool {
+    /// Declares `at` at once, or first flies the confirming Track-Out to `declaration_confirm_m`
+    /// upflow of it (where that leg has at least `r_m` inside the op-area).
+    fn confirm_or_declare(&mut self, m: &mut Memory, at: Vec2, rule: DeclarationKind, p: &Percept) {
+        let t = p.t_s;
+        let goals = m.confirm_goals(at, p.pos_m);
+        if goals.is_empty() {
+            self.declare(m, at, rule, RegionEvent::Declared, t);
+            return;
+        }
+        let leg = ConfirmLeg::new(goals.iter().map(|g| m.p.go_to(*g)).collect());
+        m.confirm = Some(Confirm { at, rule, goals });
+        self.set(m, Box::new(leg));
+    }
+
+    /// A contact while a declaration awaits its confirming Track-Out: more than
+    /// `declaration_along_m` upflow of the point, the plume goes on there and Track-In follows
+    /// it (true); elsewhere the leg flies on (false).
+    fn confirm_contact(&mut self, m: &mut Memory, p: &Percept) -> bool {
+        let beyond = m
+            .confirm
+            .as_ref()
+            .is_some_and(|c| m.upflow_of_point(p.pos_m, c.at));
+        if beyond {
+            m.confirm = None;
+        }
+        beyond
+    }
+
+    /// Runs the declaration check; true when a source was declared (or a confirming Track-Out
+    /// began).
+    fn try_declare(&mut self, m: &mut Memory, p: &Percept) -> bool {
+        let t = p.t_s;
         if m.p.map_declaration == MapDeclaration::Instead {
             return false;
         }
@@ -695,14 +781,10 @@ impl Switching {
                     _ => None,
                 };
                 match refined {
-                    Some(peak) => self.declare(
-                        m,
-                        peak,
-                        crate::estimate::tracker::SOURCE_MAP,
-                        RegionEvent::Declared,
-                        t,
-                    ),
-                    None => self.declare(m, at, rule.kind(), RegionEvent::Declared, t),
+                    Some(peak) => {
+                        self.confirm_or_declare(m, peak, crate::estimate::tracker::SOURCE_MAP, p)
+                    }
+                    None => self.confirm_or_declare(m, at, rule.kind(), p),
                 }
                 true
             }
@@ -744,7 +826,10 @@ impl Switching {
                 }
             }
             (BehaviourKind::TrackOut, AmpDone::Reached) => {
-                if !self.try_declare(m, p.t_s) {
+                if let Some(c) = m.confirm.take() {
+                    // The confirming leg met no plume upflow of the point.
+                    self.declare(m, c.at, c.rule, RegionEvent::Declared, p.t_s);
+                } else if !self.try_declare(m, p) {
                     self.enter_reacquire(m, p.pos_m);
                 }
             }
@@ -788,10 +873,14 @@ impl Arbiter<Memory> for Switching {
                 kind,
                 BehaviourKind::Transit | BehaviourKind::Mapping | BehaviourKind::Done
             );
-            if p.detected && tracking_allowed && kind != BehaviourKind::TrackIn {
+            let confirming = m.confirm.is_some() && kind == BehaviourKind::TrackOut;
+            if p.detected && confirming && !self.confirm_contact(m, p) {
+                // Chemical around the point to declare: the confirming leg flies on.
+            } else if p.detected && tracking_allowed && kind != BehaviourKind::TrackIn {
                 if kind == BehaviourKind::TrackOut
+                    && !confirming
                     && (m.p.declaration_on_upflow_contact || !m.upflow_of_lost(p.pos_m))
-                    && self.try_declare(m, p.t_s)
+                    && self.try_declare(m, p)
                 {
                     continue;
                 }
@@ -883,6 +972,7 @@ impl Amp {
                 last_detection: None,
                 lost: Vec::new(),
                 declared: Vec::new(),
+                confirm: None,
                 events: Vec::new(),
                 reacquire_since: None,
                 map,
@@ -912,6 +1002,11 @@ impl Amp {
     /// The saved lost points, oldest first.
     pub fn lost_points(&self) -> Vec<Vec2> {
         self.m.lost_positions()
+    }
+
+    /// The point awaiting its confirming Track-Out and the ends of its legs, while it flies.
+    pub fn confirming(&self) -> Option<(Vec2, &[Vec2])> {
+        self.m.confirm.as_ref().map(|c| (c.at, c.goals.as_slice()))
     }
 
     /// Declared source positions so far, in order.
