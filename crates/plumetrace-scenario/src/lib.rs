@@ -80,7 +80,7 @@ pub fn parse(text: &str, origin: &Origin) -> Result<ScenarioConfig, ScenarioErro
                 }
                 .located(text)
             })?;
-            return deserialize(toml::Value::Table(table), origin).map_err(|e| e.located(text));
+            return from_local_table(&table, origin).map_err(|e| e.located(text));
         }
         Ok(_) => None,
         Err(e) => Some(e),
@@ -91,7 +91,7 @@ pub fn parse(text: &str, origin: &Origin) -> Result<ScenarioConfig, ScenarioErro
         path: String::new(),
         message: e.to_string(),
     })?;
-    let cfg = deserialize(de, origin).map_err(|e| e.located(text))?;
+    let cfg = deserialize(de, origin, Report::Whole).map_err(|e| e.located(text))?;
     // A whole number a count takes but TOML's integers cannot hold (above 9223372036854775807)
     // cannot be checked against its bound later (the check reads the scenario back as TOML):
     // the parser's report shows where it is. Seeds, written back as strings, are not affected.
@@ -124,7 +124,33 @@ pub fn from_table(
             message,
         })?;
     }
-    deserialize(toml::Value::Table(table), origin)
+    from_local_table(&table, origin)
+}
+
+/// Reads a table whose positions are already in metres. The table is written out as TOML text
+/// and read back by the one deserializer a scenario file is read with: the serde code of every
+/// section is then generated once (for the text) instead of twice (for the text and for a
+/// `toml::Value`), which was the largest part of this crate's build. Writing and reading back
+/// keeps every value as it was (TOML's floats round-trip exactly).
+fn from_local_table(table: &toml::Table, origin: &Origin) -> Result<ScenarioConfig, ScenarioError> {
+    let invalid = |message: String| ScenarioError::Parse {
+        origin: origin.to_string(),
+        line: None,
+        path: String::new(),
+        message,
+    };
+    let text = toml::to_string(table).map_err(|e| invalid(e.to_string()))?;
+    let de = toml::Deserializer::parse(&text).map_err(|e| invalid(e.message().to_string()))?;
+    deserialize(de, origin, Report::Message)
+}
+
+/// What an error without a key path says: the parser's whole report (which quotes the line,
+/// for text the user wrote) or the message alone (for text written from a table, whose lines
+/// the user never saw).
+#[derive(Clone, Copy)]
+enum Report {
+    Whole,
+    Message,
 }
 
 /// serde's path as a key path, a key that is not a bare TOML key quoted (`planners."a b"`,
@@ -152,9 +178,10 @@ fn key_path(path: &serde_path_to_error::Path) -> String {
 
 /// Deserializes the scenario, turning serde's error into one that names the key path (and the
 /// nearest known key or name, for an unknown one).
-fn deserialize<'de, D: serde::Deserializer<'de, Error = toml::de::Error>>(
-    de: D,
+fn deserialize(
+    de: toml::Deserializer<'_>,
     origin: &Origin,
+    report: Report,
 ) -> Result<ScenarioConfig, ScenarioError> {
     serde_path_to_error::deserialize(de).map_err(|e| {
         let path = key_path(e.path());
@@ -162,7 +189,12 @@ fn deserialize<'de, D: serde::Deserializer<'de, Error = toml::de::Error>>(
         // With a key path, the message alone (the line is added from the path); without one,
         // the parser's whole report, which shows where.
         let (path, message) = if path == "." {
-            (String::new(), inner.to_string())
+            let message = match report {
+                Report::Whole => inner.to_string(),
+                // As the message of a `toml::Value`'s error read.
+                Report::Message => format!("{}\n", inner.message()),
+            };
+            (String::new(), message)
         } else {
             (path, locate::suggest(inner.message()))
         };
