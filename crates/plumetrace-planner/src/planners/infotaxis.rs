@@ -666,11 +666,13 @@ mod tests {
     }
 
     /// A planner whose map has concentrated upflow (West) of (300, 100) from detections there,
-    /// ten looks 10 s apart, and the map's read at 600 s.
+    /// ten looks 10 s apart, and the map's read at 600 s (no hold; the AMP's dilution, 30 m).
     fn concentrated() -> (Infotaxis, MapRead) {
         let mut p = planner(InfotaxisParams {
             map: MapKeys {
                 map_min_detections: 1,
+                map_hold_s: 0.0,
+                map_dilution_m: 30.0,
                 ..InfotaxisParams::default().map
             },
             confirm_m: 60.0,
