@@ -2,7 +2,9 @@
 # Regenerates the measured results under docs/results/: one page per campaign of
 # examples/campaigns/, written whole from the campaign's own summary (never edit a number by hand).
 #
-#   scripts/results.sh NAME...          run examples/campaigns/NAME.toml and write docs/results/NAME.md
+#   scripts/results.sh NAME...          run examples/campaigns/NAME.toml (or, for a campaign that flies
+#                                       test seeds, benchmarks/campaigns/NAME.toml) and write
+#                                       docs/results/NAME.md
 #   scripts/results.sh --all            every campaign with a page under docs/results/
 #   scripts/results.sh --index          rewrite docs/results/README.md (the index) only
 #
@@ -46,8 +48,13 @@ while [ $# -gt 0 ]; do
     esac
 done
 
+# The campaign file of NAME: an example campaign, else one beside the benchmark's task set.
+campaign_file() {
+    if [ -f "examples/campaigns/$1.toml" ]; then echo "examples/campaigns/$1.toml"; else echo "benchmarks/campaigns/$1.toml"; fi
+}
+
 for n in "${names[@]}"; do
-    if [ ! -f "examples/campaigns/$n.toml" ]; then
+    if [ ! -f "$(campaign_file "$n")" ]; then
         echo "results.sh: no campaign examples/campaigns/$n.toml; the campaigns are:" >&2
         ls examples/campaigns/ | sed 's/\.toml$//; s/^/  /' >&2
         exit 2
@@ -113,11 +120,11 @@ two_sample() {
 }
 
 for n in "${names[@]}"; do
-    check_two_sample "examples/campaigns/$n.toml"
+    check_two_sample "$(campaign_file "$n")"
 done
 
 for n in "${names[@]}"; do
-    file="examples/campaigns/$n.toml"
+    file="$(campaign_file "$n")"
     out="target/results/$n"
     mkdir -p target/results
     if [ "$keep" -eq 0 ]; then rm -rf "$out"; fi

@@ -32,8 +32,8 @@ fn the_run_line_summary_and_figure_say_whether_the_source_was_located() {
     );
     assert!(
         line.starts_with(
-            "demo-infotaxis: NOT located: declared 258.5 m from the source (success radius 50 m); \
-             declared at 268 s"
+            "demo-infotaxis: NOT located: declared 156.1 m from the source (success radius 50 m); \
+             declared at 1571 s"
         ),
         "{line}"
     );
@@ -44,7 +44,7 @@ fn the_run_line_summary_and_figure_say_whether_the_source_was_located() {
     let svg = std::fs::read_to_string(d.join("far/plot.svg")).unwrap();
     assert!(
         svg.contains(
-            "demo-infotaxis (seed 1): NOT located: declared 258.5 m from the source (success \
+            "demo-infotaxis (seed 1): NOT located: declared 156.1 m from the source (success \
              radius 50 m)"
         ),
         "the figure's title says it"
@@ -58,7 +58,7 @@ fn the_run_line_summary_and_figure_say_whether_the_source_was_located() {
     let (line, s) = fly(&[d.join("wide.toml").to_str().unwrap()], &d.join("wide"));
     assert!(
         line.starts_with(
-            "demo-infotaxis: located: declared 258.5 m from the source (success radius 300 m)"
+            "demo-infotaxis: located: declared 156.1 m from the source (success radius 300 m)"
         ),
         "{line}"
     );

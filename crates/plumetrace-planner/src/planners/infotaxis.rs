@@ -1,27 +1,37 @@
 //! Infotaxis on the source-likelihood map: each move is the one expected to tell the most about
 //! where the source is (Vergassola, Villermaux and Shraiman 2007), or, space-aware, the one that
-//! best weighs information against distance (Loisy and Eloy 2022).
+//! best weighs information against distance (Loisy and Eloy 2022), with moves of vehicle scale.
 //!
 //! The vehicle keeps the source-likelihood map ([`crate::estimate::map`]) over the op-area from
 //! every sample. At each decision point it looks at `headings` candidate legs of `step_m` (equal
-//! compass steps from North; a leg whose end lies less than `edge_margin_m` inside the op-area is
-//! not a candidate). A leg's outcome model comes from the map: the samples of the leg (one per
-//! map correlation time of travel) are taken as independent looks from the leg's end at the time
-//! it is reached, so a source cell gives at least one detection on the leg with probability
-//! `1 - (1 - P(c))^n`. The leg chosen minimises the objective of [`crate::estimate::infotaxis`]
-//! (the code the windy grid-world benchmark checks): the expected entropy after the leg, or the
-//! space-aware value with distances in map cells. A leg ends on arrival (within `r_m`), after
-//! twice its flight time, or at the first detection after a gap (contact is news: the next leg is
-//! chosen with it).
+//! compass steps from North), each flown from the vehicle's pose as the vehicle can fly it: a
+//! turn at the commanded turning limit (radius `speed_mps / max_turn_rate_deg_s`) onto the
+//! candidate's course, then straight ([`leg_path`]). A leg is a candidate only when every point
+//! of it lies inside the op-area and its end at least `edge_margin_m` inside. A leg's outcome
+//! model comes from the map: the leg is sampled every map correlation time of travel (at least
+//! one cell), each point a look at the time it is reached, so a source cell gives at least one
+//! detection on the leg with probability `1 - prod_i (1 - P_i(c))`: a leg across the plume's
+//! expected path is worth more than one along it. The leg chosen minimises the objective of
+//! [`crate::estimate::infotaxis`] (the code the windy grid-world benchmark checks): the expected
+//! entropy after the leg, or the space-aware value with distances in map cells. A leg ends on
+//! arrival (within `r_m`), after twice its flight time, or at a detection after `contact_gap_s`
+//! without one (a new contact is news; contacts inside the plume are not, and ending legs on them
+//! left the vehicle circling in the plume).
 //!
-//! The planner declares the most likely cell once the map's mass within `map_radius_m` of it
-//! reaches `map_mass` (read every `map_check_s`), and finishes. Every decision point reports the
-//! map's entropy, peak and mass; the whole map is reported every ten minutes and at the
-//! declaration. Courses pass the shared [`Autopilot`] (cage, flow compensation, rate filter).
+//! **Declaration.** Once the map's rule holds (mass `map_mass` within `map_radius_m` of the most
+//! likely cell, read every `map_check_s`, after `map_min_detections` detections and `map_hold_s`),
+//! the vehicle flies a confirming pass through the estimate along the flow, from `confirm_m`
+//! downflow of it to `confirm_m` upflow of it (points outside the op-area are pulled in to
+//! `edge_margin_m` inside), and declares if, after the pass, the rule still holds with the most
+//! likely cell within `map_radius_m` of where it was; otherwise the search goes on (a source
+//! further upflow shows as detections upflow of the estimate, which move the map). Every
+//! decision point reports the map's entropy, peak and mass; the whole map is reported every ten
+//! minutes and at the declaration. Courses pass the shared [`Autopilot`] (cage, flow
+//! compensation, rate filter).
 
 use crate::FlowEstimate;
 use crate::estimate::infotaxis::{choose, move_outcome};
-use crate::estimate::{MapTracker, Objective};
+use crate::estimate::{MapRead, MapTracker, Objective};
 use crate::planners::{BuildContext, PlannerParams};
 use crate::shared_keys::{AutopilotKeys, MapKeys};
 use plumetrace_core::params::{Bounds, ParamError};
@@ -35,17 +45,21 @@ plumetrace_core::params! {
     /// Parameters of the infotaxis planner.
     pub struct InfotaxisParams {
         include autopilot: AutopilotKeys = AutopilotKeys::default();
-        include map: MapKeys = MapKeys::default();
+        include map: MapKeys = MapKeys { map_mass: 0.7, map_hold_s: 300.0, map_estimate_radius_m: 10.0, map_mixing_length_m: 0.12, map_dilution_m: 15.0, ..MapKeys::default() };
         /// What a move minimises: infotaxis (the expected entropy of the map after it) or space_aware (expected log2(D + 2^(H - 1) - 1/2), distance D in map cells).
         objective: Objective = Objective::Infotaxis, "", Bounds::Any;
-        /// Length of a candidate leg (about 20 s at 2 m/s, three turning radii of the field vehicle).
-        step_m: f64 = 40.0, "m", Bounds::closed(2.0, 10_000.0);
-        /// Candidate headings per decision, equally spaced from North.
-        headings: u32 = 8, "", Bounds::whole(3, 72);
-        /// A leg must end at least this far inside the op-area.
+        /// Length of a candidate leg, its turn at the turning limit included (40 s at 2 m/s).
+        step_m: f64 = 80.0, "m", Bounds::closed(2.0, 10_000.0);
+        /// Candidate courses per decision, equally spaced from North.
+        headings: u32 = 12, "", Bounds::whole(3, 72);
+        /// A leg must end at least this far inside the op-area (and lie inside it throughout).
         edge_margin_m: f64 = 10.0, "m", Bounds::non_negative(1000.0);
         /// Arrival radius at a leg's end.
         r_m: f64 = 5.0, "m", Bounds::positive(1000.0);
+        /// A detection after this long without one ends the leg (a new contact is news); 0: every detection after a gap of 5 s does.
+        contact_gap_s: f64 = 30.0, "s", Bounds::non_negative(3600.0);
+        /// Confirming pass: once the map's rule holds, fly through the estimate along the flow from this far downflow of it to this far upflow, and declare if the rule still holds there (0: declare when the rule holds).
+        confirm_m: f64 = 20.0, "m", Bounds::non_negative(1000.0);
     }
 }
 
@@ -53,17 +67,22 @@ impl InfotaxisParams {
     fn tracker(&self, area: &OpArea) -> Result<MapTracker, ParamError> {
         self.map.tracker(area, self.autopilot.threshold_v)
     }
+
+    /// The turning radius at the commanded speed and turn-rate limit, m.
+    pub fn turn_radius_m(&self) -> f64 {
+        self.autopilot.speed_mps / self.autopilot.max_turn_rate_deg_s.to_radians()
+    }
 }
 
 impl PlannerParams for InfotaxisParams {
     const KIND: &'static str = "infotaxis";
-    const SUMMARY: &'static str = "Infotaxis on a source-likelihood map: legs chosen to minimise the expected entropy of the map (or space-aware), declaration once the map concentrates";
+    const SUMMARY: &'static str = "Infotaxis on a source-likelihood map: legs of vehicle scale within the turning limit and the op-area, chosen to minimise the expected entropy of the map (or space-aware), declaration once the map concentrates and a confirming pass agrees";
 
     const THRESHOLD_KEY: Option<&'static str> = Some("threshold_v");
     const BEHAVIOURS: &'static [BehaviourKind] = &[BehaviourKind::Infotaxis, BehaviourKind::Done];
     const RULES: &'static [RuleDoc] = &[RuleDoc {
         rule: crate::estimate::tracker::SOURCE_MAP,
-        doc: "the source map's most likely cell (the posterior mean within map_estimate_radius_m of it) once map_mass lies within map_radius_m of it for map_hold_s",
+        doc: "the source map's most likely cell (the posterior mean within map_estimate_radius_m of it) once map_mass lies within map_radius_m of it for map_hold_s, and still after a confirming pass through it along the flow (confirm_m each way)",
     }];
 
     fn detection_threshold_v(&self) -> Option<f64> {
@@ -82,11 +101,57 @@ impl PlannerParams for InfotaxisParams {
     }
 }
 
-/// The leg being flown.
-#[derive(Debug, Clone, Copy, PartialEq)]
-struct Leg {
-    goal: GoToPoint,
-    started_s: f64,
+/// Points along a leg flown from `pos` on heading `from`: a turn of radius `radius_m` towards
+/// `course` (the shorter way) until on it, then straight, `length_m` in all; one point every
+/// `spacing_m` of path and one at the end, each with its distance along the path.
+pub fn leg_path(
+    pos: Vec2,
+    from: Heading,
+    course: Heading,
+    length_m: f64,
+    radius_m: f64,
+    spacing_m: f64,
+) -> Vec<(Vec2, f64)> {
+    let turn = course.diff_deg(from).to_radians();
+    let sign = turn.signum();
+    let arc_m = (turn.abs() * radius_m).min(length_m);
+    let h0 = from.rad();
+    let at = |s: f64| -> Vec2 {
+        if s <= arc_m {
+            // Heading h(s) = h0 + sign s / R; position = pos + sign R (cos h0 - cos h, sin h - sin h0).
+            let h = h0 + sign * s / radius_m;
+            pos + Vec2::new(h0.cos() - h.cos(), h.sin() - h0.sin()) * (sign * radius_m)
+        } else {
+            let h = h0 + sign * arc_m / radius_m;
+            let turned =
+                pos + Vec2::new(h0.cos() - h.cos(), h.sin() - h0.sin()) * (sign * radius_m);
+            turned + Heading::from_rad(h).unit() * (s - arc_m)
+        }
+    };
+    let spacing = spacing_m.max(1e-3);
+    let n = (length_m / spacing).ceil().max(1.0) as usize;
+    (1..=n)
+        .map(|k| {
+            let s = (k as f64 * spacing).min(length_m);
+            (at(s), s)
+        })
+        .collect()
+}
+
+/// The leg being flown: an infotaxis leg, or the confirming pass (its waypoints and the peak it
+/// confirms).
+#[derive(Debug, Clone, PartialEq)]
+enum Leg {
+    Search {
+        goal: GoToPoint,
+        started_s: f64,
+    },
+    Confirm {
+        waypoints: Vec<Vec2>,
+        next: usize,
+        peak_m: Vec2,
+        until_s: f64,
+    },
 }
 
 /// The infotaxis planner for one vehicle.
@@ -101,8 +166,9 @@ pub struct Infotaxis {
     started: bool,
     declared: bool,
     last_steer: Steer,
-    /// Scratch: one candidate's hit probabilities and distances.
+    /// Scratch: one point's hit probabilities, a leg's miss probabilities, distances.
     hits: Vec<f64>,
+    miss: Vec<f64>,
     dist: Vec<f64>,
 }
 
@@ -126,6 +192,7 @@ impl Infotaxis {
             started: false,
             declared: false,
             hits: Vec::new(),
+            miss: Vec::new(),
             dist: Vec::new(),
         }
     }
@@ -135,33 +202,61 @@ impl Infotaxis {
         &mut self.tracker
     }
 
-    /// The candidate leg ends from `pos` (`None`: too near the op-area's edge).
-    pub fn candidates(&self, pos: Vec2) -> Vec<Option<Vec2>> {
+    /// The candidate legs from `pos` on `heading` (`None`: the leg leaves the op-area or ends
+    /// within `edge_margin_m` of its edge), as points along them (see [`leg_path`]).
+    pub fn candidates(&self, pos: Vec2, heading: Heading) -> Vec<Option<Vec<(Vec2, f64)>>> {
+        let map = self.p.map.model();
+        let spacing = (self.p.autopilot.speed_mps * map.correlation_s).max(map.resolution_m);
         (0..self.p.headings)
             .map(|k| {
-                let h = Heading::from_deg(360.0 * f64::from(k) / f64::from(self.p.headings));
-                let end = pos + h.unit() * self.p.step_m;
-                let e = self.area.edge_info(end);
-                (e.inside && e.distance_m >= self.p.edge_margin_m).then_some(end)
+                let course = Heading::from_deg(360.0 * f64::from(k) / f64::from(self.p.headings));
+                let path = leg_path(
+                    pos,
+                    heading,
+                    course,
+                    self.p.step_m,
+                    self.p.turn_radius_m(),
+                    spacing,
+                );
+                let inside = path.iter().all(|(q, _)| self.area.contains(*q));
+                let end = path.last().map(|(q, _)| self.area.edge_info(*q));
+                (inside && end.is_some_and(|e| e.inside && e.distance_m >= self.p.edge_margin_m))
+                    .then_some(path)
             })
             .collect()
     }
 
-    /// Chooses the next leg's end from `pos` at `t_s`: the candidate of smallest objective
-    /// value, or the op-area's centre when no candidate fits.
-    fn choose_leg(&mut self, pos: Vec2, t_s: f64, altitude_m: Option<f64>) -> Vec2 {
-        let leg_s = self.p.step_m / self.p.autopilot.speed_mps;
-        let samples = (leg_s / self.tracker.map().model().correlation_s.max(1e-3)).max(1.0);
-        let ends = self.candidates(pos);
+    /// Chooses the next leg's end from `pos` on `heading` at `t_s`: the candidate of smallest
+    /// objective value, or the op-area's centre when no candidate fits.
+    fn choose_leg(
+        &mut self,
+        pos: Vec2,
+        heading: Heading,
+        t_s: f64,
+        altitude_m: Option<f64>,
+    ) -> Vec2 {
+        let speed = self.p.autopilot.speed_mps;
+        let legs = self.candidates(pos, heading);
         let objective = self.p.objective;
-        let mut values = Vec::with_capacity(ends.len());
-        for end in &ends {
-            let Some(end) = *end else {
+        let mut values = Vec::with_capacity(legs.len());
+        for leg in &legs {
+            let Some(leg) = leg else {
                 values.push(None);
                 continue;
             };
             let map = self.tracker.map();
-            map.hit_probabilities(end, t_s + leg_s, altitude_m, samples, &mut self.hits);
+            self.miss.clear();
+            self.miss.resize(map.len(), 1.0);
+            for (q, s) in leg {
+                map.hit_probabilities(*q, t_s + s / speed, altitude_m, 1.0, &mut self.hits);
+                for (m, h) in self.miss.iter_mut().zip(&self.hits) {
+                    *m *= 1.0 - h;
+                }
+            }
+            for m in &mut self.miss {
+                *m = 1.0 - *m;
+            }
+            let end = leg.last().map_or(pos, |(q, _)| *q);
             let dist = (objective == Objective::SpaceAware).then(|| {
                 let r = map.model().resolution_m;
                 self.dist.clear();
@@ -169,15 +264,141 @@ impl Infotaxis {
                     .extend(map.centres().iter().map(|c| (c - end).norm() / r));
                 &self.dist[..]
             });
-            let o = move_outcome(map.probabilities(), &self.hits, None, dist);
+            let o = move_outcome(map.probabilities(), &self.miss, None, dist);
             values.push(Some(objective.value(&o)));
         }
-        match choose(&values).and_then(|k| ends[k]) {
+        match choose(&values).and_then(|k| legs[k].as_ref()?.last().map(|(q, _)| *q)) {
             Some(end) => end,
-            None => {
-                let v = self.area.vertices();
-                v.iter().fold(Vec2::zeros(), |a, b| a + b) / v.len() as f64
+            None => self.centre(),
+        }
+    }
+
+    fn centre(&self) -> Vec2 {
+        let v = self.area.vertices();
+        v.iter().fold(Vec2::zeros(), |a, b| a + b) / v.len() as f64
+    }
+
+    /// `p` if it lies `edge_margin_m` inside the op-area, else the point that far inside on the
+    /// way from `p` to `inner` (`inner` itself when none is).
+    fn pulled_in(&self, p: Vec2, inner: Vec2) -> Vec2 {
+        let ok = |q: Vec2| {
+            let e = self.area.edge_info(q);
+            e.inside && e.distance_m >= self.p.edge_margin_m
+        };
+        (0..=20)
+            .map(|k| p + (inner - p) * (f64::from(k) / 20.0))
+            .find(|q| ok(*q))
+            .unwrap_or(inner)
+    }
+
+    /// The confirming pass through `r`'s estimate: from `confirm_m` downflow to `confirm_m`
+    /// upflow of it, started at `t_s` from `pos`.
+    fn confirm_leg(&self, r: &MapRead, pos: Vec2, t_s: f64) -> Leg {
+        let up = self.flow.upflow().unit();
+        let c = self.pulled_in(r.estimate_m, self.centre());
+        let a = self.pulled_in(c - up * self.p.confirm_m, c);
+        let b = self.pulled_in(c + up * self.p.confirm_m, c);
+        let path_m = (a - pos).norm() + (b - a).norm();
+        Leg::Confirm {
+            waypoints: vec![a, b],
+            next: 0,
+            peak_m: r.peak_m,
+            until_s: t_s + 3.0 * path_m / self.p.autopilot.speed_mps + 60.0,
+        }
+    }
+}
+
+impl Infotaxis {
+    /// Reads the map when due and moves the declaration on: starts a confirming pass when the
+    /// rule holds, judges the pass when it is over; the read that declares, if any.
+    fn declaration(
+        &mut self,
+        t: f64,
+        pos: Vec2,
+        telemetry: &mut Vec<Telemetry>,
+    ) -> Option<MapRead> {
+        let confirming = matches!(self.leg, Some(Leg::Confirm { .. }));
+        if let Some(r) = self.tracker.read_due(t, telemetry)
+            && !confirming
+            && self.tracker.declares(t, &r)
+        {
+            if self.p.confirm_m <= 0.0 {
+                return Some(r);
             }
+            self.leg = Some(self.confirm_leg(&r, pos, t));
+            return None;
+        }
+        let Some(Leg::Confirm {
+            waypoints,
+            next,
+            peak_m,
+            until_s,
+        }) = &mut self.leg
+        else {
+            return None;
+        };
+        while *next < waypoints.len() && (waypoints[*next] - pos).norm() <= self.p.r_m {
+            *next += 1;
+        }
+        if *next < waypoints.len() && t <= *until_s {
+            return None;
+        }
+        let peak = *peak_m;
+        self.leg = None;
+        let r = self.tracker.read(t);
+        self.tracker.report(t, &r, telemetry, false);
+        (self.tracker.declares(t, &r) && (r.peak_m - peak).norm() <= self.p.map.map_radius_m)
+            .then_some(r)
+    }
+
+    /// The steer of the leg being flown, choosing a new leg when the last one is over.
+    fn steer(
+        &mut self,
+        s: &SensorSnapshot,
+        pos: Vec2,
+        new_contact: bool,
+        telemetry: &mut Vec<Telemetry>,
+    ) -> Steer {
+        let t = s.time_s;
+        let leg_s = self.p.step_m / self.p.autopilot.speed_mps;
+        let leg_over = match &self.leg {
+            None => true,
+            Some(Leg::Search { goal, started_s }) => {
+                matches!(goal.update(pos), ModeStatus::Done(_))
+                    || t - started_s > 2.0 * leg_s
+                    || new_contact
+            }
+            Some(Leg::Confirm { .. }) => false,
+        };
+        if leg_over {
+            let target_m = self.choose_leg(pos, s.nav.heading, t, s.nav.altitude_m);
+            self.leg = Some(Leg::Search {
+                goal: GoToPoint {
+                    target_m,
+                    speed_mps: self.p.autopilot.speed_mps,
+                    radius_m: self.p.r_m,
+                },
+                started_s: t,
+            });
+            if telemetry.is_empty() {
+                let r = self.tracker.read(t);
+                self.tracker.report(t, &r, telemetry, false);
+            }
+        }
+        let goal = match &self.leg {
+            Some(Leg::Search { goal, .. }) => Some(*goal),
+            Some(Leg::Confirm {
+                waypoints, next, ..
+            }) => waypoints.get(*next).map(|&target_m| GoToPoint {
+                target_m,
+                speed_mps: self.p.autopilot.speed_mps,
+                radius_m: self.p.r_m,
+            }),
+            None => None,
+        };
+        match goal.map(|g| g.update(pos)) {
+            Some(ModeStatus::Running(steer)) => steer,
+            _ => self.last_steer,
         }
     }
 }
@@ -212,7 +433,13 @@ impl Planner for Infotaxis {
             .chem
             .iter()
             .any(|c| c.reading > self.p.autopilot.threshold_v);
+        let gap_s = if self.p.contact_gap_s > 0.0 {
+            self.p.contact_gap_s
+        } else {
+            5.0
+        };
         let new_contact = detected && self.last_detection_s.is_none_or(|l| t - l > 5.0);
+        let news = detected && self.last_detection_s.is_none_or(|l| t - l > gap_s);
         if new_contact {
             events.push(PlannerEvent::Detection { pos_m: pos });
         }
@@ -220,8 +447,7 @@ impl Planner for Infotaxis {
             self.last_detection_s = Some(t);
         }
         if !self.declared
-            && let Some(r) = self.tracker.read_due(t, &mut telemetry)
-            && self.tracker.declares(t, &r)
+            && let Some(r) = self.declaration(t, pos, &mut telemetry)
         {
             self.declared = true;
             self.tracker.report(t, &r, &mut telemetry, true);
@@ -246,34 +472,7 @@ impl Planner for Infotaxis {
                 status: PlanStatus::Finished,
             };
         }
-        let leg_s = self.p.step_m / self.p.autopilot.speed_mps;
-        let leg_over = match self.leg {
-            None => true,
-            Some(l) => {
-                matches!(l.goal.update(pos), ModeStatus::Done(_))
-                    || t - l.started_s > 2.0 * leg_s
-                    || new_contact
-            }
-        };
-        if leg_over {
-            let target_m = self.choose_leg(pos, t, s.nav.altitude_m);
-            self.leg = Some(Leg {
-                goal: GoToPoint {
-                    target_m,
-                    speed_mps: self.p.autopilot.speed_mps,
-                    radius_m: self.p.r_m,
-                },
-                started_s: t,
-            });
-            if telemetry.is_empty() {
-                let r = self.tracker.read(t);
-                self.tracker.report(t, &r, &mut telemetry, false);
-            }
-        }
-        let steer = match self.leg.map(|l| l.goal.update(pos)) {
-            Some(ModeStatus::Running(steer)) => steer,
-            _ => self.last_steer,
-        };
+        let steer = self.steer(s, pos, news, &mut telemetry);
         self.last_steer = steer;
         let (command, status) = match self.autopilot.command_nav(t, &s.nav, steer, flow) {
             Ok(c) => (c, PlanStatus::Running),
@@ -404,17 +603,138 @@ mod tests {
         }
     }
 
-    #[test]
-    fn candidates_keep_inside_the_margin() {
-        let p = InfotaxisParams::default();
+    fn planner(p: InfotaxisParams) -> Infotaxis {
         let g = ctx().geometry;
         let tracker = p.tracker(&g.op_area).unwrap_or_else(|e| panic!("{e}"));
-        let planner = Infotaxis::new(p, g.op_area.clone(), Heading::from_deg(90.0), tracker);
-        let c = planner.candidates(Vec2::new(20.0, 100.0));
+        Infotaxis::new(p, g.op_area.clone(), Heading::from_deg(90.0), tracker)
+    }
+
+    #[test]
+    fn candidates_keep_inside_the_margin() {
+        let p = InfotaxisParams {
+            headings: 8,
+            ..InfotaxisParams::default()
+        };
+        let planner = planner(p);
+        // Heading East at x = 20: every leg that comes round to the West would end or pass
+        // outside the area; East stays in.
+        let c = planner.candidates(Vec2::new(20.0, 100.0), Heading::from_deg(90.0));
         assert_eq!(c.len(), 8);
-        // West (index 6) would end at x = -20.
         assert!(c[6].is_none());
         assert!(c[2].is_some());
+        for leg in c.iter().flatten() {
+            for (q, _) in leg {
+                assert!(planner.area.contains(*q), "{q:?}");
+            }
+        }
+    }
+
+    #[test]
+    fn a_leg_turns_within_the_turning_limit_from_the_vehicle_s_heading() {
+        // Heading North at (200, 100), the candidate due South: the vehicle cannot reverse on
+        // the spot; the leg turns on the turning radius (2 m/s at 10 deg/s: 11.5 m), so its end
+        // lies one turning diameter to the side of the straight reversal and its path never
+        // turns faster than the limit.
+        let p = InfotaxisParams::default();
+        let radius = p.turn_radius_m();
+        assert!((radius - 2.0 / 10f64.to_radians()).abs() < 1e-9);
+        let (pos, north) = (Vec2::new(200.0, 100.0), Heading::NORTH);
+        let path = leg_path(pos, north, Heading::from_deg(180.0), 80.0, radius, 1.0);
+        let end = path.last().map(|(q, _)| *q).unwrap_or(pos);
+        let straight_reversal = pos + Heading::from_deg(180.0).unit() * 80.0;
+        assert!((end - straight_reversal).norm() > radius, "{end:?}");
+        // The half-turn takes pi R of the 80 m; the rest runs South, 2 R to the East.
+        let arc = std::f64::consts::PI * radius;
+        let expected = pos + Vec2::new(2.0 * radius, -(80.0 - arc));
+        assert!((end - expected).norm() < 1e-6, "{end:?} vs {expected:?}");
+        // Consecutive points 1 m apart along the path: the heading changes by at most 1 m / R.
+        let mut prev = (pos, north);
+        for (q, _) in &path {
+            let Some(h) = Heading::of_vector(*q - prev.0) else {
+                panic!("a repeated point")
+            };
+            let change = h.diff_deg(prev.1).abs().to_radians();
+            assert!(change <= 1.0 / radius + 1e-6, "{change} at {q:?}");
+            assert!(((*q - prev.0).norm() - 1.0).abs() < 1e-2, "{q:?}");
+            prev = (*q, h);
+        }
+        // The planner's candidates are those paths: the southbound one from this pose.
+        let c = planner(p).candidates(pos, north);
+        let south = c[6].as_ref().unwrap_or_else(|| panic!("no southbound leg"));
+        let south_end = south.last().map(|(q, _)| *q).unwrap_or(pos);
+        assert!((south_end - expected).norm() < 1e-6, "{south_end:?}");
+    }
+
+    /// A planner whose map has concentrated upflow (West) of (300, 100) from detections there,
+    /// ten looks 10 s apart, and the map's read at 600 s (no hold; the AMP's dilution, 30 m).
+    fn concentrated() -> (Infotaxis, MapRead) {
+        let mut p = planner(InfotaxisParams {
+            map: MapKeys {
+                map_min_detections: 1,
+                map_hold_s: 0.0,
+                map_dilution_m: 30.0,
+                ..InfotaxisParams::default().map
+            },
+            confirm_m: 60.0,
+            ..InfotaxisParams::default()
+        });
+        let at = Vec2::new(300.0, 100.0);
+        for k in 50..60 {
+            let t = f64::from(k) * 10.0;
+            let s = snapshot(t, at, Heading::from_deg(270.0), 1.0);
+            p.tracker.feed(&s, at, Vec2::zeros(), Vec2::new(0.2, 0.0));
+        }
+        let r = p.tracker.read(600.0);
+        (p, r)
+    }
+
+    /// Flies the confirming pass kinematically from where it starts, a sample every second that
+    /// detects when `detects` says so; what the declaration step returns at the end.
+    fn fly_pass(p: &mut Infotaxis, detects: &dyn Fn(Vec2) -> bool) -> Option<MapRead> {
+        let mut telemetry = Vec::new();
+        let mut pos = Vec2::new(300.0, 100.0);
+        assert!(p.declaration(610.0, pos, &mut telemetry).is_none());
+        let Some(Leg::Confirm { waypoints, .. }) = p.leg.clone() else {
+            panic!("the rule held but no confirming pass started: {:?}", p.leg);
+        };
+        let mut t = 610.0;
+        for w in waypoints {
+            while (w - pos).norm() > 1.0 {
+                t += 1.0;
+                pos += (w - pos) / (w - pos).norm() * 2.0_f64.min((w - pos).norm());
+                let reading = if detects(pos) { 1.0 } else { 0.0 };
+                let s = snapshot(t, pos, Heading::from_deg(270.0), reading);
+                p.tracker.feed(&s, pos, Vec2::zeros(), Vec2::new(0.2, 0.0));
+                if let Some(r) = p.declaration(t, pos, &mut telemetry) {
+                    return Some(r);
+                }
+                if !matches!(p.leg, Some(Leg::Confirm { .. })) {
+                    return None;
+                }
+            }
+        }
+        panic!("the pass did not end at its last waypoint")
+    }
+
+    #[test]
+    fn the_rule_declares_only_after_a_confirming_pass_that_agrees() {
+        let (mut p, r) = concentrated();
+        assert!(
+            p.tracker.declares(600.0, &r),
+            "the map did not concentrate: {r:?}"
+        );
+        // Clean water upflow of the estimate: the pass agrees and declares the read after it.
+        let declared = fly_pass(&mut p, &|_| false).unwrap_or_else(|| panic!("no declaration"));
+        assert!(
+            (declared.peak_m - r.peak_m).norm() <= 10.0,
+            "{declared:?} vs {r:?}"
+        );
+        // The plume goes on upflow (contacts all along the pass): the mass spreads upflow and the
+        // pass declares nothing; the search resumes.
+        let (mut p, _) = concentrated();
+        let declared = fly_pass(&mut p, &|_| true);
+        assert!(declared.is_none(), "{declared:?}");
+        assert!(p.leg.is_none(), "{:?}", p.leg);
     }
 
     #[test]
