@@ -466,6 +466,10 @@ pub const CAMPAIGNS: &[(&str, &str)] = &[
         include_str!("../../../examples/campaigns/map-rule.toml"),
     ),
     (
+        "site",
+        include_str!("../../../examples/campaigns/site.toml"),
+    ),
+    (
         "track-altitude",
         include_str!("../../../examples/campaigns/track-altitude.toml"),
     ),
@@ -597,6 +601,25 @@ pub fn family_side_files() -> Vec<(String, &'static str)> {
         .iter()
         .map(|(name, text)| (format!("{name}.family.toml"), *text))
         .collect()
+}
+
+/// The example site's files, written to a `sites` directory beside the campaign inputs' one, so
+/// that a campaign naming `../sites/site.toml` (the shipped `site` campaign) finds them.
+pub fn site_side_files() -> Vec<(&'static str, &'static [u8])> {
+    vec![
+        (
+            "site.toml",
+            include_str!("../../../examples/sites/site.toml").as_bytes(),
+        ),
+        (
+            "currents.nc",
+            include_bytes!("../../../examples/sites/currents.nc"),
+        ),
+        (
+            "seabed.nc",
+            include_bytes!("../../../examples/sites/seabed.nc"),
+        ),
+    ]
 }
 
 /// Scenario files written next to every campaign input, so that campaign inputs naming

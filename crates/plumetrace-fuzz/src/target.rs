@@ -18,7 +18,7 @@
 //! watchdog.
 
 use crate::classify::{Class, classify_rejection};
-use crate::corpus::{Target, campaign_side_files, family_side_files};
+use crate::corpus::{Target, campaign_side_files, family_side_files, site_side_files};
 use crate::generate::Input;
 use plumetrace_campaign::spec::{Campaign, parse_campaign};
 use plumetrace_env::ConcentrationField;
@@ -104,6 +104,11 @@ impl Workdir {
         std::fs::create_dir_all(&campaign)?;
         for (name, text) in campaign_side_files() {
             std::fs::write(campaign.join(name), text)?;
+        }
+        let sites = dir.path().join("sites");
+        std::fs::create_dir_all(&sites)?;
+        for (name, bytes) in site_side_files() {
+            std::fs::write(sites.join(name), bytes)?;
         }
         let families = dir.path().join("families");
         std::fs::create_dir_all(&families)?;
@@ -454,7 +459,7 @@ fn check_alogs(dir: &Path, path: &Path) -> Result<(), Stop> {
     let root = path.parent().and_then(Path::parent).unwrap_or(path);
     if let Some(bad) = names(root)
         .into_iter()
-        .find(|n| !["scenario", "campaign", "families"].contains(&n.as_str()))
+        .find(|n| !["scenario", "campaign", "families", "sites"].contains(&n.as_str()))
     {
         return Err(escaped(bad));
     }
