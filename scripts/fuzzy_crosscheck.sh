@@ -30,7 +30,7 @@ out="${CARGO_TARGET_DIR:-$root/target}/fuzzy-crosscheck"
 mkdir -p "$out"
 "$venv/bin/python" "$here/fuzzy_crosscheck.py" inputs --out "$out/inputs.csv" --n "$n" --seed "$seed"
 FUZZY_INPUTS="$out/inputs.csv" FUZZY_OUTPUTS="$out/outputs.csv" FUZZY_RULES="$out/rules.csv" \
-    cargo test --quiet --manifest-path "$root/Cargo.toml" --workspace \
+    cargo test --release --quiet --manifest-path "$root/Cargo.toml" --workspace \
     --test fuzzy_avoidance -- --ignored --exact crosscheck_dump
 exec "$venv/bin/python" "$here/fuzzy_crosscheck.py" compare --inputs "$out/inputs.csv" \
     --outputs "$out/outputs.csv" --rules "$out/rules.csv" --tolerance "$tolerance"

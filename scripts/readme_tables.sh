@@ -6,8 +6,8 @@
 # the guide and the code disagree; run this after changing a planner key, a limit or a preset.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-cargo build --quiet --bin plumetrace
-bin="${CARGO_TARGET_DIR:-target}/debug/plumetrace"
+cargo build --release --quiet --bin plumetrace
+bin="${CARGO_TARGET_DIR:-target}/release/plumetrace"
 python3 - "$bin" <<'PY'
 import subprocess, sys
 bin = sys.argv[1]
