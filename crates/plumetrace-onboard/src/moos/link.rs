@@ -169,8 +169,14 @@ impl MoosLink {
     }
 
     fn log(&mut self, mark: char, text: &str) {
+        self.log_at(Instant::now(), mark, text);
+    }
+
+    /// A traffic line stamped `at` (a sent packet's lines carry the instant the pacing counted,
+    /// not the moment they were written down, which a busy machine can delay).
+    fn log_at(&mut self, at: Instant, mark: char, text: &str) {
         if let Some(t) = self.traffic.as_mut() {
-            let s = self.started.elapsed().as_secs_f64();
+            let s = at.saturating_duration_since(self.started).as_secs_f64();
             let _ = writeln!(t, "{s:.3} {mark} {}", text.trim_end());
         }
     }
@@ -233,7 +239,7 @@ impl MoosLink {
         if self.write_raw(&packet, events) {
             self.last_send = Some(now);
             for m in &messages {
-                self.log('>', &m.summary());
+                self.log_at(now, '>', &m.summary());
             }
         }
     }
