@@ -24,6 +24,8 @@ pub mod rng;
 pub mod seabed;
 mod simd;
 pub mod steady;
+#[cfg(test)]
+mod test_files;
 
 pub use domain::Rect;
 pub use environment::{Environment, FlowStepper, Plume, flow_schedule, flow_substeps};

@@ -6,6 +6,7 @@ use crate::field::ConcentrationField;
 use crate::flow::MeanFlow;
 use crate::flow::{FlowModel, UniformFlow};
 use crate::plume::{FilamentParams, FilamentPlume, Source, VerticalBoundary};
+use crate::test_files::rect;
 use crate::{StreamId, stream_rng};
 use plumetrace_core::Vec3;
 use plumetrace_core::geo::Origin;
@@ -14,15 +15,11 @@ use std::path::PathBuf;
 use std::sync::Arc;
 
 fn tmp(name: &str, bytes: &[u8]) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("plumetrace-seabed-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let p = dir.join(name);
-    std::fs::write(&p, bytes).unwrap();
-    p
-}
-
-fn rect(x0: f64, x1: f64, y0: f64, y1: f64) -> Rect {
-    Rect::new(x0, x1, y0, y1).unwrap()
+    crate::test_files::tmp_in(
+        &format!("plumetrace-seabed-{}", std::process::id()),
+        name,
+        bytes,
+    )
 }
 
 /// A projected grid, x 0..400 step 100, y 0..200 step 100: depth 30 m at x = 0 rising 5 m

@@ -2,21 +2,18 @@
 
 use super::*;
 use crate::flow::FlowField;
+use crate::test_files::rect;
 use crate::{StreamId, stream_rng};
 use plumetrace_core::geo::Origin;
 use plumetrace_netcdf::{Dataset, NcType};
 use std::path::PathBuf;
 
 fn tmp(name: &str, bytes: &[u8]) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("plumetrace-cf-{}-{name}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let p = dir.join(name);
-    std::fs::write(&p, bytes).unwrap();
-    p
-}
-
-fn rect(x0: f64, x1: f64, y0: f64, y1: f64) -> Rect {
-    Rect::new(x0, x1, y0, y1).unwrap()
+    crate::test_files::tmp_in(
+        &format!("plumetrace-cf-{}-{name}", std::process::id()),
+        name,
+        bytes,
+    )
 }
 
 fn options() -> CfOptions {

@@ -2,22 +2,18 @@
 //! local frame, and the projections that are refused.
 
 use super::super::{Seabed, SeabedOptions};
-use crate::Rect;
+use crate::test_files::rect;
 use plumetrace_core::Vec2;
 use plumetrace_core::geo::{LocalFrame, Origin, TransverseMercator};
 use std::io::Cursor;
 use std::path::PathBuf;
 
 fn tmp(name: &str, bytes: &[u8]) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("plumetrace-utm-tiff-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let p = dir.join(name);
-    std::fs::write(&p, bytes).unwrap();
-    p
-}
-
-fn rect(x0: f64, x1: f64, y0: f64, y1: f64) -> Rect {
-    Rect::new(x0, x1, y0, y1).unwrap()
+    crate::test_files::tmp_in(
+        &format!("plumetrace-utm-tiff-{}", std::process::id()),
+        name,
+        bytes,
+    )
 }
 
 fn frame(lat_deg: f64, lon_deg: f64) -> LocalFrame {

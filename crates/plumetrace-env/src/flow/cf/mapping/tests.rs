@@ -1,26 +1,22 @@
 //! Tests of CF grids in a transverse Mercator grid mapping (UTM): currents and a seabed written
 //! on a zone's eastings and northings read back in the local frame, and the mappings refused.
 
-use crate::Rect;
 use crate::flow::FlowField;
 use crate::flow::GriddedFlow;
 use crate::flow::cf::CfOptions;
 use crate::seabed::{Seabed, SeabedOptions};
+use crate::test_files::rect;
 use plumetrace_core::Vec2;
 use plumetrace_core::geo::{LocalFrame, Origin, TransverseMercator};
 use plumetrace_netcdf::Dataset;
 use std::path::PathBuf;
 
 fn tmp(name: &str, bytes: &[u8]) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("plumetrace-cf-tm-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let p = dir.join(name);
-    std::fs::write(&p, bytes).unwrap();
-    p
-}
-
-fn rect(x0: f64, x1: f64, y0: f64, y1: f64) -> Rect {
-    Rect::new(x0, x1, y0, y1).unwrap()
+    crate::test_files::tmp_in(
+        &format!("plumetrace-cf-tm-{}", std::process::id()),
+        name,
+        bytes,
+    )
 }
 
 /// Off Plymouth, 1 deg west of zone 30N's central meridian (grid north 0.77 deg off true).
