@@ -77,6 +77,11 @@ impl FlowGate {
             return true;
         };
         let judged = v_mps.norm() > self.p.min_speed_mps && r.norm() > self.p.min_speed_mps;
+        if !judged && self.doubting_since.is_some() {
+            // Too slow to judge while readings are being held back: a reversed reading's noise
+            // would pass as a slack current. Held back too, and the doubt goes on.
+            return false;
+        }
         let cos = v_mps.dot(&r) / (v_mps.norm() * r.norm()).max(1e-12);
         let implausible = judged && cos < self.p.max_turn_deg.to_radians().cos();
         if implausible {
@@ -166,5 +171,24 @@ mod tests {
         assert!(!g.accept(t0 + 102.0, Vec2::new(f64::NAN, 0.0)));
         // Slack water is not judged.
         assert!(g.accept(t0 + 103.0, Vec2::new(0.01, 0.0)));
+    }
+
+    #[test]
+    fn a_slow_sample_while_readings_are_held_back_is_held_back_too() {
+        let mut g = FlowGate::new(FlowGateParams::default());
+        let v = Vec2::new(0.08, 0.09);
+        for k in 0..60 {
+            assert!(g.accept(f64::from(k), v));
+        }
+        // A wrong-layer meter reads the current reversed; its noise now and then gives a sample
+        // too slow to judge (this one from a faulty run at 0.1 m/s), which must not pass as the
+        // current, nor end the doubt.
+        assert!(!g.accept(60.0, -v));
+        assert!(!g.accept(61.0, Vec2::new(-0.018, -0.024)));
+        assert!(g.doubting());
+        assert!(!g.accept(62.0, -v));
+        // Slow samples outside a doubt still pass, and a plausible one ends the doubt.
+        assert!(g.accept(63.0, v) && !g.doubting());
+        assert!(g.accept(64.0, Vec2::new(0.01, 0.0)));
     }
 }

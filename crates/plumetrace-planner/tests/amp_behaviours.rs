@@ -1076,3 +1076,46 @@ fn tracing_flies_at_the_track_altitude_and_the_search_at_the_altitude() {
     assert_eq!(a.behaviour(), BehaviourKind::TrackIn);
     assert_eq!(altitude(&d), 2.0);
 }
+
+#[test]
+fn a_lost_point_saved_while_flow_readings_were_held_back_moves_with_the_next_fix() {
+    // One record a second. The current meter reads North (upflow South) for 20 s, then reads it
+    // reversed (held back by the flow gate) until a fix at 60 s jumps the estimate 8 m East.
+    // The lost point, saved 16 s into the 40 s held back, had drifted by 16/40 of the jump.
+    let fly = |p: AmpParams| {
+        let mut a = amp_with(p);
+        for k in 0..=60 {
+            let t = f64::from(k);
+            let mut s = snap(t, (200.0, 299.0), 180.0, k == 30);
+            if k == 30 {
+                s.nav.pos_m = Some(Vec2::new(200.0, 300.0));
+            }
+            if k > 20 {
+                s.flow = s.flow.map(|f| FlowSample {
+                    velocity_mps: -f.velocity_mps,
+                    ..f
+                });
+            }
+            if k == 60 {
+                s.nav.pos_m = Some(Vec2::new(208.0, 299.0));
+                s.nav.last_fix_s = Some(60.0);
+            }
+            a.decide(&s);
+            if k == 36 {
+                assert_eq!(a.lost_points(), [Vec2::new(200.0, 300.0)]);
+            }
+        }
+        a.lost_points()
+    };
+    let moved = fly(AmpParams::default());
+    assert_eq!(moved.len(), 1);
+    assert!(
+        (moved[0] - Vec2::new(203.2, 300.0)).norm() < 1e-9,
+        "{moved:?}"
+    );
+    let kept = fly(AmpParams {
+        fix_smoothing: false,
+        ..AmpParams::default()
+    });
+    assert_eq!(kept, [Vec2::new(200.0, 300.0)]);
+}

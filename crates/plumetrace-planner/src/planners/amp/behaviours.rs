@@ -256,6 +256,8 @@ impl Behaviour<Memory, AmpDone> for TrackOut {
 #[derive(Debug, Clone)]
 pub(super) struct Reacquire {
     point: Vec2,
+    /// The lost point's id (its position moves with `fix_smoothing`; the Bowties stay).
+    id: u64,
     n: usize,
     leg: usize,
     bowtie: bowtie::Bowtie,
@@ -264,10 +266,11 @@ pub(super) struct Reacquire {
 
 impl Reacquire {
     /// The first Bowtie around `point`.
-    pub(super) fn new(m: &Memory, point: Vec2) -> Self {
+    pub(super) fn new(m: &Memory, point: Vec2, id: u64) -> Self {
         let (bowtie, line) = new_bowtie(m, point, 0);
         Reacquire {
             point,
+            id,
             n: 0,
             leg: 0,
             bowtie,
@@ -298,9 +301,9 @@ impl Behaviour<Memory, AmpDone> for Reacquire {
         // detection) has taken its time, or when the point itself was dropped (aged out, or set
         // under a flow that has since turned).
         m.reacquire_since.get_or_insert(p.t_s);
-        let dropped = !m.lost.iter().any(|l| l.pos == self.point);
+        let dropped = !m.lost.iter().any(|l| l.id == self.id);
         if dropped || m.reacquire_timed_out(p.t_s) {
-            return Proposal::Done(AmpDone::Searched { point: self.point });
+            return Proposal::Done(AmpDone::Searched { id: self.id });
         }
         // At most three legs per Bowtie and `N_re` Bowties: the loop ends.
         loop {
@@ -339,11 +342,12 @@ impl Behaviour<Memory, AmpDone> for Reacquire {
                         _ => {
                             let n = self.n + 1;
                             if n >= (m.p.n_re as usize).max(1) {
-                                return Proposal::Done(AmpDone::Searched { point: self.point });
+                                return Proposal::Done(AmpDone::Searched { id: self.id });
                             }
                             let (bowtie, line) = new_bowtie(m, self.point, n);
                             *self = Reacquire {
                                 point: self.point,
+                                id: self.id,
                                 n,
                                 leg: 0,
                                 bowtie,
