@@ -77,10 +77,17 @@ impl FlowGate {
             return true;
         };
         let judged = v_mps.norm() > self.p.min_speed_mps && r.norm() > self.p.min_speed_mps;
-        if !judged && self.doubting_since.is_some() {
+        if !judged && let Some(since) = self.doubting_since {
             // Too slow to judge while readings are being held back: a reversed reading's noise
-            // would pass as a slack current. Held back too, and the doubt goes on.
-            return false;
+            // would pass as a slack current. Held back too, and the doubt goes on, until it has
+            // lasted persist_s (a current that stays slack is then believed like a lasting
+            // change).
+            if t_s - since < self.p.persist_s {
+                return false;
+            }
+            self.doubting_since = None;
+            self.reference = Some((t_s, v_mps));
+            return true;
         }
         let cos = v_mps.dot(&r) / (v_mps.norm() * r.norm()).max(1e-12);
         let implausible = judged && cos < self.p.max_turn_deg.to_radians().cos();
@@ -190,5 +197,19 @@ mod tests {
         // Slow samples outside a doubt still pass, and a plausible one ends the doubt.
         assert!(g.accept(63.0, v) && !g.doubting());
         assert!(g.accept(64.0, Vec2::new(0.01, 0.0)));
+        // A current that goes slack while readings are held back is believed once the doubt
+        // has lasted persist_s, as a lasting change is.
+        let mut g = FlowGate::new(FlowGateParams {
+            persist_s: 100.0,
+            ..FlowGateParams::default()
+        });
+        assert!(g.accept(0.0, v));
+        assert!(!g.accept(1.0, -v));
+        let slack = Vec2::new(0.01, -0.01);
+        for k in 2..101 {
+            assert!(!g.accept(f64::from(k), slack), "t = {k}");
+        }
+        assert!(g.accept(101.0, slack) && !g.doubting());
+        assert!(g.accept(102.0, slack));
     }
 }

@@ -1119,3 +1119,106 @@ fn a_lost_point_saved_while_flow_readings_were_held_back_moves_with_the_next_fix
     });
     assert_eq!(kept, [Vec2::new(200.0, 300.0)]);
 }
+
+/// One contact and its loss at `at`, then the Track-Out flown to its goal; `edit` changes each
+/// snapshot (the flow reading, the navigation's last fix).
+fn lose_edited(
+    a: &mut Amp,
+    t: &mut f64,
+    at: (f64, f64),
+    edit: &dyn Fn(SensorSnapshot) -> SensorSnapshot,
+) -> Vec<PlannerEvent> {
+    let mut events = Vec::new();
+    events.extend(a.decide(&edit(snap(*t, at, 180.0, true))).events);
+    *t += 6.0;
+    events.extend(
+        a.decide(&edit(snap(*t, (at.0, at.1 - 1.0), 180.0, false)))
+            .events,
+    );
+    if a.behaviour() == BehaviourKind::TrackOut {
+        let goal = a.track_out_goal().unwrap();
+        *t += 10.0;
+        events.extend(
+            a.decide(&edit(snap(*t, (goal.x, goal.y), 180.0, false)))
+                .events,
+        );
+    }
+    *t += 1.0;
+    events
+}
+
+#[test]
+fn after_held_back_flow_readings_the_declaration_waits_for_the_next_fix() {
+    // A fix at 5 s; from 21 s the current meter reads the current reversed (held back). Three
+    // losses within 6 m along the flow would declare at once (no confirming leg here); after
+    // held-back readings the check waits for the next fix, and declares at the first Track-Out
+    // after it. A navigation that reports no fixes, or fix_wait_s = 0, declares at once.
+    let declared = |events: &[PlannerEvent]| {
+        events
+            .iter()
+            .filter(|e| matches!(e, PlannerEvent::Declared { .. }))
+            .count()
+    };
+    let fly = |p: AmpParams, fixes: bool| {
+        let mut a = amp_with(AmpParams {
+            declaration_confirm_m: 0.0,
+            ..p
+        });
+        let held_back = move |mut s: SensorSnapshot| {
+            if fixes && s.time_s >= 5.0 {
+                s.nav.last_fix_s = Some(5.0);
+            }
+            if s.time_s > 20.0 {
+                s.flow = s.flow.map(|f| FlowSample {
+                    velocity_mps: -f.velocity_mps,
+                    ..f
+                });
+            }
+            s
+        };
+        let mut events = Vec::new();
+        for k in 0..=40 {
+            let s = snap(f64::from(k), (200.0, 500.0), 0.0, false);
+            events.extend(a.decide(&held_back(s)).events);
+        }
+        let mut t = 50.0;
+        for at in [(200.0, 300.0), (205.0, 298.0), (195.0, 296.5)] {
+            events.extend(lose_edited(&mut a, &mut t, at, &held_back));
+        }
+        (a, events, t)
+    };
+    let (_, events, _) = fly(AmpParams::default(), false);
+    assert_eq!(declared(&events), 1, "no fix reported: nothing to wait for");
+    let (_, events, _) = fly(
+        AmpParams {
+            fix_wait_s: 0.0,
+            ..AmpParams::default()
+        },
+        true,
+    );
+    assert_eq!(declared(&events), 1, "fix_wait_s = 0: declared at once");
+
+    let (mut a, events, mut t) = fly(AmpParams::default(), true);
+    assert_eq!(declared(&events), 0, "waiting for the next fix");
+    assert!(a.declarations().is_empty());
+    // Readings plausible again, and a fix that does not move the estimate.
+    let fixed = move |mut s: SensorSnapshot| {
+        s.nav.last_fix_s = Some(if s.time_s >= t + 2.0 { t + 2.0 } else { 5.0 });
+        s
+    };
+    let t0 = t;
+    for k in 0..3 {
+        let s = snap(t0 + f64::from(k), (195.0, 295.5), 180.0, false);
+        a.decide(&fixed(s));
+    }
+    t = t0 + 3.0;
+    let events = lose_edited(&mut a, &mut t, (200.0, 297.0), &fixed);
+    assert_eq!(declared(&events), 1, "declared after the fix");
+    // 2.5 m upflow (South) of the most upflow of the three most upflow points, at their mean
+    // across the flow.
+    assert!(
+        (a.declarations()[0] - Vec2::new(200.0, 294.0)).norm() < 1e-9,
+        "{:?}",
+        a.declarations()
+    );
+}

@@ -256,7 +256,8 @@ impl Behaviour<Memory, AmpDone> for TrackOut {
 #[derive(Debug, Clone)]
 pub(super) struct Reacquire {
     point: Vec2,
-    /// The lost point's id (its position moves with `fix_smoothing`; the Bowties stay).
+    /// The lost point's id (its position moves with `fix_smoothing`; each Bowtie is centred
+    /// where the point is when the Bowtie begins).
     id: u64,
     n: usize,
     leg: usize,
@@ -344,9 +345,15 @@ impl Behaviour<Memory, AmpDone> for Reacquire {
                             if n >= (m.p.n_re as usize).max(1) {
                                 return Proposal::Done(AmpDone::Searched { id: self.id });
                             }
-                            let (bowtie, line) = new_bowtie(m, self.point, n);
+                            // Around where the point is now (a fix may have moved it).
+                            let point = m
+                                .lost
+                                .iter()
+                                .find(|l| l.id == self.id)
+                                .map_or(self.point, |l| l.pos);
+                            let (bowtie, line) = new_bowtie(m, point, n);
                             *self = Reacquire {
-                                point: self.point,
+                                point,
                                 id: self.id,
                                 n,
                                 leg: 0,

@@ -68,6 +68,8 @@ pub(super) struct FixWatch {
     held_back_s: f64,
     /// The last record at which it was, since then.
     last_held_back_s: Option<f64>,
+    /// When the declaration first waited for a fix, since the last fix.
+    first_wait_s: Option<f64>,
 }
 
 impl FixWatch {
@@ -76,10 +78,16 @@ impl FixWatch {
         self.held_back_s
     }
 
-    /// Whether the navigation has drifted with held-back flow readings since the last fix, the
-    /// last of them at most `wait_s` before `t_s`.
-    pub fn awaiting_fix(&self, t_s: f64, wait_s: f64) -> bool {
-        self.last_held_back_s.is_some_and(|h| t_s - h <= wait_s)
+    /// Whether a declaration checked at `t_s` waits for the next fix: flow readings were held
+    /// back since the last fix (the navigation may have drifted with them), the navigation has
+    /// reported a fix before (one that reports none gives nothing to wait for), and the wait,
+    /// counted from the first check that waited since the last fix, has lasted at most `wait_s`.
+    pub fn awaiting_fix(&mut self, t_s: f64, wait_s: f64) -> bool {
+        if self.last_held_back_s.is_none() || self.last_fix_s.is_none() {
+            return false;
+        }
+        let first = *self.first_wait_s.get_or_insert(t_s);
+        t_s - first <= wait_s
     }
 
     /// Takes the navigation record at `t_s`, with `held_back` telling whether the flow reading
@@ -119,6 +127,7 @@ impl FixWatch {
             self.since_s = Some(t_s);
             self.held_back_s = 0.0;
             self.last_held_back_s = None;
+            self.first_wait_s = None;
         }
         self.before = self.last.replace((t_s, pos));
         fix
@@ -179,10 +188,19 @@ mod tests {
             let t = f64::from(k);
             w.observe(t, &nav(Vec2::new(0.0, t), None), (10.0..20.0).contains(&t));
         }
-        // The last held-back record was at 19 s.
+        // Readings were held back, but no fix has been reported yet: nothing to wait for.
+        assert!(!w.awaiting_fix(40.0, 600.0));
+        let mut w = FixWatch::default();
+        for k in 0..=40 {
+            let t = f64::from(k);
+            let fix = (k >= 5).then_some(5.0);
+            w.observe(t, &nav(Vec2::new(0.0, t), fix), (10.0..20.0).contains(&t));
+        }
+        // Counted from the first check that waited (at 40 s).
         assert!(w.awaiting_fix(40.0, 600.0));
-        assert!(w.awaiting_fix(619.0, 600.0));
-        assert!(!w.awaiting_fix(619.5, 600.0));
+        assert!(w.awaiting_fix(640.0, 600.0));
+        assert!(!w.awaiting_fix(640.5, 600.0));
+        // A fix ends the wait.
         assert!(
             w.observe(41.0, &nav(Vec2::new(3.0, 41.0), Some(41.0)), false)
                 .is_some()
