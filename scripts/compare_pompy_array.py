@@ -493,6 +493,19 @@ def jackknife_width(profiles, ys):
     return full, float(math.sqrt((n - 1) / n * ((loo - loo.mean()) ** 2).sum()))
 
 
+def width_rows(pres, rres, pkey, rkey, what):
+    """Rows (a): the profile's width at each of SLABS, pompy's `pkey` against plumetrace's `rkey`."""
+    return [diff_row(f"(a) {what} at x = {x:.0f} m (m)",
+                     [p[pkey]["widths"][str(x)] for p in pres],
+                     [r[rkey]["widths"][str(x)] for r in rres]) for x in SLABS]
+
+
+def region_row(pres, rres, pkey, rkey):
+    """Row (b): the mean over the array region, pompy's `pkey` against plumetrace's `rkey`."""
+    return diff_row("(b) mean over the array region", [p[pkey]["region_mean"] for p in pres],
+                    [r[rkey]["region_mean"] for r in rres], 4)
+
+
 def report(pres, rres, setup):
     rows = []
     ys = array_y()
@@ -502,11 +515,7 @@ def report(pres, rres, setup):
           "error; z = difference / its standard error.\n")
     print("| statistic | pompy | plumetrace | difference | z |")
     print("|---|---|---|---|---|")
-    for x in SLABS:
-        k = str(x)
-        rows.append(diff_row(f"(a) width of the time-averaged profile at x = {x:.0f} m (m)",
-                             [p["exact"]["widths"][k] for p in pres],
-                             [r["exact"]["widths"][k] for r in rres]))
+    rows += width_rows(pres, rres, "exact", "exact", "width of the time-averaged profile")
     for x in SLABS:
         k = str(x)
         pw, pse = jackknife_width([p["exact"]["profiles"][k] for p in pres], ys)
@@ -516,8 +525,7 @@ def report(pres, rres, setup):
               f"| {fmt(rw, rse)} | {100 * diff:+.1f} % +- {100 * dse:.1f} % | {diff / dse:+.1f} |")
         rows.append({"label": f"(a') mean-profile width x={x:.0f}", "pompy": [pw, pse],
                      "plumetrace": [rw, rse], "diff": [diff, dse], "z": diff / dse})
-    rows.append(diff_row("(b) mean over the array region", [p["exact"]["region_mean"] for p in pres],
-                         [r["exact"]["region_mean"] for r in rres], 4))
+    rows.append(region_row(pres, rres, "exact", "exact"))
     for t in SPREAD_TIMES:
         k = str(t)
         rows.append(diff_row(f"(c) cross-flow spread of all puffs at t = {t:.0f} s (m)",
@@ -538,13 +546,8 @@ def report(pres, rres, setup):
     print("\n## As displayed: pompy's array generator against plumetrace's own output grid\n")
     print("| statistic | pompy (generator) | plumetrace (own grid) | difference | z |")
     print("|---|---|---|---|---|")
-    for x in SLABS:
-        k = str(x)
-        rows.append(diff_row(f"(a) width at x = {x:.0f} m (m)",
-                             [p["generator"]["widths"][k] for p in pres],
-                             [r["own_grid"]["widths"][k] for r in rres]))
-    rows.append(diff_row("(b) mean over the array region", [p["generator"]["region_mean"] for p in pres],
-                         [r["own_grid"]["region_mean"] for r in rres], 4))
+    rows += width_rows(pres, rres, "generator", "own_grid", "width")
+    rows.append(region_row(pres, rres, "generator", "own_grid"))
 
     print("\n## (d) Each display against the exact sum of its own puffs (same seeds, paired)\n")
     print("| statistic | pompy: generator / exact - 1 | plumetrace: own grid / exact - 1 |")
