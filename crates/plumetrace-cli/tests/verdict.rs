@@ -25,9 +25,23 @@ fn fly(args: &[&str], out: &Path) -> (String, serde_json::Value) {
 fn the_run_line_summary_and_figure_say_whether_the_source_was_located() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
-    // Infotaxis on the demo site declares far downflow: not located.
+    // Infotaxis on the demo site with a map that dilutes the plume after 15 m (an earlier
+    // default) declares far downflow: not located.
     let (line, s) = fly(
-        &["--preset", "demo-infotaxis", "--seed", "1"],
+        &[
+            "--preset",
+            "demo-infotaxis",
+            "--seed",
+            "1",
+            "--set",
+            "map_dilution_m=15.0",
+            "--set",
+            "map_p_detect=0.1",
+            "--set",
+            "map_diffusivity_m2ps=0.1",
+            "--set",
+            "map_mass=0.7",
+        ],
         &d.join("far"),
     );
     assert!(
@@ -53,7 +67,14 @@ fn the_run_line_summary_and_figure_say_whether_the_source_was_located() {
     let text = plumetrace_scenario::find_preset("demo-infotaxis")
         .unwrap()
         .toml;
-    let wide = text.replacen("[mission]\n", "[mission]\nsuccess_radius_m = 300.0\n", 1);
+    let wide = text
+        .replacen("[mission]\n", "[mission]\nsuccess_radius_m = 300.0\n", 1)
+        .replacen(
+            "kind = \"infotaxis\"",
+            "kind = \"infotaxis\"\nmap_dilution_m = 15.0\nmap_p_detect = 0.1\n\
+             map_diffusivity_m2ps = 0.1\nmap_mass = 0.7",
+            1,
+        );
     std::fs::write(d.join("wide.toml"), &wide).unwrap();
     let (line, s) = fly(&[d.join("wide.toml").to_str().unwrap()], &d.join("wide"));
     assert!(
@@ -68,8 +89,8 @@ fn the_run_line_summary_and_figure_say_whether_the_source_was_located() {
     );
     // Out of time before any declaration.
     let short = text
-        .replacen("time_limit_s = 2400.0", "time_limit_s = 60.0", 1)
-        .replacen("duration_s = 2400.0", "duration_s = 60.0", 1);
+        .replacen("time_limit_s = 3600.0", "time_limit_s = 60.0", 1)
+        .replacen("duration_s = 3600.0", "duration_s = 60.0", 1);
     std::fs::write(d.join("short.toml"), &short).unwrap();
     let (line, s) = fly(&[d.join("short.toml").to_str().unwrap()], &d.join("short"));
     assert!(

@@ -438,6 +438,10 @@ pub const CAMPAIGNS: &[(&str, &str)] = &[
         include_str!("../../../examples/campaigns/map-tuning.toml"),
     ),
     (
+        "infotaxis-tuning",
+        include_str!("../../../examples/campaigns/infotaxis-tuning.toml"),
+    ),
+    (
         "ten-planners-one-plume",
         include_str!("../../../examples/campaigns/ten-planners-one-plume.toml"),
     ),

@@ -18,6 +18,19 @@
 //! without one (a new contact is news; contacts inside the plume are not, and ending legs on them
 //! left the vehicle circling in the plume).
 //!
+//! **The plume model.** The map's model decides where infotaxis flies, so it must not claim more
+//! than a threshold detector can tell. Behind a bottom source the chance of a detection at the
+//! vehicle's altitude does not fall with distance over the first few hundred metres: on
+//! `duck-2003-st` it rises from 0.2 within 10 m of the source to 0.7-0.8 from 50 to 400 m
+//! downflow on the plume's axis. A model with dilution (a detection favouring sources a few tens
+//! of metres upflow) let a vehicle that met the plume far downflow concentrate the map there and
+//! declare there; without dilution a detection says "upflow, somewhere", and only non-detections
+//! upflow of the plume's head place the source, so the information is at the head and the legs go
+//! there. Infotaxis's map therefore has no dilution (`map_dilution_s = 0`, `map_dilution_m = 0`),
+//! a detection chance of 0.2 in the plume (`map_p_detect`), a spread that grows as
+//! `2 x 1.0 m^2/s x T` (`map_diffusivity_m2ps`: the meander), the AMP's vertical mixing, and
+//! declares at half the mass within `map_radius_m` (`map_mass = 0.5`).
+//!
 //! **Declaration.** Once the map's rule holds (mass `map_mass` within `map_radius_m` of the most
 //! likely cell, read every `map_check_s`, after `map_min_detections` detections and `map_hold_s`),
 //! the vehicle flies a confirming pass through the estimate along the flow, from `confirm_m`
@@ -45,7 +58,7 @@ plumetrace_core::params! {
     /// Parameters of the infotaxis planner.
     pub struct InfotaxisParams {
         include autopilot: AutopilotKeys = AutopilotKeys::default();
-        include map: MapKeys = MapKeys { map_mass: 0.7, map_hold_s: 300.0, map_estimate_radius_m: 10.0, map_mixing_length_m: 0.12, map_dilution_m: 15.0, ..MapKeys::default() };
+        include map: MapKeys = MapKeys { map_mass: 0.5, map_hold_s: 300.0, map_estimate_radius_m: 10.0, map_mixing_length_m: 0.12, map_p_detect: 0.2, map_diffusivity_m2ps: 1.0, map_dilution_s: 0.0, ..MapKeys::default() };
         /// What a move minimises: infotaxis (the expected entropy of the map after it) or space_aware (expected log2(D + 2^(H - 1) - 1/2), distance D in map cells).
         objective: Objective = Objective::Infotaxis, "", Bounds::Any;
         /// Length of a candidate leg, its turn at the turning limit included (40 s at 2 m/s).
