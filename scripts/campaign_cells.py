@@ -21,10 +21,14 @@ def median(values):
 
 
 def main():
-    if len(sys.argv) != 2:
-        sys.exit("usage: campaign_cells.py RUNS_CSV")
+    if len(sys.argv) != 2 or sys.argv[1] in ("-h", "--help"):
+        print(__doc__.strip(), file=sys.stderr)
+        sys.exit(0 if sys.argv[1:] in (["-h"], ["--help"]) else 2)
     try:
-        rows = list(csv.DictReader(open(sys.argv[1])))
+        with open(sys.argv[1]) as f:
+            rows = list(csv.DictReader(f))
+        if not rows:
+            sys.exit(f"error: {sys.argv[1]}: no runs in it (a campaign's runs.csv has a row per run)")
         groups, scenarios, configs = defaultdict(list), [], []
         for r in rows:
             groups[(r["config"], r["scenario"])].append(r)
@@ -51,8 +55,10 @@ def main():
                     cell += f" ({n - len(errors)} undeclared)"
                 cells.append(cell)
             print(f"| {c} | " + " | ".join(cells) + " |")
-    except (OSError, KeyError, ValueError) as e:
-        sys.exit(f"error: {sys.argv[1]}: not a campaign's runs.csv ({e})")
+    except OSError as e:
+        sys.exit(f"error: {sys.argv[1]}: cannot read it ({e.strerror})")
+    except (KeyError, ValueError, UnicodeDecodeError, csv.Error) as e:
+        sys.exit(f"error: {sys.argv[1]}: not a campaign's runs.csv (no or bad column {e})")
 
 
 if __name__ == "__main__":

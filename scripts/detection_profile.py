@@ -1,8 +1,8 @@
 #!/usr/bin/env python3
 """How often a vehicle's sensor detects, by where it is relative to the source.
 
-Reads the `trajectory.csv` and `summary.json` of one or more run directories (one source each)
-and prints the share of samples (one per second of mission time) that detected, binned by the
+Reads the `trajectory.csv` and `summary.json` of one or more run directories (single-source
+missions; the samples of one vehicle, `--vehicle`, 0 unless given) and prints the share of samples (one per second of mission time) that detected, binned by the
 distance along the mean flow from the source (positive: downflow) and the distance across it.
 Used by docs/planners.md (infotaxis, its plume model); standard library only.
 
@@ -31,6 +31,7 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--toward-deg", type=float, required=True,
                     help="the mean flow's direction, degrees clockwise from North (toward)")
+    ap.add_argument("--vehicle", type=int, default=0, help="the vehicle whose samples count (default 0)")
     ap.add_argument("runs", nargs="+", help="run directories (plumetrace run --out)")
     a = ap.parse_args()
     th = math.radians(a.toward_deg)
@@ -40,11 +41,15 @@ def main():
         d = Path(d)
         try:
             summary = json.loads((d / "summary.json").read_text())
+            if len(summary["sources"]) != 1:
+                sys.exit(f"error: {d}: {len(summary['sources'])} sources; this profile is of a single-source mission")
             src = summary["sources"][0]
             sx, sy = src["x_m"], src["y_m"]
             rows = csv.DictReader(open(d / "trajectory.csv"))
             last = -1e9
             for r in rows:
+                if int(r["vehicle"]) != a.vehicle:
+                    continue
                 t = float(r["t_s"])
                 if t - last < 1.0:
                     continue
