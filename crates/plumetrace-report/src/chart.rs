@@ -48,6 +48,29 @@ where
 
 /// A closed polygon drawn dashed (dash length scaled to the edge, gaps 3/4 of a dash).
 pub fn dashed(points: &[Vec2], colour: RGBColor, width: u32) -> Vec<PathElement<(f64, f64)>> {
+    dashed_where(points, colour, width, |_| true)
+}
+
+/// [`dashed`], keeping only the dashes that lie wholly within `x` by `y` (a zoomed view: a dash
+/// outside the view would otherwise be drawn pressed against its frame).
+pub fn dashed_within(
+    points: &[Vec2],
+    colour: RGBColor,
+    width: u32,
+    x: &std::ops::Range<f64>,
+    y: &std::ops::Range<f64>,
+) -> Vec<PathElement<(f64, f64)>> {
+    dashed_where(points, colour, width, |p| {
+        x.contains(&p.x) && y.contains(&p.y)
+    })
+}
+
+fn dashed_where(
+    points: &[Vec2],
+    colour: RGBColor,
+    width: u32,
+    keep: impl Fn(Vec2) -> bool,
+) -> Vec<PathElement<(f64, f64)>> {
     let mut out = Vec::new();
     let n = points.len();
     for i in 0..n {
@@ -64,12 +87,50 @@ pub fn dashed(points: &[Vec2], colour: RGBColor, width: u32) -> Vec<PathElement<
             let e = (s + dash).min(len);
             let p = a + dir * s;
             let q = a + dir * e;
-            out.push(PathElement::new(
-                vec![(p.x, p.y), (q.x, q.y)],
-                colour.stroke_width(width),
-            ));
+            if keep(p) && keep(q) {
+                out.push(PathElement::new(
+                    vec![(p.x, p.y), (q.x, q.y)],
+                    colour.stroke_width(width),
+                ));
+            }
             s += 1.75 * dash;
         }
     }
     out
+}
+
+#[cfg(test)]
+mod tests {
+    #![allow(clippy::unwrap_used)]
+
+    use super::*;
+    use plotters::element::PointCollection;
+
+    #[test]
+    fn a_zoomed_outline_keeps_only_the_dashes_inside_the_view() {
+        // A 400 x 160 m op-area seen through a 100 x 100 m window over its west end: only the
+        // west edge and the parts of the north and south edges inside the window are drawn.
+        let area = [
+            Vec2::new(60.0, -80.0),
+            Vec2::new(460.0, -80.0),
+            Vec2::new(460.0, 80.0),
+            Vec2::new(60.0, 80.0),
+        ];
+        let (x, y) = (20.0..120.0, -90.0..90.0);
+        let all = dashed(&area, BLACK, 1);
+        let kept = dashed_within(&area, BLACK, 1, &x, &y);
+        assert!(!kept.is_empty() && kept.len() < all.len() / 2);
+        for d in &kept {
+            for (px, py) in d.point_iter() {
+                assert!(
+                    x.contains(px) && y.contains(py),
+                    "({px}, {py}) outside the view"
+                );
+            }
+        }
+        assert_eq!(
+            dashed_within(&area, BLACK, 1, &(-1e9..1e9), &(-1e9..1e9)).len(),
+            all.len()
+        );
+    }
 }

@@ -6,7 +6,7 @@ use super::layout::map_overhead_px;
 use super::model::thin;
 use super::raster::{Raster, raster_cells, raster_peak};
 use super::style::{SOURCE_MARK, WIDTH_PX};
-use crate::chart::{dashed, map_chart};
+use crate::chart::{dashed_within, map_chart};
 use crate::error::ReportError;
 use plotters::prelude::*;
 use plumetrace_core::Vec2;
@@ -72,21 +72,33 @@ where
             )
             .map_err(ReportError::figure)?;
         chart
-            .draw_series(dashed(&run.op_area, BLACK, 1))
+            .draw_series(dashed_within(&run.op_area, BLACK, 1, &x, &y))
             .map_err(ReportError::figure)?;
-        // The estimated tracks up to the map's time (outside the window: clipped by plotters).
+        // The estimated tracks up to the map's time, in pieces inside the window (a piece ends
+        // where the track leaves it, so no line crosses the panel where the vehicle did not go).
         for rs in rows.values() {
-            let pts: Vec<(f64, f64)> = rs
-                .iter()
-                .filter(|q| q.t_s <= r.0)
-                .filter_map(|q| q.est_x_m.zip(q.est_y_m))
-                .filter(|p| x.contains(&p.0) && y.contains(&p.1))
-                .collect();
+            let mut pieces: Vec<Vec<(f64, f64)>> = vec![Vec::new()];
+            for q in rs.iter().filter(|q| q.t_s <= r.0) {
+                match q.est_x_m.zip(q.est_y_m) {
+                    Some(p) if x.contains(&p.0) && y.contains(&p.1) => {
+                        if let Some(last) = pieces.last_mut() {
+                            last.push(p);
+                        }
+                    }
+                    _ => {
+                        if pieces.last().is_some_and(|l| !l.is_empty()) {
+                            pieces.push(Vec::new());
+                        }
+                    }
+                }
+            }
             chart
-                .draw_series(std::iter::once(PathElement::new(
-                    thin(&pts, 2.0 * half_x / pw),
-                    RGBColor(70, 70, 70).mix(0.7).stroke_width(1),
-                )))
+                .draw_series(pieces.iter().filter(|p| p.len() > 1).map(|p| {
+                    PathElement::new(
+                        thin(p, 2.0 * half_x / pw),
+                        RGBColor(70, 70, 70).mix(0.7).stroke_width(1),
+                    )
+                }))
                 .map_err(ReportError::figure)?;
         }
         chart
@@ -111,7 +123,7 @@ where
             )
             .map_err(ReportError::figure)?;
         let (px0, _) = chart.plotting_area().get_pixel_range();
-        let note = "+ most likely cell   \u{25b2} source   \u{25cf} declared";
+        let note = "\u{00d7} most likely cell   \u{25b2} source   \u{25cf} declared";
         key.draw(&Text::new(
             note,
             (px0.start + 4, 2),
