@@ -132,6 +132,9 @@ pub struct Campaign {
     pub configs: Vec<ConfigFile>,
     /// Sweep points (one empty point without a sweep).
     pub points: Vec<SweepPoint>,
+    /// Planner keys a group gives that have no effect at its values, each naming the group
+    /// (filled by [`Campaign::check_groups`]; the campaign command prints them).
+    pub warnings: Vec<String>,
 }
 
 /// One run of the list.
@@ -250,7 +253,7 @@ impl Campaign {
         if let Some(n) = seeds {
             file.seeds = n;
         }
-        let c = Campaign::resolve(file, path, text, true)?;
+        let mut c = Campaign::resolve(file, path, text, true)?;
         if test_seeds == TestSeeds::Refuse {
             c.refuse_test_seeds()?;
         }
@@ -329,6 +332,7 @@ impl Campaign {
             scenarios,
             configs,
             points,
+            warnings: Vec::new(),
         })
     }
 
@@ -532,8 +536,10 @@ impl Campaign {
         }
     }
 
-    /// Builds every group once (scenario and planner settings), so a bad key fails before any run.
-    pub fn check_groups(&self) -> Result<(), CampaignError> {
+    /// Builds every group once (scenario and planner settings), so a bad key fails before any
+    /// run; keeps in `warnings` the planner keys a group gives that have no effect.
+    pub fn check_groups(&mut self) -> Result<(), CampaignError> {
+        let mut warnings = Vec::new();
         for s in 0..self.scenarios.len() {
             for c in 0..self.configs.len() {
                 for p in 0..self.points.len() {
@@ -555,11 +561,24 @@ impl Campaign {
                         ));
                     }
                     // The planner registry checks every planner key (set and sweep included).
-                    plumetrace_mission::MissionSetup::new(built)
+                    let setup = plumetrace_mission::MissionSetup::new(built)
                         .map_err(|e| self.group_error(s, c, p, e.to_string()))?;
+                    for (_, key, why) in setup.inert_keys {
+                        // Named by config (and sweep point): every scenario gives its keys.
+                        let mut group = format!("config '{}'", self.configs[c].name);
+                        let point = self.points[p].label();
+                        if !point.is_empty() {
+                            group.push_str(&format!(", sweep {point}"));
+                        }
+                        let w = format!("{group}: planner key {key} {why}");
+                        if !warnings.contains(&w) {
+                            warnings.push(w);
+                        }
+                    }
                 }
             }
         }
+        self.warnings = warnings;
         Ok(())
     }
 
@@ -899,7 +918,7 @@ mod tests {
                     [configs.set]\nlane_spacing_m = 30.0\n";
         let path = Path::new("c.toml");
         let file = parse_campaign(text, path).unwrap();
-        let c = Campaign::resolve(file, path, text.to_string(), true).unwrap();
+        let mut c = Campaign::resolve(file, path, text.to_string(), true).unwrap();
         let t = c.group_table(0, 0, 0, 0).unwrap();
         let planner = t["planner"].as_table().unwrap();
         assert_eq!(planner["kind"].as_str(), Some("lawnmower"));
@@ -912,11 +931,34 @@ mod tests {
         // A key the lawnmower does not have is refused with its path.
         let bad = text.replace("lane_spacing_m = 30.0", "beta_deg = 30.0");
         let file = parse_campaign(&bad, path).unwrap();
-        let c = Campaign::resolve(file, path, bad.clone(), true).unwrap();
+        let mut c = Campaign::resolve(file, path, bad.clone(), true).unwrap();
         let e = c.check_groups().unwrap_err().to_string();
         assert!(
             e.contains("planner.beta_deg") && e.contains("unknown field"),
             "{e}"
+        );
+    }
+
+    #[test]
+    fn planner_keys_without_effect_are_kept_as_warnings_naming_the_config() {
+        let text = "name = \"c\"\nseed = 1\nseeds = 1\nscenarios = [\"demo\", \"demo-survey\"]\n\
+                    [[configs]]\nname = \"no-smoothing\"\n[configs.planner]\nkind = \"amp\"\n\
+                    fix_smoothing = false\nfix_wait_s = 300.0\n\
+                    [[configs]]\nname = \"default\"\n[configs.planner]\nkind = \"amp\"\n";
+        let path = Path::new("c.toml");
+        let file = parse_campaign(text, path).unwrap();
+        let mut c = Campaign::resolve(file, path, text.to_string(), true).unwrap();
+        assert!(c.warnings.is_empty(), "filled by check_groups");
+        c.check_groups().unwrap();
+        // Once, however many scenarios give the key.
+        assert_eq!(c.warnings.len(), 1, "{:?}", c.warnings);
+        assert!(
+            c.warnings[0].starts_with(
+                "config 'no-smoothing': planner key fix_wait_s has no effect with fix_smoothing = \
+                 false"
+            ),
+            "{:?}",
+            c.warnings
         );
     }
 

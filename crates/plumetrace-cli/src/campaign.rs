@@ -59,6 +59,9 @@ pub fn run(args: &CampaignArgs) -> Result<()> {
             TestSeeds::Refuse
         },
     )?;
+    for w in &c.warnings {
+        eprintln!("warning: {}: {w}", args.file.display());
+    }
     let started = Instant::now();
     let planned = c.shard_runs(args.shard).len() as u64;
     let progress = crate::progress::Progress::new(planned, "runs");

@@ -307,6 +307,40 @@ fn keys_with_no_effect_are_warned_of_by_check_and_run() {
 }
 
 #[test]
+fn planner_keys_with_no_effect_at_the_tables_values_are_warned_of() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let with = |keys: &str| {
+        let text = demo().replacen("kind = \"amp\"", &format!("kind = \"amp\"\n{keys}"), 1);
+        assert_ne!(text, demo(), "the demo has a [planner] kind = \"amp\" line");
+        std::fs::write(d.join("k.toml"), &text).unwrap();
+        plumetrace(d, &["check", "k.toml"])
+    };
+    let (status, _, err) = with("fix_smoothing = false\nfix_wait_s = 300.0");
+    assert_eq!(status, 0, "{err}");
+    assert!(
+        err.contains(
+            "planner.fix_wait_s: has no effect with fix_smoothing = false: the wait for the next \
+             fix is part of moving lost points with it"
+        ),
+        "{err}"
+    );
+    let (_, _, err) = with("map_dilution_m = 20.0\nmap_dilution_s = 30.0");
+    assert!(
+        err.contains("planner.map_dilution_s: has no effect while map_dilution_m (20 m)"),
+        "{err}"
+    );
+    // Given where they act (the AMP's map dilutes after 30 m unless map_dilution_m = 0), or
+    // not given: no warning.
+    let (status, _, err) = with(
+        "fix_smoothing = true\nfix_wait_s = 300.0\nmap_dilution_m = 0.0\nmap_dilution_s = 30.0",
+    );
+    assert_eq!((status, err.contains("has no effect")), (0, false), "{err}");
+    let (_, _, err) = with("fix_smoothing = false");
+    assert!(!err.contains("has no effect"), "{err}");
+}
+
+#[test]
 fn replay_takes_the_planner_table_of_a_scenario_file() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();

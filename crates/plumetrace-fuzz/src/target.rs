@@ -596,7 +596,7 @@ fn campaign(input: &Input, path: &Path, deadline: Instant) -> Result<String, Sto
     let c = match std::str::from_utf8(&input.bytes) {
         Ok(text) => {
             let file = parse_campaign(text, path).map_err(rejected)?;
-            let c = Campaign::resolve(file, path, text.to_string(), true).map_err(rejected)?;
+            let mut c = Campaign::resolve(file, path, text.to_string(), true).map_err(rejected)?;
             c.check_groups().map_err(rejected)?;
             c
         }

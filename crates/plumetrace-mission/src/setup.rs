@@ -84,8 +84,12 @@ pub struct MissionSetup {
     pub depth_m: Option<f64>,
     /// Message channels.
     pub comms: CommsParams,
-    /// What `check` should tell the user: missions that cannot succeed, defaults that matter.
+    /// What `check` should tell the user: missions that cannot succeed, defaults that matter,
+    /// and [`MissionSetup::inert_keys`].
     pub warnings: Vec<String>,
+    /// Planner keys the scenario gives that have no effect at its values (also among
+    /// `warnings`): the planner table's path, the key, and why.
+    pub inert_keys: Vec<(String, &'static str, String)>,
     /// Whether `env` has had its spin-up already ([`MissionSetup::spin_up`],
     /// [`MissionSetup::use_spun_up`]); [`crate::Mission::new`] then starts at once.
     pub spun_up: bool,
@@ -123,6 +127,8 @@ impl MissionSetup {
             prior_flow_given: spec.prior_flow_given,
         };
         let mut planned = Vec::with_capacity(sc.vehicles.len());
+        // Planner keys given that have no effect at the table's values.
+        let mut inert = Vec::new();
         for (k, v) in sc.vehicles.iter().enumerate() {
             let Some(r) = &v.planner else {
                 if v.detection_threshold_v.is_some() {
@@ -157,13 +163,24 @@ impl MissionSetup {
             };
             // Build once here so that `check` catches what building would reject.
             config.build(&context, &r.key).map_err(&invalid)?;
+            for (key, why) in config.keys_without_effect(&r.table) {
+                let w = (r.key.clone(), key, why);
+                if !inert.contains(&w) {
+                    inert.push(w);
+                }
+            }
             planned.push(Some(PlannedVehicle {
                 key: r.key.clone(),
                 config,
                 context,
             }));
         }
-        let warnings = warnings(&sc.vehicles, &planned, &spec, &geometry, &sc.env);
+        let mut warnings = warnings(&sc.vehicles, &planned, &spec, &geometry, &sc.env);
+        warnings.extend(
+            inert
+                .iter()
+                .map(|(table, key, why)| format!("{table}.{key}: {why}")),
+        );
         if planned.iter().all(Option::is_none) {
             return Err(MissionError::NotAMission {
                 origin,
@@ -183,6 +200,7 @@ impl MissionSetup {
             depth_m: sc.depth_m,
             comms: sc.comms,
             warnings,
+            inert_keys: inert,
             spun_up: false,
         })
     }

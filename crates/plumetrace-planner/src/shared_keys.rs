@@ -104,6 +104,32 @@ impl MapKeys {
         }
     }
 
+    /// The map keys that have no effect at these values, with why.
+    pub fn without_effect(&self) -> Vec<(&'static str, String)> {
+        let mut out = Vec::new();
+        if self.map_dilution_m > 0.0 {
+            out.push((
+                "map_dilution_s",
+                format!(
+                    "has no effect while map_dilution_m ({} m) is positive: dilution is then \
+                     measured along the flow from there",
+                    self.map_dilution_m
+                ),
+            ));
+        }
+        if self.map_mixing_length_m > 0.0 {
+            out.push((
+                "map_vertical_diffusivity_m2ps",
+                format!(
+                    "has no effect while map_mixing_length_m ({} m) is positive: the vertical \
+                     diffusivity is then that length times the measured flow speed",
+                    self.map_mixing_length_m
+                ),
+            ));
+        }
+        out
+    }
+
     /// The declaration rule.
     pub fn rule(&self) -> MapRule {
         MapRule {

@@ -593,7 +593,7 @@ pub fn task_campaign(
     );
     let path = tasks_dir.join(format!("{}.campaign.toml", task.name));
     write_if_changed(&path, &text)?;
-    let c = Campaign::resolve(file, &path, text, true)?;
+    let mut c = Campaign::resolve(file, &path, text, true)?;
     c.check_groups()?;
     check_time_limit(set, &c, task)?;
     Ok(c)

@@ -102,6 +102,10 @@ impl PlannerParams for InfotaxisParams {
         Some(self.autopilot.threshold_v)
     }
 
+    fn without_effect(&self) -> Vec<(&'static str, String)> {
+        self.map.without_effect()
+    }
+
     fn build(&self, ctx: &BuildContext) -> Result<Box<dyn Planner>, ParamError> {
         let area = ctx.geometry.op_area.clone();
         let tracker = self.tracker(&area)?;

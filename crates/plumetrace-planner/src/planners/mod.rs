@@ -101,6 +101,12 @@ pub trait PlannerParams:
     /// The reading above which a chemical sample is a detection, if the planner thresholds.
     fn detection_threshold_v(&self) -> Option<f64>;
 
+    /// Keys that have no effect at these values, each with why: `check` and `run` warn of those
+    /// a planner table gives ([`PlannerConfig::keys_without_effect`]).
+    fn without_effect(&self) -> Vec<(&'static str, String)> {
+        Vec::new()
+    }
+
     /// The planner; errors name keys of the planner's table (without a prefix).
     fn build(&self, ctx: &BuildContext) -> Result<Box<dyn Planner>, ParamError>;
 }
@@ -239,6 +245,12 @@ macro_rules! registry {
             fn build(&self, ctx: &BuildContext) -> Result<Box<dyn Planner>, ParamError> {
                 match self {
                     $(PlannerSpec::$variant(p) => p.build(ctx),)*
+                }
+            }
+
+            fn without_effect(&self) -> Vec<(&'static str, String)> {
+                match self {
+                    $(PlannerSpec::$variant(p) => p.without_effect(),)*
                 }
             }
 
@@ -391,6 +403,16 @@ impl PlannerConfig {
     /// The detection threshold, if the planner thresholds readings.
     pub fn detection_threshold_v(&self) -> Option<f64> {
         self.spec.detection_threshold_v()
+    }
+
+    /// The keys `table` (the table this configuration was read from) gives that have no effect
+    /// at the configuration's values, each with why.
+    pub fn keys_without_effect(&self, table: &toml::Table) -> Vec<(&'static str, String)> {
+        self.spec
+            .without_effect()
+            .into_iter()
+            .filter(|(key, _)| table.contains_key(*key))
+            .collect()
     }
 
     /// It needs a position estimate.

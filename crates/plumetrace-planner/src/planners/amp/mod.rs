@@ -344,6 +344,19 @@ impl PlannerParams for AmpParams {
         Some(self.autopilot.threshold_v)
     }
 
+    fn without_effect(&self) -> Vec<(&'static str, String)> {
+        let mut out = self.map.without_effect();
+        if !self.fix_smoothing {
+            out.push((
+                "fix_wait_s",
+                "has no effect with fix_smoothing = false: the wait for the next fix is part of \
+                 moving lost points with it (set fix_smoothing = true, or leave fix_wait_s out)"
+                    .to_string(),
+            ));
+        }
+        out
+    }
+
     fn build(&self, ctx: &BuildContext) -> Result<Box<dyn Planner>, ParamError> {
         // Refuse a map that does not fit (Amp::new would leave it out).
         self.map_tracker(&ctx.geometry.op_area)?;
