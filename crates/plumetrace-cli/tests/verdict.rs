@@ -21,29 +21,30 @@ fn fly(args: &[&str], out: &Path) -> (String, serde_json::Value) {
     (printed, json(&out.join("summary.json")))
 }
 
+/// Infotaxis's earlier map model (dilution after 15 m), under which it declared far downflow on
+/// the demo site.
+const EARLIER_MAP: [(&str, &str); 4] = [
+    ("map_dilution_m", "15.0"),
+    ("map_p_detect", "0.1"),
+    ("map_diffusivity_m2ps", "0.1"),
+    ("map_mass", "0.7"),
+];
+
 #[test]
 fn the_run_line_summary_and_figure_say_whether_the_source_was_located() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
     // Infotaxis on the demo site with a map that dilutes the plume after 15 m (an earlier
     // default) declares far downflow: not located.
-    let (line, s) = fly(
-        &[
-            "--preset",
-            "demo-infotaxis",
-            "--seed",
-            "1",
-            "--set",
-            "map_dilution_m=15.0",
-            "--set",
-            "map_p_detect=0.1",
-            "--set",
-            "map_diffusivity_m2ps=0.1",
-            "--set",
-            "map_mass=0.7",
-        ],
-        &d.join("far"),
-    );
+    let sets: Vec<String> = EARLIER_MAP
+        .iter()
+        .map(|(k, v)| format!("{k}={v}"))
+        .collect();
+    let mut args = vec!["--preset", "demo-infotaxis", "--seed", "1"];
+    for set in &sets {
+        args.extend(["--set", set.as_str()]);
+    }
+    let (line, s) = fly(&args, &d.join("far"));
     assert!(
         line.starts_with(
             "demo-infotaxis: NOT located: declared 156.1 m from the source (success radius 50 m); \
@@ -67,12 +68,15 @@ fn the_run_line_summary_and_figure_say_whether_the_source_was_located() {
     let text = plumetrace_scenario::find_preset("demo-infotaxis")
         .unwrap()
         .toml;
+    let keys: String = EARLIER_MAP
+        .iter()
+        .map(|(k, v)| format!("\n{k} = {v}"))
+        .collect();
     let wide = text
         .replacen("[mission]\n", "[mission]\nsuccess_radius_m = 300.0\n", 1)
         .replacen(
             "kind = \"infotaxis\"",
-            "kind = \"infotaxis\"\nmap_dilution_m = 15.0\nmap_p_detect = 0.1\n\
-             map_diffusivity_m2ps = 0.1\nmap_mass = 0.7",
+            &format!("kind = \"infotaxis\"{keys}"),
             1,
         );
     std::fs::write(d.join("wide.toml"), &wide).unwrap();

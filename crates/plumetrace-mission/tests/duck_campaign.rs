@@ -23,11 +23,20 @@ fn run_seeds_with(preset: &str, n: u64, planner: &[(&str, toml::Value)]) -> Vec<
             table.insert((*key).into(), value.clone());
         }
     }
+    run_config(preset, &cfg, n)
+}
+
+/// `cfg` (the preset's, changed) at seeds 1..=n on two threads, in seed order.
+fn run_config(
+    preset: &str,
+    cfg: &plumetrace_scenario::ScenarioConfig,
+    n: u64,
+) -> Vec<(u64, Summary)> {
     let seeds: Vec<u64> = (1..=n).collect();
     let results = std::sync::Mutex::new(Vec::new());
     std::thread::scope(|s| {
         for chunk in seeds.chunks(seeds.len().div_ceil(2)) {
-            let (cfg, results) = (&cfg, &results);
+            let results = &results;
             s.spawn(move || {
                 for &seed in chunk {
                     let sc = build(cfg, &Origin::Preset(preset.into()), Some(seed)).unwrap();
@@ -119,28 +128,10 @@ fn infotaxis_traces_the_duck_plume_to_its_head() {
         "kind".to_string(),
         toml::Value::String("infotaxis".into()),
     )]));
-    let results: Vec<Summary> = std::thread::scope(|s| {
-        let handles: Vec<_> = [[1u64, 3, 5, 7, 9], [2, 4, 6, 8, 10]]
-            .map(|seeds| {
-                let cfg = &cfg;
-                s.spawn(move || {
-                    seeds.map(|seed| {
-                        let sc =
-                            build(cfg, &Origin::Preset("duck-2003-st".into()), Some(seed)).unwrap();
-                        run_mission(sc, &mut |_, _| {}).unwrap().summary
-                    })
-                })
-            })
-            .into_iter()
-            .collect();
-        handles
-            .into_iter()
-            .flat_map(|h| h.join().unwrap())
-            .collect()
-    });
+    let results = run_config("duck-2003-st", &cfg, 10);
     let mut errors: Vec<f64> = results
         .iter()
-        .filter_map(|r| r.first_declaration.as_ref())
+        .filter_map(|r| r.1.first_declaration.as_ref())
         .map(|d| d.error_m)
         .collect();
     errors.sort_by(f64::total_cmp);

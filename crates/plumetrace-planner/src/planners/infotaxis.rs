@@ -22,9 +22,9 @@
 //! than a threshold detector can tell. In the simulated Duck plume the chance of a detection at
 //! the vehicle's altitude, behind the bottom source, does not fall with distance over the first
 //! few hundred metres: on `duck-2003-st`'s axis it is 0.25 within 10 m of the source, 0.45-0.55
-//! from 25 to 200 m and 0.8 from 200 to 400 m downflow (docs/planners.md, "Its plume model"). A model with dilution (a detection favouring sources a few tens
-//! of metres upflow) let a vehicle that met the plume far downflow concentrate the map there and
-//! declare there; without dilution a detection says "upflow, somewhere", and only non-detections
+//! from 25 to 200 m and 0.8 from 200 to 400 m downflow (docs/planners.md, "Its plume model").
+//! A model with dilution (a detection favouring sources a few tens of metres upflow) let a
+//! vehicle that met the plume far downflow concentrate the map there and declare there; without dilution a detection says "upflow, somewhere", and only non-detections
 //! upflow of the plume's head place the source, so the information is at the head and the legs go
 //! there. Infotaxis's map therefore has no dilution (`map_dilution_s = 0`, `map_dilution_m = 0`),
 //! a detection chance of 0.2 in the plume (`map_p_detect`), a spread that grows as

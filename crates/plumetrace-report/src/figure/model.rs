@@ -143,17 +143,27 @@ pub(super) fn track_pos(r: &TrajectoryRow) -> (f64, f64) {
 
 /// The pieces of a true track outside `area`.
 pub(super) fn outside_pieces(rows: &[&TrajectoryRow], area: &OpArea) -> Vec<Vec<(f64, f64)>> {
+    pieces_where(rows.iter().map(|r| Some((r.true_x_m, r.true_y_m))), |p| {
+        !area.contains(Vec2::new(p.0, p.1))
+    })
+}
+
+/// The runs of consecutive points that are given and `keep` holds for, each of two points or
+/// more (a point left out, or not given, ends a run).
+pub(super) fn pieces_where(
+    points: impl Iterator<Item = Option<(f64, f64)>>,
+    keep: impl Fn((f64, f64)) -> bool,
+) -> Vec<Vec<(f64, f64)>> {
     let mut pieces: Vec<Vec<(f64, f64)>> = Vec::new();
-    let mut was_out = false;
-    for r in rows {
-        let p = (r.true_x_m, r.true_y_m);
-        let out = !area.contains(Vec2::new(p.0, p.1));
-        match (out, was_out, pieces.last_mut()) {
-            (true, true, Some(piece)) => piece.push(p),
-            (true, _, _) => pieces.push(vec![p]),
+    let mut was_kept = false;
+    for p in points {
+        let kept = p.filter(|p| keep(*p));
+        match (kept, was_kept, pieces.last_mut()) {
+            (Some(p), true, Some(piece)) => piece.push(p),
+            (Some(p), _, _) => pieces.push(vec![p]),
             _ => {}
         }
-        was_out = out;
+        was_kept = kept.is_some();
     }
     pieces.retain(|p| p.len() > 1);
     pieces

@@ -3,7 +3,7 @@
 //! and the estimated tracks up to the map's time.
 
 use super::layout::map_overhead_px;
-use super::model::thin;
+use super::model::{pieces_where, thin};
 use super::raster::{Raster, raster_cells, raster_peak};
 use super::style::{SOURCE_MARK, WIDTH_PX};
 use crate::chart::{dashed_within, map_chart};
@@ -77,23 +77,14 @@ where
         // The estimated tracks up to the map's time, in pieces inside the window (a piece ends
         // where the track leaves it, so no line crosses the panel where the vehicle did not go).
         for rs in rows.values() {
-            let mut pieces: Vec<Vec<(f64, f64)>> = vec![Vec::new()];
-            for q in rs.iter().filter(|q| q.t_s <= r.0) {
-                match q.est_x_m.zip(q.est_y_m) {
-                    Some(p) if x.contains(&p.0) && y.contains(&p.1) => {
-                        if let Some(last) = pieces.last_mut() {
-                            last.push(p);
-                        }
-                    }
-                    _ => {
-                        if pieces.last().is_some_and(|l| !l.is_empty()) {
-                            pieces.push(Vec::new());
-                        }
-                    }
-                }
-            }
+            let pieces = pieces_where(
+                rs.iter()
+                    .filter(|q| q.t_s <= r.0)
+                    .map(|q| q.est_x_m.zip(q.est_y_m)),
+                |p| x.contains(&p.0) && y.contains(&p.1),
+            );
             chart
-                .draw_series(pieces.iter().filter(|p| p.len() > 1).map(|p| {
+                .draw_series(pieces.iter().map(|p| {
                     PathElement::new(
                         thin(p, 2.0 * half_x / pw),
                         RGBColor(70, 70, 70).mix(0.7).stroke_width(1),
