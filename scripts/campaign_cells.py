@@ -2,9 +2,15 @@
 """One cell per config and scenario of a campaign's runs.csv: the median error of the declaring
 runs, how many runs declared within 10 m and within 20 m, the median signed along-flow error
 (positive: downflow), and how many runs did not declare. Used by docs/planners.md (infotaxis's
-tuning table); standard library only.
+tuning tables); standard library only.
 
     python3 scripts/campaign_cells.py out/infotaxis-tuning/runs.csv
+    python3 scripts/campaign_cells.py out/infotaxis-along/runs.csv --against default
+
+With `--against CONFIG` a second table pairs every other config's runs with CONFIG's runs of the
+same scenario and seed (a campaign's configs fly the same plumes, seed for seed): per cell, the
+runs whose error is smaller and larger than CONFIG's, and the median of the differences (negative:
+closer to the source), over the pairs in which both declared.
 """
 
 import csv
@@ -20,8 +26,39 @@ def median(values):
     return v[n // 2] if n % 2 else (v[n // 2 - 1] + v[n // 2]) / 2
 
 
+def short(scenario):
+    return scenario.split("/")[-1].replace(".family.toml", "")
+
+
+def paired(groups, scenarios, configs, base):
+    """The second table: each config against `base`, run by run."""
+    print()
+    print(f"| config against {base} | " + " | ".join(short(s) for s in scenarios) + " |")
+    print("| --- " * (len(scenarios) + 1) + "|")
+    for c in configs:
+        if c == base:
+            continue
+        cells = []
+        for s in scenarios:
+            ours = {r["seed_index"]: r for r in groups[(c, s)] if r["declared"] == "true"}
+            theirs = {r["seed_index"]: r for r in groups[(base, s)] if r["declared"] == "true"}
+            diffs = [float(ours[k]["error_m"]) - float(theirs[k]["error_m"]) for k in ours if k in theirs]
+            if not diffs:
+                cells.append("no pair declared")
+                continue
+            closer = sum(d < 0 for d in diffs)
+            further = sum(d > 0 for d in diffs)
+            cells.append(f"{closer} closer, {further} further of {len(diffs)}, {median(diffs):+.1f} m")
+        print(f"| {c} | " + " | ".join(cells) + " |")
+
+
 def main():
-    if len(sys.argv) != 2 or sys.argv[1] in ("-h", "--help"):
+    args = sys.argv[1:]
+    base = None
+    if len(args) == 3 and args[1] == "--against":
+        base = args[2]
+        args = args[:1]
+    if len(args) != 1 or args[0] in ("-h", "--help") or args[0].startswith("--"):
         print(__doc__.strip(), file=sys.stderr)
         sys.exit(0 if sys.argv[1:] in (["-h"], ["--help"]) else 2)
     try:
@@ -36,7 +73,9 @@ def main():
                 scenarios.append(r["scenario"])
             if r["config"] not in configs:
                 configs.append(r["config"])
-        print("| config | " + " | ".join(s.split("/")[-1].replace(".family.toml", "") for s in scenarios) + " |")
+        if base is not None and base not in configs:
+            sys.exit(f"error: --against {base}: no such config in {sys.argv[1]} (its configs: {', '.join(configs)})")
+        print("| config | " + " | ".join(short(s) for s in scenarios) + " |")
         print("| --- " * (len(scenarios) + 1) + "|")
         for c in configs:
             cells = []
@@ -55,6 +94,8 @@ def main():
                     cell += f" ({n - len(errors)} undeclared)"
                 cells.append(cell)
             print(f"| {c} | " + " | ".join(cells) + " |")
+        if base is not None:
+            paired(groups, scenarios, configs, base)
     except OSError as e:
         sys.exit(f"error: {sys.argv[1]}: cannot read it ({e.strerror})")
     except (KeyError, ValueError, UnicodeDecodeError, csv.Error) as e:

@@ -442,6 +442,10 @@ pub const CAMPAIGNS: &[(&str, &str)] = &[
         include_str!("../../../examples/campaigns/infotaxis-tuning.toml"),
     ),
     (
+        "infotaxis-along",
+        include_str!("../../../examples/campaigns/infotaxis-along.toml"),
+    ),
+    (
         "ten-planners-one-plume",
         include_str!("../../../examples/campaigns/ten-planners-one-plume.toml"),
     ),

@@ -74,6 +74,8 @@ plumetrace_core::params! {
         map_correlation_s: f64 = 10.0, "s", Bounds::closed(0.0, 3600.0);
         /// Source map: growth of the back-projection spread, sigma^2 = (3 m)^2 + 2 D T.
         map_diffusivity_m2ps: f64 = 0.1, "m^2/s", Bounds::closed(0.0, 1000.0);
+        /// Source map: growth of the spread along the flow as a fraction of map_diffusivity_m2ps (1: the same spread in every direction; below 1 a sample says less about sources downflow of where the flow carried it from).
+        map_along_ratio: f64 = 1.0, "", Bounds::closed(0.0, 1.0);
         /// Source map: vertical diffusivity that mixes a bottom source up to the vehicle's altitude, when map_mixing_length_m is 0 (0: no vertical model).
         map_vertical_diffusivity_m2ps: f64 = 0.01, "m^2/s", Bounds::closed(0.0, 100.0);
         /// Source map: when positive, the vertical diffusivity is this mixing length times the measured flow speed (bottom boundary-layer mixing grows with the current), replacing map_vertical_diffusivity_m2ps.
@@ -94,6 +96,7 @@ impl MapKeys {
             resolution_m: self.map_resolution_m,
             p_detect: self.map_p_detect,
             diffusivity_m2ps: self.map_diffusivity_m2ps,
+            along_ratio: self.map_along_ratio,
             vertical_diffusivity_m2ps: self.map_vertical_diffusivity_m2ps,
             vertical_mixing_length_m: self.map_mixing_length_m,
             window_s: self.map_window_s,
@@ -115,6 +118,14 @@ impl MapKeys {
                      measured along the flow from there",
                     self.map_dilution_m
                 ),
+            ));
+        }
+        if self.map_diffusivity_m2ps == 0.0 {
+            out.push((
+                "map_along_ratio",
+                "has no effect while map_diffusivity_m2ps is 0: the spread does not grow in any \
+                 direction"
+                    .to_string(),
             ));
         }
         if self.map_mixing_length_m > 0.0 {

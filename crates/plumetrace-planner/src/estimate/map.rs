@@ -20,6 +20,14 @@
 //! grow with travel time). Travel times are taken at steps of one spread of flow travel (at
 //! least one second and half a cell), so successive footprints overlap.
 //!
+//! **Spread along the flow.** The spread need not be the same in every direction: with
+//! `along_ratio` below 1 it grows along the flow's path by `2 along_ratio diffusivity T` and
+//! across it by `2 diffusivity T`, an ellipse whose long axis lies across the displacement
+//! `X(t_k) - X(t_k - T)`. The meander moves chemical across the mean flow more than along it;
+//! a round spread as wide as the meander also said that a sample saw sources downflow of where
+//! the flow carried its chemical from, which moved the map's peak downflow. Successive
+//! footprints are then one along-flow spread apart.
+//!
 //! **Vertical mixing.** The source is on the bottom and the vehicle samples at altitude `z`.
 //! Chemical released at the bed spreads upwards as a reflected Gaussian with vertical diffusivity
 //! `K_z`: after travel time `T` the concentration at height `z` is `exp(-z^2 / (4 K_z T))` of the
@@ -76,6 +84,9 @@ pub struct MapModel {
     pub spread0_m: f64,
     /// Growth of the spread: `sigma^2 = spread0^2 + 2 diffusivity T`, m^2/s.
     pub diffusivity_m2ps: f64,
+    /// Growth of the spread along the flow as a fraction of `diffusivity_m2ps` (1: the same
+    /// spread in every direction).
+    pub along_ratio: f64,
     /// Vertical diffusivity for the bottom source's mixing up to the vehicle (0: off), m^2/s.
     pub vertical_diffusivity_m2ps: f64,
     /// When positive, the vertical diffusivity is this length times the measured flow speed
@@ -102,6 +113,7 @@ impl Default for MapModel {
             window_s: 3600.0,
             spread0_m: 3.0,
             diffusivity_m2ps: 0.1,
+            along_ratio: 1.0,
             vertical_diffusivity_m2ps: 0.01,
             vertical_mixing_length_m: 0.0,
             p_detect: 0.1,
@@ -328,10 +340,7 @@ impl SourceMap {
     /// Computes the footprint of a sample at `pos_m`, time `t_s`, altitude `altitude_m` into
     /// the scratch buffer (see the module docs); the touched candidates are in `self.touched`.
     fn footprint(&mut self, pos_m: Vec2, t_s: f64, altitude_m: Option<f64>) {
-        for &k in &self.touched {
-            self.scratch[k] = 0.0;
-        }
-        self.touched.clear();
+        self.footprint_clear();
         let m = self.model;
         let r = m.resolution_m;
         let z2 = altitude_m.filter(|z| z.is_finite()).map_or(0.0, |z| z * z);
@@ -350,6 +359,12 @@ impl SourceMap {
         let mut travel = 0.0_f64;
         while travel <= m.window_s {
             let sigma = (m.spread0_m * m.spread0_m + 2.0 * m.diffusivity_m2ps * travel).sqrt();
+            let sigma_along = if m.along_ratio == 1.0 {
+                sigma
+            } else {
+                (m.spread0_m * m.spread0_m + 2.0 * m.along_ratio * m.diffusivity_m2ps * travel)
+                    .sqrt()
+            };
             let vertical = if kz > 0.0 && z2 > 0.0 {
                 if travel > 0.0 {
                     (-z2 / (4.0 * kz * travel)).exp()
@@ -366,11 +381,26 @@ impl SourceMap {
             };
             let vertical = vertical * dilution;
             if vertical > 1e-3 {
-                let e = pos_m - (x_now - self.flow.at(t_s - travel));
-                self.splat(e, sigma, vertical);
+                let moved = x_now - self.flow.at(t_s - travel);
+                let e = pos_m - moved;
+                let along = moved.norm();
+                if sigma_along != sigma && along > 1e-9 {
+                    self.splat_along(e, moved / along, sigma_along, sigma, vertical);
+                } else {
+                    self.splat(e, sigma, vertical);
+                }
             }
-            travel += (sigma / speed).max(1.0).max(0.5 * r / speed);
+            // One spread along the flow's path between footprints, so that they overlap.
+            travel += (sigma_along / speed).max(1.0).max(0.5 * r / speed);
         }
+    }
+
+    /// Sets the footprint to zero.
+    fn footprint_clear(&mut self) {
+        for &k in &self.touched {
+            self.scratch[k] = 0.0;
+        }
+        self.touched.clear();
     }
 
     /// Raises the footprint to `peak * exp(-d^2 / (2 sigma^2))` within 3 sigma of `centre` (the
@@ -413,6 +443,82 @@ impl SourceMap {
                     }
                     self.scratch[k] = v;
                 }
+            }
+        }
+    }
+
+    /// Raises the footprint to `peak * exp(-a^2 / (2 sigma_along^2) - c^2 / (2 sigma_across^2))`
+    /// with `a` and `c` a cell's offset from `centre` along `dir` (a unit vector) and across it,
+    /// where that is at least [`FOOTPRINT_FLOOR`]. Along a row the exponent is a quadratic in the
+    /// column, so each row costs three exponentials and a product per cell.
+    fn splat_along(
+        &mut self,
+        centre: Vec2,
+        dir: Vec2,
+        sigma_along: f64,
+        sigma_across: f64,
+        peak: f64,
+    ) {
+        if peak.is_nan() || peak < FOOTPRINT_FLOOR {
+            return;
+        }
+        let r = self.model.resolution_m;
+        let (wa, wc) = (
+            0.5 / (sigma_along * sigma_along),
+            0.5 / (sigma_across * sigma_across),
+        );
+        // exponent = -(qa x^2 + 2 qb x y + qc y^2) for the offset (x, y)
+        let qa = dir.x * dir.x * wa + dir.y * dir.y * wc;
+        let qc = dir.y * dir.y * wa + dir.x * dir.x * wc;
+        let qb = dir.x * dir.y * (wa - wc);
+        // Within three spreads (as the round splat) and above the floor.
+        let limit = (peak / FOOTPRINT_FLOOR).ln().min(4.5);
+        // The ellipse exponent = -limit: its extent in y is sqrt(limit qa / (qa qc - qb^2)).
+        let det = qa * qc - qb * qb;
+        if !(det > 0.0 && qa > 0.0) {
+            return;
+        }
+        let half_y = (limit * qa / det).sqrt();
+        let j_lo = ((centre.y - half_y - self.y0) / r - 0.5).ceil().max(0.0);
+        let j_hi = ((centre.y + half_y - self.y0) / r - 0.5).floor() + 1.0;
+        let j_hi = j_hi.min(self.ny as f64);
+        if j_lo >= j_hi {
+            return;
+        }
+        for j in j_lo as usize..j_hi as usize {
+            let y = self.y0 + (j as f64 + 0.5) * r - centre.y;
+            // Along the row: qa x^2 + 2 qb y x + qc y^2 <= limit.
+            let disc = qb * qb * y * y - qa * (qc * y * y - limit);
+            if disc < 0.0 {
+                continue;
+            }
+            let root = disc.sqrt();
+            let (x_lo, x_hi) = ((-qb * y - root) / qa, (-qb * y + root) / qa);
+            let i_lo = ((centre.x + x_lo - self.x0) / r - 0.5).ceil().max(0.0);
+            let i_hi = (((centre.x + x_hi - self.x0) / r - 0.5).floor() + 1.0).min(self.nx as f64);
+            if i_lo >= i_hi {
+                continue;
+            }
+            let (i_lo, i_hi) = (i_lo as usize, i_hi as usize);
+            let x = self.x0 + (i_lo as f64 + 0.5) * r - centre.x;
+            // g(k + 1) = g(k) * step, step(k + 1) = step(k) * exp(-2 qa r^2).
+            let mut g = peak * (-(qa * x * x + 2.0 * qb * x * y + qc * y * y)).exp();
+            let mut step = (-(qa * (2.0 * x * r + r * r) + 2.0 * qb * r * y)).exp();
+            let shrink = (-2.0 * qa * r * r).exp();
+            let row = j * self.nx;
+            for i in i_lo..i_hi {
+                let k = self.index[row + i];
+                if k != u32::MAX && g >= FOOTPRINT_FLOOR {
+                    let k = k as usize;
+                    if g > self.scratch[k] {
+                        if self.scratch[k] == 0.0 {
+                            self.touched.push(k);
+                        }
+                        self.scratch[k] = g;
+                    }
+                }
+                g *= step;
+                step *= shrink;
             }
         }
     }
@@ -701,6 +807,80 @@ mod tests {
         let (best, _) = m.most_likely();
         // The cells upflow of the track lost mass; the argmax is not among them.
         assert!((best.y - 100.0).abs() > 10.0 || best.x > 300.0, "{best:?}");
+    }
+
+    #[test]
+    fn an_ellipse_whose_spreads_agree_is_the_round_splat_in_every_direction() {
+        let mut m = SourceMap::new(&area(), model()).unwrap_or_else(|| panic!("no map"));
+        let centre = Vec2::new(201.3, 97.8);
+        m.splat(centre, 12.0, 0.8);
+        let round = m.scratch.clone();
+        let mut compared = 0;
+        for deg in [0.0_f64, 17.0, 45.0, 90.0, 133.0, 200.0, 301.0] {
+            let dir = Vec2::new(deg.to_radians().cos(), deg.to_radians().sin());
+            m.footprint_clear();
+            m.splat_along(centre, dir, 12.0, 12.0, 0.8);
+            for (k, (&a, &b)) in m.scratch.iter().zip(&round).enumerate() {
+                let d2 = (m.centres[k] - centre).norm_squared();
+                // Both cover the disc of three spreads; the round one also its box's corners.
+                if d2 < (2.9 * 12.0_f64).powi(2) {
+                    assert!(
+                        (a - b).abs() <= 1e-12 * b,
+                        "{deg} deg, cell {k}: {a} vs {b}"
+                    );
+                    compared += 1;
+                } else if d2 > (3.1 * 12.0_f64).powi(2) {
+                    assert_eq!(a, 0.0, "{deg} deg, cell {k} beyond three spreads");
+                }
+            }
+        }
+        assert!(compared > 7 * 150, "{compared}");
+    }
+
+    #[test]
+    fn a_narrow_spread_along_the_flow_says_less_about_cells_downflow_of_the_sample() {
+        // One detection at (200, 100) after 200 s of current at 0.2 m/s, spread 1 m^2/s, the
+        // current towards several directions: with the spread along the flow at 0.3 of it the
+        // cells downflow of the sample fall and the cells up the flow's path keep their
+        // footprint.
+        for deg in [0.0_f64, 30.0, 135.0, 250.0] {
+            let u = Vec2::new(deg.to_radians().cos(), deg.to_radians().sin());
+            let n = Vec2::new(-u.y, u.x);
+            let sample = Vec2::new(200.0, 100.0);
+            let footprint = |along_ratio: f64| {
+                let model = MapModel {
+                    diffusivity_m2ps: 1.0,
+                    along_ratio,
+                    dilution_s: 0.0,
+                    ..model()
+                };
+                let mut m = SourceMap::new(&area(), model).unwrap_or_else(|| panic!("no map"));
+                for k in 0..=200 {
+                    m.add_flow(k as f64, u * 0.2);
+                }
+                m.footprint(sample, 200.0, None);
+                let at = |p: Vec2| m.scratch[m.candidate_at(p).unwrap_or(0)];
+                (
+                    at(sample + u * 20.0),
+                    at(sample - u * 40.0),
+                    at(sample - u * 40.0 + n * 25.0),
+                )
+            };
+            let (down_round, up_round, side_round) = footprint(1.0);
+            let (down, up, side) = footprint(0.3);
+            assert!(
+                down < 0.5 * down_round,
+                "{deg} deg downflow: {down} against {down_round}"
+            );
+            assert!(
+                up > 0.9 * up_round,
+                "{deg} deg upflow: {up} against {up_round}"
+            );
+            assert!(
+                side > 0.5 * side_round,
+                "{deg} deg across: {side} against {side_round}"
+            );
+        }
     }
 
     #[test]
