@@ -297,13 +297,52 @@ where
             .map_err(ReportError::figure)?;
         chart
             .draw_series(std::iter::once(Text::new(
-                format!("source map entropy (0-{h_max:.1} bits)"),
+                "source map entropy (bits: the scale at the right)",
                 (t_max_min * 0.01, y_hi),
                 ("sans-serif", 12).into_font().color(&ENTROPY_LINE),
             )))
             .map_err(ReportError::figure)?;
+        // Its own scale: ticks on the panel's right edge, labelled in the margin beside it.
+        let tick = t_max_min * 5.0 / p.plot_w_px.max(1.0);
+        for h in entropy_ticks(h_max) {
+            let y = y_lo + h / h_max * (y_hi - y_lo) * ENTROPY_TOP;
+            let label = if h.fract() == 0.0 {
+                format!("{h:.0}")
+            } else {
+                format!("{h:.1}")
+            };
+            chart
+                .draw_series([PathElement::new(
+                    vec![(t_max_min - tick, y), (t_max_min, y)],
+                    ENTROPY_LINE.stroke_width(2),
+                )])
+                .map_err(ReportError::figure)?;
+            chart
+                .draw_series(std::iter::once(
+                    EmptyElement::at((t_max_min, y))
+                        + Text::new(
+                            label,
+                            (3, 0),
+                            label_style(11, ENTROPY_LINE, Pos::new(HPos::Left, VPos::Center)),
+                        ),
+                ))
+                .map_err(ReportError::figure)?;
+        }
     }
     Ok(())
+}
+
+/// The entropy scale's ticks: 0 and every multiple of a round step up to `h_max`, at most five.
+fn entropy_ticks(h_max: f64) -> Vec<f64> {
+    let step = [0.5, 1.0, 2.0, 5.0, 10.0, 20.0, 50.0, 100.0]
+        .into_iter()
+        .find(|s| h_max / s <= 4.0)
+        .unwrap_or(h_max.max(1.0));
+    (0..)
+        .map(|k| f64::from(k) * step)
+        .take_while(|h| *h <= h_max * (1.0 + 1e-9))
+        .take(5)
+        .collect()
 }
 
 /// Lines at declarations, aborts and incidents, each labelled.
@@ -656,6 +695,31 @@ mod tests {
             "line top {top}, label bottom {}",
             label.rect.3
         );
+        // Its scale at the right: 0, 5 and 10 bits, beside the panel, the highest nearest the
+        // top; no text meets another.
+        let ticks: Vec<_> = text_boxes(&svg)
+            .into_iter()
+            .filter(|t| ["0", "5", "10"].contains(&t.text.as_str()) && t.rect.0 > 850.0)
+            .collect();
+        assert_eq!(ticks.len(), 3, "{ticks:?}");
+        assert!(
+            ticks[2].rect.1 < ticks[1].rect.1 && ticks[1].rect.1 < ticks[0].rect.1,
+            "{ticks:?}"
+        );
+        assert!(
+            overlapping_texts(&svg).is_empty(),
+            "{:?}",
+            overlapping_texts(&svg)
+        );
+    }
+
+    #[test]
+    fn the_entropy_scale_has_round_ticks_up_to_the_largest_value() {
+        assert_eq!(entropy_ticks(11.3), vec![0.0, 5.0, 10.0]);
+        assert_eq!(entropy_ticks(4.0), vec![0.0, 1.0, 2.0, 3.0, 4.0]);
+        assert_eq!(entropy_ticks(1.2), vec![0.0, 0.5, 1.0]);
+        assert_eq!(entropy_ticks(0.3), vec![0.0]);
+        assert_eq!(entropy_ticks(16.6), vec![0.0, 5.0, 10.0, 15.0]);
     }
 
     #[test]
