@@ -69,17 +69,25 @@ impl From<&RunReport> for ReportFile {
     }
 }
 
-/// Reads an onboard file, naming it (and the line of the key, where it is written) in errors.
+/// Reads an onboard file, naming it (and the line of the key, where it is written) in errors,
+/// and warns of planner keys it gives that have no effect.
 pub fn load(path: &std::path::Path) -> Result<Onboard> {
     let text = plumetrace_env::input::read_text(path, plumetrace_env::input::MAX_TEXT_BYTES)
         .map_err(anyhow::Error::msg)
         .with_context(|| format!("reading {}", path.display()))?;
-    Onboard::from_toml(&text).map_err(|e| {
-        let line = plumetrace_scenario::locate::line_of(&text, &e.key)
+    let at = |key: &str| {
+        plumetrace_scenario::locate::line_of(&text, key)
             .map(|l| format!(":{l}"))
-            .unwrap_or_default();
-        anyhow::anyhow!("{}{line}: {e}", path.display())
-    })
+            .unwrap_or_default()
+    };
+    let onboard = Onboard::from_toml(&text)
+        .map_err(|e| anyhow::anyhow!("{}{}: {e}", path.display(), at(&e.key)))?;
+    // Keys with no effect: flown as written, but said before the vehicle goes.
+    for (key, why) in &onboard.inert_keys {
+        let key = format!("planner.{key}");
+        eprintln!("warning: {}{}: {key}: {why}", path.display(), at(&key));
+    }
+    Ok(onboard)
 }
 
 /// Output files written under a temporary name beside their own and renamed together once the
@@ -208,10 +216,15 @@ fn fly(onboard: &Onboard, args: &OnboardArgs) -> Result<()> {
     let file = ReportFile::from(&report);
     let json = serde_json::to_string_pretty(&file)?;
     write_atomic(&args.out.join("onboard.json"), json.as_bytes())?;
+    let end = match report.end {
+        runner::RunEnd::Finished => "the planner finished",
+        runner::RunEnd::Aborted => "the planner aborted",
+        runner::RunEnd::TimeLimit => "run.time_limit_s reached",
+        runner::RunEnd::LinkGaveUp => "the link gave up (down for link.give_up_s)",
+    };
     crate::outln!(
-        "{}: {} after {:.1} s; {} navigation records, {} decisions, {} commands sent, {} rejected by the chokepoint, {} pauses, {} declarations; {} lines accepted, {} rejected; wrote {}",
+        "{}: {end}, after {:.1} s; {} navigation records, {} decisions, {} commands sent, {} rejected by the chokepoint, {} pauses, {} declarations; {} lines accepted, {} rejected; wrote {}",
         args.file.display(),
-        file.end,
         report.time_s,
         report.nav_records,
         report.decisions,

@@ -208,6 +208,54 @@ fn onboard_check_connects_to_nothing_and_writes_nothing() {
 }
 
 #[test]
+fn onboard_warns_of_planner_keys_without_effect_before_it_flies() {
+    let dir = tempfile::tempdir().unwrap();
+    let file = dir.path().join("inert.toml");
+    let inert = "kind = \"amp\"\nfix_smoothing = false\nfix_wait_s = 300.0";
+    std::fs::write(&file, ONBOARD.replacen("kind = \"amp\"", inert, 1)).unwrap();
+    let check = |file: &std::path::Path| {
+        let o = common::run_ok(&["onboard", file.to_str().unwrap(), "--check"]);
+        (
+            String::from_utf8_lossy(&o.stdout).to_string(),
+            String::from_utf8_lossy(&o.stderr).to_string(),
+        )
+    };
+    let (said, warned) = check(&file);
+    assert!(said.contains("inert.toml: ok: planner amp"), "{said}");
+    assert!(
+        warned.contains("warning: ")
+            && warned.contains(
+                "inert.toml:8: planner.fix_wait_s: has no effect with fix_smoothing = false"
+            ),
+        "{warned}"
+    );
+    // Nothing said of a file whose keys all act.
+    let plain = dir.path().join("plain.toml");
+    std::fs::write(&plain, ONBOARD).unwrap();
+    let (_, warned) = check(&plain);
+    assert!(!warned.contains("warning"), "{warned}");
+    // Flying warns too, before it connects (here to a port nobody listens on: the link gives
+    // up after half a second).
+    let out = dir.path().join("flight");
+    let o = common::run_ok(&[
+        "onboard",
+        file.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    let warned = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        warned.contains("planner.fix_wait_s: has no effect"),
+        "{warned}"
+    );
+    let said = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        said.contains("inert.toml: the link gave up (down for link.give_up_s), after"),
+        "{said}"
+    );
+}
+
+#[test]
 fn family_out_at_a_file_says_so_and_writes_nothing() {
     let dir = tempfile::tempdir().unwrap();
     let file = dir.path().join("plain");

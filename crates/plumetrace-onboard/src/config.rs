@@ -409,6 +409,9 @@ pub struct Onboard {
     pub planner: PlannerConfig,
     /// What the planner is built with.
     pub context: BuildContext,
+    /// Planner keys the file gives that have no effect at its values, with why (the vehicle
+    /// flies, and the operator is warned before it does).
+    pub inert_keys: Vec<(&'static str, String)>,
 }
 
 fn err(key: &str, message: impl Into<String>) -> ParamError {
@@ -549,10 +552,12 @@ impl Onboard {
             team: Vec::new(),
         };
         check_planner(&planner, &context, &l.limits)?;
+        let inert_keys = planner.keys_without_effect(&file.planner);
         Ok(Onboard {
             file,
             planner,
             context,
+            inert_keys,
         })
     }
 }

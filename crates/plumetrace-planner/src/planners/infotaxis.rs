@@ -28,7 +28,9 @@
 //! upflow of the plume's head place the source, so the information is at the head and the legs go
 //! there. Infotaxis's map therefore has no dilution (`map_dilution_s = 0`, `map_dilution_m = 0`),
 //! a detection chance of 0.2 in the plume (`map_p_detect`), a spread that grows as
-//! `2 x 1.0 m^2/s x T` (`map_diffusivity_m2ps`: the meander), the AMP's vertical mixing, and
+//! `2 x 1.0 m^2/s x T` (`map_diffusivity_m2ps`: the meander) in every direction
+//! (`map_along_ratio = 1`: narrower along the flow, it moved the declarations upflow on every
+//! family, nearer on Duck-like sites and further on coastal ones), the AMP's vertical mixing, and
 //! declares at half the mass within `map_radius_m` (`map_mass = 0.5`).
 //!
 //! **Declaration.** Once the map's rule holds (mass `map_mass` within `map_radius_m` of the most
