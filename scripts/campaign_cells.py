@@ -52,20 +52,38 @@ def paired(groups, scenarios, configs, base):
         print(f"| {c} | " + " | ".join(cells) + " |")
 
 
+def usage_error(message):
+    print(f"error: {message}", file=sys.stderr)
+    print("usage: python3 scripts/campaign_cells.py RUNS_CSV [--against CONFIG]", file=sys.stderr)
+    sys.exit(2)
+
+
 def main():
     args = sys.argv[1:]
-    base = None
-    if len(args) == 3 and args[1] == "--against":
-        base = args[2]
-        args = args[:1]
-    if len(args) != 1 or args[0] in ("-h", "--help") or args[0].startswith("--"):
-        print(__doc__.strip(), file=sys.stderr)
-        sys.exit(0 if sys.argv[1:] in (["-h"], ["--help"]) else 2)
+    if any(a in ("-h", "--help") for a in args):
+        print(__doc__.strip())
+        sys.exit(0)
+    base, files, k = None, [], 0
+    while k < len(args):
+        a = args[k]
+        if a == "--against" or a.startswith("--against="):
+            base = a.split("=", 1)[1] if "=" in a else (args[k + 1] if k + 1 < len(args) else "")
+            if not base or base.startswith("--"):
+                usage_error("--against needs a config name (one of the campaign's configs)")
+            k += 1 if "=" in a else 2
+        elif a.startswith("-"):
+            usage_error(f"unknown option {a}")
+        else:
+            files.append(a)
+            k += 1
+    if len(files) != 1:
+        usage_error("give one campaign's runs.csv" if not files else f"one runs.csv at a time, got {len(files)}")
+    path = files[0]
     try:
-        with open(sys.argv[1]) as f:
+        with open(path) as f:
             rows = list(csv.DictReader(f))
         if not rows:
-            sys.exit(f"error: {sys.argv[1]}: no runs in it (a campaign's runs.csv has a row per run)")
+            sys.exit(f"error: {path}: no runs in it (a campaign's runs.csv has a row per run)")
         groups, scenarios, configs = defaultdict(list), [], []
         for r in rows:
             groups[(r["config"], r["scenario"])].append(r)
@@ -74,7 +92,7 @@ def main():
             if r["config"] not in configs:
                 configs.append(r["config"])
         if base is not None and base not in configs:
-            sys.exit(f"error: --against {base}: no such config in {sys.argv[1]} (its configs: {', '.join(configs)})")
+            sys.exit(f"error: --against {base}: no such config in {path} (its configs: {', '.join(configs)})")
         print("| config | " + " | ".join(short(s) for s in scenarios) + " |")
         print("| --- " * (len(scenarios) + 1) + "|")
         for c in configs:
@@ -97,9 +115,11 @@ def main():
         if base is not None:
             paired(groups, scenarios, configs, base)
     except OSError as e:
-        sys.exit(f"error: {sys.argv[1]}: cannot read it ({e.strerror})")
-    except (KeyError, ValueError, UnicodeDecodeError, csv.Error) as e:
-        sys.exit(f"error: {sys.argv[1]}: not a campaign's runs.csv (no or bad column {e})")
+        sys.exit(f"error: {path}: cannot read it ({e.strerror})")
+    except UnicodeDecodeError:
+        sys.exit(f"error: {path}: not a text file (a campaign's runs.csv is CSV text)")
+    except (KeyError, ValueError, csv.Error) as e:
+        sys.exit(f"error: {path}: not a campaign's runs.csv (no or bad column {e})")
 
 
 if __name__ == "__main__":

@@ -82,10 +82,24 @@ pub fn load(path: &std::path::Path) -> Result<Onboard> {
     };
     let onboard = Onboard::from_toml(&text)
         .map_err(|e| anyhow::anyhow!("{}{}: {e}", path.display(), at(&e.key)))?;
-    // Keys with no effect: flown as written, but said before the vehicle goes.
-    for (key, why) in &onboard.inert_keys {
-        let key = format!("planner.{key}");
-        eprintln!("warning: {}{}: {key}: {why}", path.display(), at(&key));
+    // Keys with no effect: flown as written, but said before the vehicle goes, in the file's
+    // order.
+    let mut warnings: Vec<(Option<usize>, String)> = onboard
+        .inert_keys
+        .iter()
+        .map(|(key, why)| {
+            let key = format!("planner.{key}");
+            let line = plumetrace_scenario::locate::line_of(&text, &key);
+            let at = line.map(|l| format!(":{l}")).unwrap_or_default();
+            (
+                line,
+                format!("warning: {}{at}: {key}: {why}", path.display()),
+            )
+        })
+        .collect();
+    warnings.sort();
+    for (_, w) in warnings {
+        eprintln!("{w}");
     }
     Ok(onboard)
 }
@@ -220,6 +234,10 @@ fn fly(onboard: &Onboard, args: &OnboardArgs) -> Result<()> {
         runner::RunEnd::Finished => "the planner finished",
         runner::RunEnd::Aborted => "the planner aborted",
         runner::RunEnd::TimeLimit => "run.time_limit_s reached",
+        runner::RunEnd::LinkGaveUp if report.connections == 0 => {
+            "the link gave up (never connected to the front seat in link.give_up_s; link.log \
+             says why)"
+        }
         runner::RunEnd::LinkGaveUp => "the link gave up (down for link.give_up_s)",
     };
     crate::outln!(

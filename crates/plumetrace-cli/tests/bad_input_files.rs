@@ -250,7 +250,7 @@ fn onboard_warns_of_planner_keys_without_effect_before_it_flies() {
     );
     let said = String::from_utf8_lossy(&o.stdout);
     assert!(
-        said.contains("inert.toml: the link gave up (down for link.give_up_s), after"),
+        said.contains("inert.toml: the link gave up (never connected to the front seat"),
         "{said}"
     );
 }

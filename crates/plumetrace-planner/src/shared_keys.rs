@@ -124,7 +124,7 @@ impl MapKeys {
             out.push((
                 "map_along_ratio",
                 "has no effect while map_diffusivity_m2ps is 0: the spread does not grow in any \
-                 direction"
+                 direction (set map_diffusivity_m2ps above 0, or leave map_along_ratio out)"
                     .to_string(),
             ));
         }

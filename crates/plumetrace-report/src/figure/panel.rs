@@ -304,7 +304,21 @@ where
             .map_err(ReportError::figure)?;
         // Its own scale: ticks on the panel's right edge, labelled in the margin beside it.
         let tick = t_max_min * 5.0 / p.plot_w_px.max(1.0);
-        for h in entropy_ticks(h_max) {
+        let ticks = entropy_ticks(h_max);
+        let top = ticks
+            .last()
+            .map_or(0.0, |h| y_lo + h / h_max * (y_hi - y_lo) * ENTROPY_TOP);
+        chart
+            .draw_series(std::iter::once(
+                EmptyElement::at((t_max_min, top))
+                    + Text::new(
+                        "bits",
+                        (3, -14),
+                        label_style(11, ENTROPY_LINE, Pos::new(HPos::Left, VPos::Center)),
+                    ),
+            ))
+            .map_err(ReportError::figure)?;
+        for h in ticks {
             let y = y_lo + h / h_max * (y_hi - y_lo) * ENTROPY_TOP;
             let label = if h.fract() == 0.0 {
                 format!("{h:.0}")
@@ -702,6 +716,15 @@ mod tests {
             .filter(|t| ["0", "5", "10"].contains(&t.text.as_str()) && t.rect.0 > 850.0)
             .collect();
         assert_eq!(ticks.len(), 3, "{ticks:?}");
+        let unit = text_boxes(&svg)
+            .into_iter()
+            .find(|t| t.text == "bits" && t.rect.0 > 850.0)
+            .unwrap();
+        assert!(
+            unit.rect.3 <= ticks[2].rect.1,
+            "{unit:?} above {:?}",
+            ticks[2]
+        );
         assert!(
             ticks[2].rect.1 < ticks[1].rect.1 && ticks[1].rect.1 < ticks[0].rect.1,
             "{ticks:?}"
