@@ -325,15 +325,27 @@ fn planner_keys_with_no_effect_at_the_tables_values_are_warned_of() {
         ),
         "{err}"
     );
-    let (_, _, err) = with("map_dilution_m = 20.0\nmap_dilution_s = 30.0");
+    let (_, _, err) =
+        with("map_declaration = \"instead\"\nmap_dilution_m = 20.0\nmap_dilution_s = 30.0");
     assert!(
         err.contains("planner.map_dilution_s: has no effect while map_dilution_m (20 m)"),
         "{err}"
     );
+    // Without a map declaration (the default) the AMP keeps no map: every map key given idles.
+    let (status, _, err) = with("map_mass = 0.5\nmap_along_ratio = 0.5");
+    assert_eq!(status, 0, "{err}");
+    for key in ["map_mass", "map_along_ratio"] {
+        assert!(
+            err.contains(&format!(
+                "planner.{key}: has no effect with map_declaration = \"off\" (the default)"
+            )),
+            "{key}: {err}"
+        );
+    }
     // Given where they act (the AMP's map dilutes after 30 m unless map_dilution_m = 0), or
     // not given: no warning.
     let (status, _, err) = with(
-        "fix_smoothing = true\nfix_wait_s = 300.0\nmap_dilution_m = 0.0\nmap_dilution_s = 30.0",
+        "fix_smoothing = true\nfix_wait_s = 300.0\nmap_declaration = \"also\"\nmap_dilution_m = 0.0\nmap_dilution_s = 30.0",
     );
     assert_eq!((status, err.contains("has no effect")), (0, false), "{err}");
     let (_, _, err) = with("fix_smoothing = false");

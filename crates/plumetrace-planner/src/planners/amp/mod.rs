@@ -345,7 +345,23 @@ impl PlannerParams for AmpParams {
     }
 
     fn without_effect(&self) -> Vec<(&'static str, String)> {
-        let mut out = self.map.without_effect();
+        // Without a map declaration the AMP keeps no map: every map key is idle.
+        let mut out = if self.map_declaration == MapDeclaration::Off {
+            MapKeys::keys()
+                .into_iter()
+                .map(|k| {
+                    (
+                        k.name,
+                        "has no effect with map_declaration = \"off\" (the default): the AMP \
+                         keeps no source map (set map_declaration = \"also\" or \"instead\", or \
+                         leave the key out)"
+                            .to_string(),
+                    )
+                })
+                .collect()
+        } else {
+            self.map.without_effect()
+        };
         if !self.fix_smoothing {
             out.push((
                 "fix_wait_s",
