@@ -13,6 +13,7 @@ runs whose error is smaller and larger than CONFIG's, and the median of the diff
 closer to the source), over the pairs in which both declared.
 """
 
+import argparse
 import csv
 import sys
 from collections import defaultdict
@@ -52,33 +53,15 @@ def paired(groups, scenarios, configs, base):
         print(f"| {c} | " + " | ".join(cells) + " |")
 
 
-def usage_error(message):
-    print(f"error: {message}", file=sys.stderr)
-    print("usage: python3 scripts/campaign_cells.py RUNS_CSV [--against CONFIG]", file=sys.stderr)
-    sys.exit(2)
-
-
 def main():
-    args = sys.argv[1:]
-    if any(a in ("-h", "--help") for a in args):
-        print(__doc__.strip())
-        sys.exit(0)
-    base, files, k = None, [], 0
-    while k < len(args):
-        a = args[k]
-        if a == "--against" or a.startswith("--against="):
-            base = a.split("=", 1)[1] if "=" in a else (args[k + 1] if k + 1 < len(args) else "")
-            if not base or base.startswith("--"):
-                usage_error("--against needs a config name (one of the campaign's configs)")
-            k += 1 if "=" in a else 2
-        elif a.startswith("-"):
-            usage_error(f"unknown option {a}")
-        else:
-            files.append(a)
-            k += 1
-    if len(files) != 1:
-        usage_error("give one campaign's runs.csv" if not files else f"one runs.csv at a time, got {len(files)}")
-    path = files[0]
+    ap = argparse.ArgumentParser(
+        description=__doc__.strip(), formatter_class=argparse.RawDescriptionHelpFormatter
+    )
+    ap.add_argument("runs_csv", help="a campaign's runs.csv")
+    ap.add_argument("--against", metavar="CONFIG",
+                    help="pair every other config's runs with this config's, seed for seed")
+    a = ap.parse_args()
+    path, base = a.runs_csv, a.against
     try:
         with open(path) as f:
             rows = list(csv.DictReader(f))

@@ -75,13 +75,10 @@ pub fn load(path: &std::path::Path) -> Result<Onboard> {
     let text = plumetrace_env::input::read_text(path, plumetrace_env::input::MAX_TEXT_BYTES)
         .map_err(anyhow::Error::msg)
         .with_context(|| format!("reading {}", path.display()))?;
-    let at = |key: &str| {
-        plumetrace_scenario::locate::line_of(&text, key)
-            .map(|l| format!(":{l}"))
-            .unwrap_or_default()
-    };
+    let line = |key: &str| plumetrace_scenario::locate::line_of(&text, key);
+    let at = |line: Option<usize>| line.map(|l| format!(":{l}")).unwrap_or_default();
     let onboard = Onboard::from_toml(&text)
-        .map_err(|e| anyhow::anyhow!("{}{}: {e}", path.display(), at(&e.key)))?;
+        .map_err(|e| anyhow::anyhow!("{}{}: {e}", path.display(), at(line(&e.key))))?;
     // Keys with no effect: flown as written, but said before the vehicle goes, in the file's
     // order.
     let mut warnings: Vec<(Option<usize>, String)> = onboard
@@ -89,11 +86,10 @@ pub fn load(path: &std::path::Path) -> Result<Onboard> {
         .iter()
         .map(|(key, why)| {
             let key = format!("planner.{key}");
-            let line = plumetrace_scenario::locate::line_of(&text, &key);
-            let at = line.map(|l| format!(":{l}")).unwrap_or_default();
+            let l = line(&key);
             (
-                line,
-                format!("warning: {}{at}: {key}: {why}", path.display()),
+                l,
+                format!("warning: {}{}: {key}: {why}", path.display(), at(l)),
             )
         })
         .collect();

@@ -204,6 +204,22 @@ pub struct SourceMap {
 /// Footprint values below this are taken as zero (the cell is left alone).
 const FOOTPRINT_FLOOR: f64 = 1e-4;
 
+/// Raises candidate `k`'s footprint value (none for a cell outside the op-area) to `v` where `v`
+/// is above it and at least [`FOOTPRINT_FLOOR`], noting the candidates it touches.
+#[inline]
+fn raise(scratch: &mut [f64], touched: &mut Vec<usize>, k: u32, v: f64) {
+    if k == u32::MAX || v < FOOTPRINT_FLOOR {
+        return;
+    }
+    let k = k as usize;
+    if v > scratch[k] {
+        if scratch[k] == 0.0 {
+            touched.push(k);
+        }
+        scratch[k] = v;
+    }
+}
+
 /// The most grid cells a map may have.
 pub const MAX_CELLS: usize = 4_000_000;
 
@@ -432,17 +448,7 @@ impl SourceMap {
             }
             let row = &self.index[j * self.nx + i_lo..j * self.nx + i_hi];
             for (&k, &gx) in row.iter().zip(&self.gx) {
-                let v = gy * gx;
-                if k == u32::MAX || v < FOOTPRINT_FLOOR {
-                    continue;
-                }
-                let k = k as usize;
-                if v > self.scratch[k] {
-                    if self.scratch[k] == 0.0 {
-                        self.touched.push(k);
-                    }
-                    self.scratch[k] = v;
-                }
+                raise(&mut self.scratch, &mut self.touched, k, gy * gx);
             }
         }
     }
@@ -505,18 +511,8 @@ impl SourceMap {
             let mut g = peak * (-(qa * x * x + 2.0 * qb * x * y + qc * y * y)).exp();
             let mut step = (-(qa * (2.0 * x * r + r * r) + 2.0 * qb * r * y)).exp();
             let shrink = (-2.0 * qa * r * r).exp();
-            let row = j * self.nx;
-            for i in i_lo..i_hi {
-                let k = self.index[row + i];
-                if k != u32::MAX && g >= FOOTPRINT_FLOOR {
-                    let k = k as usize;
-                    if g > self.scratch[k] {
-                        if self.scratch[k] == 0.0 {
-                            self.touched.push(k);
-                        }
-                        self.scratch[k] = g;
-                    }
-                }
+            for &k in &self.index[j * self.nx + i_lo..j * self.nx + i_hi] {
+                raise(&mut self.scratch, &mut self.touched, k, g);
                 g *= step;
                 step *= shrink;
             }

@@ -285,10 +285,9 @@ where
         .collect();
     let h_max = entropy.iter().map(|p| p.1).fold(0.0, f64::max);
     if entropy.len() > 1 && h_max > 0.0 {
-        let scaled: Vec<(f64, f64)> = entropy
-            .iter()
-            .map(|&(t, h)| (t, y_lo + h / h_max * (y_hi - y_lo) * ENTROPY_TOP))
-            .collect();
+        // Bits to the reading axis: 0 at the foot, `h_max` at ENTROPY_TOP of the height.
+        let to_y = |h: f64| y_lo + h / h_max * (y_hi - y_lo) * ENTROPY_TOP;
+        let scaled: Vec<(f64, f64)> = entropy.iter().map(|&(t, h)| (t, to_y(h))).collect();
         chart
             .draw_series(std::iter::once(PathElement::new(
                 scaled,
@@ -305,9 +304,7 @@ where
         // Its own scale: ticks on the panel's right edge, labelled in the margin beside it.
         let tick = t_max_min * 5.0 / p.plot_w_px.max(1.0);
         let ticks = entropy_ticks(h_max);
-        let top = ticks
-            .last()
-            .map_or(0.0, |h| y_lo + h / h_max * (y_hi - y_lo) * ENTROPY_TOP);
+        let top = ticks.last().map_or(y_lo, |&h| to_y(h));
         chart
             .draw_series(std::iter::once(
                 EmptyElement::at((t_max_min, top))
@@ -319,12 +316,7 @@ where
             ))
             .map_err(ReportError::figure)?;
         for h in ticks {
-            let y = y_lo + h / h_max * (y_hi - y_lo) * ENTROPY_TOP;
-            let label = if h.fract() == 0.0 {
-                format!("{h:.0}")
-            } else {
-                format!("{h:.1}")
-            };
+            let y = to_y(h);
             chart
                 .draw_series([PathElement::new(
                     vec![(t_max_min - tick, y), (t_max_min, y)],
@@ -335,7 +327,7 @@ where
                 .draw_series(std::iter::once(
                     EmptyElement::at((t_max_min, y))
                         + Text::new(
-                            label,
+                            tick_label(h),
                             (3, 0),
                             label_style(11, ENTROPY_LINE, Pos::new(HPos::Left, VPos::Center)),
                         ),
