@@ -331,6 +331,20 @@ fn planner_keys_with_no_effect_at_the_tables_values_are_warned_of() {
         err.contains("planner.map_dilution_s: has no effect while map_dilution_m (20 m)"),
         "{err}"
     );
+    // A ratio that follows the current replaces the fixed one; neither acts without a spread.
+    let (_, _, err) =
+        with("map_declaration = \"instead\"\nmap_along_speed_mps = 0.3\nmap_along_ratio = 0.5");
+    assert!(
+        err.contains("planner.map_along_ratio: has no effect while map_along_speed_mps (0.3 m/s)"),
+        "{err}"
+    );
+    let (_, _, err) = with(
+        "map_declaration = \"instead\"\nmap_diffusivity_m2ps = 0.0\nmap_along_speed_mps = 0.3",
+    );
+    assert!(
+        err.contains("planner.map_along_speed_mps: has no effect while map_diffusivity_m2ps is 0"),
+        "{err}"
+    );
     // Without a map declaration (the default) the AMP keeps no map: every map key given idles.
     let (status, _, err) = with("map_mass = 0.5\nmap_along_ratio = 0.5");
     assert_eq!(status, 0, "{err}");

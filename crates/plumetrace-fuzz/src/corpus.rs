@@ -446,6 +446,10 @@ pub const CAMPAIGNS: &[(&str, &str)] = &[
         include_str!("../../../examples/campaigns/infotaxis-along.toml"),
     ),
     (
+        "infotaxis-along-speed",
+        include_str!("../../../examples/campaigns/infotaxis-along-speed.toml"),
+    ),
+    (
         "ten-planners-one-plume",
         include_str!("../../../examples/campaigns/ten-planners-one-plume.toml"),
     ),

@@ -76,6 +76,8 @@ plumetrace_core::params! {
         map_diffusivity_m2ps: f64 = 0.1, "m^2/s", Bounds::closed(0.0, 1000.0);
         /// Source map: growth of the spread along the flow as a fraction of map_diffusivity_m2ps (1: the same spread in every direction; below 1 a sample says less about sources downflow of where the flow carried it from).
         map_along_ratio: f64 = 1.0, "", Bounds::closed(0.0, 1.0);
+        /// Source map: when positive, the along-flow growth follows the measured current, min(1, U / map_along_speed_mps) of map_diffusivity_m2ps, replacing map_along_ratio (round in a current at least this fast, narrower along the flow the slower it runs).
+        map_along_speed_mps: f64 = 0.0, "m/s", Bounds::closed(0.0, 10.0);
         /// Source map: vertical diffusivity that mixes a bottom source up to the vehicle's altitude, when map_mixing_length_m is 0 (0: no vertical model).
         map_vertical_diffusivity_m2ps: f64 = 0.01, "m^2/s", Bounds::closed(0.0, 100.0);
         /// Source map: when positive, the vertical diffusivity is this mixing length times the measured flow speed (bottom boundary-layer mixing grows with the current), replacing map_vertical_diffusivity_m2ps.
@@ -97,6 +99,7 @@ impl MapKeys {
             p_detect: self.map_p_detect,
             diffusivity_m2ps: self.map_diffusivity_m2ps,
             along_ratio: self.map_along_ratio,
+            along_speed_mps: self.map_along_speed_mps,
             vertical_diffusivity_m2ps: self.map_vertical_diffusivity_m2ps,
             vertical_mixing_length_m: self.map_mixing_length_m,
             window_s: self.map_window_s,
@@ -121,11 +124,23 @@ impl MapKeys {
             ));
         }
         if self.map_diffusivity_m2ps == 0.0 {
+            for key in ["map_along_ratio", "map_along_speed_mps"] {
+                out.push((
+                    key,
+                    format!(
+                        "has no effect while map_diffusivity_m2ps is 0: the spread does not grow \
+                         in any direction (set map_diffusivity_m2ps above 0, or leave {key} out)"
+                    ),
+                ));
+            }
+        } else if self.map_along_speed_mps > 0.0 {
             out.push((
                 "map_along_ratio",
-                "has no effect while map_diffusivity_m2ps is 0: the spread does not grow in any \
-                 direction (set map_diffusivity_m2ps above 0, or leave map_along_ratio out)"
-                    .to_string(),
+                format!(
+                    "has no effect while map_along_speed_mps ({} m/s) is positive: the ratio \
+                     then follows the measured current",
+                    self.map_along_speed_mps
+                ),
             ));
         }
         if self.map_mixing_length_m > 0.0 {

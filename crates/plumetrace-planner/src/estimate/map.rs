@@ -26,7 +26,9 @@
 //! `X(t_k) - X(t_k - T)`. The meander moves chemical across the mean flow more than along it;
 //! a round spread as wide as the meander also said that a sample saw sources downflow of where
 //! the flow carried its chemical from, which moved the map's peak downflow. Successive
-//! footprints are then one along-flow spread apart.
+//! footprints are then one along-flow spread apart. With `along_speed_mps` positive the ratio
+//! follows the measured current instead, `min(1, U / along_speed_mps)`: round in a current at
+//! least that fast, narrower along the path the slower the current runs.
 //!
 //! **Vertical mixing.** The source is on the bottom and the vehicle samples at altitude `z`.
 //! Chemical released at the bed spreads upwards as a reflected Gaussian with vertical diffusivity
@@ -87,6 +89,9 @@ pub struct MapModel {
     /// Growth of the spread along the flow as a fraction of `diffusivity_m2ps` (1: the same
     /// spread in every direction).
     pub along_ratio: f64,
+    /// When positive, the along-flow ratio is `min(1, U / along_speed_mps)` with `U` the measured
+    /// flow speed, replacing `along_ratio`, m/s.
+    pub along_speed_mps: f64,
     /// Vertical diffusivity for the bottom source's mixing up to the vehicle (0: off), m^2/s.
     pub vertical_diffusivity_m2ps: f64,
     /// When positive, the vertical diffusivity is this length times the measured flow speed
@@ -114,6 +119,7 @@ impl Default for MapModel {
             spread0_m: 3.0,
             diffusivity_m2ps: 0.1,
             along_ratio: 1.0,
+            along_speed_mps: 0.0,
             vertical_diffusivity_m2ps: 0.01,
             vertical_mixing_length_m: 0.0,
             p_detect: 0.1,
@@ -371,15 +377,19 @@ impl SourceMap {
         } else {
             m.dilution_s
         };
+        let along_ratio = if m.along_speed_mps > 0.0 {
+            (self.flow.speed_mps() / m.along_speed_mps).min(1.0)
+        } else {
+            m.along_ratio
+        };
         let x_now = self.flow.at(t_s);
         let mut travel = 0.0_f64;
         while travel <= m.window_s {
             let sigma = (m.spread0_m * m.spread0_m + 2.0 * m.diffusivity_m2ps * travel).sqrt();
-            let sigma_along = if m.along_ratio == 1.0 {
+            let sigma_along = if along_ratio == 1.0 {
                 sigma
             } else {
-                (m.spread0_m * m.spread0_m + 2.0 * m.along_ratio * m.diffusivity_m2ps * travel)
-                    .sqrt()
+                (m.spread0_m * m.spread0_m + 2.0 * along_ratio * m.diffusivity_m2ps * travel).sqrt()
             };
             let vertical = if kz > 0.0 && z2 > 0.0 {
                 if travel > 0.0 {
@@ -877,6 +887,39 @@ mod tests {
                 "{deg} deg across: {side} against {side_round}"
             );
         }
+    }
+
+    #[test]
+    fn an_along_speed_makes_the_ratio_follow_the_measured_current() {
+        // The same samples in currents of 0.15 and 0.6 m/s: with an along speed of 0.3 m/s the
+        // map equals one with a fixed ratio of 0.5 in the slower current and the round map in
+        // the faster one (the fixed ratio is then ignored), and the two ratios differ.
+        let fly = |speed: f64, model: MapModel| {
+            let mut m = SourceMap::new(&area(), model).unwrap_or_else(|| panic!("no map"));
+            for k in 0..200 {
+                let t = k as f64;
+                m.add_flow(t, Vec2::new(speed, 0.0));
+                m.observe(Vec2::new(300.0, 90.0 + 0.1 * t), t, None, k % 7 == 0);
+            }
+            m.log_probabilities().to_vec()
+        };
+        let base = MapModel {
+            diffusivity_m2ps: 1.0,
+            dilution_s: 0.0,
+            ..model()
+        };
+        let following = MapModel {
+            along_speed_mps: 0.3,
+            along_ratio: 0.2,
+            ..base
+        };
+        let fixed = |along_ratio: f64| MapModel {
+            along_ratio,
+            ..base
+        };
+        assert_eq!(fly(0.15, following), fly(0.15, fixed(0.5)));
+        assert_eq!(fly(0.6, following), fly(0.6, fixed(1.0)));
+        assert_ne!(fly(0.15, fixed(0.5)), fly(0.15, fixed(1.0)));
     }
 
     #[test]

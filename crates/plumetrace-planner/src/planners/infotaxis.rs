@@ -28,9 +28,12 @@
 //! upflow of the plume's head place the source, so the information is at the head and the legs go
 //! there. Infotaxis's map therefore has no dilution (`map_dilution_s = 0`, `map_dilution_m = 0`),
 //! a detection chance of 0.2 in the plume (`map_p_detect`), a spread that grows as
-//! `2 x 1.0 m^2/s x T` (`map_diffusivity_m2ps`: the meander) in every direction
-//! (`map_along_ratio = 1`: narrower along the flow, it moved the declarations upflow on every
-//! family, nearer on Duck-like sites and further on coastal ones), the AMP's vertical mixing, and
+//! `2 x 1.0 m^2/s x T` (`map_diffusivity_m2ps`: the meander) across the flow and as
+//! `min(1, U / 0.45 m/s)` of that along it (`map_along_speed_mps = 0.45`, with `U` the measured
+//! current: a round spread as wide as the meander lets a detection in a slow current raise cells
+//! up to about `4.5 D / U` downflow of where it was taken (the footprint's three spreads), 45 m
+//! at 0.1 m/s, which moved the declarations downflow; following the current keeps that reach at
+//! its value at 0.45 m/s, about 12 m, in every slower current), the AMP's vertical mixing, and
 //! declares at half the mass within `map_radius_m` (`map_mass = 0.5`).
 //!
 //! **Declaration.** Once the map's rule holds (mass `map_mass` within `map_radius_m` of the most
@@ -60,7 +63,7 @@ plumetrace_core::params! {
     /// Parameters of the infotaxis planner.
     pub struct InfotaxisParams {
         include autopilot: AutopilotKeys = AutopilotKeys::default();
-        include map: MapKeys = MapKeys { map_mass: 0.5, map_hold_s: 300.0, map_estimate_radius_m: 10.0, map_mixing_length_m: 0.12, map_p_detect: 0.2, map_diffusivity_m2ps: 1.0, map_dilution_s: 0.0, ..MapKeys::default() };
+        include map: MapKeys = MapKeys { map_mass: 0.5, map_hold_s: 300.0, map_estimate_radius_m: 10.0, map_mixing_length_m: 0.12, map_p_detect: 0.2, map_diffusivity_m2ps: 1.0, map_along_speed_mps: 0.45, map_dilution_s: 0.0, ..MapKeys::default() };
         /// What a move minimises: infotaxis (the expected entropy of the map after it) or space_aware (expected log2(D + 2^(H - 1) - 1/2), distance D in map cells).
         objective: Objective = Objective::Infotaxis, "", Bounds::Any;
         /// Length of a candidate leg, its turn at the turning limit included (40 s at 2 m/s).
