@@ -250,6 +250,17 @@ fn fly(onboard: &Onboard, args: &OnboardArgs) -> Result<()> {
         report.lines.rejected_total(),
         args.out.display()
     );
+    // A flight that never reached the vehicle did nothing: say so in the exit status too, so
+    // that a script (or a watch on the vehicle) does not take it for a flight.
+    if report.end == runner::RunEnd::LinkGaveUp && report.connections == 0 {
+        anyhow::bail!(
+            "{}: never connected to the front seat in link.give_up_s ({} s); {} says why, and \
+             the other files of the attempt are beside it",
+            args.file.display(),
+            onboard.file.link.give_up_s,
+            args.out.join("link.log").display()
+        );
+    }
     Ok(())
 }
 

@@ -235,14 +235,17 @@ fn onboard_warns_of_planner_keys_without_effect_before_it_flies() {
     let (_, warned) = check(&plain);
     assert!(!warned.contains("warning"), "{warned}");
     // Flying warns too, before it connects (here to a port nobody listens on: the link gives
-    // up after half a second).
+    // up after half a second). A flight that never connected writes its files and fails.
     let out = dir.path().join("flight");
-    let o = common::run_ok(&[
-        "onboard",
-        file.to_str().unwrap(),
-        "--out",
-        out.to_str().unwrap(),
-    ]);
+    let o = common::bin()
+        .args([
+            "onboard",
+            file.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+        ])
+        .output()
+        .unwrap();
     let warned = String::from_utf8_lossy(&o.stderr);
     assert!(
         warned.contains("planner.fix_wait_s: has no effect"),
@@ -253,6 +256,14 @@ fn onboard_warns_of_planner_keys_without_effect_before_it_flies() {
         said.contains("inert.toml: the link gave up (never connected to the front seat"),
         "{said}"
     );
+    assert_eq!(o.status.code(), Some(1), "{warned}");
+    assert!(
+        warned.contains("inert.toml: never connected to the front seat in link.give_up_s (0.5 s)"),
+        "{warned}"
+    );
+    for f in ["link.log", "onboard.json", "run.alog", "snapshots.jsonl.gz"] {
+        assert!(out.join(f).is_file(), "{f} not written");
+    }
 }
 
 #[test]
