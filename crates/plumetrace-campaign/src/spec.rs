@@ -226,7 +226,7 @@ pub fn parse_campaign(text: &str, path: &Path) -> Result<CampaignFile, CampaignE
         CampaignError::Invalid {
             file,
             key: if key == "." { String::new() } else { key },
-            message: e.into_inner().to_string(),
+            message: plumetrace_core::plain_types(&e.into_inner().to_string()),
         }
     })
 }

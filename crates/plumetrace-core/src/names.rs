@@ -147,6 +147,27 @@ impl Serializer for NameOnly {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn rust_type_names_read_as_plain_words() {
+        assert_eq!(
+            plain_types("invalid type: string \"long\", expected f64\nin `x`"),
+            "invalid type: string \"long\", expected a number\nin `x`"
+        );
+        assert_eq!(
+            plain_types("invalid value: integer `-1`, expected u32"),
+            "invalid value: integer `-1`, expected a whole number, 0 or more"
+        );
+        // Other expectations, and words that only begin like a type, are left alone.
+        for m in [
+            "unknown field `a`, expected `b`",
+            "expected f64x",
+            "expected a boolean",
+            "expected",
+        ] {
+            assert_eq!(plain_types(m), m);
+        }
+    }
     use crate::{BehaviourKind, PlanStatus};
 
     #[test]
@@ -164,6 +185,43 @@ mod tests {
             );
         }
     }
+}
+
+/// A deserializer's message with Rust's type names in plain words: `expected f64` reads
+/// `expected a number`, `expected u32` `expected a whole number, 0 or more` (and `i64` without
+/// the bound); the rest of the message is unchanged.
+pub fn plain_types(message: &str) -> String {
+    const NAMES: [(&str, &str); 12] = [
+        ("f64", "a number"),
+        ("f32", "a number"),
+        ("usize", "a whole number, 0 or more"),
+        ("u64", "a whole number, 0 or more"),
+        ("u32", "a whole number, 0 or more"),
+        ("u16", "a whole number, 0 or more"),
+        ("u8", "a whole number, 0 or more"),
+        ("isize", "a whole number"),
+        ("i64", "a whole number"),
+        ("i32", "a whole number"),
+        ("i16", "a whole number"),
+        ("i8", "a whole number"),
+    ];
+    let mut out = String::with_capacity(message.len());
+    let mut rest = message;
+    while let Some(at) = rest.find("expected ") {
+        let (head, tail) = rest.split_at(at + "expected ".len());
+        out.push_str(head);
+        let word_end = tail
+            .find(|c: char| !c.is_ascii_alphanumeric())
+            .unwrap_or(tail.len());
+        let word = &tail[..word_end];
+        match NAMES.iter().find(|(rust, _)| *rust == word) {
+            Some((_, plain)) => out.push_str(plain),
+            None => out.push_str(word),
+        }
+        rest = &tail[word_end..];
+    }
+    out.push_str(rest);
+    out
 }
 
 /// The candidate nearest to `word`, when one is near enough to be what was meant: a typo of a

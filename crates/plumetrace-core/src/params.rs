@@ -342,7 +342,7 @@ pub fn read_own<T: serde::de::DeserializeOwned>(
             } else {
                 key_path(prefix, &path)
             },
-            message: e.into_inner().to_string(),
+            message: crate::plain_types(e.into_inner().message()),
         }
     })
 }
@@ -601,7 +601,11 @@ mod tests {
             Err("q.count".to_string())
         );
         let cases = [
-            ("rate_hz = \"x\"", "p.rate_hz", "invalid type"),
+            (
+                "rate_hz = \"x\"",
+                "p.rate_hz",
+                "invalid type: string \"x\", expected a number",
+            ),
             ("gain = \"x\"", "p.gain", "invalid type"),
             ("cuont = 3", "p.cuont", "did you mean `count`?"),
             ("gian = 1.0", "p.gian", "did you mean `gain`?"),

@@ -442,7 +442,10 @@ impl Onboard {
         let de = toml::Deserializer::parse(text).map_err(|e| err("", e.to_string()))?;
         let file: OnboardFile = serde_path_to_error::deserialize(de).map_err(|e| {
             let path = e.path().to_string();
-            err(if path == "." { "" } else { &path }, e.inner().to_string())
+            err(
+                if path == "." { "" } else { &path },
+                plumetrace_core::plain_types(&e.inner().to_string()),
+            )
         })?;
         Onboard::check(file)
     }

@@ -491,7 +491,7 @@ impl Family {
             invalid(
                 path,
                 if key == "." { "" } else { &key },
-                e.into_inner().to_string(),
+                plumetrace_core::plain_types(&e.into_inner().to_string()),
             )
         })?;
         check(&file, path).map_err(|e| e.located(text))?;

@@ -194,7 +194,7 @@ fn deserialize(
                 // As the message of a `toml::Value`'s error read.
                 Report::Message => format!("{}\n", inner.message()),
             };
-            (String::new(), message)
+            (String::new(), plumetrace_core::plain_types(&message))
         } else {
             (path, locate::suggest(inner.message()))
         };

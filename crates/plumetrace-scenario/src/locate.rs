@@ -82,8 +82,13 @@ fn segments(path: &str) -> Vec<Segment> {
 
 /// serde's message for an unknown key or name (`unknown field `dtt_s`, expected `dt_s` or
 /// `duration_s``, `unknown variant ...`) with the nearest known one suggested in place of the
-/// list when one is near; any other message unchanged.
+/// list when one is near; Rust's type names in plain words ([`plumetrace_core::plain_types`]).
 pub fn suggest(message: &str) -> String {
+    plumetrace_core::plain_types(&suggest_near(message))
+}
+
+/// [`suggest`]'s "did you mean", any other message unchanged.
+fn suggest_near(message: &str) -> String {
     let Some((what, rest)) = ["unknown field `", "unknown variant `"]
         .iter()
         .find_map(|p| message.strip_prefix(p).map(|rest| (*p, rest)))

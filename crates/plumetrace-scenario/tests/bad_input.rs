@@ -96,6 +96,25 @@ fn unknown_and_mistyped_keys_are_rejected_with_their_path() {
 }
 
 #[test]
+fn mistyped_values_say_what_was_expected_in_plain_words() {
+    for (from, to, want) in [
+        (
+            "nx = 21",
+            "nx = \"many\"",
+            "flow.farrell.nx: invalid type: string \"many\", expected a whole number, 0 or more",
+        ),
+        (
+            "dt_s = 0.1",
+            "dt_s = \"fast\"",
+            "sim.dt_s: invalid type: string \"fast\", expected a number",
+        ),
+    ] {
+        let e = error_of(&demo_with(|t| t.replacen(from, to, 1)));
+        assert!(e.contains(want), "{to}: {e}");
+    }
+}
+
+#[test]
 fn missing_tables_and_files_are_explained() {
     let no_mean = demo_with(|t| {
         t.replace(
