@@ -207,7 +207,7 @@ fn set_and_planner_change_the_scenario_as_a_campaign_does() {
         ),
         (
             &["--set", "beta_deg=-5"],
-            "error: preset 'demo': planner.beta_deg: must be >= 0 and <= 90, got -5",
+            "error: preset 'demo': planner.beta_deg: must be >= 0 and <= 90 deg, got -5 deg",
         ),
         (
             &["--set", "beta_deg"],

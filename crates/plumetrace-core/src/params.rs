@@ -364,16 +364,24 @@ pub fn read_included<T: Params + serde::Serialize>(
     T::read(own, prefix)
 }
 
-/// Checks one value (used by [`params!`](crate::params!)).
+/// Checks one value (used by [`params!`](crate::params!)); a value outside its bounds is named
+/// with the key's `unit` (`must be > 0 and <= 10 m/s, got 50 m/s`).
 pub fn check<T: ParamValue>(
     prefix: &str,
     name: &str,
     value: &T,
     bounds: &Bounds,
+    unit: &str,
 ) -> Result<(), ParamError> {
-    value
-        .check(bounds)
-        .map_err(|e| ParamError::at(prefix, name, e.to_string()))
+    value.check(bounds).map_err(|e| {
+        let message = match e {
+            BoundsError::Outside { bounds, value } if !unit.is_empty() => {
+                format!("must be {bounds} {unit}, got {value} {unit}")
+            }
+            e => e.to_string(),
+        };
+        ParamError::at(prefix, name, message)
+    })
 }
 
 /// The keys as Markdown table rows (`| key | type | default | unit | bounds | doc |`).
@@ -485,7 +493,7 @@ macro_rules! params {
 
             fn check_bounds(&self, prefix: &str) -> Result<(), $crate::params::ParamError> {
                 $( $crate::params::Params::check_bounds(&self.$inc, prefix)?; )*
-                $( $crate::params::check(prefix, stringify!($field), &self.$field, &$bounds)?; )*
+                $( $crate::params::check(prefix, stringify!($field), &self.$field, &$bounds, $unit)?; )*
                 Ok(())
             }
 
@@ -639,6 +647,14 @@ mod tests {
         .unwrap_err();
         assert_eq!(e.key, "planners.a.count");
         assert_eq!(e.message, "must be 3..=10, got 2");
+        // A key with a unit says it on both sides.
+        let e = Set {
+            rate_hz: 200.0,
+            ..Set::default()
+        }
+        .check_bounds("p")
+        .unwrap_err();
+        assert_eq!(e.message, "must be > 0 and <= 100 Hz, got 200 Hz");
         let rows = markdown_rows(&keys);
         assert!(
             rows.starts_with("| `rate_hz` | number | `10.0` | Hz | > 0 and <= 100 | A rate. |")
