@@ -21,12 +21,13 @@ fn fly(args: &[&str], out: &Path) -> (String, serde_json::Value) {
     (printed, json(&out.join("summary.json")))
 }
 
-/// Infotaxis's earlier map model (dilution after 15 m), under which it declared far downflow on
-/// the demo site.
-const EARLIER_MAP: [(&str, &str); 4] = [
+/// Infotaxis's earlier map model (dilution after 15 m, a round spread), under which it declared
+/// far downflow on the demo site.
+const EARLIER_MAP: [(&str, &str); 5] = [
     ("map_dilution_m", "15.0"),
     ("map_p_detect", "0.1"),
     ("map_diffusivity_m2ps", "0.1"),
+    ("map_along_speed_mps", "0.0"),
     ("map_mass", "0.7"),
 ];
 
