@@ -223,10 +223,21 @@ pub fn parse_campaign(text: &str, path: &Path) -> Result<CampaignFile, CampaignE
     })?;
     serde_path_to_error::deserialize(de).map_err(|e| {
         let key = e.path().to_string();
-        CampaignError::Invalid {
-            file,
-            key: if key == "." { String::new() } else { key },
-            message: plumetrace_core::plain_types(&e.into_inner().to_string()),
+        let inner = e.into_inner();
+        // With a key path the message and its line; without one, the parser's whole report,
+        // which shows where.
+        if key == "." {
+            CampaignError::Invalid {
+                file,
+                key: String::new(),
+                message: plumetrace_core::plain_types(&inner.to_string()),
+            }
+        } else {
+            CampaignError::Invalid {
+                file,
+                key,
+                message: plumetrace_scenario::locate::message_with_line(&inner, text),
+            }
         }
     })
 }

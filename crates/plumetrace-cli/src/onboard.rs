@@ -234,6 +234,10 @@ fn fly(onboard: &Onboard, args: &OnboardArgs) -> Result<()> {
             "the link gave up (never connected to the front seat in link.give_up_s; link.log \
              says why)"
         }
+        runner::RunEnd::LinkGaveUp if report.nav_records == 0 => {
+            "the link gave up (connected, but no navigation record came from the front seat in \
+             link.give_up_s; link.log says what did)"
+        }
         runner::RunEnd::LinkGaveUp => "the link gave up (down for link.give_up_s)",
     };
     crate::outln!(
@@ -250,12 +254,17 @@ fn fly(onboard: &Onboard, args: &OnboardArgs) -> Result<()> {
         report.lines.rejected_total(),
         args.out.display()
     );
-    // A flight that never reached the vehicle did nothing: say so in the exit status too, so
-    // that a script (or a watch on the vehicle) does not take it for a flight.
-    if report.end == runner::RunEnd::LinkGaveUp && report.connections == 0 {
+    // A flight that never heard the vehicle's navigation did nothing: say so in the exit status
+    // too, so that a script (or a watch on the vehicle) does not take it for a flight.
+    if report.end == runner::RunEnd::LinkGaveUp && report.nav_records == 0 {
+        let what = if report.connections == 0 {
+            "never connected to the front seat"
+        } else {
+            "connected, but no navigation record came from the front seat"
+        };
         anyhow::bail!(
-            "{}: never connected to the front seat in link.give_up_s ({} s); {} says why, and \
-             the other files of the attempt are beside it",
+            "{}: {what} in link.give_up_s ({} s); {} says why, and the other files of the \
+             attempt are beside it",
             args.file.display(),
             onboard.file.link.give_up_s,
             args.out.join("link.log").display()

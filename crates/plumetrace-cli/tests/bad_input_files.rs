@@ -267,6 +267,65 @@ fn onboard_warns_of_planner_keys_without_effect_before_it_flies() {
 }
 
 #[test]
+fn an_onboard_flight_whose_front_seat_never_sends_navigation_fails_after_writing_its_files() {
+    // A peer that accepts the connection and says nothing (a front seat that is up but not
+    // sending): the link counts the connection, drops it after link.silence_timeout_s, and the
+    // flight, having heard no navigation, gives up after link.give_up_s.
+    let listener = std::net::TcpListener::bind("127.0.0.1:0").unwrap();
+    let port = listener.local_addr().unwrap().port();
+    let held = std::thread::spawn(move || {
+        let mut conns = Vec::new();
+        listener.set_nonblocking(true).unwrap();
+        let until = std::time::Instant::now() + std::time::Duration::from_secs(20);
+        while std::time::Instant::now() < until && conns.len() < 50 {
+            match listener.accept() {
+                Ok((c, _)) => conns.push(c),
+                Err(_) => std::thread::sleep(std::time::Duration::from_millis(10)),
+            }
+        }
+        conns.len()
+    });
+    let dir = tempfile::tempdir().unwrap();
+    let file = dir.path().join("silent.toml");
+    std::fs::write(
+        &file,
+        ONBOARD
+            .replacen("127.0.0.1:9", &format!("127.0.0.1:{port}"), 1)
+            .replacen(
+                "give_up_s = 0.5",
+                "give_up_s = 1.0\nsilence_timeout_s = 0.5",
+                1,
+            ),
+    )
+    .unwrap();
+    let out = dir.path().join("flight");
+    let o = common::bin()
+        .args([
+            "onboard",
+            file.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+        ])
+        .output()
+        .unwrap();
+    let (said, err) = (
+        String::from_utf8_lossy(&o.stdout),
+        String::from_utf8_lossy(&o.stderr),
+    );
+    assert_eq!(o.status.code(), Some(1), "{said}{err}");
+    assert!(
+        said.contains("the link gave up (connected, but no navigation record came"),
+        "{said}"
+    );
+    assert!(
+        err.contains("silent.toml: connected, but no navigation record came from the front seat"),
+        "{err}"
+    );
+    assert!(out.join("onboard.json").is_file());
+    drop(held);
+}
+
+#[test]
 fn family_out_at_a_file_says_so_and_writes_nothing() {
     let dir = tempfile::tempdir().unwrap();
     let file = dir.path().join("plain");

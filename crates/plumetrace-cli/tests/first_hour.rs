@@ -216,7 +216,7 @@ fn set_and_planner_change_the_scenario_as_a_campaign_does() {
         (
             &["--set", "kind=moth"],
             "error: --set \"kind=moth\": the value is not TOML (a string is quoted: \
-             kind='\"moth\"'): ",
+             kind='\"moth\"')\n",
         ),
         (
             &["--set", "sources.3.x_m=1"],

@@ -155,8 +155,12 @@ mod tests {
             "invalid type: string \"long\", expected a number\nin `x`"
         );
         assert_eq!(
-            plain_types("invalid value: integer `-1`, expected u32"),
+            plain_types("invalid value: integer `-1`, expected u64"),
             "invalid value: integer `-1`, expected a whole number, 0 or more"
+        );
+        assert_eq!(
+            plain_types("invalid value: integer `99999999999`, expected u32"),
+            "invalid value: integer `99999999999`, expected a whole number from 0 to 4294967295"
         );
         // Other expectations, and words that only begin like a type, are left alone.
         for m in [
@@ -188,17 +192,18 @@ mod tests {
 }
 
 /// A deserializer's message with Rust's type names in plain words: `expected f64` reads
-/// `expected a number`, `expected u32` `expected a whole number, 0 or more` (and `i64` without
-/// the bound); the rest of the message is unchanged.
+/// `expected a number`, `expected u32` `expected a whole number from 0 to 4294967295` (`u64` and
+/// `usize`: `0 or more`, as every whole number TOML writes below zero is refused by its sign;
+/// `i64` without a bound); the rest of the message is unchanged.
 pub fn plain_types(message: &str) -> String {
     const NAMES: [(&str, &str); 12] = [
         ("f64", "a number"),
         ("f32", "a number"),
         ("usize", "a whole number, 0 or more"),
         ("u64", "a whole number, 0 or more"),
-        ("u32", "a whole number, 0 or more"),
-        ("u16", "a whole number, 0 or more"),
-        ("u8", "a whole number, 0 or more"),
+        ("u32", "a whole number from 0 to 4294967295"),
+        ("u16", "a whole number from 0 to 65535"),
+        ("u8", "a whole number from 0 to 255"),
         ("isize", "a whole number"),
         ("i64", "a whole number"),
         ("i32", "a whole number"),

@@ -365,7 +365,8 @@ pub fn read_included<T: Params + serde::Serialize>(
 }
 
 /// Checks one value (used by [`params!`](crate::params!)); a value outside its bounds is named
-/// with the key's `unit` (`must be > 0 and <= 10 m/s, got 50 m/s`).
+/// with the key's `unit` (`must be > 0 and <= 10 m/s, got 50 m/s`), unless the unit is the
+/// sensor's own (`unit`, `1/(s unit)`: the reading's unit, which the key does not know).
 pub fn check<T: ParamValue>(
     prefix: &str,
     name: &str,
@@ -375,7 +376,9 @@ pub fn check<T: ParamValue>(
 ) -> Result<(), ParamError> {
     value.check(bounds).map_err(|e| {
         let message = match e {
-            BoundsError::Outside { bounds, value } if !unit.is_empty() => {
+            BoundsError::Outside { bounds, value }
+                if !unit.is_empty() && !unit.contains("unit") =>
+            {
                 format!("must be {bounds} {unit}, got {value} {unit}")
             }
             e => e.to_string(),

@@ -74,9 +74,9 @@ plumetrace_core::params! {
         map_correlation_s: f64 = 10.0, "s", Bounds::closed(0.0, 3600.0);
         /// Source map: growth of the back-projection spread, sigma^2 = (3 m)^2 + 2 D T.
         map_diffusivity_m2ps: f64 = 0.1, "m^2/s", Bounds::closed(0.0, 1000.0);
-        /// Source map: growth of the spread along the flow as a fraction of map_diffusivity_m2ps (1: the same spread in every direction; below 1 a sample says less about sources downflow of where the flow carried it from).
+        /// Source map: growth of the spread along the flow as a fraction of map_diffusivity_m2ps, when map_along_speed_mps is 0 (1: the same spread in every direction; below 1 a sample says less about sources downflow of where the flow carried it from).
         map_along_ratio: f64 = 1.0, "", Bounds::closed(0.0, 1.0);
-        /// Source map: when positive, the along-flow growth follows the measured current, min(1, U / map_along_speed_mps) of map_diffusivity_m2ps, replacing map_along_ratio (round in a current at least this fast, narrower along the flow the slower it runs).
+        /// Source map: when positive, the along-flow growth follows the current, min(1, U / map_along_speed_mps) of map_diffusivity_m2ps with U the speed of the vehicle's latest flow reading, replacing map_along_ratio (round in a current at least this fast, narrower along the flow the slower it runs).
         map_along_speed_mps: f64 = 0.0, "m/s", Bounds::closed(0.0, 10.0);
         /// Source map: vertical diffusivity that mixes a bottom source up to the vehicle's altitude, when map_mixing_length_m is 0 (0: no vertical model).
         map_vertical_diffusivity_m2ps: f64 = 0.01, "m^2/s", Bounds::closed(0.0, 100.0);
@@ -138,7 +138,8 @@ impl MapKeys {
                 "map_along_ratio",
                 format!(
                     "has no effect while map_along_speed_mps ({} m/s) is positive: the ratio \
-                     then follows the measured current",
+                     then follows the measured current (set map_along_speed_mps = 0 for a fixed \
+                     ratio, or leave map_along_ratio out)",
                     self.map_along_speed_mps
                 ),
             ));

@@ -488,11 +488,14 @@ impl Family {
         let de = toml::Deserializer::parse(text).map_err(|e| invalid(path, "", e.to_string()))?;
         let file: FamilyFile = serde_path_to_error::deserialize(de).map_err(|e| {
             let key = e.path().to_string();
-            invalid(
-                path,
-                if key == "." { "" } else { &key },
-                plumetrace_core::plain_types(&e.into_inner().to_string()),
-            )
+            let inner = e.into_inner();
+            // With a key path the message alone, at the key's line; without one, the parser's
+            // whole report, which shows where.
+            if key == "." {
+                invalid(path, "", plumetrace_core::plain_types(&inner.to_string()))
+            } else {
+                invalid(path, &key, crate::locate::suggest(inner.message())).located(text)
+            }
         })?;
         check(&file, path).map_err(|e| e.located(text))?;
         let (base_origin, base_text) = if file.base.ends_with(".toml") {

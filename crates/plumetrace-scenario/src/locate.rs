@@ -80,6 +80,16 @@ fn segments(path: &str) -> Vec<Segment> {
     out
 }
 
+/// A TOML deserializer's message for a key of `text` ([`suggest`]'s words) with the line it
+/// points at, `... (line 3)`, for files whose errors carry no line of their own.
+pub fn message_with_line(error: &toml::de::Error, text: &str) -> String {
+    let line = error
+        .span()
+        .map(|s| format!(" (line {})", line_at(text, s.start.min(text.len()))))
+        .unwrap_or_default();
+    format!("{}{line}", suggest(error.message()))
+}
+
 /// serde's message for an unknown key or name (`unknown field `dtt_s`, expected `dt_s` or
 /// `duration_s``, `unknown variant ...`) with the nearest known one suggested in place of the
 /// list when one is near; Rust's type names in plain words ([`plumetrace_core::plain_types`]).

@@ -57,14 +57,13 @@ pub enum SetError {
     #[error("--set {0:?}: expected KEY=VALUE")]
     Syntax(String),
     /// The value is not TOML.
-    #[error("--set {set:?}: the value is not TOML{hint}: {error}")]
+    #[error("--set {set:?}: the value is not TOML{hint}")]
     Value {
         /// The override.
         set: String,
-        /// A hint for a bare word (a string is quoted).
+        /// What to do: for a bare word, that a string is quoted; otherwise the parser's
+        /// message (its line and column would point into the parser's own wrapping).
         hint: String,
-        /// The parser's message.
-        error: Box<toml::de::Error>,
     },
     /// Nothing after `=`.
     #[error("--set {0:?}: no value")]
@@ -98,9 +97,8 @@ pub fn apply_sets(table: &mut toml::Table, sets: &[String]) -> Result<Vec<String
                 {
                     format!(" (a string is quoted: {}='\"{value}\"')", key.trim())
                 } else {
-                    String::new()
+                    format!(": {}", error.message().trim_end())
                 },
-                error: Box::new(error),
             })?
             .remove("v")
             .ok_or_else(|| SetError::NoValue(s.clone()))?;

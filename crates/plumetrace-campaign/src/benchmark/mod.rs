@@ -245,21 +245,9 @@ impl TaskSet {
         let f: TaskSetFile = serde_path_to_error::deserialize(de).map_err(|e| {
             let key = e.path().to_string();
             let inner = e.into_inner();
-            let line = inner
-                .span()
-                .map(|s| {
-                    format!(
-                        " (line {})",
-                        text[..s.start.min(text.len())].matches('\n').count() + 1
-                    )
-                })
-                .unwrap_or_default();
             bad(
                 key,
-                format!(
-                    "{}{line}",
-                    plumetrace_scenario::locate::suggest(inner.message())
-                ),
+                plumetrace_scenario::locate::message_with_line(&inner, text),
             )
         })?;
         let mut scenario_names = Vec::new();

@@ -30,10 +30,10 @@
 //! a detection chance of 0.2 in the plume (`map_p_detect`), a spread that grows as
 //! `2 x 1.0 m^2/s x T` (`map_diffusivity_m2ps`: the meander) across the flow and as
 //! `min(1, U / 0.45 m/s)` of that along it (`map_along_speed_mps = 0.45`, with `U` the measured
-//! current: a round spread as wide as the meander lets a detection in a slow current raise cells
-//! up to about `4.5 D / U` downflow of where it was taken (the footprint's three spreads), 45 m
-//! at 0.1 m/s, which moved the declarations downflow; following the current keeps that reach at
-//! its value at 0.45 m/s, about 12 m, in every slower current), the AMP's vertical mixing, and
+//! current: a round spread as wide as the meander lets a detection raise cells up to
+//! `4.5 D / U + U spread0^2 / (2 D)` downflow of where it was taken (the footprint's three
+//! spreads), 45 m at 0.1 m/s, which moved the declarations downflow; following the current keeps
+//! that reach at its value at 0.45 m/s, 12 m, in every slower current), the AMP's vertical mixing, and
 //! declares at half the mass within `map_radius_m` (`map_mass = 0.5`).
 //!
 //! **Declaration.** Once the map's rule holds (mass `map_mass` within `map_radius_m` of the most
