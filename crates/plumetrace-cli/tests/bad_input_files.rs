@@ -113,6 +113,19 @@ fn two_vehicles_with_one_name_are_refused() {
     );
 }
 
+/// Flies an onboard file into `out`, whatever its exit status.
+fn fly_onboard(file: &std::path::Path, out: &std::path::Path) -> std::process::Output {
+    common::bin()
+        .args([
+            "onboard",
+            file.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+        ])
+        .output()
+        .unwrap()
+}
+
 /// An onboard file for a Bluefin front seat on a port nobody listens on.
 const ONBOARD: &str = r#"name = "t"
 [mission]
@@ -237,15 +250,7 @@ fn onboard_warns_of_planner_keys_without_effect_before_it_flies() {
     // Flying warns too, before it connects (here to a port nobody listens on: the link gives
     // up after half a second). A flight that never connected writes its files and fails.
     let out = dir.path().join("flight");
-    let o = common::bin()
-        .args([
-            "onboard",
-            file.to_str().unwrap(),
-            "--out",
-            out.to_str().unwrap(),
-        ])
-        .output()
-        .unwrap();
+    let o = fly_onboard(&file, &out);
     let warned = String::from_utf8_lossy(&o.stderr);
     assert!(
         warned.contains("planner.fix_wait_s: has no effect"),
@@ -299,15 +304,7 @@ fn an_onboard_flight_whose_front_seat_never_sends_navigation_fails_after_writing
     )
     .unwrap();
     let out = dir.path().join("flight");
-    let o = common::bin()
-        .args([
-            "onboard",
-            file.to_str().unwrap(),
-            "--out",
-            out.to_str().unwrap(),
-        ])
-        .output()
-        .unwrap();
+    let o = fly_onboard(&file, &out);
     let (said, err) = (
         String::from_utf8_lossy(&o.stdout),
         String::from_utf8_lossy(&o.stderr),
