@@ -6,6 +6,9 @@ tuning tables); standard library only.
 
     python3 scripts/campaign_cells.py out/infotaxis-tuning/runs.csv
     python3 scripts/campaign_cells.py out/infotaxis-along/runs.csv --against default
+    python3 scripts/campaign_cells.py target/results/infotaxis-field-scale/runs.csv --beyond 50
+
+With `--beyond M` each cell also counts the declarations more than M metres from the source.
 
 With `--against CONFIG` a second table pairs every other config's runs with CONFIG's runs of the
 same scenario and seed (a campaign's configs fly the same plumes, seed for seed): per cell, the
@@ -60,6 +63,8 @@ def main():
     ap.add_argument("runs_csv", help="a campaign's runs.csv")
     ap.add_argument("--against", metavar="CONFIG",
                     help="pair every other config's runs with this config's, seed for seed")
+    ap.add_argument("--beyond", metavar="M", type=float,
+                    help="also count the declarations more than M metres from the source")
     a = ap.parse_args()
     path, base = a.runs_csv, a.against
     try:
@@ -91,6 +96,8 @@ def main():
                 n = len(runs)
                 cell = (f"{median(errors):.1f} m, {sum(e <= 10 for e in errors)}/{n}, "
                         f"{sum(e <= 20 for e in errors)}/{n}, {along:+.1f} m")
+                if a.beyond is not None:
+                    cell += f", {sum(e > a.beyond for e in errors)} beyond {a.beyond:g} m"
                 if n > len(errors):
                     cell += f" ({n - len(errors)} undeclared)"
                 cells.append(cell)
