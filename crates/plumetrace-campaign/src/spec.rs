@@ -230,7 +230,7 @@ pub fn parse_campaign(text: &str, path: &Path) -> Result<CampaignFile, CampaignE
             CampaignError::Invalid {
                 file,
                 key: String::new(),
-                message: plumetrace_core::plain_types(&inner.to_string()),
+                message: plumetrace_core::toml_message(&inner, false),
             }
         } else {
             CampaignError::Invalid {

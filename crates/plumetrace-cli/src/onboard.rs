@@ -226,19 +226,27 @@ fn fly(onboard: &Onboard, args: &OnboardArgs) -> Result<()> {
     let file = ReportFile::from(&report);
     let json = serde_json::to_string_pretty(&file)?;
     write_atomic(&args.out.join("onboard.json"), json.as_bytes())?;
+    // A flight that never heard the vehicle's navigation did nothing: what happened, and what
+    // link.log says of it.
+    let unheard =
+        (report.end == runner::RunEnd::LinkGaveUp && report.nav_records == 0).then_some({
+            if report.connections == 0 {
+                ("never connected to the front seat", "link.log says why")
+            } else {
+                (
+                    "connected, but no navigation record came from the front seat",
+                    "link.log says what did",
+                )
+            }
+        });
     let end = match report.end {
         runner::RunEnd::Finished => "the planner finished",
         runner::RunEnd::Aborted => "the planner aborted",
         runner::RunEnd::TimeLimit => "run.time_limit_s reached",
-        runner::RunEnd::LinkGaveUp if report.connections == 0 => {
-            "the link gave up (never connected to the front seat in link.give_up_s; link.log \
-             says why)"
-        }
-        runner::RunEnd::LinkGaveUp if report.nav_records == 0 => {
-            "the link gave up (connected, but no navigation record came from the front seat in \
-             link.give_up_s; link.log says what did)"
-        }
-        runner::RunEnd::LinkGaveUp => "the link gave up (down for link.give_up_s)",
+        runner::RunEnd::LinkGaveUp => match unheard {
+            Some((what, log)) => &format!("the link gave up ({what} in link.give_up_s; {log})"),
+            None => "the link gave up (down for link.give_up_s)",
+        },
     };
     crate::outln!(
         "{}: {end}, after {:.1} s; {} navigation records, {} decisions, {} commands sent, {} rejected by the chokepoint, {} pauses, {} declarations; {} lines accepted, {} rejected; wrote {}",
@@ -254,14 +262,9 @@ fn fly(onboard: &Onboard, args: &OnboardArgs) -> Result<()> {
         report.lines.rejected_total(),
         args.out.display()
     );
-    // A flight that never heard the vehicle's navigation did nothing: say so in the exit status
-    // too, so that a script (or a watch on the vehicle) does not take it for a flight.
-    if report.end == runner::RunEnd::LinkGaveUp && report.nav_records == 0 {
-        let what = if report.connections == 0 {
-            "never connected to the front seat"
-        } else {
-            "connected, but no navigation record came from the front seat"
-        };
+    // Said in the exit status too, so that a script (or a watch on the vehicle) does not take it
+    // for a flight.
+    if let Some((what, _)) = unheard {
         anyhow::bail!(
             "{}: {what} in link.give_up_s ({} s); {} says why, and the other files of the \
              attempt are beside it",

@@ -34,7 +34,7 @@ pub use frame::{
     signed_area2,
 };
 pub use message::{Link, Message, MessageBody, Outgoing, Recipient};
-pub use names::{closest, plain_types, variant_name};
+pub use names::{closest, plain_types, toml_message, variant_name};
 pub use planner::{
     BehaviourKind, Decision, DeclarationKind, PlanStatus, Planner, PlannerEvent, RegionEvent,
     RuleDoc, Telemetry,

@@ -229,6 +229,16 @@ pub fn plain_types(message: &str) -> String {
     out
 }
 
+/// A TOML deserializer's error in plain words ([`plain_types`]): its message alone when the
+/// caller names the key (and so the place), else the parser's whole report, which shows where.
+pub fn toml_message(error: &toml::de::Error, at_key: bool) -> String {
+    if at_key {
+        plain_types(error.message())
+    } else {
+        plain_types(&error.to_string())
+    }
+}
+
 /// The candidate nearest to `word`, when one is near enough to be what was meant: a typo of a
 /// letter or two (more for long words), two letters swapped, or a candidate that `word` is a
 /// part of. Used for "did you mean" in messages about unknown names.

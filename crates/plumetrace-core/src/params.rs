@@ -342,7 +342,7 @@ pub fn read_own<T: serde::de::DeserializeOwned>(
             } else {
                 key_path(prefix, &path)
             },
-            message: crate::plain_types(e.into_inner().message()),
+            message: crate::toml_message(&e.into_inner(), true),
         }
     })
 }

@@ -442,16 +442,11 @@ impl Onboard {
         let de = toml::Deserializer::parse(text).map_err(|e| err("", e.to_string()))?;
         let file: OnboardFile = serde_path_to_error::deserialize(de).map_err(|e| {
             let path = e.path().to_string();
-            // With a key path the message alone (the caller adds the key's line); without
-            // one, the parser's whole report, which shows where.
-            let message = if path == "." {
-                e.inner().to_string()
-            } else {
-                e.inner().message().to_string()
-            };
+            // With a key path the message alone (the caller adds the key's line).
+            let at_key = path != ".";
             err(
-                if path == "." { "" } else { &path },
-                plumetrace_core::plain_types(&message),
+                if at_key { &path } else { "" },
+                plumetrace_core::toml_message(e.inner(), at_key),
             )
         })?;
         Onboard::check(file)

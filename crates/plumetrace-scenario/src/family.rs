@@ -492,7 +492,7 @@ impl Family {
             // With a key path the message alone, at the key's line; without one, the parser's
             // whole report, which shows where.
             if key == "." {
-                invalid(path, "", plumetrace_core::plain_types(&inner.to_string()))
+                invalid(path, "", plumetrace_core::toml_message(&inner, false))
             } else {
                 invalid(path, &key, crate::locate::suggest(inner.message())).located(text)
             }
