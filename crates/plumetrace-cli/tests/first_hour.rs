@@ -325,6 +325,15 @@ fn planner_keys_with_no_effect_at_the_tables_values_are_warned_of() {
         ),
         "{err}"
     );
+    let (_, _, err) = with("declaration_fix_frames = 1\ndeclaration_frame_wait_s = 600.0");
+    assert!(
+        err.contains(
+            "planner.declaration_frame_wait_s: has no effect with declaration_fix_frames = 1"
+        ),
+        "{err}"
+    );
+    let (_, _, err) = with("declaration_frame_wait_s = 600.0");
+    assert!(!err.contains("declaration_frame_wait_s"), "{err}");
     let (_, _, err) =
         with("map_declaration = \"instead\"\nmap_dilution_m = 20.0\nmap_dilution_s = 30.0");
     assert!(

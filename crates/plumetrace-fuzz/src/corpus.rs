@@ -394,6 +394,10 @@ pub const CAMPAIGNS: &[(&str, &str)] = &[
         include_str!("../../../examples/campaigns/amp-unbiased-tuning-faults.toml"),
     ),
     (
+        "amp-fix-frames",
+        include_str!("../../../examples/campaigns/amp-fix-frames.toml"),
+    ),
+    (
         "moth-comparison",
         include_str!("../../../examples/campaigns/moth-comparison.toml"),
     ),

@@ -160,6 +160,7 @@ impl MissionSetup {
                 vehicle: v.vehicle.id,
                 vehicle_kind: v.vehicle.params.kind,
                 team: sc.vehicles.iter().map(|v| v.name.clone()).collect(),
+                mission_end_s: Some(spec.time_limit_s),
             };
             // Build once here so that `check` catches what building would reject.
             config.build(&context, &r.key).map_err(&invalid)?;

@@ -758,7 +758,9 @@ fn demo_without_current_meter(seed: u64, track_flow_window_s: f64, prior_deg: f6
         Vec::new(),
         plumetrace_core::Heading::from_deg(prior_deg),
     )
-    .trusting_prior();
+    .trusting_prior()
+    // As the registry builds it: held points are declared before the mission's end.
+    .ending_at(Some(2400.0));
     let mut m = Mission::new(setup, MissionOptions::default()).unwrap();
     m.replace_planner(0, Box::new(WithoutCurrentMeter(amp)))
         .unwrap();

@@ -555,6 +555,7 @@ impl Onboard {
             vehicle: plumetrace_core::VehicleId(0),
             vehicle_kind: m.vehicle_kind,
             team: Vec::new(),
+            mission_end_s: Some(file.run.time_limit_s),
         };
         check_planner(&planner, &context, &l.limits)?;
         let inert_keys = planner.keys_without_effect(&file.planner);

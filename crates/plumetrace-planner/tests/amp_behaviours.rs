@@ -1162,6 +1162,7 @@ fn after_held_back_flow_readings_the_declaration_waits_for_the_next_fix() {
     let fly = |p: AmpParams, fixes: bool| {
         let mut a = amp_with(AmpParams {
             declaration_confirm_m: 0.0,
+            declaration_fix_frames: 1,
             ..p
         });
         let held_back = move |mut s: SensorSnapshot| {
@@ -1221,4 +1222,146 @@ fn after_held_back_flow_readings_the_declaration_waits_for_the_next_fix() {
         "{:?}",
         a.declarations()
     );
+}
+
+/// The declarations among `events`.
+fn declared_at(events: &[PlannerEvent]) -> Vec<Vec2> {
+    events
+        .iter()
+        .filter_map(|e| match e {
+            PlannerEvent::Declared { pos_m, .. } => Some(*pos_m),
+            _ => None,
+        })
+        .collect()
+}
+
+#[test]
+fn the_declared_point_is_the_mean_of_points_from_two_fix_frames() {
+    // A fix at 5 s. Three losses within 6 m along the flow make a point (2.5 m South of the most
+    // upflow, at the mean across: (200, 294)); it is held. Losses in the same frame do not make
+    // the next point. A fix at `t_fix` moves the estimate 3 m East and 4 m South: the same three
+    // losses, seen there, make (203, 290), and the mean (201.5, 292) is declared. (The held
+    // point's lost points stay in the list of six while the next frame's are more upflow.)
+    let p = AmpParams {
+        declaration_confirm_m: 0.0,
+        ..AmpParams::default()
+    };
+    assert_eq!(p.declaration_fix_frames, 2, "the default");
+    let t_fix = 400.0;
+    let nav = move |mut s: SensorSnapshot| {
+        if s.time_s >= t_fix {
+            s.nav.last_fix_s = Some(t_fix);
+            s.nav.pos_m = s.nav.pos_m.map(|q| q + Vec2::new(3.0, -4.0));
+        } else if s.time_s >= 5.0 {
+            s.nav.last_fix_s = Some(5.0);
+        }
+        s
+    };
+    let mut a = amp_with(p.clone());
+    let mut events = Vec::new();
+    for k in 0..=40 {
+        events.extend(
+            a.decide(&nav(snap(f64::from(k), (200.0, 500.0), 0.0, false)))
+                .events,
+        );
+    }
+    let mut t = 50.0;
+    let losses = [(200.0, 300.0), (205.0, 298.0), (195.0, 296.5)];
+    for at in losses {
+        events.extend(lose_edited(&mut a, &mut t, at, &nav));
+    }
+    assert!(declared_at(&events).is_empty(), "the first point is held");
+    assert!(a.declarations().is_empty());
+    for at in losses {
+        events.extend(lose_edited(&mut a, &mut t, at, &nav));
+    }
+    assert!(
+        declared_at(&events).is_empty(),
+        "losses of the same frame make no second point"
+    );
+    assert!(t < t_fix, "{t}");
+    t = t_fix;
+    for at in losses {
+        events.extend(lose_edited(&mut a, &mut t, at, &nav));
+    }
+    let declared = declared_at(&events);
+    assert_eq!(declared.len(), 1, "{declared:?}");
+    assert!(
+        (declared[0] - Vec2::new(201.5, 292.0)).norm() < 1e-9,
+        "the mean of (200, 294) and (203, 290): {declared:?}"
+    );
+
+    // One frame: declared at once, at the first point.
+    let mut once = amp_with(AmpParams {
+        declaration_fix_frames: 1,
+        ..p.clone()
+    });
+    let mut events = Vec::new();
+    for k in 0..=40 {
+        events.extend(
+            once.decide(&nav(snap(f64::from(k), (200.0, 500.0), 0.0, false)))
+                .events,
+        );
+    }
+    let mut t = 50.0;
+    for at in losses {
+        events.extend(lose_edited(&mut once, &mut t, at, &nav));
+    }
+    let declared = declared_at(&events);
+    assert_eq!(declared.len(), 1, "{declared:?}");
+    assert!((declared[0] - Vec2::new(200.0, 294.0)).norm() < 1e-9);
+}
+
+#[test]
+fn a_held_point_is_declared_after_the_wait_or_in_the_missions_last_minute() {
+    // Fixes at 5 s and never again: the held point waits for a frame that never comes.
+    let nav = |mut s: SensorSnapshot| {
+        if s.time_s >= 5.0 {
+            s.nav.last_fix_s = Some(5.0);
+        }
+        s
+    };
+    let fly = |a: &mut Amp, until: f64| {
+        let mut events = Vec::new();
+        for k in 0..=40 {
+            events.extend(
+                a.decide(&nav(snap(f64::from(k), (200.0, 500.0), 0.0, false)))
+                    .events,
+            );
+        }
+        let mut t = 50.0;
+        for at in [(200.0, 300.0), (205.0, 298.0), (195.0, 296.5)] {
+            events.extend(lose_edited(a, &mut t, at, &nav));
+        }
+        assert!(declared_at(&events).is_empty(), "held");
+        let held_at = t;
+        while t < until && declared_at(&events).is_empty() {
+            t += 1.0;
+            events.extend(a.decide(&nav(snap(t, (150.0, 250.0), 90.0, false))).events);
+        }
+        (declared_at(&events), held_at, t)
+    };
+    let p = AmpParams {
+        declaration_confirm_m: 0.0,
+        declaration_frame_wait_s: 300.0,
+        ..AmpParams::default()
+    };
+    let mut a = amp_with(p.clone());
+    let (declared, held_at, t) = fly(&mut a, 2000.0);
+    assert_eq!(declared.len(), 1, "declared after the wait");
+    assert!(
+        (declared[0] - Vec2::new(200.0, 294.0)).norm() < 1e-9,
+        "{declared:?}"
+    );
+    assert!(t > held_at + 290.0 && t <= held_at + 310.0, "{held_at} {t}");
+
+    // A mission that ends at 500 s: declared in its last minute, before the wait is out.
+    let mut a = amp_with(AmpParams {
+        declaration_frame_wait_s: 3600.0,
+        ..p
+    })
+    .ending_at(Some(500.0));
+    let (declared, _, t) = fly(&mut a, 2000.0);
+    assert_eq!(declared.len(), 1);
+    assert!((439.0..=441.0).contains(&t), "{t}");
 }

@@ -533,6 +533,7 @@ mod tests {
             vehicle: VehicleId(0),
             vehicle_kind: VehicleKind::Auv,
             team: Vec::new(),
+            mission_end_s: None,
         }
     }
 

@@ -436,6 +436,7 @@ mod tests {
             vehicle: VehicleId(0),
             vehicle_kind: plumetrace_core::VehicleKind::Auv,
             team: Vec::new(),
+            mission_end_s: None,
         };
         let p = LawnmowerParams {
             edge_margin_m: 150.0,

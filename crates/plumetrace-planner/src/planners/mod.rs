@@ -73,6 +73,11 @@ pub struct BuildContext {
     /// snapshot logs (a replay builds without the check).
     #[serde(skip)]
     pub team: Vec<String>,
+    /// When the mission ends, s of mission time (the scenario's `mission.time_limit_s`; on a
+    /// vehicle link, `run.time_limit_s`), so that a planner holding a declaration makes it
+    /// before then; `None`: no end is known.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub mission_end_s: Option<f64>,
 }
 
 /// The parameters of one planner, and how to make the planner from them.

@@ -70,12 +70,20 @@ pub(super) struct FixWatch {
     last_held_back_s: Option<f64>,
     /// When the declaration first waited for a fix, since the last fix.
     first_wait_s: Option<f64>,
+    /// How many fixes the navigation has reported.
+    count: u64,
 }
 
 impl FixWatch {
     /// Held-back time since the last fix (or the first record), s.
     pub fn held_back_s(&self) -> f64 {
         self.held_back_s
+    }
+
+    /// How many fixes the navigation has reported so far: the frame the positions of now are in
+    /// (each fix puts the estimate back on the truth within its own error, a new one each time).
+    pub fn count(&self) -> u64 {
+        self.count
     }
 
     /// Whether a declaration checked at `t_s` waits for the next fix: flow readings were held
@@ -112,6 +120,7 @@ impl FixWatch {
         let mut fix = None;
         if fixed {
             self.last_fix_s = nav.last_fix_s;
+            self.count += 1;
             if let (Some((t0, p0)), Some((t1, p1))) = (self.before, self.last) {
                 let (d01, d1) = (t1 - t0, t_s - t1);
                 if d01 > 0.0 && d1 > 0.0 && d01 <= MAX_RECORD_GAP_S && d1 <= MAX_RECORD_GAP_S {

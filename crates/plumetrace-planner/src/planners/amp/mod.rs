@@ -157,6 +157,10 @@ plumetrace_core::params! {
         fix_smoothing: bool = true, "", Bounds::Any;
         /// With fix_smoothing, when flow readings were held back since the last position fix, the declaration check does not declare until the next fix (which places the lost points) for at most this long, counted from the first check it held back; tracing goes on meanwhile, and the check runs again at the next Track-Out's end (0: declare at once). Only a navigation that has reported a fix is waited for. On the faults family's tuning sites 600 s raised declarations within 10 m from 269 to 274 of 300, at a median 226 s later; 300 s gave 267, 900 and 1200 s 274 with one mission without a declaration.
         fix_wait_s: f64 = 600.0, "s", Bounds::non_negative(1e5);
+        /// How many points, each from its own position-fix frame, the declared point is the mean of. Each fix puts the navigation back on the truth within the fix's own error, a new error each time, and the lost points saved until the next fix carry it (with the drift since): a point declared from one frame's lost points is off by that frame's error (3-5 m a side on the faults family). Above 1, the point a declaration would make (after its confirming Track-Out) is held and tracing goes on; the check then counts only the lost points saved after the next fix, and the point it makes is the next one; their mean is declared (1: the first point, as in the field). A navigation that has reported no fix is not waited for, nor are multi-source searches. On the three families' tuning sites 2 raised declarations within 10 m from 184, 192 and 193 of 200 (faults, coastal, duck-like) to 194, 197 and 199, and the median declaration time from 1555, 1347 and 1258 s to 3551, 2876 and 2343 s; 3 gained nothing more on the faults family and took 20 minutes longer again.
+        declaration_fix_frames: u32 = 2, "", Bounds::whole(1, 10);
+        /// With declaration_fix_frames above 1, the longest wait from the first held point: then the mean of the points so far is declared (a fix that never comes, or a plume the vehicle does not trace again). Held points are also declared in the mission's last minute, when the mission's end is known (the scenario's time limit; onboard, run.time_limit_s). On the tuning sites 1800 s left 194 of 200 faults sites within 10 m at 192, and 7200 s gained nothing over 3600.
+        declaration_frame_wait_s: f64 = 3600.0, "s", Bounds::non_negative(1e5);
         /// Without a current meter (no flow reading yet), the current is estimated from the vehicle's own track, one sample per this window: the drift of the navigation positions against the water track (heading and water speed) plus the jumps at position fixes spread over the time since the fix before; the samples go through the flow estimate (flow_average_s, flow_gate_deg from the prior) as a meter's readings would (0: the prior direction alone).
         track_flow_window_s: f64 = 60.0, "s", Bounds::non_negative(3600.0);
         /// A track sample of the current slower than this is not used (it carries no direction: before the first fix of a vehicle that dead-reckons through the water alone, the track shows no current).
@@ -362,6 +366,15 @@ impl PlannerParams for AmpParams {
         } else {
             self.map.without_effect()
         };
+        if self.declaration_fix_frames <= 1 {
+            out.push((
+                "declaration_frame_wait_s",
+                "has no effect with declaration_fix_frames = 1: nothing is held for a later fix \
+                 frame (set declaration_fix_frames = 2 or more, or leave \
+                 declaration_frame_wait_s out)"
+                    .to_string(),
+            ));
+        }
         if !self.fix_smoothing {
             out.push((
                 "fix_wait_s",
@@ -382,6 +395,7 @@ impl PlannerParams for AmpParams {
             ctx.geometry.subregions.clone(),
             ctx.geometry.prior_flow_toward(),
         );
+        let amp = amp.ending_at(ctx.mission_end_s);
         Ok(Box::new(if ctx.geometry.prior_flow_given {
             amp.trusting_prior()
         } else {
@@ -442,6 +456,22 @@ struct LostPoint {
     held_back_s: f64,
     /// Which point this is (its position moves with `fix_smoothing`).
     id: u64,
+    /// The fix frame it was saved in (how many fixes the navigation had reported).
+    frame: u64,
+}
+
+/// How long before the mission's end points held for later fix frames are declared, s.
+const LAST_CALL_S: f64 = 60.0;
+
+/// A point a declaration would have made, held until later fix frames give theirs
+/// (`declaration_fix_frames`).
+#[derive(Debug, Clone, PartialEq)]
+struct Candidate {
+    at: Vec2,
+    rule: DeclarationKind,
+    /// The fix frame it was made in.
+    frame: u64,
+    t_s: f64,
 }
 
 /// A declaration held back while the confirming Track-Out flies upflow of it
@@ -476,6 +506,10 @@ struct Memory {
     declared: Vec<Vec2>,
     /// A declaration awaiting its confirming Track-Out.
     confirm: Option<Confirm>,
+    /// Points held for later fix frames (`declaration_fix_frames`), oldest first.
+    candidates: Vec<Candidate>,
+    /// When the mission ends, s (held points are declared before then).
+    end_s: Option<f64>,
     flow: FlowEstimate,
     events: Vec<PlannerEvent>,
     /// When Reacquire began after the last detection.
@@ -581,6 +615,66 @@ impl Memory {
         self.lost.iter().map(|l| l.pos).collect()
     }
 
+    /// The lost points the declaration check counts, oldest first: while a point is held
+    /// (`declaration_fix_frames`), only those saved in a later fix frame than its own.
+    fn checked_positions(&self) -> Vec<Vec2> {
+        let after = self.candidates.last().map(|c| c.frame);
+        self.lost
+            .iter()
+            .filter(|l| after.is_none_or(|f| l.frame > f))
+            .map(|l| l.pos)
+            .collect()
+    }
+
+    /// The mean of the held points (`None`: none is held).
+    fn candidate_mean(&self) -> Option<Vec2> {
+        let n = self.candidates.len();
+        (n > 0).then(|| self.candidates.iter().fold(Vec2::zeros(), |a, c| a + c.at) / n as f64)
+    }
+
+    /// A point is held from the navigation's present fix frame: another now would repeat its
+    /// frame's error.
+    fn held_in_this_frame(&self) -> bool {
+        self.candidates
+            .last()
+            .is_some_and(|c| c.frame == self.fixes.count())
+    }
+
+    /// Takes the point a declaration would make at `t`: `Some` point to declare now (the mean of
+    /// the held points with it, once `declaration_fix_frames` frames have given one), or `None`
+    /// when it is held for a later fix frame.
+    fn hold_for_frames(&mut self, at: Vec2, rule: DeclarationKind, t: f64) -> Option<Vec2> {
+        let wanted = self.p.declaration_fix_frames as usize;
+        if wanted <= 1 || self.multi_region() || self.fixes.count() == 0 {
+            return Some(at);
+        }
+        if self.held_in_this_frame() {
+            return None;
+        }
+        self.candidates.push(Candidate {
+            at,
+            rule,
+            frame: self.fixes.count(),
+            t_s: t,
+        });
+        if self.candidates.len() < wanted {
+            return None;
+        }
+        self.candidate_mean()
+    }
+
+    /// The held points' mean and the last one's rule, once `declaration_frame_wait_s` has passed
+    /// since the first was held, or in the mission's last minute.
+    fn frames_timed_out(&self, t: f64) -> Option<(Vec2, DeclarationKind)> {
+        let first = self.candidates.first()?;
+        let ending = self.end_s.is_some_and(|end| t >= end - LAST_CALL_S);
+        if t - first.t_s <= self.p.declaration_frame_wait_s && !ending {
+            return None;
+        }
+        let last = self.candidates.last()?;
+        Some((self.candidate_mean()?, last.rule.clone()))
+    }
+
     /// Drops lost points older than `lost_point_max_age_s`, and those saved under a flow
     /// direction more than `lost_point_max_turn_deg` from the current estimate.
     fn prune_lost(&mut self, t: f64) {
@@ -611,6 +705,7 @@ impl Memory {
             flow: self.flow.toward(),
             held_back_s: self.fixes.held_back_s(),
             id: self.next_lost_id,
+            frame: self.fixes.count(),
         });
         self.next_lost_id += 1;
         self.events.push(PlannerEvent::LostPoint { pos_m: p });
@@ -621,6 +716,9 @@ impl Memory {
                     let u = self.flow.upflow().unit();
                     // Among the older points (the new one always enters, or a list of six
                     // upflow points would never change); `min_by` keeps the first of equals.
+                    // While a point is held for a later fix frame, its frame's points stay: a
+                    // later frame's point enters the check's count only when it is among the
+                    // most upflow, as the held one's were.
                     let older = &self.lost[..self.lost.len() - 1];
                     older
                         .iter()
@@ -700,6 +798,7 @@ impl Switching {
         m.lost.clear();
         m.last_detection = None;
         m.confirm = None;
+        m.candidates.clear();
         m.log(PlannerEvent::Region {
             index: k,
             what: RegionEvent::Started,
@@ -751,7 +850,27 @@ impl Switching {
         }
     }
 
+    /// Declares `at`, or holds it for a later fix frame (`declaration_fix_frames`) while
+    /// Reacquire goes on tracing from `pos`.
     fn declare(
+        &mut self,
+        m: &mut Memory,
+        at: Vec2,
+        rule: DeclarationKind,
+        what: RegionEvent,
+        pos: Vec2,
+        t: f64,
+    ) {
+        match m.hold_for_frames(at, rule.clone(), t) {
+            Some(at) => self.declare_now(m, at, rule, what, t),
+            None => {
+                m.confirm = None;
+                self.enter_reacquire(m, pos);
+            }
+        }
+    }
+
+    fn declare_now(
         &mut self,
         m: &mut Memory,
         at: Vec2,
@@ -760,6 +879,7 @@ impl Switching {
         t: f64,
     ) {
         m.confirm = None;
+        m.candidates.clear();
         m.declared.push(at);
         m.log(PlannerEvent::Declared { pos_m: at, rule });
         if m.multi_region() {
@@ -793,7 +913,7 @@ impl Switching {
         let t = p.t_s;
         let goals = m.confirm_goals(at, p.pos_m);
         if goals.is_empty() {
-            self.declare(m, at, rule, RegionEvent::Declared, t);
+            self.declare(m, at, rule, RegionEvent::Declared, p.pos_m, t);
             return;
         }
         let leg = ConfirmLeg::new(goals.iter().map(|g| m.p.go_to(*g)).collect());
@@ -828,7 +948,7 @@ impl Switching {
             return false;
         }
         let rule = m.p.declaration_rule();
-        match rule.check_placed(&m.lost_positions(), m.flow.upflow(), m.p.placement()) {
+        match rule.check_placed(&m.checked_positions(), m.flow.upflow(), m.p.placement()) {
             Some(at) => {
                 let refined = match (m.p.map_declaration, m.map.as_mut()) {
                     (MapDeclaration::Refine, Some(tracker)) => {
@@ -859,7 +979,7 @@ impl Switching {
     fn after(&mut self, m: &mut Memory, p: &Percept, done: AmpDone) {
         match (self.active.kind(), done) {
             (_, AmpDone::AtEdge { at }) => {
-                self.declare(
+                self.declare_now(
                     m,
                     at,
                     declaration::UPFLOW_EDGE,
@@ -891,7 +1011,7 @@ impl Switching {
             (BehaviourKind::TrackOut, AmpDone::Reached) => {
                 if let Some(c) = m.confirm.take() {
                     // The confirming leg met no plume upflow of the point.
-                    self.declare(m, c.at, c.rule, RegionEvent::Declared, p.t_s);
+                    self.declare(m, c.at, c.rule, RegionEvent::Declared, p.pos_m, p.t_s);
                 } else if !self.try_declare(m, p) {
                     self.enter_reacquire(m, p.pos_m);
                 }
@@ -909,6 +1029,9 @@ impl Switching {
 impl Arbiter<Memory> for Switching {
     fn arbitrate(&mut self, p: &Percept, m: &mut Memory) -> Option<Steer> {
         m.prune_lost(p.t_s);
+        if let Some((at, rule)) = m.frames_timed_out(p.t_s) {
+            self.declare_now(m, at, rule, RegionEvent::Declared, p.t_s);
+        }
         // On the way to the search start: its corner follows the flow estimate as it settles
         // (the first sample of a noisy current meter can point anywhere).
         let kind = self.active.kind();
@@ -977,6 +1100,13 @@ pub struct Amp {
 }
 
 impl Amp {
+    /// The planner for a mission that ends at `end_s` (s of mission time): points held for later
+    /// fix frames (`declaration_fix_frames`) are declared in its last minute at the latest.
+    pub fn ending_at(mut self, end_s: Option<f64>) -> Self {
+        self.m.end_s = end_s.filter(|e| e.is_finite());
+        self
+    }
+
     /// The planner with its flow gate judging the first readings against the prior flow
     /// direction (one the mission plan gives): a current meter that reads reversed from the
     /// start is then held back too.
@@ -1038,6 +1168,8 @@ impl Amp {
                 fixes: fixes::FixWatch::default(),
                 declared: Vec::new(),
                 confirm: None,
+                candidates: Vec::new(),
+                end_s: None,
                 events: Vec::new(),
                 reacquire_since: None,
                 map,
@@ -1116,6 +1248,7 @@ impl Amp {
         let ground = s.nav.heading.unit() * s.nav.speed_mps + flow;
         let mode = self.m.p.map_declaration;
         let multi = self.m.multi_region();
+        let held = self.m.held_in_this_frame();
         let Some(tracker) = self.m.map.as_mut() else {
             return;
         };
@@ -1132,7 +1265,7 @@ impl Amp {
         };
         let by_map = matches!(mode, MapDeclaration::Instead | MapDeclaration::Also);
         let holds = tracker.declares(t, &read);
-        if !by_map || !searching || !holds {
+        if !by_map || !searching || !holds || held {
             return;
         }
         tracker.report(t, &read, telemetry, true);
@@ -1145,16 +1278,19 @@ impl Amp {
             read.estimate_m,
             crate::estimate::tracker::SOURCE_MAP,
             RegionEvent::Declared,
+            pos,
             t,
         );
     }
 
-    /// The source estimate: the last declaration, else the most upflow lost point.
+    /// The source estimate: the last declaration, else the mean of the held points, else the
+    /// most upflow lost point.
     fn source_estimate(&self) -> Option<Vec2> {
         self.m
             .declared
             .last()
             .copied()
+            .or_else(|| self.m.candidate_mean())
             .or_else(|| self.m.most_upflow_lost())
     }
 }
