@@ -1224,6 +1224,28 @@ fn after_held_back_flow_readings_the_declaration_waits_for_the_next_fix() {
     );
 }
 
+/// Three losses within 6 m along the flow: a point 2.5 m South of the most upflow, at their mean
+/// across, (200, 294).
+const THREE_LOSSES: [(f64, f64); 3] = [(200.0, 300.0), (205.0, 298.0), (195.0, 296.5)];
+
+/// Flies `a` for 40 s, then loses the plume at `THREE_LOSSES`, every snapshot edited by `nav`;
+/// returns the events and the time after.
+fn three_losses(
+    a: &mut Amp,
+    nav: &dyn Fn(SensorSnapshot) -> SensorSnapshot,
+) -> (Vec<PlannerEvent>, f64) {
+    let mut events = Vec::new();
+    for k in 0..=40 {
+        let s = snap(f64::from(k), (200.0, 500.0), 0.0, false);
+        events.extend(a.decide(&nav(s)).events);
+    }
+    let mut t = 50.0;
+    for at in THREE_LOSSES {
+        events.extend(lose_edited(a, &mut t, at, nav));
+    }
+    (events, t)
+}
+
 /// The declarations among `events`.
 fn declared_at(events: &[PlannerEvent]) -> Vec<Vec2> {
     events
@@ -1258,18 +1280,8 @@ fn the_declared_point_is_the_mean_of_points_from_two_fix_frames() {
         s
     };
     let mut a = amp_with(p.clone());
-    let mut events = Vec::new();
-    for k in 0..=40 {
-        events.extend(
-            a.decide(&nav(snap(f64::from(k), (200.0, 500.0), 0.0, false)))
-                .events,
-        );
-    }
-    let mut t = 50.0;
-    let losses = [(200.0, 300.0), (205.0, 298.0), (195.0, 296.5)];
-    for at in losses {
-        events.extend(lose_edited(&mut a, &mut t, at, &nav));
-    }
+    let (mut events, mut t) = three_losses(&mut a, &nav);
+    let losses = THREE_LOSSES;
     assert!(declared_at(&events).is_empty(), "the first point is held");
     assert!(a.declarations().is_empty());
     for at in losses {
@@ -1296,17 +1308,7 @@ fn the_declared_point_is_the_mean_of_points_from_two_fix_frames() {
         declaration_fix_frames: 1,
         ..p.clone()
     });
-    let mut events = Vec::new();
-    for k in 0..=40 {
-        events.extend(
-            once.decide(&nav(snap(f64::from(k), (200.0, 500.0), 0.0, false)))
-                .events,
-        );
-    }
-    let mut t = 50.0;
-    for at in losses {
-        events.extend(lose_edited(&mut once, &mut t, at, &nav));
-    }
+    let (events, _) = three_losses(&mut once, &nav);
     let declared = declared_at(&events);
     assert_eq!(declared.len(), 1, "{declared:?}");
     assert!((declared[0] - Vec2::new(200.0, 294.0)).norm() < 1e-9);
@@ -1322,17 +1324,7 @@ fn a_held_point_is_declared_after_the_wait_or_in_the_missions_last_minute() {
         s
     };
     let fly = |a: &mut Amp, until: f64| {
-        let mut events = Vec::new();
-        for k in 0..=40 {
-            events.extend(
-                a.decide(&nav(snap(f64::from(k), (200.0, 500.0), 0.0, false)))
-                    .events,
-            );
-        }
-        let mut t = 50.0;
-        for at in [(200.0, 300.0), (205.0, 298.0), (195.0, 296.5)] {
-            events.extend(lose_edited(a, &mut t, at, &nav));
-        }
+        let (mut events, mut t) = three_losses(a, &nav);
         assert!(declared_at(&events).is_empty(), "held");
         let held_at = t;
         while t < until && declared_at(&events).is_empty() {

@@ -313,7 +313,7 @@ impl PlannerParams for AmpParams {
     const RULES: &'static [RuleDoc] = &[
         RuleDoc {
             rule: declaration::ALONG_FLOW,
-            doc: "the three most upflow lost points lie within declaration_along_m of each other along the flow: declaration_upflow_m upflow of the most upflow one, across the flow as declaration_across says (with 0 and most_upflow: the most upflow one, the field rule), once a confirming Track-Out declaration_confirm_m upflow of it met no plume (0: at once, the field rule)",
+            doc: "the three most upflow lost points lie within declaration_along_m of each other along the flow: declaration_upflow_m upflow of the most upflow one, across the flow as declaration_across says (with 0 and most_upflow: the most upflow one, the field rule), once a confirming Track-Out declaration_confirm_m upflow of it met no plume (0: at once, the field rule); with declaration_fix_frames above 1, the mean of such points from that many position-fix frames (fewer when declaration_frame_wait_s or the mission's end comes first)",
         },
         RuleDoc {
             rule: declaration::ALONG_AND_CROSS_FLOW,
