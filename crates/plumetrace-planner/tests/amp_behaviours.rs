@@ -1357,3 +1357,25 @@ fn a_held_point_is_declared_after_the_wait_or_in_the_missions_last_minute() {
     assert_eq!(declared.len(), 1);
     assert!((439.0..=441.0).contains(&t), "{t}");
 }
+
+#[test]
+fn a_held_point_is_declared_before_a_cage_abort() {
+    let nav = |mut s: SensorSnapshot| {
+        if s.time_s >= 5.0 {
+            s.nav.last_fix_s = Some(5.0);
+        }
+        s
+    };
+    let mut a = amp_with(AmpParams {
+        declaration_confirm_m: 0.0,
+        ..AmpParams::default()
+    });
+    let (events, t) = three_losses(&mut a, &nav);
+    assert!(declared_at(&events).is_empty(), "held");
+    let d = a.decide(&nav(snap(t + 1.0, (-40.0, 300.0), 0.0, false)));
+    assert_eq!(d.status, PlanStatus::Abort);
+    let declared = declared_at(&d.events);
+    assert_eq!(declared.len(), 1, "{:?}", d.events);
+    assert!((declared[0] - Vec2::new(200.0, 294.0)).norm() < 1e-9);
+    assert_eq!(a.declarations(), declared);
+}

@@ -157,7 +157,7 @@ plumetrace_core::params! {
         fix_smoothing: bool = true, "", Bounds::Any;
         /// With fix_smoothing, when flow readings were held back since the last position fix, the declaration check does not declare until the next fix (which places the lost points) for at most this long, counted from the first check it held back; tracing goes on meanwhile, and the check runs again at the next Track-Out's end (0: declare at once). Only a navigation that has reported a fix is waited for. On the faults family's tuning sites 600 s raised declarations within 10 m from 269 to 274 of 300, at a median 226 s later; 300 s gave 267, 900 and 1200 s 274 with one mission without a declaration.
         fix_wait_s: f64 = 600.0, "s", Bounds::non_negative(1e5);
-        /// How many points, each from its own position-fix frame, the declared point is the mean of. Each fix puts the navigation back on the truth within the fix's own error, a new error each time, and the lost points saved until the next fix carry it (with the drift since): a point declared from one frame's lost points is off by that frame's error (3-5 m a side on the faults family). Above 1, the point a declaration would make (after its confirming Track-Out) is held and tracing goes on; the check then counts only the lost points saved after the next fix, and the point it makes is the next one; their mean is declared (1: the first point, as in the field). A navigation that has reported no fix is not waited for, nor are multi-source searches. On the three families' tuning sites 2 raised declarations within 10 m from 184, 192 and 193 of 200 (faults, coastal, duck-like) to 194, 197 and 199, and the median declaration time from 1555, 1347 and 1258 s to 3551, 2876 and 2343 s; 3 gained nothing more on the faults family and took 20 minutes longer again.
+        /// How many points, each from its own position-fix frame, the declared point is the mean of. Each fix puts the navigation back on the truth within the fix's own error, a new error each time, and the lost points saved until the next fix carry it (with the drift since): a point declared from one frame's lost points is off by that frame's error (3-5 m a side on the faults family). Above 1, the point a lost-point rule would declare (after its confirming Track-Out) is held and tracing goes on; the check then counts only the lost points saved after the next fix, and the point it makes then is averaged with the held one (and so on); their mean is declared (1: the first point, as in the field). A navigation that has reported no fix is not waited for, nor are multi-source searches or the source map's points. Chosen on the three families' tuning sites (2 raised declarations within 10 m from 184, 192 and 193 of 200 to 194, 197 and 199; 3 gained nothing more on the faults family). On their test sites the default's share within 10 m went from 98.0, 87.5 and 98.0 % (coastal, faults, duck-like) to 97.5, 94.5 and 99.0 %, and its median declaration time from 1347, 1663 and 1250 s to 2818, 3689 and 2514 s.
         declaration_fix_frames: u32 = 2, "", Bounds::whole(1, 10);
         /// With declaration_fix_frames above 1, the longest wait from the first held point: then the mean of the points so far is declared (a fix that never comes, or a plume the vehicle does not trace again). Held points are also declared in the mission's last minute, when the mission's end is known (the scenario's time limit; onboard, run.time_limit_s). On the tuning sites 1800 s declared 192 of 200 fault sites within 10 m against 194 with 3600 s, and 7200 s gained nothing over 3600.
         declaration_frame_wait_s: f64 = 3600.0, "s", Bounds::non_negative(1e5);
@@ -645,7 +645,10 @@ impl Memory {
     /// when it is held for a later fix frame.
     fn hold_for_frames(&mut self, at: Vec2, rule: DeclarationKind, t: f64) -> Option<Vec2> {
         let wanted = self.p.declaration_fix_frames as usize;
-        if wanted <= 1 || self.multi_region() || self.fixes.count() == 0 {
+        // The map's points pool every frame's detections: only the lost-point rules' are held.
+        let lost_point_rule =
+            rule == declaration::ALONG_FLOW || rule == declaration::ALONG_AND_CROSS_FLOW;
+        if wanted <= 1 || self.multi_region() || self.fixes.count() == 0 || !lost_point_rule {
             return Some(at);
         }
         if self.held_in_this_frame() {
@@ -1248,7 +1251,6 @@ impl Amp {
         let ground = s.nav.heading.unit() * s.nav.speed_mps + flow;
         let mode = self.m.p.map_declaration;
         let multi = self.m.multi_region();
-        let held = self.m.held_in_this_frame();
         let Some(tracker) = self.m.map.as_mut() else {
             return;
         };
@@ -1265,7 +1267,7 @@ impl Amp {
         };
         let by_map = matches!(mode, MapDeclaration::Instead | MapDeclaration::Also);
         let holds = tracker.declares(t, &read);
-        if !by_map || !searching || !holds || held {
+        if !by_map || !searching || !holds {
             return;
         }
         tracker.report(t, &read, telemetry, true);
@@ -1376,6 +1378,16 @@ impl Planner for Amp {
         let (command, status) = match self.autopilot.command_nav(t, &s.nav, steer, flow) {
             Ok(c) => (c, status),
             Err(abort) => {
+                // A point held for a later fix frame is declared before the planner gives up.
+                if let Some(at) = self.m.candidate_mean() {
+                    let rule = self.m.candidates.last().map(|c| c.rule.clone());
+                    self.m.candidates.clear();
+                    self.m.declared.push(at);
+                    self.m.log(PlannerEvent::Declared {
+                        pos_m: at,
+                        rule: rule.unwrap_or(declaration::ALONG_FLOW),
+                    });
+                }
                 self.m.log(PlannerEvent::CageAbort {
                     distance_outside_m: abort.distance_outside_m,
                 });
