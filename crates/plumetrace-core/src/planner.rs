@@ -311,6 +311,14 @@ pub trait Planner: Send {
     fn detour_ended(&mut self, pos_m: Vec2) {
         let _ = pos_m;
     }
+
+    /// The run ends at `t_s` for a reason the planner did not choose (on a vehicle: the link
+    /// given up, the time limit): what it still has to report, such as a declaration it was
+    /// holding. The default has nothing.
+    fn run_ended(&mut self, t_s: f64) -> Vec<PlannerEvent> {
+        let _ = t_s;
+        Vec::new()
+    }
 }
 
 #[cfg(test)]

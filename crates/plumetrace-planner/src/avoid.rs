@@ -338,4 +338,8 @@ impl Planner for AvoidObstacles {
     fn detour_ended(&mut self, pos_m: Vec2) {
         self.inner.detour_ended(pos_m);
     }
+
+    fn run_ended(&mut self, t_s: f64) -> Vec<PlannerEvent> {
+        self.inner.run_ended(t_s)
+    }
 }

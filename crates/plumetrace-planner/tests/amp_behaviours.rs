@@ -1379,3 +1379,25 @@ fn a_held_point_is_declared_before_a_cage_abort() {
     assert!((declared[0] - Vec2::new(200.0, 294.0)).norm() < 1e-9);
     assert_eq!(a.declarations(), declared);
 }
+
+#[test]
+fn a_run_that_ends_on_its_own_gets_the_held_point_declared() {
+    let nav = |mut s: SensorSnapshot| {
+        if s.time_s >= 5.0 {
+            s.nav.last_fix_s = Some(5.0);
+        }
+        s
+    };
+    let mut a = amp_with(AmpParams {
+        declaration_confirm_m: 0.0,
+        ..AmpParams::default()
+    });
+    assert!(a.run_ended(1.0).is_empty(), "nothing held yet");
+    let (events, t) = three_losses(&mut a, &nav);
+    assert!(declared_at(&events).is_empty(), "held");
+    let declared = declared_at(&a.run_ended(t));
+    assert_eq!(declared.len(), 1, "{declared:?}");
+    assert!((declared[0] - Vec2::new(200.0, 294.0)).norm() < 1e-9);
+    assert_eq!(a.declarations(), declared);
+    assert!(a.run_ended(t + 1.0).is_empty(), "declared once");
+}

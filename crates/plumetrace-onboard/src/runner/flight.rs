@@ -46,6 +46,13 @@ pub(super) struct Flight<'a> {
 }
 
 impl<'a> Flight<'a> {
+    /// The same flight with `planner` in place of the one `onboard` builds (tests).
+    #[cfg(test)]
+    pub(super) fn flying(mut self, planner: Box<dyn Planner>) -> Self {
+        self.planner = planner;
+        self
+    }
+
     /// The planner of `onboard` built and its clock started, paused until navigation comes.
     pub(super) fn new(onboard: &'a Onboard) -> Result<Self, RunError> {
         let planner = onboard.planner.build(&onboard.context, "planner")?;
@@ -284,13 +291,20 @@ impl<'a> Flight<'a> {
         self.s.report
     }
 
-    /// Any other end: the end sent if the link is up, the link closed.
+    /// Any other end: what the planner still has to report (a declaration it was holding)
+    /// recorded, the end sent if the link is up, the link closed.
     pub(super) fn ended(mut self, link: &mut dyn Link, end: RunEnd) -> RunReport {
+        let t = self.s.now_s();
+        for e in self.planner.run_ended(t) {
+            if let PlannerEvent::Declared { pos_m, .. } = e {
+                self.s.report.declarations.push(pos_m);
+            }
+        }
         if link.connected() {
             link.send(Outgoing::Finished, self.s.stamp());
         }
         self.s.report.end = end;
-        self.s.report.time_s = self.s.now_s();
+        self.s.report.time_s = t;
         self.s.report.lines = link.counts().clone();
         link.close();
         self.s.report

@@ -290,4 +290,43 @@ mod tests {
         assert!((0.7..1.6).contains(&wall), "gave up after {wall} s");
         assert!(report.connections >= 5, "{}", report.connections);
     }
+
+    /// A planner that holds a declaration until its run ends.
+    struct Holding;
+
+    impl plumetrace_core::Planner for Holding {
+        fn decide(&mut self, _: &SensorSnapshot) -> Decision {
+            Decision::new(
+                plumetrace_core::Command {
+                    heading: plumetrace_core::Heading::NORTH,
+                    speed_mps: 0.0,
+                    vertical: plumetrace_core::VerticalCommand::Altitude(2.0),
+                },
+                plumetrace_core::PlanStatus::Running,
+            )
+        }
+        fn run_ended(&mut self, _t_s: f64) -> Vec<plumetrace_core::PlannerEvent> {
+            vec![plumetrace_core::PlannerEvent::Declared {
+                pos_m: Vec2::new(100.0, -2.0),
+                rule: plumetrace_core::DeclarationKind::new("held"),
+            }]
+        }
+    }
+
+    #[test]
+    fn a_run_that_ends_on_its_own_records_what_the_planner_held() {
+        let onboard = amp_over_bluefin("give_up_s = 0.5", 5.0);
+        let flight = Flight::new(&onboard)
+            .unwrap_or_else(|e| panic!("{e}"))
+            .flying(Box::new(Holding));
+        let mut link = Script {
+            start: Instant::now(),
+            events: Vec::new(),
+            sent: Vec::new(),
+            counts: LineCounts::default(),
+        };
+        let report = flight.ended(&mut link, RunEnd::LinkGaveUp);
+        assert_eq!(report.end, RunEnd::LinkGaveUp);
+        assert_eq!(report.declarations, vec![Vec2::new(100.0, -2.0)]);
+    }
 }

@@ -473,6 +473,10 @@ impl Planner for Periodic {
     fn detour_ended(&mut self, pos_m: Vec2) {
         self.inner.detour_ended(pos_m);
     }
+
+    fn run_ended(&mut self, t_s: f64) -> Vec<plumetrace_core::PlannerEvent> {
+        self.inner.run_ended(t_s)
+    }
 }
 
 /// Every planner's parameters at their defaults, by kind name (campaigns digest it, so results

@@ -666,6 +666,15 @@ impl Memory {
         self.candidate_mean()
     }
 
+    /// Declares the held points' mean at once (the run is ending): the event, if one was held.
+    fn declare_held(&mut self) -> Option<PlannerEvent> {
+        let at = self.candidate_mean()?;
+        let rule = self.candidates.last()?.rule.clone();
+        self.candidates.clear();
+        self.declared.push(at);
+        Some(PlannerEvent::Declared { pos_m: at, rule })
+    }
+
     /// The held points' mean and the last one's rule, once `declaration_frame_wait_s` has passed
     /// since the first was held, or in the mission's last minute.
     fn frames_timed_out(&self, t: f64) -> Option<(Vec2, DeclarationKind)> {
@@ -1298,6 +1307,11 @@ impl Amp {
 }
 
 impl Planner for Amp {
+    /// A point held for a later fix frame is declared as it is.
+    fn run_ended(&mut self, _t_s: f64) -> Vec<PlannerEvent> {
+        self.m.declare_held().into_iter().collect()
+    }
+
     fn decide(&mut self, s: &SensorSnapshot) -> Decision {
         let t = s.time_s;
         if let Some(f) = s.flow {
@@ -1379,14 +1393,8 @@ impl Planner for Amp {
             Ok(c) => (c, status),
             Err(abort) => {
                 // A point held for a later fix frame is declared before the planner gives up.
-                if let Some(at) = self.m.candidate_mean() {
-                    let rule = self.m.candidates.last().map(|c| c.rule.clone());
-                    self.m.candidates.clear();
-                    self.m.declared.push(at);
-                    self.m.log(PlannerEvent::Declared {
-                        pos_m: at,
-                        rule: rule.unwrap_or(declaration::ALONG_FLOW),
-                    });
+                if let Some(e) = self.m.declare_held() {
+                    self.m.log(e);
                 }
                 self.m.log(PlannerEvent::CageAbort {
                     distance_outside_m: abort.distance_outside_m,
