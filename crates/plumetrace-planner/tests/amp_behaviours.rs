@@ -1358,14 +1358,17 @@ fn a_held_point_is_declared_after_the_wait_or_in_the_missions_last_minute() {
     assert!((439.0..=441.0).contains(&t), "{t}");
 }
 
+/// A navigation that reports one fix, at 5 s.
+fn one_fix_at_5_s(mut s: SensorSnapshot) -> SensorSnapshot {
+    if s.time_s >= 5.0 {
+        s.nav.last_fix_s = Some(5.0);
+    }
+    s
+}
+
 #[test]
 fn a_held_point_is_declared_before_a_cage_abort() {
-    let nav = |mut s: SensorSnapshot| {
-        if s.time_s >= 5.0 {
-            s.nav.last_fix_s = Some(5.0);
-        }
-        s
-    };
+    let nav = one_fix_at_5_s;
     let mut a = amp_with(AmpParams {
         declaration_confirm_m: 0.0,
         ..AmpParams::default()
@@ -1382,12 +1385,7 @@ fn a_held_point_is_declared_before_a_cage_abort() {
 
 #[test]
 fn a_run_that_ends_on_its_own_gets_the_held_point_declared() {
-    let nav = |mut s: SensorSnapshot| {
-        if s.time_s >= 5.0 {
-            s.nav.last_fix_s = Some(5.0);
-        }
-        s
-    };
+    let nav = one_fix_at_5_s;
     let mut a = amp_with(AmpParams {
         declaration_confirm_m: 0.0,
         ..AmpParams::default()
