@@ -1358,6 +1358,14 @@ fn a_held_point_is_declared_after_the_wait_or_in_the_missions_last_minute() {
     assert!((439.0..=441.0).contains(&t), "{t}");
 }
 
+/// The AMP at its defaults but declaring without a confirming Track-Out.
+fn unconfirmed_amp() -> Amp {
+    amp_with(AmpParams {
+        declaration_confirm_m: 0.0,
+        ..AmpParams::default()
+    })
+}
+
 /// A navigation that reports one fix, at 5 s.
 fn one_fix_at_5_s(mut s: SensorSnapshot) -> SensorSnapshot {
     if s.time_s >= 5.0 {
@@ -1369,10 +1377,7 @@ fn one_fix_at_5_s(mut s: SensorSnapshot) -> SensorSnapshot {
 #[test]
 fn a_held_point_is_declared_before_a_cage_abort() {
     let nav = one_fix_at_5_s;
-    let mut a = amp_with(AmpParams {
-        declaration_confirm_m: 0.0,
-        ..AmpParams::default()
-    });
+    let mut a = unconfirmed_amp();
     let (events, t) = three_losses(&mut a, &nav);
     assert!(declared_at(&events).is_empty(), "held");
     let d = a.decide(&nav(snap(t + 1.0, (-40.0, 300.0), 0.0, false)));
@@ -1386,10 +1391,7 @@ fn a_held_point_is_declared_before_a_cage_abort() {
 #[test]
 fn a_run_that_ends_on_its_own_gets_the_held_point_declared() {
     let nav = one_fix_at_5_s;
-    let mut a = amp_with(AmpParams {
-        declaration_confirm_m: 0.0,
-        ..AmpParams::default()
-    });
+    let mut a = unconfirmed_amp();
     assert!(a.run_ended(1.0).is_empty(), "nothing held yet");
     let (events, t) = three_losses(&mut a, &nav);
     assert!(declared_at(&events).is_empty(), "held");

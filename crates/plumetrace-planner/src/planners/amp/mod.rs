@@ -666,10 +666,15 @@ impl Memory {
         self.candidate_mean()
     }
 
+    /// The held points' mean and the last one's rule (`None`: none is held).
+    fn held(&self) -> Option<(Vec2, DeclarationKind)> {
+        let rule = self.candidates.last()?.rule.clone();
+        Some((self.candidate_mean()?, rule))
+    }
+
     /// Declares the held points' mean at once (the run is ending): the event, if one was held.
     fn declare_held(&mut self) -> Option<PlannerEvent> {
-        let at = self.candidate_mean()?;
-        let rule = self.candidates.last()?.rule.clone();
+        let (at, rule) = self.held()?;
         self.candidates.clear();
         self.declared.push(at);
         Some(PlannerEvent::Declared { pos_m: at, rule })
@@ -683,8 +688,7 @@ impl Memory {
         if t - first.t_s <= self.p.declaration_frame_wait_s && !ending {
             return None;
         }
-        let last = self.candidates.last()?;
-        Some((self.candidate_mean()?, last.rule.clone()))
+        self.held()
     }
 
     /// Drops lost points older than `lost_point_max_age_s`, and those saved under a flow
