@@ -140,6 +140,25 @@ pub fn run(args: &ReplayArgs) -> Result<bool> {
         report.decisions,
         report.differing
     );
+    for (vehicle, keys) in &report.defaulted {
+        let keys: Vec<String> = keys.iter().map(|k| format!("`{k}`")).collect();
+        crate::outln!(
+            "  note: vehicle {vehicle}'s logged planner table has no {} (the log predates {}): \
+             replayed with today's defaults, which may not be how it flew; give {} with \
+             --planner-file to replay as flown",
+            keys.join(", "),
+            if keys.len() == 1 {
+                "the key"
+            } else {
+                "these keys"
+            },
+            if keys.len() == 1 {
+                "its value"
+            } else {
+                "their values"
+            },
+        );
+    }
     for d in &report.first {
         crate::outln!(
             "  line {}, vehicle {}, t = {:.1} s: logged heading {:.2} deg, speed {:.2} m/s, {}; replayed heading {:.2} deg, speed {:.2} m/s, {}",

@@ -375,10 +375,8 @@ fn planner_keys_with_no_effect_at_the_tables_values_are_warned_of() {
     assert!(!err.contains("has no effect"), "{err}");
 }
 
-#[test]
-fn replay_takes_the_planner_table_of_a_scenario_file() {
-    let dir = tempfile::tempdir().unwrap();
-    let d = dir.path();
+/// The snapshot log of a 30 s demo run written under `dir`.
+fn short_demo_log(dir: &Path) -> std::path::PathBuf {
     run_ok(&[
         "run",
         "--preset",
@@ -388,9 +386,16 @@ fn replay_takes_the_planner_table_of_a_scenario_file() {
         "--set",
         "mission.spinup_s=10",
         "--out",
-        d.join("o").to_str().unwrap(),
+        dir.join("o").to_str().unwrap(),
     ]);
-    let log = d.join("o/snapshots.jsonl.gz");
+    dir.join("o/snapshots.jsonl.gz")
+}
+
+#[test]
+fn replay_takes_the_planner_table_of_a_scenario_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let log = short_demo_log(d);
     std::fs::write(
         d.join("p.toml"),
         "[planner]\nkind = \"amp\"\nbeta_dg = 25.0\n",
@@ -413,6 +418,76 @@ fn replay_takes_the_planner_table_of_a_scenario_file() {
     );
     assert_eq!(status, 0, "{err}");
     assert!(out.contains(", 0 differ"), "{out}");
+}
+
+#[test]
+fn a_log_from_before_a_key_existed_replays_with_a_note_naming_it() {
+    use std::io::BufRead;
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let log = short_demo_log(d);
+    let (status, out, err) = plumetrace(d, &["replay", log.to_str().unwrap()]);
+    assert_eq!(status, 0, "{err}");
+    assert!(!out.contains("note:"), "a log writes every key: {out}");
+    // The same log as one written before the two keys existed: its planner table lacks them.
+    let lines: Vec<String> = plumetrace_log::snapshot::open(&log)
+        .unwrap()
+        .lines()
+        .map(Result::unwrap)
+        .collect();
+    let mut header: serde_json::Value = serde_json::from_str(&lines[0]).unwrap();
+    let table = header["vehicles"][0]["planner"]
+        .as_str()
+        .unwrap()
+        .to_string();
+    let older: String = table
+        .lines()
+        .filter(|l| {
+            !l.starts_with("declaration_fix_frames") && !l.starts_with("declaration_frame_wait_s")
+        })
+        .map(|l| format!("{l}\n"))
+        .collect();
+    assert_ne!(older, table, "the table has the keys to take out: {table}");
+    header["vehicles"][0]["planner"] = serde_json::Value::String(older);
+    let mut text = format!("{header}\n");
+    for l in &lines[1..] {
+        text.push_str(l);
+        text.push('\n');
+    }
+    std::fs::write(d.join("old.jsonl"), text).unwrap();
+    let (status, out, err) = plumetrace(d, &["replay", "old.jsonl"]);
+    assert_eq!(status, 0, "{err}");
+    assert!(
+        out.contains(
+            "note: vehicle 0's logged planner table has no `declaration_fix_frames`, \
+             `declaration_frame_wait_s` (the log predates these keys): replayed with today's \
+             defaults"
+        ),
+        "{out}"
+    );
+}
+
+#[test]
+fn a_value_of_the_wrong_type_is_told_the_keys_bounds() {
+    let dir = tempfile::tempdir().unwrap();
+    let (status, _, err) = plumetrace(
+        dir.path(),
+        &[
+            "check",
+            "--preset",
+            "demo",
+            "--set",
+            "declaration_fix_frames=2.5",
+        ],
+    );
+    assert_eq!(status, 1);
+    assert!(
+        err.contains(
+            "planner.declaration_fix_frames: invalid type: floating point `2.5`, expected a \
+             whole number in 1..=10"
+        ),
+        "{err}"
+    );
 }
 
 #[test]

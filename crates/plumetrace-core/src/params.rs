@@ -336,15 +336,47 @@ pub fn read_own<T: serde::de::DeserializeOwned>(
     }
     serde_path_to_error::deserialize(toml::Value::Table(table)).map_err(|e| {
         let path = e.path().to_string();
+        let message = crate::toml_message(&e.into_inner(), true);
         ParamError {
             key: if path == "." {
                 prefix.to_string()
             } else {
                 key_path(prefix, &path)
             },
-            message: crate::toml_message(&e.into_inner(), true),
+            message: match known.iter().find(|d| d.name == path) {
+                Some(doc) => expecting_key_bounds(&message, doc),
+                None => message,
+            },
         }
     })
+}
+
+/// A type error's message for the key `doc` expecting the key's own bounds rather than its
+/// type's range (`expected a whole number from 0 to 4294967295` reads `expected a whole number
+/// in 1..=10`); a key without bounds, or a message that expects nothing, is left as it is.
+fn expecting_key_bounds(message: &str, doc: &KeyDoc) -> String {
+    const EXPECTED: &str = ", expected ";
+    match message.find(EXPECTED) {
+        Some(at) if !doc.bounds.is_empty() => {
+            let article = if doc.type_name.starts_with(['a', 'e', 'i', 'o', 'u']) {
+                "an"
+            } else {
+                "a"
+            };
+            let within = if doc.bounds.starts_with(|c: char| c.is_ascii_digit()) {
+                "in "
+            } else {
+                ""
+            };
+            format!(
+                "{}{EXPECTED}{article} {} {within}{}",
+                &message[..at],
+                doc.type_name,
+                doc.bounds
+            )
+        }
+        _ => message.to_string(),
+    }
 }
 
 /// Reads an included set: the keys of `table` that belong to it are taken out and read over
@@ -621,6 +653,28 @@ mod tests {
             ("cuont = 3", "p.cuont", "did you mean `count`?"),
             ("gian = 1.0", "p.gian", "did you mean `gain`?"),
             ("zzz = 1", "p.zzz", "unknown field `zzz` ("),
+            // A type error expects the key's bounds, not its type's range.
+            (
+                "count = 2.5",
+                "p.count",
+                "invalid type: floating point `2.5`, expected a whole number in 3..=10",
+            ),
+            (
+                "count = -1",
+                "p.count",
+                "invalid value: integer `-1`, expected a whole number in 3..=10",
+            ),
+            (
+                "gain = true",
+                "p.gain",
+                "invalid type: boolean `true`, expected a number >= 0 and <= 2",
+            ),
+            // Keys without bounds keep serde's words.
+            (
+                "on = 1",
+                "p.on",
+                "invalid type: integer `1`, expected a boolean",
+            ),
         ];
         for (text, key, message) in cases {
             let e = Outer::read(table(text), "p")

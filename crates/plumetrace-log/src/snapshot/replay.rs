@@ -52,6 +52,10 @@ pub struct ReplayReport {
     pub differing: u64,
     /// The first differences (at most [`ReplayReport::KEEP`]).
     pub first: Vec<Difference>,
+    /// Per vehicle replayed with its logged table, the keys of its planner that the table does
+    /// not give (a log writes every key, so a log from before a key existed): they replay with
+    /// today's defaults, which may not be how the logged planner flew.
+    pub defaulted: Vec<(u32, Vec<String>)>,
 }
 
 impl ReplayReport {
@@ -125,8 +129,11 @@ pub fn replay_with(
             message: e.to_string(),
         })?;
     let header = read_header(&first)?;
-    let (mut planners, thresholds) = build_planners(&header, tables)?;
-    let mut report = ReplayReport::default();
+    let (mut planners, thresholds, defaulted) = build_planners(&header, tables)?;
+    let mut report = ReplayReport {
+        defaulted,
+        ..ReplayReport::default()
+    };
     for (n, line) in lines.enumerate() {
         let number = n as u64 + 2;
         let text = line.map_err(|e| ReplayError::Line {
@@ -168,17 +175,23 @@ pub fn replay_with(
     Ok(report)
 }
 
-/// The rebuilt planners by vehicle, and their detection thresholds.
-type Rebuilt = (BTreeMap<u32, Box<dyn Planner>>, BTreeMap<u32, Option<f64>>);
+/// The rebuilt planners by vehicle, their detection thresholds, and the keys each logged table
+/// left to today's defaults ([`ReplayReport::defaulted`]).
+type Rebuilt = (
+    BTreeMap<u32, Box<dyn Planner>>,
+    BTreeMap<u32, Option<f64>>,
+    Vec<(u32, Vec<String>)>,
+);
 
-/// Each logged vehicle's planner, rebuilt from the header (or from `tables`), and its detection
-/// threshold.
+/// Each logged vehicle's planner, rebuilt from the header (or from `tables`), its detection
+/// threshold, and the keys its logged table does not give.
 fn build_planners(
     header: &Header,
     tables: &dyn Fn(u32) -> Option<toml::Table>,
 ) -> Result<Rebuilt, ReplayError> {
     let mut planners: BTreeMap<u32, Box<dyn Planner>> = BTreeMap::new();
     let mut thresholds: BTreeMap<u32, Option<f64>> = BTreeMap::new();
+    let mut defaulted = Vec::new();
     for v in &header.vehicles {
         if planners.contains_key(&v.id) {
             return Err(ReplayError::Line {
@@ -192,16 +205,33 @@ fn build_planners(
                 message: "its prior flow direction is not a finite number".into(),
             });
         }
-        let table = match tables(v.id) {
-            Some(t) => t,
-            None => v.planner.parse().map_err(|e| ReplayError::Planner {
-                vehicle: v.id,
-                message: format!("its planner table: {e}"),
-            })?,
+        let (table, logged) = match tables(v.id) {
+            Some(t) => (t, false),
+            None => (
+                v.planner.parse().map_err(|e| ReplayError::Planner {
+                    vehicle: v.id,
+                    message: format!("its planner table: {e}"),
+                })?,
+                true,
+            ),
         };
         let planner = PlannerConfig::from_table(&table, &v.planner_key)
             .and_then(|c| {
                 thresholds.insert(v.id, c.detection_threshold_v());
+                if logged {
+                    let missing: Vec<String> = c
+                        .to_table()
+                        .map(|all| {
+                            all.keys()
+                                .filter(|k| !table.contains_key(*k))
+                                .cloned()
+                                .collect()
+                        })
+                        .unwrap_or_default();
+                    if !missing.is_empty() {
+                        defaulted.push((v.id, missing));
+                    }
+                }
                 c.build(&v.context, &v.planner_key)
             })
             .map_err(|e| ReplayError::Planner {
@@ -210,7 +240,7 @@ fn build_planners(
             })?;
         planners.insert(v.id, planner);
     }
-    Ok((planners, thresholds))
+    Ok((planners, thresholds, defaulted))
 }
 
 #[cfg(test)]
