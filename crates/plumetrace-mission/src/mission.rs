@@ -24,7 +24,7 @@ use std::time::Instant;
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct MissionOptions {
     /// Accumulate the time-averaged plume over the op-area for the figure (a grid of
-    /// concentration queries every 20 s).
+    /// concentration queries every [`MeanPlumeRecorder::every_s`] of the time limit).
     pub mean_plume: bool,
     /// Keep every step of every vehicle's trajectory.
     pub trajectory: bool,
@@ -236,7 +236,9 @@ impl Flight {
             let mean_plume = options.mean_plume.then(|| {
                 MeanPlumeRecorder::new(
                     MeanPlumeRecorder::grid_over(&spec.op_area, env.domain(), z),
-                    sample_every,
+                    (MeanPlumeRecorder::every_s(spec.time_limit_s) / dt_s)
+                        .round()
+                        .max(1.0) as u64,
                 )
             });
             let plume_frames = options
