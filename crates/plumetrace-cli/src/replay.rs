@@ -140,22 +140,25 @@ pub fn run(args: &ReplayArgs) -> Result<bool> {
         report.decisions,
         report.differing
     );
-    for (vehicle, keys) in &report.defaulted {
-        let keys: Vec<String> = keys.iter().map(|k| format!("`{k}`")).collect();
+    for d in &report.defaulted {
+        let keys: Vec<String> = d.keys.iter().map(|k| format!("`{k}`")).collect();
+        let one = keys.len() == 1;
         crate::outln!(
-            "  note: vehicle {vehicle}'s logged planner table has no {} (the log predates {}): \
-             replayed with today's defaults, which may not be how it flew; give {} with \
-             --planner-file to replay as flown",
+            "  note: vehicle {} ({})'s logged planner table has no {} (the log predates {}): {} \
+             with today's {}, which may not be how it flew; to replay it as flown, give \
+             `--planner-file F --vehicle {}` with F its logged table (the log's first line, \
+             `vehicles[].planner`) and {} as flown",
+            d.vehicle,
+            d.name,
             keys.join(", "),
-            if keys.len() == 1 {
-                "the key"
+            if one { "the key" } else { "these keys" },
+            if one { "it replays" } else { "they replay" },
+            if one { "default" } else { "defaults" },
+            d.vehicle,
+            if one {
+                "the key's value"
             } else {
-                "these keys"
-            },
-            if keys.len() == 1 {
-                "its value"
-            } else {
-                "their values"
+                "these keys' values"
             },
         );
     }

@@ -459,9 +459,10 @@ fn a_log_from_before_a_key_existed_replays_with_a_note_naming_it() {
     assert_eq!(status, 0, "{err}");
     assert!(
         out.contains(
-            "note: vehicle 0's logged planner table has no `declaration_fix_frames`, \
-             `declaration_frame_wait_s` (the log predates these keys): replayed with today's \
-             defaults"
+            "note: vehicle 0 (auv)'s logged planner table has no `declaration_fix_frames`, \
+             `declaration_frame_wait_s` (the log predates these keys): they replay with today's \
+             defaults, which may not be how it flew; to replay it as flown, give \
+             `--planner-file F --vehicle 0`"
         ),
         "{out}"
     );

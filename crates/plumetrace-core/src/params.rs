@@ -351,32 +351,62 @@ pub fn read_own<T: serde::de::DeserializeOwned>(
     })
 }
 
-/// A type error's message for the key `doc` expecting the key's own bounds rather than its
-/// type's range (`expected a whole number from 0 to 4294967295` reads `expected a whole number
-/// in 1..=10`); a key without bounds, or a message that expects nothing, is left as it is.
+/// A type error's message for the key `doc` expecting what the key takes rather than what its
+/// Rust type takes: the key's own bounds and unit (`expected a whole number from 0 to 4294967295`
+/// reads `expected a whole number in 1..=10`; a whole number written with a decimal point is told
+/// so), or a choice's names (`expected one of "oldest", "most_downflow"`, where serde speaks of
+/// a `unit variant`). A key without bounds, or a message that expects nothing, is left as it is.
 fn expecting_key_bounds(message: &str, doc: &KeyDoc) -> String {
     const EXPECTED: &str = ", expected ";
-    match message.find(EXPECTED) {
-        Some(at) if !doc.bounds.is_empty() => {
-            let article = if doc.type_name.starts_with(['a', 'e', 'i', 'o', 'u']) {
-                "an"
-            } else {
-                "a"
-            };
-            let within = if doc.bounds.starts_with(|c: char| c.is_ascii_digit()) {
-                "in "
-            } else {
-                ""
-            };
-            format!(
-                "{}{EXPECTED}{article} {} {within}{}",
-                &message[..at],
-                doc.type_name,
-                doc.bounds
-            )
+    let Some(at) = message.find(EXPECTED) else {
+        return message.to_string();
+    };
+    let head = &message[..at];
+    if doc.type_name.starts_with("one of ") {
+        // A name that is not one of them keeps serde's list (and its words).
+        if head.starts_with("unknown variant") {
+            return message.to_string();
         }
-        _ => message.to_string(),
+        let head = if head.contains("unit variant") {
+            "invalid value: not a name"
+        } else {
+            head
+        };
+        return format!("{head}{EXPECTED}{} (a name in quotes)", doc.type_name);
     }
+    if doc.bounds.is_empty() {
+        return message.to_string();
+    }
+    let article = if doc.type_name.starts_with(['a', 'e', 'i', 'o', 'u']) {
+        "an"
+    } else {
+        "a"
+    };
+    let within = if doc.bounds.starts_with(|c: char| c.is_ascii_digit()) {
+        "in "
+    } else {
+        ""
+    };
+    let unit = if doc.unit.is_empty() || doc.unit.contains("unit") {
+        String::new()
+    } else {
+        format!(" {}", doc.unit)
+    };
+    // `floating point `4.0``: a whole number with a decimal point.
+    let whole_float = head
+        .split_once("floating point `")
+        .and_then(|(_, rest)| rest.split('`').next())
+        .and_then(|v| v.parse::<f64>().ok())
+        .is_some_and(|v| v.is_finite() && v.fract() == 0.0);
+    let hint = if whole_float && doc.type_name == "whole number" {
+        " (written without a decimal point)"
+    } else {
+        ""
+    };
+    format!(
+        "{head}{EXPECTED}{article} {} {within}{}{unit}{hint}",
+        doc.type_name, doc.bounds
+    )
 }
 
 /// Reads an included set: the keys of `table` that belong to it are taken out and read over
@@ -668,6 +698,24 @@ mod tests {
                 "gain = true",
                 "p.gain",
                 "invalid type: boolean `true`, expected a number >= 0 and <= 2",
+            ),
+            // With the key's unit, and a whole number written with a decimal point told so.
+            (
+                "rate_hz = true",
+                "p.rate_hz",
+                "invalid type: boolean `true`, expected a number > 0 and <= 100 Hz",
+            ),
+            (
+                "count = 4.0",
+                "p.count",
+                "invalid type: floating point `4.0`, expected a whole number in 3..=10 (written \
+                 without a decimal point)",
+            ),
+            // A choice expects its names.
+            (
+                "mode = 3",
+                "p.mode",
+                r#"expected one of "oldest", "most_downflow" (a name in quotes)"#,
             ),
             // Keys without bounds keep serde's words.
             (

@@ -420,14 +420,15 @@ pub struct MeanPlumeRecorder {
 }
 
 impl MeanPlumeRecorder {
-    /// How often a mission of `time_limit_s` samples its figure's plume, s: about 120 samples
-    /// over the time limit, at least every 20 s and at most every 60 s (as often as the replay
-    /// page's frames, [`crate::PLUME_FRAME_EVERY_S`]). A current of 0.1-0.3 m/s carries the
-    /// filaments 6-18 m between samples 60 s apart, one to three cells of the figure's grid over
-    /// a kilometre of op-area. Every 60 s instead of 20 s, a `duck-2003-st` run (a 2 h limit)
-    /// takes 0.42 s of CPU instead of 0.55 s (docs/results/performance.md), and its figure's
-    /// cells' colours differ from the 20 s average's by 1.5 of 255 levels on average. A mission of 40 minutes or less (the
-    /// demos) still samples every 20 s.
+    /// How often a mission of `time_limit_s` samples its figure's plume, s: the time limit over
+    /// 120 (about 120 samples in a mission that runs to its limit), within 20-60 s (60 s: as
+    /// often as the replay page's frames, [`crate::PLUME_FRAME_EVERY_S`]). A current of 0.1-0.3
+    /// m/s carries the filaments 6-18 m between samples 60 s apart, one to three cells of the
+    /// figure's grid over a kilometre of op-area. Every 60 s instead of 20 s, a `duck-2003-st`
+    /// run (a 2 h limit) takes 0.42 s of CPU instead of 0.55 s (docs/results/performance.md),
+    /// and its figure's cells' colours differ from the 20 s average's by 1.5 of 255 levels on
+    /// average. A mission of 40 minutes or less (`demo`, `demo-survey`, `demo-surge-cast`)
+    /// still samples every 20 s.
     pub fn every_s(time_limit_s: f64) -> f64 {
         let every = time_limit_s / 120.0;
         if every.is_finite() {

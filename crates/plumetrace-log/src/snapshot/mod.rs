@@ -21,7 +21,7 @@ mod replay;
 
 pub use file::{SnapshotLogFile, open};
 pub use replay::{
-    Difference, ReplayError, ReplayReport, Replayed, read_header, replay, replay_with,
+    Defaulted, Difference, ReplayError, ReplayReport, Replayed, read_header, replay, replay_with,
 };
 
 use crate::LogError;

@@ -55,7 +55,18 @@ pub struct ReplayReport {
     /// Per vehicle replayed with its logged table, the keys of its planner that the table does
     /// not give (a log writes every key, so a log from before a key existed): they replay with
     /// today's defaults, which may not be how the logged planner flew.
-    pub defaulted: Vec<(u32, Vec<String>)>,
+    pub defaulted: Vec<Defaulted>,
+}
+
+/// Keys a logged planner table does not give ([`ReplayReport::defaulted`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Defaulted {
+    /// Vehicle index.
+    pub vehicle: u32,
+    /// Vehicle name, as logged.
+    pub name: String,
+    /// The keys, in the planner's table order.
+    pub keys: Vec<String>,
 }
 
 impl ReplayReport {
@@ -180,7 +191,7 @@ pub fn replay_with(
 type Rebuilt = (
     BTreeMap<u32, Box<dyn Planner>>,
     BTreeMap<u32, Option<f64>>,
-    Vec<(u32, Vec<String>)>,
+    Vec<Defaulted>,
 );
 
 /// Each logged vehicle's planner, rebuilt from the header (or from `tables`), its detection
@@ -229,7 +240,11 @@ fn build_planners(
                         })
                         .unwrap_or_default();
                     if !missing.is_empty() {
-                        defaulted.push((v.id, missing));
+                        defaulted.push(Defaulted {
+                            vehicle: v.id,
+                            name: v.name.clone(),
+                            keys: missing,
+                        });
                     }
                 }
                 c.build(&v.context, &v.planner_key)
