@@ -377,21 +377,13 @@ fn expecting_key_bounds(message: &str, doc: &KeyDoc) -> String {
     if doc.bounds.is_empty() {
         return message.to_string();
     }
-    let article = if doc.type_name.starts_with(['a', 'e', 'i', 'o', 'u']) {
-        "an"
-    } else {
-        "a"
-    };
+    // Bounded keys are numbers or whole numbers (choices and flags have none).
     let within = if doc.bounds.starts_with(|c: char| c.is_ascii_digit()) {
         "in "
     } else {
         ""
     };
-    let unit = if doc.unit.is_empty() || doc.unit.contains("unit") {
-        String::new()
-    } else {
-        format!(" {}", doc.unit)
-    };
+    let unit = shown_unit(doc.unit).map_or(String::new(), |u| format!(" {u}"));
     // `floating point `4.0``: a whole number with a decimal point.
     let whole_float = head
         .split_once("floating point `")
@@ -404,9 +396,15 @@ fn expecting_key_bounds(message: &str, doc: &KeyDoc) -> String {
         ""
     };
     format!(
-        "{head}{EXPECTED}{article} {} {within}{}{unit}{hint}",
+        "{head}{EXPECTED}a {} {within}{}{unit}{hint}",
         doc.type_name, doc.bounds
     )
+}
+
+/// A key's unit as its messages show it: none for counts, flags and choices, nor for the
+/// sensor's own unit (`unit`, `1/(s unit)`: the reading's unit, which the key does not know).
+fn shown_unit(unit: &str) -> Option<&str> {
+    (!unit.is_empty() && !unit.contains("unit")).then_some(unit)
 }
 
 /// Reads an included set: the keys of `table` that belong to it are taken out and read over
@@ -427,8 +425,7 @@ pub fn read_included<T: Params + serde::Serialize>(
 }
 
 /// Checks one value (used by [`params!`](crate::params!)); a value outside its bounds is named
-/// with the key's `unit` (`must be > 0 and <= 10 m/s, got 50 m/s`), unless the unit is the
-/// sensor's own (`unit`, `1/(s unit)`: the reading's unit, which the key does not know).
+/// with the key's unit as `shown_unit` shows it (`must be > 0 and <= 10 m/s, got 50 m/s`).
 pub fn check<T: ParamValue>(
     prefix: &str,
     name: &str,
@@ -437,13 +434,11 @@ pub fn check<T: ParamValue>(
     unit: &str,
 ) -> Result<(), ParamError> {
     value.check(bounds).map_err(|e| {
-        let message = match e {
-            BoundsError::Outside { bounds, value }
-                if !unit.is_empty() && !unit.contains("unit") =>
-            {
+        let message = match (e, shown_unit(unit)) {
+            (BoundsError::Outside { bounds, value }, Some(unit)) => {
                 format!("must be {bounds} {unit}, got {value} {unit}")
             }
-            e => e.to_string(),
+            (e, _) => e.to_string(),
         };
         ParamError::at(prefix, name, message)
     })

@@ -33,6 +33,12 @@ pub struct MissionOptions {
     pub plume_frames_every_s: Option<f64>,
 }
 
+/// The whole number of steps of `dt_s` nearest to `every_s`, at least one (how often a recorder
+/// samples).
+fn steps_of(every_s: f64, dt_s: f64) -> u64 {
+    (every_s / dt_s).round().max(1.0) as u64
+}
+
 /// The replay page's plume frame interval when nothing else is asked for, s.
 pub const PLUME_FRAME_EVERY_S: f64 = 60.0;
 
@@ -221,7 +227,7 @@ impl Flight {
                     }
                 })
                 .collect();
-            let sample_every = (20.0 / dt_s).round().max(1.0) as u64;
+            let sample_every = steps_of(20.0, dt_s);
             let thresholds: Vec<Option<f64>> = planned
                 .iter()
                 .map(|p| p.as_ref().and_then(|p| p.config.detection_threshold_v()))
@@ -236,9 +242,7 @@ impl Flight {
             let mean_plume = options.mean_plume.then(|| {
                 MeanPlumeRecorder::new(
                     MeanPlumeRecorder::grid_over(&spec.op_area, env.domain(), z),
-                    (MeanPlumeRecorder::every_s(spec.time_limit_s) / dt_s)
-                        .round()
-                        .max(1.0) as u64,
+                    steps_of(MeanPlumeRecorder::every_s(spec.time_limit_s), dt_s),
                 )
             });
             let plume_frames = options
@@ -251,7 +255,7 @@ impl Flight {
                         (x0 - pad, x1 + pad, y0 - pad, y1 + pad),
                         env.domain(),
                         z,
-                        (every / dt_s).round().max(1.0) as u64,
+                        steps_of(every, dt_s),
                     )
                 });
             let faults = setups

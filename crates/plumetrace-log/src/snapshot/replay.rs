@@ -226,33 +226,31 @@ fn build_planners(
                 true,
             ),
         };
-        let planner = PlannerConfig::from_table(&table, &v.planner_key)
-            .and_then(|c| {
-                thresholds.insert(v.id, c.detection_threshold_v());
-                if logged {
-                    let missing: Vec<String> = c
-                        .to_table()
-                        .map(|all| {
-                            all.keys()
-                                .filter(|k| !table.contains_key(*k))
-                                .cloned()
-                                .collect()
-                        })
-                        .unwrap_or_default();
-                    if !missing.is_empty() {
-                        defaulted.push(Defaulted {
-                            vehicle: v.id,
-                            name: v.name.clone(),
-                            keys: missing,
-                        });
-                    }
-                }
-                c.build(&v.context, &v.planner_key)
-            })
-            .map_err(|e| ReplayError::Planner {
+        let rebuild_error = |e: plumetrace_core::params::ParamError| ReplayError::Planner {
+            vehicle: v.id,
+            message: e.to_string(),
+        };
+        let config = PlannerConfig::from_table(&table, &v.planner_key).map_err(rebuild_error)?;
+        thresholds.insert(v.id, config.detection_threshold_v());
+        // Every key a table written today would give that the logged one does not.
+        let missing: Vec<String> = match (logged, config.to_table()) {
+            (true, Ok(all)) => all
+                .keys()
+                .filter(|k| !table.contains_key(*k))
+                .cloned()
+                .collect(),
+            _ => Vec::new(),
+        };
+        if !missing.is_empty() {
+            defaulted.push(Defaulted {
                 vehicle: v.id,
-                message: e.to_string(),
-            })?;
+                name: v.name.clone(),
+                keys: missing,
+            });
+        }
+        let planner = config
+            .build(&v.context, &v.planner_key)
+            .map_err(rebuild_error)?;
         planners.insert(v.id, planner);
     }
     Ok((planners, thresholds, defaulted))
