@@ -313,8 +313,9 @@ pub trait Planner: Send {
     }
 
     /// The run ends at `t_s` for a reason the planner did not choose (on a vehicle: the link
-    /// given up, the time limit): what it still has to report, such as a declaration it was
-    /// holding. The default has nothing.
+    /// given up, the time limit; in a simulated mission: the time limit, a collision, leaving the
+    /// domain): what it still has to report, such as a declaration it was holding. Called once,
+    /// after the last decision. The default has nothing.
     fn run_ended(&mut self, t_s: f64) -> Vec<PlannerEvent> {
         let _ = t_s;
         Vec::new()

@@ -56,6 +56,12 @@ impl ConcentrationField for Plume {
             Plume::Steady(s) => s.grid_concentrations(grid, points, out),
         }
     }
+    fn display_grid_concentrations(&self, grid: &GridSpec, points: &[Vec3], out: &mut [f64]) {
+        match self {
+            Plume::Filaments(f) => f.display_grid_concentrations(grid, points, out),
+            Plume::Steady(s) => s.display_grid_concentrations(grid, points, out),
+        }
+    }
 }
 
 /// The simulated ocean: domain, flow, plume and obstacles, stepped at a fixed `dt`.

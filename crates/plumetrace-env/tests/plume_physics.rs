@@ -956,3 +956,55 @@ fn a_grid_query_is_bit_for_bit_the_point_by_point_query() {
         );
     }
 }
+
+#[test]
+fn a_display_grid_is_within_a_few_units_in_the_last_place_and_the_same_whatever_the_threads() {
+    for (mut env, z) in spun_up_under_each_boundary() {
+        run(&mut env, 5.0);
+        let mut nonzero = 0;
+        // A grid as fine as the filaments and one coarser than them, both over the domain's edge.
+        for (x0, x1, y0, y1, nx, ny) in [
+            (-10.0, 200.0, -60.0, 60.0, 211, 121),
+            (13.7, 151.3, -47.1, 33.3, 19, 11),
+        ] {
+            let spec = GridSpec {
+                x_min_m: x0,
+                x_max_m: x1,
+                y_min_m: y0,
+                y_max_m: y1,
+                nx,
+                ny,
+                z_m: z,
+            };
+            let pts = spec.points();
+            let on = |threads: usize| {
+                let pool = rayon::ThreadPoolBuilder::new()
+                    .num_threads(threads)
+                    .build()
+                    .unwrap();
+                let mut out = vec![f64::NAN; pts.len()];
+                pool.install(|| {
+                    env.plume()
+                        .display_grid_concentrations(&spec, &pts, &mut out)
+                });
+                out
+            };
+            let display = on(1);
+            let bits = |v: &[f64]| v.iter().map(|c| c.to_bits()).collect::<Vec<_>>();
+            assert_eq!(bits(&display), bits(&on(3)), "{spec:?}");
+            let mut exact = vec![f64::NAN; pts.len()];
+            env.plume().grid_concentrations(&spec, &pts, &mut exact);
+            for ((p, d), e) in pts.iter().zip(&display).zip(&exact) {
+                // Every term is positive and within 2 units in the last place (2.2e-16 each),
+                // so the sums are too, but for the rounding of the additions themselves.
+                assert!(
+                    (d - e).abs() <= 1e-15 * e,
+                    "{d:e} against {e:e} at {p:?} of {spec:?}"
+                );
+                assert_eq!(*d > 0.0, *e > 0.0, "at {p:?}");
+                nonzero += usize::from(*e > 0.0);
+            }
+        }
+        assert!(nonzero > 100, "{nonzero} points with a concentration");
+    }
+}

@@ -466,6 +466,13 @@ impl Flight {
                 }
             }
         }
+        // Vehicles flying on after their planners' own decisions: an incident now ends their
+        // runs for a reason the planners did not choose.
+        let flying: Vec<bool> = self
+            .statuses
+            .iter()
+            .map(|s| *s == VehicleStatus::Active)
+            .collect();
         for (id, e) in &report.events {
             if let WorldEvent::Incident { what } = e {
                 let k = id.0 as usize;
@@ -477,6 +484,32 @@ impl Flight {
                 self.statuses[k] = VehicleStatus::of_incident(*what);
             }
         }
+        let t = self.fleet.time_s();
+        if !self.statuses.contains(&VehicleStatus::Active) {
+            self.end = Some(MissionEnd {
+                reason: EndReason::PlannersDone,
+                t_s: t,
+            });
+        } else if self.fleet.steps() >= self.step_limit {
+            self.end = Some(MissionEnd {
+                reason: EndReason::TimeLimit,
+                t_s: t,
+            });
+        }
+        // What a planner still has to report when its run ends for a reason it did not choose
+        // (an incident, the time limit), as on a vehicle: a declaration it was holding.
+        let time_limit = matches!(self.end, Some(e) if e.reason == EndReason::TimeLimit);
+        let mut ended = Vec::new();
+        for (k, planner) in self.planners.iter_mut().enumerate() {
+            let Some(planner) = planner else { continue };
+            let stopped = flying[k] && self.statuses[k] != VehicleStatus::Active;
+            if stopped || (time_limit && self.statuses[k] == VehicleStatus::Active) {
+                let events = planner.run_ended(t);
+                if !events.is_empty() {
+                    ended.push((k, events));
+                }
+            }
+        }
         let t0 = Instant::now();
         {
             let view = StepView {
@@ -484,6 +517,7 @@ impl Flight {
                 report: &report,
                 mission_events: &mission_events,
                 statuses: &self.statuses,
+                ended: &ended,
             };
             self.events.observe(&view);
             self.stats.observe(&view);
@@ -502,18 +536,6 @@ impl Flight {
             }
         }
         self.fleet.add_record_time(t0.elapsed().as_secs_f64());
-        let t = self.fleet.time_s();
-        if !self.statuses.contains(&VehicleStatus::Active) {
-            self.end = Some(MissionEnd {
-                reason: EndReason::PlannersDone,
-                t_s: t,
-            });
-        } else if self.fleet.steps() >= self.step_limit {
-            self.end = Some(MissionEnd {
-                reason: EndReason::TimeLimit,
-                t_s: t,
-            });
-        }
         Ok(self.end)
     }
 

@@ -24,9 +24,27 @@ pub struct StepView<'a> {
     pub mission_events: &'a [(VehicleId, MissionEvent)],
     /// Every vehicle's status after the step.
     pub statuses: &'a [VehicleStatus],
+    /// What planners still had to report as their runs ended in this step for a reason they
+    /// did not choose (an incident, the time limit: [`plumetrace_core::Planner::run_ended`]),
+    /// by vehicle index: a declaration a planner was holding.
+    pub ended: &'a [(usize, Vec<PlannerEvent>)],
 }
 
 impl StepView<'_> {
+    /// Every planner event of the step with its vehicle's index: each decision's events, then
+    /// what planners reported as their runs ended ([`StepView::ended`]).
+    pub fn planner_events(&self) -> impl Iterator<Item = (usize, &PlannerEvent)> {
+        let decided = self.report.decisions.iter().enumerate().flat_map(|(k, d)| {
+            d.iter()
+                .flat_map(move |d| d.events.iter().map(move |e| (k, e)))
+        });
+        let ended = self
+            .ended
+            .iter()
+            .flat_map(|(k, events)| events.iter().map(move |e| (*k, e)));
+        decided.chain(ended)
+    }
+
     /// Each vehicle that decided this step, with the snapshot it decided on (recorded only when
     /// an observer wants snapshots) and its decision, by vehicle index.
     pub fn decided(
@@ -145,6 +163,15 @@ impl Observer for EventRecorder {
                 t_s: t,
                 vehicle: id.0,
                 event: EventKind::World(e.clone()),
+            }));
+        // After the incident that ended a run, what its planner still had to report.
+        self.events
+            .extend(step.ended.iter().flat_map(|(k, events)| {
+                events.iter().map(move |e| EventRecord {
+                    t_s: t,
+                    vehicle: *k as u32,
+                    event: EventKind::Planner(e.clone()),
+                })
             }));
         self.events
             .extend(step.mission_events.iter().map(|(id, e)| EventRecord {
@@ -328,20 +355,18 @@ impl TrackStats {
 impl Observer for TrackStats {
     fn observe(&mut self, step: &StepView<'_>) {
         let t = step.report.t_s;
-        for (i, d) in step.report.decisions.iter().enumerate() {
-            let (Some(d), Some(track)) = (d, self.tracks.get_mut(i)) else {
+        for (i, e) in step.planner_events() {
+            let Some(track) = self.tracks.get_mut(i) else {
                 continue;
             };
-            for e in &d.events {
-                match e {
-                    PlannerEvent::Detection { pos_m } if track.first_detection.is_none() => {
-                        track.first_detection = Some((t, *pos_m));
-                    }
-                    PlannerEvent::Declared { pos_m, rule } => {
-                        track.declarations.push((t, *pos_m, rule.clone()));
-                    }
-                    _ => {}
+            match e {
+                PlannerEvent::Detection { pos_m } if track.first_detection.is_none() => {
+                    track.first_detection = Some((t, *pos_m));
                 }
+                PlannerEvent::Declared { pos_m, rule } => {
+                    track.declarations.push((t, *pos_m, rule.clone()));
+                }
+                _ => {}
             }
         }
         for (i, b) in behaviour_switches(step.report) {
@@ -411,7 +436,7 @@ pub fn bounds_of(points: &[Vec2]) -> (f64, f64, f64, f64) {
 }
 
 /// Accumulates the time-averaged concentration over a grid every `sample_every` steps (the
-/// figure's plume).
+/// figure's plume; display precision, [`ConcentrationField::display_grid_concentrations`]).
 #[derive(Debug)]
 pub struct MeanPlumeRecorder {
     /// The average so far.
@@ -441,7 +466,7 @@ impl MeanPlumeRecorder {
     /// An average over `grid`, sampled every `sample_every` steps.
     pub fn new(grid: GridSpec, sample_every: u64) -> Self {
         MeanPlumeRecorder {
-            grid: MeanConcentrationGrid::new(grid, 0.0),
+            grid: MeanConcentrationGrid::new(grid, 0.0).for_display(),
             sample_every: sample_every.max(1),
         }
     }
@@ -483,8 +508,9 @@ pub struct PlumeFrame {
 }
 
 /// Samples the plume and the flow every `every_s` seconds (the replay page's background):
-/// concentration on a grid of at most 96 x 96 points at the first vehicle's altitude, flow on
-/// one of at most 12 x 12. A mission of 2 h sampled every 60 s keeps 121 frames of about 37 kB.
+/// concentration on a grid of at most 96 x 96 points at the first vehicle's altitude (display
+/// precision, [`ConcentrationField::display_grid_concentrations`]), flow on one of at most 12 x
+/// 12. A mission of 2 h sampled every 60 s keeps 121 frames of about 37 kB.
 #[derive(Debug)]
 pub struct PlumeFrames {
     /// Where the concentration is sampled.
@@ -558,7 +584,7 @@ impl PlumeFrames {
         world
             .env()
             .plume()
-            .grid_concentrations(&self.grid, &self.points, &mut c);
+            .display_grid_concentrations(&self.grid, &self.points, &mut c);
         let flow = world.env().flow();
         self.frames.push(PlumeFrame {
             t_s: world.time_s(),

@@ -188,14 +188,14 @@ impl Observer for TeamStats {
                 _ => {}
             }
         }
+        if step
+            .planner_events()
+            .any(|(_, e)| matches!(e, PlannerEvent::Declared { .. }))
+        {
+            self.declared = true;
+        }
         for (k, d) in step.report.decisions.iter().enumerate() {
             let Some(d) = d else { continue };
-            if d.events
-                .iter()
-                .any(|e| matches!(e, PlannerEvent::Declared { .. }))
-            {
-                self.declared = true;
-            }
             for tel in &d.telemetry {
                 let Telemetry::Formation {
                     scale_cw,

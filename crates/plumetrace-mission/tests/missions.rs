@@ -782,3 +782,92 @@ fn without_a_current_meter_the_amp_reads_the_current_from_its_track() {
     }
     assert!(prior_alone_missed >= 2, "{prior_alone_missed}");
 }
+
+/// A planner holding a point it would declare later: due east at `speed_mps`, every second; its
+/// run's end (not chosen by it) declares the point, once.
+struct HoldsAPoint {
+    speed_mps: f64,
+    held: Option<plumetrace_core::Vec2>,
+}
+
+impl plumetrace_core::Planner for HoldsAPoint {
+    fn decide(&mut self, _: &plumetrace_core::SensorSnapshot) -> plumetrace_core::Decision {
+        plumetrace_core::Decision::new(
+            plumetrace_core::Command {
+                heading: plumetrace_core::Heading::from_deg(90.0),
+                speed_mps: self.speed_mps,
+                vertical: plumetrace_core::VerticalCommand::Altitude(3.0),
+            },
+            plumetrace_core::PlanStatus::Running,
+        )
+    }
+    fn decision_period_s(&self) -> f64 {
+        1.0
+    }
+    fn run_ended(&mut self, _t_s: f64) -> Vec<plumetrace_core::PlannerEvent> {
+        self.held
+            .take()
+            .map(|pos_m| plumetrace_core::PlannerEvent::Declared {
+                pos_m,
+                rule: plumetrace_core::DeclarationKind::new("held"),
+            })
+            .into_iter()
+            .collect()
+    }
+}
+
+#[test]
+fn a_point_held_when_the_run_ends_for_the_world_is_declared_as_on_a_vehicle() {
+    let held = plumetrace_core::Vec2::new(101.0, 2.0);
+    let fly = |speed_mps: f64, limit_s: f64| {
+        let setup = MissionSetup::new(shortened("demo", 0.0, limit_s, 1)).unwrap();
+        let mut m = Mission::new(setup, MissionOptions::default()).unwrap();
+        let planner = HoldsAPoint {
+            speed_mps,
+            held: Some(held),
+        };
+        m.replace_planner(0, Box::new(planner)).unwrap();
+        m.run(&mut |_, _| {}).unwrap();
+        m.finish().unwrap()
+    };
+    let declared = |run: &plumetrace_mission::MissionRun| -> Vec<f64> {
+        run.events
+            .iter()
+            .filter(|e| matches!(e.event, EventKind::Planner(PlannerEvent::Declared { .. })))
+            .map(|e| e.t_s)
+            .collect()
+    };
+    // The time limit: the held point is declared at the last step, and the mission counts it.
+    let run = fly(0.5, 60.0);
+    let at = declared(&run);
+    assert_eq!(at.len(), 1, "{at:?}");
+    assert!(at[0] > 59.0, "declared at {} s", at[0]);
+    assert_eq!(run.outcome, Outcome::Declared);
+    assert_eq!(run.summary.declarations.len(), 1);
+    let d = &run.summary.declarations[0];
+    assert_eq!((d.x_m, d.y_m), (held.x, held.y));
+    // Leaving the domain (east edge 50 m from the start at 2.5 m/s) ends the run: the point is
+    // declared after the incident, once, and the outcome stays the failure.
+    let run = fly(2.5, 600.0);
+    assert_eq!(run.outcome, Outcome::LeftDomain);
+    let at = declared(&run);
+    assert_eq!(at.len(), 1, "{at:?}");
+    let left = run
+        .events
+        .iter()
+        .position(|e| {
+            matches!(
+                e.event,
+                EventKind::World(plumetrace_sim::WorldEvent::Incident { .. })
+            )
+        })
+        .unwrap();
+    let decl = run
+        .events
+        .iter()
+        .position(|e| matches!(e.event, EventKind::Planner(PlannerEvent::Declared { .. })))
+        .unwrap();
+    assert!(decl > left, "the declaration comes after the incident");
+    assert!(at[0] < 100.0, "declared at {} s, when it left", at[0]);
+    assert_eq!(run.summary.declarations.len(), 1);
+}

@@ -1,6 +1,6 @@
 //! Filament storage, release, transport and growth.
 
-use super::index::CellIndex;
+use super::index::{CellIndex, TermExp};
 use crate::error::{EnvError, require_finite, require_non_negative, require_positive};
 use crate::field::ConcentrationField;
 use crate::flow::FlowField;
@@ -947,8 +947,24 @@ impl ConcentrationField for FilamentPlume {
         self.index().concentration(p)
     }
     fn grid_concentrations(&self, grid: &crate::GridSpec, points: &[Vec3], out: &mut [f64]) {
+        self.grid_query(grid, points, out, TermExp::Standard);
+    }
+    fn display_grid_concentrations(
+        &self,
+        grid: &crate::GridSpec,
+        points: &[Vec3],
+        out: &mut [f64],
+    ) {
+        self.grid_query(grid, points, out, TermExp::Lanes);
+    }
+}
+
+impl FilamentPlume {
+    /// A grid query with the exponentials taken `how`; point by point if `points` and `out` are
+    /// not the grid's.
+    fn grid_query(&self, grid: &crate::GridSpec, points: &[Vec3], out: &mut [f64], how: TermExp) {
         if points.len() == grid.nx * grid.ny && out.len() == points.len() {
-            self.index().grid_concentrations(grid, out);
+            self.index().grid_concentrations(grid, out, how);
         } else {
             self.concentrations(points, out);
         }

@@ -5,6 +5,7 @@
 //! least the largest cut-off radius, so a query touches at most 3 x 3 cells (more only when the
 //! cell size is raised to bound the number of cells).
 
+use super::exp_lanes::ScaledExp;
 use super::filament::{FilamentPlume, VerticalBoundary};
 use crate::{GridSpec, Rect};
 use plumetrace_core::Vec3;
@@ -229,27 +230,6 @@ fn axis_span(c: f64, half: f64, origin: f64, inv_step: f64) -> (usize, usize) {
     (a, b)
 }
 
-/// The squared distance from `c` to the nearest of `coords[lo..hi]` (a grid's coordinates,
-/// `coords[k]` about `origin + k / inv_step`), infinite if there is none.
-fn nearest_sq(c: f64, origin: f64, inv_step: f64, coords: &[f64], lo: usize, hi: usize) -> f64 {
-    if lo >= hi {
-        return f64::INFINITY;
-    }
-    let t = (c - origin) * inv_step;
-    // The index at or just below `c`, within one (both neighbours are looked at).
-    let k = if t > 0.0 { t as usize } else { 0 };
-    let k = k.clamp(lo, hi - 1);
-    let (a, b) = (k.saturating_sub(1).max(lo), (k + 2).min(hi));
-    let mut m = f64::INFINITY;
-    for &p in &coords[a..b] {
-        let d = (p - c) * (p - c);
-        if d < m {
-            m = d;
-        }
-    }
-    m
-}
-
 /// Per cell `0..cells`, the points `lo..hi` whose window (`windows`, one per point) holds it;
 /// `None` unless every such set is one run of points.
 fn spans(windows: &[Option<(usize, usize)>], cells: usize) -> Option<Vec<(usize, usize)>> {
@@ -274,24 +254,107 @@ fn spans(windows: &[Option<(usize, usize)>], cells: usize) -> Option<Vec<(usize,
         .collect()
 }
 
+/// How a grid query computes each term's exponential.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum TermExp {
+    /// The standard library's `exp`, as [`CellIndex::concentration`]: bit for bit what point
+    /// queries give.
+    Standard,
+    /// [`super::exp_lanes::exp_nonpositive`] in vector lanes: each term within 2 units in the last place of the
+    /// standard one, the same bits on every CPU (for figures and pages).
+    Lanes,
+}
+
+/// A grid query's terms, gathered in the order the points add them and then evaluated and added
+/// in that order, in batches of at most `cap`.
+struct Gathered {
+    /// The grid point (in the band) each term is added to.
+    at: Vec<u32>,
+    /// The exponential's argument, then the term.
+    arg: Vec<f64>,
+    /// The filament's peak.
+    amp: Vec<f64>,
+    n: usize,
+    cap: usize,
+}
+
+impl Gathered {
+    fn with_room(cap: usize) -> Self {
+        Gathered {
+            at: vec![0; cap],
+            arg: vec![0.0; cap],
+            amp: vec![0.0; cap],
+            n: 0,
+            cap,
+        }
+    }
+
+    /// Keeps a term if `keep`: the slot past the last kept term is written either way and only a
+    /// kept term takes it (no branch to mispredict on a filament's ragged edge).
+    #[inline(always)]
+    fn push_if(&mut self, keep: bool, at: usize, arg: f64, amp: f64) {
+        self.at[self.n] = at as u32;
+        self.arg[self.n] = arg;
+        self.amp[self.n] = amp;
+        self.n += usize::from(keep);
+    }
+
+    /// The terms of filament `e` at the points `xs` of a row (`at`: the first one's place),
+    /// `dy2` from the row, with the `N` heights `dz2` (in order).
+    #[inline(always)]
+    fn row<const N: usize>(&mut self, e: &Entry, xs: &[f64], at: usize, dy2: f64, dz2: &[f64; 3]) {
+        for (i, &x) in xs.iter().enumerate() {
+            let dx = x - e.x;
+            // The point query's sums: d2 = (dx^2 + dy^2) + dz^2, a term where d2 is below
+            // the cut-off.
+            let dxy2 = dx * dx + dy2;
+            for &t in &dz2[..N] {
+                let d2 = dxy2 + t;
+                self.push_if(d2 < e.lim2, at + i, d2 * e.neg_inv_2r2, e.amp);
+            }
+        }
+    }
+
+    /// Evaluates the terms gathered and adds each to its point, in order.
+    fn flush(&mut self, how: TermExp, arch: pulp::Arch, out: &mut [f64]) {
+        let n = self.n;
+        let (arg, amp) = (&mut self.arg[..n], &self.amp[..n]);
+        match how {
+            TermExp::Standard => {
+                for (a, &m) in arg.iter_mut().zip(amp) {
+                    *a = m * a.exp();
+                }
+            }
+            TermExp::Lanes => arch.dispatch(ScaledExp { arg, amp }),
+        }
+        for (&at, &term) in self.at[..n].iter().zip(&self.arg[..n]) {
+            out[at as usize] += term;
+        }
+        self.n = 0;
+    }
+}
+
 impl CellIndex {
     /// Concentrations at every point of `grid`, row by row with x fastest (the order of
-    /// [`GridSpec::points`]): bit for bit what [`CellIndex::concentration`] gives at each point.
+    /// [`GridSpec::points`]): with [`TermExp::Standard`], bit for bit what
+    /// [`CellIndex::concentration`] gives at each point.
     ///
     /// A point's sum adds its filaments in the index's memory order (cell rows, then cells, then
     /// the filaments of a cell), which is one order for every point; so the filaments can be
     /// taken one at a time, each adding its terms to the grid points it reaches, and every point
     /// still sums the same terms in the same order. Each filament visits only the grid points
-    /// near it instead of every point scanning every filament of its 3 x 3 cells. A grid that is
-    /// not a proper lattice (a single row or column, a spacing that is not finite and positive)
-    /// is queried point by point.
-    pub(crate) fn grid_concentrations(&self, grid: &GridSpec, out: &mut [f64]) {
+    /// near it instead of every point scanning every filament of its 3 x 3 cells. The terms are
+    /// gathered first and their exponentials taken in batches, then added in the same order. A
+    /// grid that is not a proper lattice (a single row or column, a spacing that is not finite
+    /// and positive) is queried point by point.
+    pub(crate) fn grid_concentrations(&self, grid: &GridSpec, out: &mut [f64], how: TermExp) {
         let Some(axes) = self.grid_axes(grid) else {
             for (o, p) in out.iter_mut().zip(grid.points()) {
                 *o = self.concentration(p);
             }
             return;
         };
+        let arch = crate::simd::best();
         // One band of rows per thread: a filament is visited once per band its cells reach.
         let band_rows = grid.ny.div_ceil(rayon::current_num_threads().max(1));
         out.par_chunks_mut(grid.nx * band_rows)
@@ -299,7 +362,7 @@ impl CellIndex {
             .for_each(|(band, rows)| {
                 rows.fill(0.0);
                 let j0 = band * band_rows;
-                self.scatter_band(&axes, j0, j0 + rows.len() / grid.nx, rows);
+                self.scatter_band(&axes, j0, j0 + rows.len() / grid.nx, rows, how, arch);
             });
     }
 
@@ -342,9 +405,19 @@ impl CellIndex {
 
     /// Adds every filament's terms to the grid rows `j0..j1` (`out`, row by row), filament by
     /// filament in the index's order.
-    fn scatter_band(&self, axes: &GridAxes, j0: usize, j1: usize, out: &mut [f64]) {
+    fn scatter_band(
+        &self,
+        axes: &GridAxes,
+        j0: usize,
+        j1: usize,
+        out: &mut [f64],
+        how: TermExp,
+        arch: pulp::Arch,
+    ) {
         let nx = axes.xs.len();
         let (x_origin, y_origin) = (axes.xs[0], axes.ys[0]);
+        // Room for a few thousand terms, and for every term of a whole row.
+        let mut terms_of = Gathered::with_room((3 * nx).max(4096));
         for (cj, &(rs0, rs1)) in axes.row_span.iter().enumerate() {
             let (rs0, rs1) = (rs0.max(j0), rs1.min(j1));
             if rs0 >= rs1 {
@@ -357,21 +430,13 @@ impl CellIndex {
                 let c = cj * self.ncx + ci;
                 let (a, b) = (self.starts[c] as usize, self.starts[c + 1] as usize);
                 for e in &self.entries[a..b] {
-                    let (all_terms, n) = self.terms(e, axes.z);
-                    let terms = &all_terms[..n];
-                    // d2 = dxy2 + dz2 is at least dz2: a filament none of whose terms is
-                    // within reach at this height adds nothing.
-                    let near = terms.iter().fold(f64::INFINITY, |m, &t| m.min(t));
-                    if near >= e.lim2 {
+                    // d2 = dxy2 + dz2 is at least dz2: a term out of reach at this height
+                    // adds nothing anywhere (nor a filament with no term in reach).
+                    let (all_terms, n) = self.terms(e, axes.z, e.lim2);
+                    if n == 0 {
                         continue;
                     }
-                    // Likewise with the nearest grid row and column: fp addition is monotone,
-                    // so every point's d2 is at least this sum.
-                    let dy2 = nearest_sq(e.y, y_origin, axes.inv_dy, &axes.ys, rs0, rs1);
-                    let dx2 = nearest_sq(e.x, x_origin, axes.inv_dx, &axes.xs, cs0, cs1);
-                    if dx2 + dy2 + near >= e.lim2 {
-                        continue;
-                    }
+                    let near = all_terms[..n].iter().fold(f64::INFINITY, |m, &t| m.min(t));
                     // At least the reach left in the plane (the rounding of the difference
                     // is below the added billionth).
                     let half = ((e.lim2 - near).max(0.0) + 1e-9 * e.lim2).sqrt();
@@ -389,29 +454,27 @@ impl CellIndex {
                         if dy2 > e.lim2 {
                             continue;
                         }
-                        let row = &mut out[(j - j0) * nx..(j - j0 + 1) * nx];
-                        for (o, &x) in row[ca..cb].iter_mut().zip(&axes.xs[ca..cb]) {
-                            let dx = x - e.x;
-                            let dxy2 = dx * dx + dy2;
-                            if dxy2 > e.lim2 {
-                                continue;
-                            }
-                            for dz2 in terms {
-                                let d2 = dxy2 + dz2;
-                                if d2 < e.lim2 {
-                                    *o += e.amp * (d2 * e.neg_inv_2r2).exp();
-                                }
-                            }
+                        if terms_of.n + (cb - ca) * n > terms_of.cap {
+                            terms_of.flush(how, arch, out);
+                        }
+                        let row = (j - j0) * nx;
+                        let xs = &axes.xs[ca..cb];
+                        match n {
+                            1 => terms_of.row::<1>(e, xs, row + ca, dy2, &all_terms),
+                            2 => terms_of.row::<2>(e, xs, row + ca, dy2, &all_terms),
+                            _ => terms_of.row::<3>(e, xs, row + ca, dy2, &all_terms),
                         }
                     }
                 }
             }
         }
+        terms_of.flush(how, arch, out);
     }
 
-    /// The squared vertical distances from height `z` to filament `e` and to its images in the
-    /// seabed and the surface, in the order [`CellIndex::concentration`] adds them, and how many.
-    fn terms(&self, e: &Entry, z: f64) -> ([f64; 3], usize) {
+    /// The squared vertical distances below `lim2` from height `z` to filament `e` and to its
+    /// images in the seabed and the surface, in the order [`CellIndex::concentration`] adds
+    /// them, and how many.
+    fn terms(&self, e: &Entry, z: f64, lim2: f64) -> ([f64; 3], usize) {
         let mut t = [0.0; 3];
         let mut n = 0;
         for dz in [
@@ -422,8 +485,11 @@ impl CellIndex {
         .into_iter()
         .flatten()
         {
-            t[n] = dz * dz;
-            n += 1;
+            let dz2 = dz * dz;
+            if dz2 < lim2 {
+                t[n] = dz2;
+                n += 1;
+            }
         }
         (t, n)
     }
