@@ -22,10 +22,13 @@ pub enum CampaignError {
         message: String,
     },
     /// A scenario with a configuration and sweep point does not build.
-    #[error("{file}: {group}: {message}")]
+    #[error("{file}{}: {group}: {message}", line.map(|l| format!(" line {l}")).unwrap_or_default())]
     Group {
         /// The campaign file.
         file: String,
+        /// The line of the campaign file that gives the key at fault, when it gives it (a key
+        /// of the scenario's own file is not in it).
+        line: Option<usize>,
         /// Scenario, configuration and sweep point.
         group: String,
         /// The scenario or planner error (with its key path).

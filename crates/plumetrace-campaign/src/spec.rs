@@ -516,8 +516,9 @@ impl Campaign {
     ) -> Result<plumetrace_scenario::ScenarioConfig, CampaignError> {
         let t = self.group_table(scenario, config, point, seed_index)?;
         let origin = &self.scenarios[scenario].origin;
-        plumetrace_scenario::from_table(t, origin)
-            .map_err(|e| self.group_error(scenario, config, point, e.to_string()))
+        plumetrace_scenario::from_table(t, origin).map_err(|e| {
+            self.group_error_at(scenario, config, point, e.to_string(), scenario_key(&e))
+        })
     }
 
     /// A readable name of a group for errors and tables.
@@ -540,11 +541,51 @@ impl Campaign {
         point: usize,
         message: String,
     ) -> CampaignError {
+        self.group_error_at(scenario, config, point, message, None)
+    }
+
+    /// [`Campaign::group_error`] for the scenario key `key` (`planner.beta_deg`,
+    /// `plume.vertical_diffusivity_m2ps`), with the line of the campaign file that sets it.
+    fn group_error_at(
+        &self,
+        scenario: usize,
+        config: usize,
+        point: usize,
+        message: String,
+        key: Option<&str>,
+    ) -> CampaignError {
         CampaignError::Group {
             file: self.path.display().to_string(),
+            line: key.and_then(|k| self.line_setting(config, point, k)),
             group: self.group_name(scenario, config, point),
             message,
         }
+    }
+
+    /// The line of the campaign file that gives scenario key `key` to configuration `config`
+    /// at sweep point `point`: the sweep's key, else the configuration's `set`, else its planner
+    /// table (the order they are applied in, last first). A bare key of `set` and of the sweep is
+    /// the planner's; a planner key is the last part of `planner.NAME` or `planners.P.NAME`.
+    fn line_setting(&self, config: usize, point: usize, key: &str) -> Option<usize> {
+        let locate = |path: String| plumetrace_scenario::locate::line_of(&self.text, &path);
+        let planner_key = key.strip_prefix("planner.").or_else(|| {
+            key.strip_prefix("planners.")
+                .and_then(|k| k.split_once('.'))
+                .map(|(_, k)| k)
+        });
+        let gives = |k: &str| k == key || (!k.contains('.') && Some(k) == planner_key);
+        if let Some((k, _)) = self.points[point].values.iter().find(|(k, _)| gives(k)) {
+            return locate(format!("sweep.{}", quoted(k)));
+        }
+        let c = &self.configs[config];
+        if let Some(k) = c.set.keys().find(|k| gives(k)) {
+            return locate(format!("configs[{config}].set.{}", quoted(k)));
+        }
+        let name = planner_key?;
+        c.planner
+            .as_ref()?
+            .contains_key(name)
+            .then(|| locate(format!("configs[{config}].planner.{}", quoted(name))))?
     }
 
     /// Builds every group once (scenario and planner settings), so a bad key fails before any
@@ -557,8 +598,9 @@ impl Campaign {
                     // A family is checked on its first site (every site has the same keys).
                     let cfg = self.group_config(s, c, p, 0)?;
                     let origin = &self.scenarios[s].origin;
-                    let built = plumetrace_scenario::build(&cfg, origin, None)
-                        .map_err(|e| self.group_error(s, c, p, e.to_string()))?;
+                    let built = plumetrace_scenario::build(&cfg, origin, None).map_err(|e| {
+                        self.group_error_at(s, c, p, e.to_string(), scenario_key(&e))
+                    })?;
                     if built.mission.is_none() {
                         return Err(self.group_error(
                             s,
@@ -572,8 +614,15 @@ impl Campaign {
                         ));
                     }
                     // The planner registry checks every planner key (set and sweep included).
-                    let setup = plumetrace_mission::MissionSetup::new(built)
-                        .map_err(|e| self.group_error(s, c, p, e.to_string()))?;
+                    let setup = plumetrace_mission::MissionSetup::new(built).map_err(|e| {
+                        let key = match &e {
+                            plumetrace_mission::MissionError::Invalid { error, .. } => {
+                                Some(error.key.as_str())
+                            }
+                            _ => None,
+                        };
+                        self.group_error_at(s, c, p, e.to_string(), key)
+                    })?;
                     for (_, key, why) in setup.inert_keys {
                         // Named by config (and sweep point): every scenario gives its keys.
                         let mut group = format!("config '{}'", self.configs[c].name);
@@ -875,6 +924,17 @@ fn sweep_points(
 }
 
 /// A key as written in a key path.
+/// The key path a scenario error names, if any.
+fn scenario_key(e: &plumetrace_scenario::ScenarioError) -> Option<&str> {
+    match e {
+        plumetrace_scenario::ScenarioError::Parse { path, .. }
+        | plumetrace_scenario::ScenarioError::Invalid { path, .. } => {
+            (!path.is_empty()).then_some(path.as_str())
+        }
+        _ => None,
+    }
+}
+
 fn quoted(key: &str) -> String {
     plumetrace_core::params::quoted_key(key)
 }
@@ -948,6 +1008,53 @@ mod tests {
             e.contains("planner.beta_deg") && e.contains("unknown field"),
             "{e}"
         );
+    }
+
+    #[test]
+    fn a_bad_key_is_named_with_the_campaign_line_that_gives_it() {
+        let head = "name = \"c\"\nseed = 1\nseeds = 1\nscenarios = [\"demo\"]\n\n\
+                    [[configs]]\nname = \"ok\"\n\n";
+        let path = Path::new("c.toml");
+        let error = |tail: &str| {
+            let text = format!("{head}{tail}");
+            let file = parse_campaign(&text, path).unwrap();
+            let mut c = Campaign::resolve(file, path, text, true).unwrap();
+            c.check_groups().unwrap_err().to_string()
+        };
+        // A planner table's key (line 13), a bare `set` key, a dotted `set` path to a planner
+        // and to another table (line 11), a swept key (line 10).
+        let cases = [
+            (
+                "[[configs]]\nname = \"b\"\n[configs.planner]\nkind = \"amp\"\nbeta_dgs = 3.0\n",
+                "c.toml line 13: scenario 'demo', config 'b'",
+                "planner.beta_dgs: unknown field",
+            ),
+            (
+                "[[configs]]\nname = \"b\"\nset = { beta_deg = 300.0 }\n",
+                "c.toml line 11: scenario 'demo', config 'b'",
+                "planner.beta_deg: must be >= 0",
+            ),
+            (
+                "[[configs]]\nname = \"b\"\nset = { \"planner.l_u_m\" = \"x\" }\n",
+                "c.toml line 11: scenario 'demo', config 'b'",
+                "planner.l_u_m: invalid type",
+            ),
+            (
+                "[[configs]]\nname = \"b\"\nset = { \"plume.vertical_diffusivity_m2ps\" = -1.0 }\n",
+                "c.toml line 11: scenario 'demo', config 'b'",
+                "plume.vertical_diffusivity_m2ps: must be >= 0",
+            ),
+            (
+                "[sweep]\nl_c_m = [\n  10.0,\n  -1.0,\n]\n",
+                "c.toml line 10: scenario 'demo', config 'ok', sweep l_c_m=-1.0",
+                "planner.l_c_m: must be >= 0",
+            ),
+        ];
+        for (tail, head_of_error, what) in cases {
+            let e = error(tail);
+            assert!(e.starts_with(head_of_error), "{e}");
+            assert!(e.contains(what), "{e}");
+        }
     }
 
     #[test]
