@@ -18,7 +18,7 @@
 # - a campaign of `--seeds` seeds (default 1000) of `duck-2003-st`, `plumetrace campaign --jobs
 #   N` (default 2), whole process with runs.csv, summary and charts written;
 # - `plumetrace bench missions --runs 48 --threads J` once per build.
-# The two campaigns' runs.csv must be the same apart from the run-time columns; the script stops
+# The two campaigns' runs.csv must be the same (apart from any run-time column); the script stops
 # if they are not.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -217,7 +217,8 @@ end="<!-- performance.sh end -->"
     echo "duck-2003-st --seed 7 --stats\` on one thread (\`RAYON_NUM_THREADS=1\`) with every default"
     echo "output; the campaign is \`plumetrace campaign FILE --out DIR --jobs $jobs\` over \`scenarios ="
     echo "[\"duck-2003-st\"]\`, \`seeds = $seeds\`, one configuration, timed as a whole process with"
-    echo "its files written; the two builds' runs.csv are the same apart from the run times."
+    echo "its files written; the two builds' runs.csv are the same (the script compares them, any"
+    echo "column of run times set aside, and stops if they differ)."
     echo
     echo "$section"
     echo

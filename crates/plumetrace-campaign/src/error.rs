@@ -12,10 +12,12 @@ pub enum CampaignError {
         message: String,
     },
     /// The campaign file is malformed or has a bad value.
-    #[error("{file}: {}{message}", if key.is_empty() { String::new() } else { format!("{key}: ") })]
+    #[error("{file}{}: {}{message}", line.map(|l| format!(" line {l}")).unwrap_or_default(), if key.is_empty() { String::new() } else { format!("{key}: ") })]
     Invalid {
         /// The campaign file.
         file: String,
+        /// The line of the key in the file (or of the table it belongs in), when known.
+        line: Option<usize>,
         /// Key path in it (empty for syntax errors, which name their line).
         key: String,
         /// What is wrong.
@@ -88,6 +90,19 @@ pub enum RunError {
 }
 
 impl CampaignError {
+    /// The error with the line of its key in `text` (the campaign file's), where it names a key
+    /// and has no line yet: the key's own line, or the table's it belongs in
+    /// ([`plumetrace_scenario::locate::line_of`]).
+    pub fn located(mut self, text: &str) -> Self {
+        if let CampaignError::Invalid { line, key, .. } = &mut self
+            && line.is_none()
+            && !key.is_empty()
+        {
+            *line = plumetrace_scenario::locate::line_of(text, key);
+        }
+        self
+    }
+
     pub(crate) fn io(path: &std::path::Path, e: impl std::fmt::Display) -> Self {
         CampaignError::Io {
             path: path.display().to_string(),

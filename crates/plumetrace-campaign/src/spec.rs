@@ -89,6 +89,9 @@ pub struct ScenarioEntry {
     pub table: toml::Table,
     /// A family of sites (a `.family.toml` entry): each seed index flies its own site.
     pub family: Option<Family>,
+    /// The scenario file's text, to name the line of a key it gives (empty for a preset, a
+    /// family or a file not read).
+    pub text: String,
 }
 
 /// One sweep point: the value of each swept key.
@@ -211,35 +214,79 @@ pub fn parse_campaign(text: &str, path: &Path) -> Result<CampaignFile, CampaignE
             plumetrace_scenario::first_datetime(&toml::Value::Table(table), "")
     {
         return Err(CampaignError::Invalid {
+            line: None,
             file,
             key,
             message: format!("is a date/time ({value}); no campaign key takes one"),
         });
     }
     let de = toml::Deserializer::parse(text).map_err(|e| CampaignError::Invalid {
+        line: None,
         file: file.clone(),
         key: String::new(),
         message: e.to_string(),
     })?;
-    serde_path_to_error::deserialize(de).map_err(|e| {
+    let mut parsed: CampaignFile = serde_path_to_error::deserialize(de).map_err(|e| {
         let key = e.path().to_string();
         let inner = e.into_inner();
         // With a key path the message and its line; without one, the parser's whole report,
         // which shows where.
         if key == "." {
+            // A key missing at the top needs no excerpt of the file.
+            let message = if inner.message().starts_with("missing field") {
+                plumetrace_scenario::locate::suggest(inner.message())
+            } else {
+                plumetrace_core::toml_message(&inner, false)
+            };
             CampaignError::Invalid {
+                line: None,
                 file,
                 key: String::new(),
-                message: plumetrace_core::toml_message(&inner, false),
+                message,
             }
         } else {
             CampaignError::Invalid {
+                line: inner
+                    .span()
+                    .map(|s| plumetrace_scenario::locate::line_at(text, s.start.min(text.len()))),
                 file,
                 key,
-                message: plumetrace_scenario::locate::message_with_line(&inner, text),
+                message: plumetrace_scenario::locate::suggest(inner.message()),
             }
         }
-    })
+    })?;
+    for c in &mut parsed.configs {
+        c.set = dotted(std::mem::take(&mut c.set));
+    }
+    parsed.sweep = dotted(std::mem::take(&mut parsed.sweep));
+    Ok(parsed)
+}
+
+/// `set` and `sweep` keys as dotted paths: `plume.vertical_diffusivity_m2ps = 0.002` written
+/// without quotes is TOML for a table `plume` holding the key, which is read as the path it spells
+/// (no scenario key set this way takes a table); a quoted `"flow.mean" = { ... }` stays one key
+/// whose value is the table.
+fn dotted(table: toml::Table) -> toml::Table {
+    fn walk(prefix: &str, table: toml::Table, out: &mut toml::Table) {
+        for (k, v) in table {
+            let key = if prefix.is_empty() {
+                k
+            } else {
+                format!("{prefix}.{k}")
+            };
+            match v {
+                toml::Value::Table(inner) if !key.contains('.') || !prefix.is_empty() => {
+                    walk(&key, inner, out)
+                }
+                v => {
+                    out.insert(key, v);
+                }
+            }
+        }
+    }
+    let mut out = toml::Table::new();
+    walk("", table, &mut out);
+    out
 }
 
 impl Campaign {
@@ -264,11 +311,12 @@ impl Campaign {
         if let Some(n) = seeds {
             file.seeds = n;
         }
-        let mut c = Campaign::resolve(file, path, text, true)?;
+        let mut c =
+            Campaign::resolve(file, path, text.clone(), true).map_err(|e| e.located(&text))?;
         if test_seeds == TestSeeds::Refuse {
-            c.refuse_test_seeds()?;
+            c.refuse_test_seeds().map_err(|e| e.located(&text))?;
         }
-        c.check_groups()?;
+        c.check_groups().map_err(|e| e.located(&text))?;
         Ok(c)
     }
 
@@ -287,6 +335,7 @@ impl Campaign {
             if let Some(hit) = set.test_seed_use(name, self.file.seed, self.file.seeds) {
                 let task = set.task(&hit.task).ok();
                 return Err(CampaignError::Invalid {
+                    line: None,
                     file: self.path.display().to_string(),
                     key: "seed".into(),
                     message: format!(
@@ -318,6 +367,7 @@ impl Campaign {
     ) -> Result<Self, CampaignError> {
         let fname = path.display().to_string();
         let invalid = |key: String, message: String| CampaignError::Invalid {
+            line: None,
             file: fname.clone(),
             key,
             message,
@@ -469,6 +519,7 @@ impl Campaign {
         let c = &self.configs[config];
         if let Some(p) = &c.planner {
             let path = planner_path(&t).map_err(|e| CampaignError::Invalid {
+                line: None,
                 file: self.path.display().to_string(),
                 key: format!("configs[{config}].planner"),
                 message: e.to_string(),
@@ -476,6 +527,7 @@ impl Campaign {
             let segments: Vec<&str> = path.split('.').collect();
             set_path(&mut t, &segments, toml::Value::Table(p.clone())).map_err(|e| {
                 CampaignError::Invalid {
+                    line: None,
                     file: self.path.display().to_string(),
                     key: format!("configs[{config}].planner"),
                     message: e.to_string(),
@@ -484,6 +536,7 @@ impl Campaign {
         }
         for (k, v) in &c.set {
             set_key(&mut t, k, v.clone()).map_err(|e| CampaignError::Invalid {
+                line: None,
                 file: self.path.display().to_string(),
                 key: format!("configs[{config}].set.{}", quoted(k)),
                 message: e.to_string(),
@@ -491,6 +544,7 @@ impl Campaign {
         }
         for (k, v) in &self.points[point].values {
             set_key(&mut t, k, v.clone()).map_err(|e| CampaignError::Invalid {
+                line: None,
                 file: self.path.display().to_string(),
                 key: format!("sweep.{}", quoted(k)),
                 message: e.to_string(),
@@ -516,9 +570,8 @@ impl Campaign {
     ) -> Result<plumetrace_scenario::ScenarioConfig, CampaignError> {
         let t = self.group_table(scenario, config, point, seed_index)?;
         let origin = &self.scenarios[scenario].origin;
-        plumetrace_scenario::from_table(t, origin).map_err(|e| {
-            self.group_error_at(scenario, config, point, e.to_string(), scenario_key(&e))
-        })
+        plumetrace_scenario::from_table(t, origin)
+            .map_err(|e| self.group_error_at(scenario, config, point, e.to_string(), e.key_path()))
     }
 
     /// A readable name of a group for errors and tables.
@@ -554,9 +607,23 @@ impl Campaign {
         message: String,
         key: Option<&str>,
     ) -> CampaignError {
+        let line = key.and_then(|k| self.line_setting(config, point, k));
+        // A key the campaign does not give comes from the scenario's own file: its line there,
+        // after the file's name that starts the scenario's message.
+        let entry = &self.scenarios[scenario];
+        let in_scenario = key
+            .filter(|_| line.is_none())
+            .and_then(|k| plumetrace_scenario::locate::line_of_key(&entry.text, k));
+        let message = match in_scenario {
+            Some(l) => {
+                let origin = format!("{}: ", entry.origin);
+                message.replacen(&origin, &format!("{}:{l}: ", entry.origin), 1)
+            }
+            None => message,
+        };
         CampaignError::Group {
             file: self.path.display().to_string(),
-            line: key.and_then(|k| self.line_setting(config, point, k)),
+            line,
             group: self.group_name(scenario, config, point),
             message,
         }
@@ -567,25 +634,40 @@ impl Campaign {
     /// table (the order they are applied in, last first). A bare key of `set` and of the sweep is
     /// the planner's; a planner key is the last part of `planner.NAME` or `planners.P.NAME`.
     fn line_setting(&self, config: usize, point: usize, key: &str) -> Option<usize> {
-        let locate = |path: String| plumetrace_scenario::locate::line_of(&self.text, &path);
+        // `name` in the table at `table`: written as one quoted key, or as the dotted path it
+        // spells when written unquoted.
+        let locate = |table: String, name: &str| {
+            let at = |p: String| plumetrace_scenario::locate::line_of_key(&self.text, &p);
+            at(format!("{table}.{}", quoted(name)))
+                .or_else(|| at(format!("{table}.{}", dotted_path(name))))
+        };
         let planner_key = key.strip_prefix("planner.").or_else(|| {
             key.strip_prefix("planners.")
                 .and_then(|k| k.split_once('.'))
                 .map(|(_, k)| k)
         });
-        let gives = |k: &str| k == key || (!k.contains('.') && Some(k) == planner_key);
+        // A key the error names, or one under a table it names (`plumes` for a `set` of
+        // `plumes.vertical_diffusivity_m2ps`).
+        let gives = |k: &str| {
+            k == key
+                || k.strip_prefix(key)
+                    .is_some_and(|rest| rest.starts_with('.'))
+                || (!k.contains('.') && Some(k) == planner_key)
+        };
         if let Some((k, _)) = self.points[point].values.iter().find(|(k, _)| gives(k)) {
-            return locate(format!("sweep.{}", quoted(k)));
+            return locate("sweep".into(), k);
         }
         let c = &self.configs[config];
         if let Some(k) = c.set.keys().find(|k| gives(k)) {
-            return locate(format!("configs[{config}].set.{}", quoted(k)));
+            return locate(format!("configs[{config}].set"), k);
         }
+        // The configuration's planner table replaces the scenario's: a planner key it lacks
+        // (`kind`, missing) belongs there too.
         let name = planner_key?;
-        c.planner
-            .as_ref()?
-            .contains_key(name)
-            .then(|| locate(format!("configs[{config}].planner.{}", quoted(name))))?
+        c.planner.as_ref()?;
+        let table = format!("configs[{config}].planner");
+        locate(table.clone(), name)
+            .or_else(|| plumetrace_scenario::locate::line_of(&self.text, &table))
     }
 
     /// Builds every group once (scenario and planner settings), so a bad key fails before any
@@ -598,9 +680,8 @@ impl Campaign {
                     // A family is checked on its first site (every site has the same keys).
                     let cfg = self.group_config(s, c, p, 0)?;
                     let origin = &self.scenarios[s].origin;
-                    let built = plumetrace_scenario::build(&cfg, origin, None).map_err(|e| {
-                        self.group_error_at(s, c, p, e.to_string(), scenario_key(&e))
-                    })?;
+                    let built = plumetrace_scenario::build(&cfg, origin, None)
+                        .map_err(|e| self.group_error_at(s, c, p, e.to_string(), e.key_path()))?;
                     if built.mission.is_none() {
                         return Err(self.group_error(
                             s,
@@ -780,6 +861,7 @@ fn scenario_entry(
                 .map_or(Origin::File(p), |f| f.base_origin.clone()),
             table: family.as_ref().map(|f| f.base.clone()).unwrap_or_default(),
             family,
+            text: String::new(),
         });
     }
     let (origin, text) = if s.ends_with(".toml") {
@@ -806,11 +888,16 @@ fn scenario_entry(
     let table: toml::Table = text.parse().map_err(|e: toml::de::Error| {
         invalid(format!("scenarios[{i}]"), format!("{origin}: {e}"))
     })?;
+    let text = match origin {
+        Origin::File(_) => text,
+        _ => String::new(),
+    };
     Ok(ScenarioEntry {
         label: s.to_string(),
         origin,
         table,
         family: None,
+        text,
     })
 }
 
@@ -924,15 +1011,9 @@ fn sweep_points(
 }
 
 /// A key as written in a key path.
-/// The key path a scenario error names, if any.
-fn scenario_key(e: &plumetrace_scenario::ScenarioError) -> Option<&str> {
-    match e {
-        plumetrace_scenario::ScenarioError::Parse { path, .. }
-        | plumetrace_scenario::ScenarioError::Invalid { path, .. } => {
-            (!path.is_empty()).then_some(path.as_str())
-        }
-        _ => None,
-    }
+/// A dotted key's parts, each quoted as a key path needs.
+fn dotted_path(key: &str) -> String {
+    key.split('.').map(quoted).collect::<Vec<_>>().join(".")
 }
 
 fn quoted(key: &str) -> String {
@@ -1054,6 +1135,102 @@ mod tests {
             let e = error(tail);
             assert!(e.starts_with(head_of_error), "{e}");
             assert!(e.contains(what), "{e}");
+        }
+        // More places: an unquoted dotted path (TOML's nested table) in `set`, a misspelled
+        // table in one, a planner table without `kind` (its own line).
+        let cases = [
+            (
+                "[[configs]]\nname = \"b\"\n[configs.set]\nplume.vertical_diffusivity_m2s = 1.0\n",
+                "c.toml line 12: scenario 'demo', config 'b'",
+                "plume.vertical_diffusivity_m2s: unknown field",
+            ),
+            (
+                "[[configs]]\nname = \"b\"\nset = { \"plumes.vertical_diffusivity_m2ps\" = 1.0 }\n",
+                "c.toml line 11: scenario 'demo', config 'b'",
+                "plumes: unknown field",
+            ),
+            (
+                "[[configs]]\nname = \"b\"\n[configs.planner]\nbeta_deg = 30.0\n",
+                "c.toml line 11: scenario 'demo', config 'b'",
+                "planner.kind: missing",
+            ),
+        ];
+        for (tail, head_of_error, what) in cases {
+            let e = error(tail);
+            assert!(e.starts_with(head_of_error), "{e}");
+            assert!(e.contains(what), "{e}");
+        }
+    }
+
+    #[test]
+    fn dotted_keys_written_without_quotes_are_the_paths_they_spell() {
+        let text = "name = \"c\"\nseed = 1\nseeds = 1\nscenarios = [\"demo\"]\n\
+                    [[configs]]\nname = \"b\"\n[configs.set]\n\
+                    plume.vertical_diffusivity_m2ps = 0.002\nmission.time_limit_s = 600\n\
+                    beta_deg = 25.0\n\"flow.mean\" = { speed_mps = 0.2, toward_deg = 80.0 }\n\
+                    [sweep]\nplanner.l_u_m = [12.0, 18.0]\n";
+        let path = Path::new("c.toml");
+        let file = parse_campaign(text, path).unwrap();
+        let set: Vec<&str> = file.configs[0].set.keys().map(String::as_str).collect();
+        assert_eq!(
+            set,
+            [
+                "beta_deg",
+                "flow.mean",
+                "mission.time_limit_s",
+                "plume.vertical_diffusivity_m2ps"
+            ]
+        );
+        assert!(
+            file.configs[0].set["flow.mean"].is_table(),
+            "a quoted key keeps its table"
+        );
+        assert_eq!(file.sweep.keys().collect::<Vec<_>>(), ["planner.l_u_m"]);
+        let mut c = Campaign::resolve(file, path, text.to_string(), true).unwrap();
+        c.check_groups().unwrap();
+        let t = c.group_table(0, 0, 1, 0).unwrap();
+        assert_eq!(
+            t["plume"]["vertical_diffusivity_m2ps"].as_float(),
+            Some(0.002)
+        );
+        assert_eq!(t["mission"]["time_limit_s"].as_integer(), Some(600));
+        assert_eq!(t["planner"]["l_u_m"].as_float(), Some(18.0));
+        assert_eq!(t["flow"]["mean"]["toward_deg"].as_float(), Some(80.0));
+    }
+
+    #[test]
+    fn a_key_of_the_scenario_file_is_named_with_its_line_there_and_file_errors_with_theirs() {
+        let dir = tempfile::tempdir().unwrap();
+        let scenario = plumetrace_scenario::find_preset("demo")
+            .unwrap()
+            .toml
+            .replace("kind = \"amp\"", "kind = \"amp\"\nbeta_dgs = 20.0");
+        std::fs::write(dir.path().join("s.toml"), &scenario).unwrap();
+        let line = scenario
+            .lines()
+            .position(|l| l.starts_with("beta_dgs"))
+            .unwrap()
+            + 1;
+        let path = dir.path().join("c.toml");
+        let text = "name = \"c\"\nseed = 1\nseeds = 1\nscenarios = [\"s.toml\"]\n";
+        std::fs::write(&path, text).unwrap();
+        let e = Campaign::load(&path, None).unwrap_err().to_string();
+        assert!(
+            e.contains(&format!("s.toml:{line}: planner.beta_dgs: unknown field")),
+            "{e}"
+        );
+        assert!(!e.contains("c.toml line"), "{e}");
+        // The campaign file's own bad values name their lines.
+        for (bad, want) in [
+            ("seeds = 0", "c.toml line 3: seeds: must be 1 to"),
+            (
+                "seeds = 1\nsuccess_radius_m = -5.0",
+                "c.toml line 4: success_radius_m:",
+            ),
+        ] {
+            std::fs::write(&path, text.replace("seeds = 1", bad)).unwrap();
+            let e = Campaign::load(&path, None).unwrap_err().to_string();
+            assert!(e.contains(want), "{e}");
         }
     }
 

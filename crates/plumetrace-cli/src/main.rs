@@ -304,8 +304,9 @@ fn planners_text() -> String {
 /// How the flow steps along plume steps of `dt_s`, for `check` ([`plumetrace_env::flow_schedule`]).
 fn flow_steps(flow: &dyn plumetrace_env::FlowField, dt_s: f64) -> String {
     match plumetrace_env::flow_schedule(flow, dt_s) {
-        (1, n) => format!("{n} flow sub-steps per step"),
-        (every, _) => format!("the flow grid steps once per {every} steps"),
+        (1, 1) => "once per plume step".into(),
+        (1, n) => format!("{n} times per plume step"),
+        (every, _) => format!("once per {every} plume steps"),
     }
 }
 
@@ -335,7 +336,11 @@ fn check(args: &load::ScenarioArgs) -> Result<()> {
             );
         }
         if plumetrace_env::flow_schedule(built.env.flow(), dt) != (1, 1) {
-            let _ = write!(series, "; {}", flow_steps(built.env.flow(), dt));
+            let _ = write!(
+                series,
+                "; the flow steps {}",
+                flow_steps(built.env.flow(), dt)
+            );
         }
         crate::outln!("{file}: ok (plume run, {steps} steps of {dt} s{series})");
         return Ok(());
@@ -362,7 +367,8 @@ fn check(args: &load::ScenarioArgs) -> Result<()> {
         setup.spec.spinup_dt_s,
         match flow {
             Some(limit) => format!(
-                " (the flow's stable limit {limit:.1} s: {} and {})",
+                " (the flow's stable limit is {limit:.1} s and it steps at most half of that: \
+                 {} in the mission, {} in the spin-up)",
                 sub(env.dt_s()),
                 sub(setup.spec.spinup_dt_s)
             ),

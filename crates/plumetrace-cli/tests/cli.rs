@@ -465,7 +465,7 @@ fn check_says_how_the_flow_grid_steps() {
     // The preset's grid steps every 0.05 s under 0.01 s puff steps.
     let out = check(&text);
     assert!(
-        out.contains("the flow grid steps once per 5 steps"),
+        out.contains("the flow steps once per 5 plume steps"),
         "{out}"
     );
     // With the plume's step (no block), nothing is said.
@@ -479,7 +479,7 @@ fn check_says_how_the_flow_grid_steps() {
     // A plume step beyond half the grid's stable limit takes sub-steps.
     let coarse = along.replace("dt_s = 0.01", "dt_s = 0.5");
     let out = check(&coarse);
-    assert!(out.contains("flow sub-steps per step"), "{out}");
+    assert!(out.contains(" times per plume step"), "{out}");
 }
 
 #[test]

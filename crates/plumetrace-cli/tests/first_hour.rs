@@ -220,7 +220,7 @@ fn set_and_planner_change_the_scenario_as_a_campaign_does() {
         ),
         (
             &["--set", "sources.3.x_m=1"],
-            "error: --set \"sources.3.x_m=1\": 'sources.3': index 3 past the 1 entries",
+            "error: --set \"sources.3.x_m=1\": 'sources.3': index 3 is past the end: the array has 1 entry, index 0",
         ),
     ];
     for (extra, want) in cases {

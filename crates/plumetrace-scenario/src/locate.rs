@@ -8,11 +8,24 @@ use toml::de::{DeTable, DeValue};
 /// key, a key set from elsewhere) the deepest table on its way that is written. `None` when the
 /// text does not parse or nothing of the path is in it.
 pub fn line_of(text: &str, path: &str) -> Option<usize> {
+    walk(text, path).map(|(line, _)| line)
+}
+
+/// The 1-based line at which `path` itself is written in `text`; `None` when it is not (unlike
+/// [`line_of`], no table on its way stands in for it).
+pub fn line_of_key(text: &str, path: &str) -> Option<usize> {
+    walk(text, path).and_then(|(line, whole)| whole.then_some(line))
+}
+
+/// The line of the deepest step of `path` written in `text`, and whether that is all of it.
+fn walk(text: &str, path: &str) -> Option<(usize, bool)> {
     let root = DeValue::Table(DeTable::parse(text).ok()?.into_inner());
     let mut here = &root;
     let mut found: Option<usize> = None;
-    for segment in segments(path) {
-        let next = match (&segment, here) {
+    let steps = segments(path);
+    let mut taken = 0;
+    for segment in steps.iter() {
+        let next = match (segment, here) {
             (Segment::Key(k), DeValue::Table(t)) => t
                 .iter()
                 .find(|(name, _)| name.get_ref().as_ref() == k.as_str())
@@ -25,8 +38,9 @@ pub fn line_of(text: &str, path: &str) -> Option<usize> {
         let Some((start, value)) = next else { break };
         found = Some(start);
         here = value;
+        taken += 1;
     }
-    found.map(|start| line_at(text, start))
+    found.map(|start| (line_at(text, start), taken == steps.len()))
 }
 
 /// The 1-based line of byte `offset` in `text`.

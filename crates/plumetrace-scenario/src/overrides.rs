@@ -30,7 +30,7 @@ pub enum OverrideError {
         segment: String,
     },
     /// An index past the end of an array.
-    #[error("'{at}': index {index} past the {len} entries")]
+    #[error("'{at}': index {index} is past the end: {}", entries(*len))]
     PastTheEnd {
         /// The path up to and with the index.
         at: String,
@@ -147,6 +147,15 @@ pub fn planner_path(table: &toml::Table) -> Result<String, OverrideError> {
     }
 }
 
+/// How many entries an array has, and its indices, in words.
+fn entries(len: usize) -> String {
+    match len {
+        0 => "the array is empty".into(),
+        1 => "the array has 1 entry, index 0".into(),
+        n => format!("the array has {n} entries, indices 0 to {}", n - 1),
+    }
+}
+
 /// Sets `key` in a scenario table: a bare name is a key of the scenario's planner (see
 /// [`planner_path`]); a dotted path walks tables, and whole-number segments index arrays
 /// (`sources.0.mass_rate_per_s`).
@@ -260,7 +269,10 @@ mod tests {
         assert_eq!(t["sources"][0]["x_m"].as_float(), Some(5.0));
         assert_eq!(t["plume"]["growth_rate_m2ps"].as_float(), Some(0.01));
         let cases = [
-            ("sources.3.x_m", "'sources.3': index 3 past the 1 entries"),
+            (
+                "sources.3.x_m",
+                "'sources.3': index 3 is past the end: the array has 1 entry, index 0",
+            ),
             (
                 "sources.a.x_m",
                 "'sources.a': 'a' is not an index of an array",

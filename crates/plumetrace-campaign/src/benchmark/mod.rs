@@ -472,6 +472,7 @@ impl Entrant {
         let mut table: toml::Table =
             text.parse()
                 .map_err(|e: toml::de::Error| CampaignError::Invalid {
+                    line: None,
                     file: path.display().to_string(),
                     key: String::new(),
                     message: e.to_string(),
@@ -490,6 +491,7 @@ impl Entrant {
                 .map(|k| k.name())
                 .collect();
             return Err(CampaignError::Invalid {
+                line: None,
                 file: path.display().to_string(),
                 key: "kind".into(),
                 message: match given {

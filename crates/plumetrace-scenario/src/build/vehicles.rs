@@ -56,9 +56,17 @@ pub(super) fn vehicles(
             .iter()
             .any(|v| v.planner.as_deref() == Some(n.as_str()))
     }) {
+        // A scenario with one `[planner]` that met a `planners.NAME...` key set from outside
+        // (an override, a campaign's `set`) meant that table.
+        let message = if cfg.planner.is_some() && cfg.planners.len() == 1 {
+            "no vehicle flies it: this scenario's planner is its one [planner] table; give its \
+             keys as `planner.KEY` (or bare, `KEY`, in --set and a campaign's set and sweep)"
+        } else {
+            "no vehicle flies it (name it in a vehicle: planner = \"NAME\")"
+        };
         return Err(Invalid::new(
             format!("planners.{}", quoted_key(name)),
-            "no vehicle flies it (name it in a vehicle: planner = \"NAME\")",
+            message,
         ));
     }
     Ok(vehicles)
