@@ -5,6 +5,8 @@
 //!   ([`plume`](mod@plume));
 //! - [`missions()`]: missions per second of a mission preset on several thread counts;
 //! - [`map()`]: the source-likelihood map's update at an op-area's size;
+//! - [`raster()`]: the display rasters a run draws (the figure's averaged plume, the page's
+//!   frames), per query;
 //! - [`infotaxis()`]: infotaxis in the windy grid world of the published benchmark
 //!   ([`gridworld`]).
 //!
@@ -16,12 +18,14 @@ pub mod gridworld;
 pub mod map;
 pub mod missions;
 pub mod plume;
+pub mod raster;
 
 pub use error::BenchError;
 pub use gridworld::{InfotaxisBench, InfotaxisBenchOptions, Policy, infotaxis};
 pub use map::{MapBench, MapBenchOptions, map};
 pub use missions::{MissionBench, MissionBenchOptions, MissionBenchRow, StageSplit, missions};
 pub use plume::{Case, PlumeBench, PlumeBenchOptions, plume};
+pub use raster::{RasterBench, RasterBenchOptions, RasterGrid, raster};
 
 /// The median of a list (NaN for an empty one).
 pub(crate) fn median(values: &[f64]) -> f64 {

@@ -1,12 +1,14 @@
 //! `plumetrace bench plume` times the plume model; `plumetrace bench missions` times whole
 //! missions on several thread counts; `plumetrace bench infotaxis` runs the windy grid-world
 //! benchmark of infotaxis; `plumetrace bench map` times the source-likelihood map's update at the
-//! Duck op-area size. Each prints one JSON object. The benchmarks are in [`plumetrace_bench`];
+//! Duck op-area size; `plumetrace bench raster` times the display rasters a run draws. Each prints
+//! one JSON object. The benchmarks are in [`plumetrace_bench`];
 //! here are their flags.
 
 use anyhow::Result;
 use plumetrace_bench::{
     InfotaxisBenchOptions, MapBenchOptions, MissionBenchOptions, PlumeBenchOptions,
+    RasterBenchOptions,
 };
 
 /// Benchmarks.
@@ -20,6 +22,23 @@ pub enum BenchCommand {
     Infotaxis(InfotaxisBenchArgs),
     /// Cost of one update of the source-likelihood map over a preset's op-area.
     Map(MapBenchArgs),
+    /// Cost of one query of the display rasters a run draws (the figure's averaged plume, the
+    /// replay page's frames), on a preset's plume after its spin-up, on one thread.
+    Raster(RasterBenchArgs),
+}
+
+/// Arguments of `plumetrace bench raster`.
+#[derive(Debug, clap::Args)]
+pub struct RasterBenchArgs {
+    /// Mission preset whose plume and op-area are drawn.
+    #[arg(long, default_value = "duck-2003-st")]
+    preset: String,
+    /// Run seed (the plume's realisation).
+    #[arg(long, default_value_t = 7, allow_hyphen_values = true, value_parser = crate::args::seed)]
+    seed: u64,
+    /// Queries of each grid to time, in each precision.
+    #[arg(long, default_value_t = 50, allow_hyphen_values = true, value_parser = crate::args::runs)]
+    queries: u64,
 }
 
 /// Arguments of `plumetrace bench map`.
@@ -176,6 +195,13 @@ pub fn run(cmd: &BenchCommand) -> Result<()> {
                 preset: a.preset.clone(),
                 resolution: a.resolution,
                 samples: a.samples,
+            })?)?
+        }
+        BenchCommand::Raster(a) => {
+            serde_json::to_string_pretty(&plumetrace_bench::raster(&RasterBenchOptions {
+                preset: a.preset.clone(),
+                seed: a.seed,
+                queries: a.queries,
             })?)?
         }
         BenchCommand::Infotaxis(a) => {

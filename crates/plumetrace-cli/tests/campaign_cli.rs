@@ -198,3 +198,25 @@ fn bench_missions_reports_rates_per_thread_count() {
         .unwrap();
     assert!(String::from_utf8_lossy(&out.stderr).contains("not a mission"));
 }
+
+#[test]
+fn bench_raster_times_the_grids_a_run_draws_in_both_precisions() {
+    let out = run_ok(&["bench", "raster", "--preset", "demo", "--queries", "2"]);
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert!(v["filaments"].as_u64().unwrap() > 100, "{v}");
+    // The figure's grid is 160 points across; the page's at most 96 on its longer side.
+    assert_eq!(v["figure"]["points"][0], 160);
+    assert_eq!(v["page"]["points"][0], 96);
+    for grid in ["figure", "page"] {
+        let g = &v[grid];
+        assert!(g["ms_per_query_display"].as_f64().unwrap() > 0.0, "{g}");
+        assert!(g["ms_per_query_standard"].as_f64().unwrap() > 0.0, "{g}");
+        let d = g["max_relative_difference"].as_f64().unwrap();
+        assert!((0.0..1e-15).contains(&d), "{g}");
+    }
+    let out = bin()
+        .args(["bench", "raster", "--preset", "pompy"])
+        .output()
+        .unwrap();
+    assert!(String::from_utf8_lossy(&out.stderr).contains("not a mission"));
+}

@@ -249,14 +249,7 @@ impl Flight {
                 .plume_frames_every_s
                 .filter(|s| s.is_finite() && *s > 0.0)
                 .map(|every| {
-                    let (x0, x1, y0, y1) = crate::record::bounds_of(&spec.op_area);
-                    let pad = 0.15 * (x1 - x0).max(y1 - y0);
-                    PlumeFrames::new(
-                        (x0 - pad, x1 + pad, y0 - pad, y1 + pad),
-                        env.domain(),
-                        z,
-                        steps_of(every, dt_s),
-                    )
+                    PlumeFrames::over(&spec.op_area, env.domain(), z, steps_of(every, dt_s))
                 });
             let faults = setups
                 .iter()

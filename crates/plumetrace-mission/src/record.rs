@@ -530,6 +530,24 @@ pub const PLUME_FRAME_MAX_SIDE: usize = 96;
 pub const FLOW_FRAME_MAX_SIDE: usize = 12;
 
 impl PlumeFrames {
+    /// The replay page's frames of a mission: over the op-area `vertices` with a 15 % margin
+    /// (clipped to `domain`), at height `z_m`, one every `every_steps` steps.
+    pub fn over(
+        vertices: &[Vec2],
+        domain: plumetrace_env::Rect,
+        z_m: f64,
+        every_steps: u64,
+    ) -> Self {
+        let (x0, x1, y0, y1) = bounds_of(vertices);
+        let pad = 0.15 * (x1 - x0).max(y1 - y0);
+        PlumeFrames::new(
+            (x0 - pad, x1 + pad, y0 - pad, y1 + pad),
+            domain,
+            z_m,
+            every_steps,
+        )
+    }
+
     /// Frames over `bounds` (x0, x1, y0, y1, m, clipped to `domain`) at height `z_m`, one every
     /// `every_steps` steps.
     pub fn new(
