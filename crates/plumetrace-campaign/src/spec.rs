@@ -264,8 +264,10 @@ pub fn parse_campaign(text: &str, path: &Path) -> Result<CampaignFile, CampaignE
 
 /// `set` and `sweep` keys as dotted paths: `plume.vertical_diffusivity_m2ps = 0.002` written
 /// without quotes is TOML for a table `plume` holding the key, which is read as the path it spells
-/// (no scenario key set this way takes a table); a quoted `"flow.mean" = { ... }` stays one key
-/// whose value is the table.
+/// (a bare key with a table value could only have been a planner key, and no planner key takes a
+/// table). So an unquoted `flow.mean = { speed_mps = 0.2 }` sets `flow.mean.speed_mps` and keeps
+/// the scenario's other `flow.mean` keys, where a quoted `"flow.mean" = { ... }` stays one key
+/// whose table replaces the scenario's (docs/campaigns.md says so).
 fn dotted(table: toml::Table) -> toml::Table {
     fn walk(prefix: &str, table: toml::Table, out: &mut toml::Table) {
         for (k, v) in table {
@@ -646,12 +648,15 @@ impl Campaign {
                 .and_then(|k| k.split_once('.'))
                 .map(|(_, k)| k)
         });
-        // A key the error names, or one under a table it names (`plumes` for a `set` of
-        // `plumes.vertical_diffusivity_m2ps`).
+        // A key the error names, one under a table it names (`plumes` for a `set` of
+        // `plumes.vertical_diffusivity_m2ps`) or a table over it (a `set` of `flow.mean` for
+        // `flow.mean.speed_mps`), however the paths are written (`sources[0]`, `sources.0`).
+        let steps = plumetrace_scenario::locate::path_steps(key);
         let gives = |k: &str| {
-            k == key
-                || k.strip_prefix(key)
-                    .is_some_and(|rest| rest.starts_with('.'))
+            let given = plumetrace_scenario::locate::path_steps(k);
+            let n = given.len().min(steps.len());
+            (k.contains('.') && given[..n] == steps[..n])
+                || k == key
                 || (!k.contains('.') && Some(k) == planner_key)
         };
         if let Some((k, _)) = self.points[point].values.iter().find(|(k, _)| gives(k)) {
@@ -1010,12 +1015,12 @@ fn sweep_points(
     Ok(points)
 }
 
-/// A key as written in a key path.
 /// A dotted key's parts, each quoted as a key path needs.
 fn dotted_path(key: &str) -> String {
     key.split('.').map(quoted).collect::<Vec<_>>().join(".")
 }
 
+/// A key as written in a key path.
 fn quoted(key: &str) -> String {
     plumetrace_core::params::quoted_key(key)
 }
@@ -1137,8 +1142,20 @@ mod tests {
             assert!(e.contains(what), "{e}");
         }
         // More places: an unquoted dotted path (TOML's nested table) in `set`, a misspelled
-        // table in one, a planner table without `kind` (its own line).
+        // table in one, a planner table without `kind` (its own line), an index the error
+        // writes `sources[0]`, a table whose key is at fault.
         let cases = [
+            (
+                "[[configs]]\nname = \"b\"\nset = { \"sources.0.z_m\" = -3.0 }\n",
+                "c.toml line 11: scenario 'demo', config 'b'",
+                "sources[0].z_m: must be >= 0",
+            ),
+            (
+                "[[configs]]\nname = \"b\"\n\
+                 set = { \"flow.mean\" = { speed_mps = -1.0, toward_deg = 80.0 } }\n",
+                "c.toml line 11: scenario 'demo', config 'b'",
+                "flow.mean.speed_mps: must be >= 0",
+            ),
             (
                 "[[configs]]\nname = \"b\"\n[configs.set]\nplume.vertical_diffusivity_m2s = 1.0\n",
                 "c.toml line 12: scenario 'demo', config 'b'",

@@ -43,6 +43,18 @@ fn walk(text: &str, path: &str) -> Option<(usize, bool)> {
     found.map(|start| (line_at(text, start), taken == steps.len()))
 }
 
+/// The steps of a key path, however it is written: `sources[0].z_m`, `sources.0.z_m` and
+/// `"sources".0."z_m"` all give `sources`, `0`, `z_m`.
+pub fn path_steps(path: &str) -> Vec<String> {
+    segments(path)
+        .into_iter()
+        .map(|s| match s {
+            Segment::Key(k) => k,
+            Segment::Index(i) => i.to_string(),
+        })
+        .collect()
+}
+
 /// The 1-based line of byte `offset` in `text`.
 pub fn line_at(text: &str, offset: usize) -> usize {
     text.get(..offset)

@@ -323,6 +323,17 @@ fn planner_tables_are_wired_to_vehicles_with_key_paths() {
                 + "\n[planners.tracer]\nkind = \"amp\"\n",
             "planner: no vehicle flies it",
         ),
+        // Beside `[planner]`, a `[planners.NAME]` written with a kind and flown by no vehicle,
+        // and one made by a key set from outside (no kind), which meant `[planner]`.
+        (
+            find_preset("demo").unwrap().toml.to_string() + "\n[planners.survey]\nkind = \"amp\"\n",
+            "planners.survey: no vehicle flies it (name it in a vehicle: planner = \"NAME\")",
+        ),
+        (
+            find_preset("demo").unwrap().toml.to_string()
+                + "\n[planners.tracer]\nbeta_deg = 20.0\n",
+            "planners.tracer: no vehicle flies it: this scenario's planner is its one [planner] table",
+        ),
     ];
     for (text, want) in cases {
         let e = error_of(text);

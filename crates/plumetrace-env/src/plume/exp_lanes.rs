@@ -13,7 +13,8 @@
 #[inline(always)]
 pub(crate) fn exp_nonpositive(x: f64) -> f64 {
     const LOG2_E: f64 = std::f64::consts::LOG2_E;
-    // ln 2 split so that `k * LN2_HI` is exact for |k| < 2^20 (its low 32 bits are zero).
+    // ln 2 split so that `k * LN2_HI` is exact for |k| < 2^21 (its low 21 bits are zero; here
+    // |k| <= 1010).
     const LN2_HI: f64 = 6.931_471_803_691_238e-1;
     const LN2_LO: f64 = 1.908_214_929_270_587_7e-10;
     // 1.5 * 2^52: adding it rounds to a whole number, which then sits in the low bits.

@@ -348,7 +348,11 @@ impl CellIndex {
     /// grid that is not a proper lattice (a single row or column, a spacing that is not finite
     /// and positive) is queried point by point.
     pub(crate) fn grid_concentrations(&self, grid: &GridSpec, out: &mut [f64], how: TermExp) {
-        let Some(axes) = self.grid_axes(grid) else {
+        // A band's points are numbered in 32 bits (`Gathered::at`).
+        let axes = self
+            .grid_axes(grid)
+            .filter(|_| grid.nx.saturating_mul(grid.ny) <= u32::MAX as usize);
+        let Some(axes) = axes else {
             for (o, p) in out.iter_mut().zip(grid.points()) {
                 *o = self.concentration(p);
             }

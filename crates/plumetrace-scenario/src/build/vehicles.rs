@@ -56,9 +56,12 @@ pub(super) fn vehicles(
             .iter()
             .any(|v| v.planner.as_deref() == Some(n.as_str()))
     }) {
-        // A scenario with one `[planner]` that met a `planners.NAME...` key set from outside
-        // (an override, a campaign's `set`) meant that table.
-        let message = if cfg.planner.is_some() && cfg.planners.len() == 1 {
+        // A `[planners.NAME]` without a kind beside a `[planner]` was made by a key set from
+        // outside (an override, a campaign's `set`) that meant the `[planner]` table.
+        let made_by_a_key = cfg.planners[name]
+            .keys()
+            .all(|k| k != "kind" && k != "strategy");
+        let message = if cfg.planner.is_some() && cfg.planners.len() == 1 && made_by_a_key {
             "no vehicle flies it: this scenario's planner is its one [planner] table; give its \
              keys as `planner.KEY` (or bare, `KEY`, in --set and a campaign's set and sweep)"
         } else {
