@@ -11,8 +11,11 @@
 //!   (declares a source there), `source_estimate = (x, y)` (telemetry), `done = True` (the
 //!   mission is over for this vehicle).
 //!
-//! An optional attribute `decision_period_s` (default 1 s) sets how often it is asked. A Python
-//! exception in `decide`, or a command that breaks these rules, stops the vehicle and is raised
+//! An optional attribute `decision_period_s` (default 1 s) sets how often it is asked. An optional
+//! method `run_ended(t_s) -> None or (x, y)` is called once when the run ends for a reason the
+//! planner did not choose (the time limit, a collision, leaving the domain): a point it returns
+//! is declared then (a point it was holding for a later declaration). A Python exception in
+//! `decide` or `run_ended`, or an answer that breaks these rules, stops the vehicle and is raised
 //! by `run` once the mission has ended.
 
 use crate::error::msg;
@@ -223,5 +226,52 @@ impl Planner for PyPlanner {
 
     fn decision_period_s(&self) -> f64 {
         self.period_s
+    }
+
+    fn run_ended(&mut self, t_s: f64) -> Vec<PlannerEvent> {
+        if self.failed {
+            return Vec::new();
+        }
+        match Python::attach(|py| self.held_point(py, t_s)) {
+            Ok(point) => point
+                .map(|pos_m| PlannerEvent::Declared {
+                    pos_m,
+                    rule: DeclarationKind::CUSTOM,
+                })
+                .into_iter()
+                .collect(),
+            Err(e) => {
+                self.failed = true;
+                if let Ok(mut slot) = self.error.lock() {
+                    slot.get_or_insert(e);
+                }
+                Vec::new()
+            }
+        }
+    }
+}
+
+impl PyPlanner {
+    /// What the object's optional `run_ended(t_s)` returns: `None`, or a point to declare.
+    fn held_point(&self, py: Python<'_>, t_s: f64) -> PyResult<Option<Vec2>> {
+        let obj = self.obj.bind(py);
+        if !obj.hasattr("run_ended")? {
+            return Ok(None);
+        }
+        let answer = obj.call_method1("run_ended", (t_s,))?;
+        if answer.is_none() {
+            return Ok(None);
+        }
+        let bad = || {
+            msg(format!(
+                "run_ended at {t_s:.1} s returned {answer}, not None or a point (x, y) of finite \
+                 numbers"
+            ))
+        };
+        let (x, y): (f64, f64) = answer.extract().map_err(|_| bad())?;
+        if !(x.is_finite() && y.is_finite()) {
+            return Err(bad());
+        }
+        Ok(Some(Vec2::new(x, y)))
     }
 }

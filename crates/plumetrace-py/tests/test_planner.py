@@ -112,3 +112,52 @@ def test_a_bad_command_is_an_error_naming_the_key(planner, words):
 def test_an_object_without_decide_is_refused():
     with pytest.raises(plumetrace.PlumetraceError, match="decide"):
         plumetrace.run("demo", planner=object())
+
+
+class HoldsAPoint:
+    """Due east at `speed` (the demo's east edge is 50 m from its start); holds a point it
+    declares only when told its run ended."""
+
+    decision_period_s = 1.0
+
+    def __init__(self, speed, answer=(101.0, 2.0)):
+        self.speed = speed
+        self.answer = answer
+        self.told = []
+
+    def decide(self, s):
+        return {"heading_deg": 90.0, "speed_mps": self.speed, "altitude_m": 3.0}
+
+    def run_ended(self, t_s):
+        self.told.append(t_s)
+        return self.answer
+
+
+def test_a_held_point_is_declared_when_the_run_ends_for_the_world():
+    # Out of the domain: the point is declared after the incident, once; the outcome stays it.
+    p = HoldsAPoint(2.5)
+    r = plumetrace.run("demo", seed=1, planner=p, set={"mission.time_limit_s": 600.0})
+    assert r.outcome == "left_domain"
+    assert len(p.told) == 1 and p.told[0] < 100.0
+    d = r.summary["first_declaration"]
+    assert (d["x_m"], d["y_m"]) == (101.0, 2.0)
+    assert d["rule"] == "custom"
+    # The time limit: declared then, and the mission counts it.
+    p = HoldsAPoint(0.5)
+    r = plumetrace.run("demo", seed=1, planner=p, set={"mission.time_limit_s": 60.0})
+    assert r.outcome == "declared" and len(p.told) == 1
+    # Nothing held: nothing declared.
+    r = plumetrace.run(
+        "demo", seed=1, planner=HoldsAPoint(0.5, None), set={"mission.time_limit_s": 60.0}
+    )
+    assert r.summary["first_declaration"] is None
+
+
+def test_a_bad_held_point_is_an_error_naming_run_ended():
+    with pytest.raises(plumetrace.PlumetraceError, match="run_ended at .* not None or a point"):
+        plumetrace.run(
+            "demo",
+            seed=1,
+            planner=HoldsAPoint(0.5, (1.0, float("nan"))),
+            set={"mission.time_limit_s": 60.0},
+        )
