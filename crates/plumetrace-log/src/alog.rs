@@ -264,7 +264,17 @@ impl<W: Write> AlogWriter<W> {
             }
             VerticalCommand::Surface => self.num(t, "DESIRED_DEPTH", 0.0)?,
         }
-        for e in &d.events {
+        self.events(t, &d.events)?;
+        if d.status != PlanStatus::Running {
+            self.post(t, "CPT_STATUS", variant_name(&d.status).unwrap_or("?"))?;
+        }
+        Ok(())
+    }
+
+    /// Posts a planner's events at `t` (a decision's, or what it reported as its run ended):
+    /// behaviours, detections and declarations.
+    pub fn events(&mut self, t: f64, events: &[PlannerEvent]) -> std::io::Result<()> {
+        for e in events {
             match e {
                 PlannerEvent::Behaviour { behaviour } => {
                     self.post(t, "CPT_BEHAVIOUR", variant_name(behaviour).unwrap_or("?"))?;
@@ -283,9 +293,6 @@ impl<W: Write> AlogWriter<W> {
                 )?,
                 _ => {}
             }
-        }
-        if d.status != PlanStatus::Running {
-            self.post(t, "CPT_STATUS", variant_name(&d.status).unwrap_or("?"))?;
         }
         Ok(())
     }

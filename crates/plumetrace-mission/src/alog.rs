@@ -139,6 +139,16 @@ impl Observer for AlogObserver {
                 return;
             }
         }
+        // What a planner reported as the world ended its run (a declaration it held).
+        for (k, events) in step.ended {
+            let Some(Some(f)) = self.writers.get_mut(*k) else {
+                continue;
+            };
+            if let Err(e) = f.writer.events(step.report.t_s, events) {
+                self.error = Some(RecordError::file(&f.path, e));
+                return;
+            }
+        }
     }
 
     fn wants_snapshots(&self) -> bool {

@@ -819,6 +819,7 @@ impl plumetrace_core::Planner for HoldsAPoint {
 #[test]
 fn a_point_held_when_the_run_ends_for_the_world_is_declared_as_on_a_vehicle() {
     let held = plumetrace_core::Vec2::new(101.0, 2.0);
+    let dir = tempfile::tempdir().unwrap();
     let fly = |speed_mps: f64, limit_s: f64| {
         let setup = MissionSetup::new(shortened("demo", 0.0, limit_s, 1)).unwrap();
         let mut m = Mission::new(setup, MissionOptions::default()).unwrap();
@@ -827,8 +828,24 @@ fn a_point_held_when_the_run_ends_for_the_world_is_declared_as_on_a_vehicle() {
             held: Some(held),
         };
         m.replace_planner(0, Box::new(planner)).unwrap();
+        let planned: Vec<bool> = m.planned().iter().map(Option::is_some).collect();
+        let alog = plumetrace_mission::alog::AlogObserver::create(
+            dir.path(),
+            &m.vehicle_names(),
+            &planned,
+        )
+        .unwrap();
+        m.observe(Box::new(alog)).unwrap();
         m.run(&mut |_, _| {}).unwrap();
         m.finish().unwrap()
+    };
+    // The .alog posts the declaration too.
+    let alog_declarations = || {
+        let text = std::fs::read_to_string(dir.path().join("auv.alog")).unwrap();
+        text.lines()
+            .filter(|l| l.contains("CPT_DECLARATION"))
+            .map(str::to_string)
+            .collect::<Vec<_>>()
     };
     let declared = |run: &plumetrace_mission::MissionRun| -> Vec<f64> {
         run.events
@@ -846,6 +863,12 @@ fn a_point_held_when_the_run_ends_for_the_world_is_declared_as_on_a_vehicle() {
     assert_eq!(run.summary.declarations.len(), 1);
     let d = &run.summary.declarations[0];
     assert_eq!((d.x_m, d.y_m), (held.x, held.y));
+    let posted = alog_declarations();
+    assert_eq!(posted.len(), 1, "{posted:?}");
+    assert!(
+        posted[0].contains("x=101.00,y=2.00,rule=held"),
+        "{posted:?}"
+    );
     // Leaving the domain (east edge 50 m from the start at 2.5 m/s) ends the run: the point is
     // declared after the incident, once, and the outcome stays the failure.
     let run = fly(2.5, 600.0);
