@@ -245,13 +245,21 @@ pub fn parse_campaign(text: &str, path: &Path) -> Result<CampaignFile, CampaignE
                 message,
             }
         } else {
+            let mut message = plumetrace_scenario::locate::suggest(inner.message());
+            if key == "seeds" {
+                // Its bounds, not the type's (0 is refused too).
+                message = message.replace(
+                    "expected a whole number, 0 or more",
+                    &format!("expected a whole number from 1 to {MAX_SEEDS}"),
+                );
+            }
             CampaignError::Invalid {
                 line: inner
                     .span()
                     .map(|s| plumetrace_scenario::locate::line_at(text, s.start.min(text.len()))),
                 file,
                 key,
-                message: plumetrace_scenario::locate::suggest(inner.message()),
+                message,
             }
         }
     })?;
@@ -1240,6 +1248,11 @@ mod tests {
         // The campaign file's own bad values name their lines.
         for (bad, want) in [
             ("seeds = 0", "c.toml line 3: seeds: must be 1 to"),
+            (
+                "seeds = 2.5",
+                "c.toml line 3: seeds: invalid type: floating point `2.5`, expected a whole \
+                 number from 1 to 1000000",
+            ),
             (
                 "seeds = 1\nsuccess_radius_m = -5.0",
                 "c.toml line 4: success_radius_m:",
