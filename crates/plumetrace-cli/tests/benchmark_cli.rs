@@ -269,7 +269,7 @@ fn benchmark_errors_name_what_is_wrong() {
             "--out",
             o,
         ],
-        "mine.toml: kind: 'mot' is not a planner (did you mean 'moth'?)",
+        "mine.toml line 1: kind: 'mot' is not a planner (did you mean 'moth'?)",
     );
     std::fs::write(&bad, "kind = \"moth\"\nspeed_mp = 3.0\n").unwrap();
     fails_with(

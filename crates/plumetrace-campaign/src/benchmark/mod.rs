@@ -490,8 +490,11 @@ impl Entrant {
                 .iter()
                 .map(|k| k.name())
                 .collect();
+            let line = ["kind", "planner.kind"]
+                .iter()
+                .find_map(|k| plumetrace_scenario::locate::line_of_key(&text, k));
             return Err(CampaignError::Invalid {
-                line: None,
+                line,
                 file: path.display().to_string(),
                 key: "kind".into(),
                 message: match given {
