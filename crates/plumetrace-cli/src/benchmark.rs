@@ -1,7 +1,7 @@
 //! `plumetrace benchmark`: every task of the shipped task set flown on its test seeds by the
 //! planners asked for, each task a campaign (parallel, resumable), then the leaderboard.
 
-use anyhow::{Context, Result};
+use anyhow::Result;
 use plumetrace_campaign::benchmark::{
     BenchmarkOptions, Entrant, Given, Task, TaskDone, TaskSet, Watch, plan, run_benchmark,
 };
@@ -78,9 +78,16 @@ fn given(set: &TaskSet, a: &BenchmarkArgs) -> Result<Vec<Given>> {
     }
     for f in &a.planner_file {
         let e = Entrant::from_file(f)?;
-        if let Some(t) = &e.planner {
-            plumetrace_planner::PlannerConfig::from_table(t, "")
-                .with_context(|| f.display().to_string())?;
+        if let Some(t) = &e.planner
+            && let Err(error) = plumetrace_planner::PlannerConfig::from_table(t, "")
+        {
+            // The key's line in the file (written bare or under `[planner]`).
+            let text = std::fs::read_to_string(f).unwrap_or_default();
+            let line = [error.key.clone(), format!("planner.{}", error.key)]
+                .iter()
+                .find_map(|k| plumetrace_scenario::locate::line_of_key(&text, k));
+            let at = line.map(|l| format!(" line {l}")).unwrap_or_default();
+            return Err(anyhow::anyhow!("{}{at}: {error}", f.display()));
         }
         given.push(Given::file(e));
     }

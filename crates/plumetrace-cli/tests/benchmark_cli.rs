@@ -282,7 +282,7 @@ fn benchmark_errors_name_what_is_wrong() {
             "--out",
             o,
         ],
-        "mine.toml: speed_mp: unknown field `speed_mp`; did you mean `speed_mps`?",
+        "mine.toml line 2: speed_mp: unknown field `speed_mp`; did you mean `speed_mps`?",
     );
     let foreign = tmp.path().join("foreign");
     std::fs::create_dir_all(&foreign).unwrap();
