@@ -219,7 +219,9 @@ fn fly(onboard: &Onboard, args: &OnboardArgs) -> Result<()> {
         anyhow::bail!("writing {}: {e}", log_path.display());
     }
     log.finish()?;
-    alog.finish()
+    // What the planner reported as the run ended (a declaration it held) is posted too.
+    alog.events(report.time_s, &report.ended_events)
+        .and_then(|()| alog.finish())
         .and_then(|w| w.into_inner().map_err(|e| e.into_error()))
         .with_context(|| format!("writing {}", alog_path.display()))?;
     pending.commit()?;

@@ -299,6 +299,7 @@ impl<'a> Flight<'a> {
             if let PlannerEvent::Declared { pos_m, .. } = e {
                 self.s.report.declarations.push(pos_m);
             }
+            self.s.report.ended_events.push(e);
         }
         if link.connected() {
             link.send(Outgoing::Finished, self.s.stamp());

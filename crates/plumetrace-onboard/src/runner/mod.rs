@@ -88,6 +88,10 @@ pub struct RunReport {
     pub pauses: Vec<Pause>,
     /// Declared source positions, m.
     pub declarations: Vec<Vec2>,
+    /// What the planner reported when the run ended for a reason it did not choose
+    /// (`Planner::run_ended`: a declaration it was holding), at `time_s`; its declarations are
+    /// among `declarations` too.
+    pub ended_events: Vec<plumetrace_core::PlannerEvent>,
     /// Lines accepted and rejected by the link.
     pub lines: LineCounts,
 }
@@ -328,5 +332,13 @@ mod tests {
         let report = flight.ended(&mut link, RunEnd::LinkGaveUp);
         assert_eq!(report.end, RunEnd::LinkGaveUp);
         assert_eq!(report.declarations, vec![Vec2::new(100.0, -2.0)]);
+        // The events themselves, for the .alog (with their rule).
+        assert_eq!(
+            report.ended_events,
+            vec![plumetrace_core::PlannerEvent::Declared {
+                pos_m: Vec2::new(100.0, -2.0),
+                rule: plumetrace_core::DeclarationKind::new("held"),
+            }]
+        );
     }
 }

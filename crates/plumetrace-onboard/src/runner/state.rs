@@ -55,6 +55,7 @@ impl State {
                 connections: 0,
                 pauses: Vec::new(),
                 declarations: Vec::new(),
+                ended_events: Vec::new(),
                 lines: LineCounts::default(),
             },
         }
