@@ -1143,16 +1143,9 @@ mod tests {
                 "c.toml line 10: scenario 'demo', config 'ok', sweep l_c_m=-1.0",
                 "planner.l_c_m: must be >= 0",
             ),
-        ];
-        for (tail, head_of_error, what) in cases {
-            let e = error(tail);
-            assert!(e.starts_with(head_of_error), "{e}");
-            assert!(e.contains(what), "{e}");
-        }
-        // More places: an unquoted dotted path (TOML's nested table) in `set`, a misspelled
-        // table in one, a planner table without `kind` (its own line), an index the error
-        // writes `sources[0]`, a table whose key is at fault.
-        let cases = [
+            // More places: an index the error writes `sources[0]`, a table whose key is at
+            // fault, an unquoted dotted path (TOML's nested table) in `set`, a misspelled table
+            // in one, a planner table without `kind` (its own line).
             (
                 "[[configs]]\nname = \"b\"\nset = { \"sources.0.z_m\" = -3.0 }\n",
                 "c.toml line 11: scenario 'demo', config 'b'",

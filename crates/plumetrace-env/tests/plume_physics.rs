@@ -47,6 +47,20 @@ fn filaments(env: &Environment) -> &FilamentPlume {
     env.plume().filaments().unwrap()
 }
 
+/// The grid over `(x0, x1, y0, y1)` of `(nx, ny)` points at height `z`.
+fn grid(bounds: (f64, f64, f64, f64), (nx, ny): (usize, usize), z: f64) -> GridSpec {
+    let (x_min_m, x_max_m, y_min_m, y_max_m) = bounds;
+    GridSpec {
+        x_min_m,
+        x_max_m,
+        y_min_m,
+        y_max_m,
+        nx,
+        ny,
+        z_m: z,
+    }
+}
+
 fn run(env: &mut Environment, seconds: f64) {
     let n = (seconds / env.dt_s()).round() as u64;
     for _ in 0..n {
@@ -932,15 +946,7 @@ fn a_grid_query_is_bit_for_bit_the_point_by_point_query() {
             (0.0, 200.0, 0.0, 1.0, 50, 1),
             (13.7, 151.3, -47.1, 33.3, 3, 2),
         ] {
-            let spec = GridSpec {
-                x_min_m: x0,
-                x_max_m: x1,
-                y_min_m: y0,
-                y_max_m: y1,
-                nx,
-                ny,
-                z_m: z,
-            };
+            let spec = grid((x0, x1, y0, y1), (nx, ny), z);
             let pts = spec.points();
             let mut grid = vec![f64::NAN; pts.len()];
             env.plume().grid_concentrations(&spec, &pts, &mut grid);
@@ -967,15 +973,7 @@ fn a_display_grid_is_within_a_few_units_in_the_last_place_and_the_same_whatever_
             (-10.0, 200.0, -60.0, 60.0, 211, 121),
             (13.7, 151.3, -47.1, 33.3, 19, 11),
         ] {
-            let spec = GridSpec {
-                x_min_m: x0,
-                x_max_m: x1,
-                y_min_m: y0,
-                y_max_m: y1,
-                nx,
-                ny,
-                z_m: z,
-            };
+            let spec = grid((x0, x1, y0, y1), (nx, ny), z);
             let pts = spec.points();
             let on = |threads: usize| {
                 let pool = rayon::ThreadPoolBuilder::new()

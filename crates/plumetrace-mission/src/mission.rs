@@ -459,13 +459,9 @@ impl Flight {
                 }
             }
         }
-        // Vehicles flying on after their planners' own decisions: an incident now ends their
-        // runs for a reason the planners did not choose.
-        let flying: Vec<bool> = self
-            .statuses
-            .iter()
-            .map(|s| *s == VehicleStatus::Active)
-            .collect();
+        // Vehicles an incident stops while still flying (not finished or aborted by their
+        // planners this step): their runs end for a reason the planners did not choose.
+        let mut stopped: Vec<usize> = Vec::new();
         for (id, e) in &report.events {
             if let WorldEvent::Incident { what } = e {
                 let k = id.0 as usize;
@@ -473,6 +469,9 @@ impl Flight {
                 if self.statuses[k] != VehicleStatus::NoPlanner {
                     self.first_failure
                         .get_or_insert(Outcome::of_incident(*what));
+                }
+                if self.statuses[k] == VehicleStatus::Active {
+                    stopped.push(k);
                 }
                 self.statuses[k] = VehicleStatus::of_incident(*what);
             }
@@ -493,13 +492,15 @@ impl Flight {
         // (an incident, the time limit), as on a vehicle: a declaration it was holding.
         let time_limit = matches!(self.end, Some(e) if e.reason == EndReason::TimeLimit);
         let mut ended = Vec::new();
-        for (k, planner) in self.planners.iter_mut().enumerate() {
-            let Some(planner) = planner else { continue };
-            let stopped = flying[k] && self.statuses[k] != VehicleStatus::Active;
-            if stopped || (time_limit && self.statuses[k] == VehicleStatus::Active) {
-                let events = planner.run_ended(t);
-                if !events.is_empty() {
-                    ended.push((k, events));
+        if time_limit || !stopped.is_empty() {
+            for (k, planner) in self.planners.iter_mut().enumerate() {
+                let Some(planner) = planner else { continue };
+                let active = self.statuses[k] == VehicleStatus::Active;
+                if stopped.contains(&k) || (time_limit && active) {
+                    let events = planner.run_ended(t);
+                    if !events.is_empty() {
+                        ended.push((k, events));
+                    }
                 }
             }
         }
