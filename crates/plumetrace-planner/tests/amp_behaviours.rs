@@ -46,6 +46,16 @@ fn amp_with(p: AmpParams) -> Amp {
     Amp::new(p, area, vec![], Heading::NORTH)
 }
 
+/// The fix smoothing moving only what was saved while flow readings were held back (no fix
+/// error, no drift between fixes assumed).
+fn held_back_only(p: AmpParams) -> AmpParams {
+    AmpParams {
+        fix_error_m: 0.0,
+        fix_drift_mps: 0.0,
+        ..p
+    }
+}
+
 /// The paper's behaviour where the defaults depart from it.
 fn paper() -> AmpParams {
     AmpParams {
@@ -1107,7 +1117,7 @@ fn a_lost_point_saved_while_flow_readings_were_held_back_moves_with_the_next_fix
         }
         a.lost_points()
     };
-    let moved = fly(AmpParams::default());
+    let moved = fly(held_back_only(AmpParams::default()));
     assert_eq!(moved.len(), 1);
     assert!(
         (moved[0] - Vec2::new(203.2, 300.0)).norm() < 1e-9,
@@ -1160,11 +1170,11 @@ fn after_held_back_flow_readings_the_declaration_waits_for_the_next_fix() {
             .count()
     };
     let fly = |p: AmpParams, fixes: bool| {
-        let mut a = amp_with(AmpParams {
+        let mut a = amp_with(held_back_only(AmpParams {
             declaration_confirm_m: 0.0,
             declaration_fix_frames: 1,
             ..p
-        });
+        }));
         let held_back = move |mut s: SensorSnapshot| {
             if fixes && s.time_s >= 5.0 {
                 s.nav.last_fix_s = Some(5.0);
@@ -1264,10 +1274,11 @@ fn the_declared_point_is_the_mean_of_points_from_two_fix_frames() {
     // the next point. A fix at `t_fix` moves the estimate 3 m East and 4 m South: the same three
     // losses, seen there, make (203, 290), and the mean (201.5, 292) is declared. (The held
     // point's lost points stay in the list of six while the next frame's are more upflow.)
-    let p = AmpParams {
+    // Only held-back stretches move here (a fix and its smoothing: the next test).
+    let p = held_back_only(AmpParams {
         declaration_confirm_m: 0.0,
         ..AmpParams::default()
-    };
+    });
     assert_eq!(p.declaration_fix_frames, 2, "the default");
     let t_fix = 400.0;
     let nav = move |mut s: SensorSnapshot| {
@@ -1312,6 +1323,85 @@ fn the_declared_point_is_the_mean_of_points_from_two_fix_frames() {
     let declared = declared_at(&events);
     assert_eq!(declared.len(), 1, "{declared:?}");
     assert!((declared[0] - Vec2::new(200.0, 294.0)).norm() < 1e-9);
+}
+
+#[test]
+fn each_held_point_moves_with_the_fix_that_ends_its_frame() {
+    // Fixes at 5, 400 and 800 s; the estimate jumps by j1 = (3, -4) at 400 s and by
+    // j2 = (4, 2) at 800 s, records every second. Frame 1's three losses (saved at 56, 73 and
+    // 90 s) make (200, 294), held; frame 2's (at 407, 424 and 441 s), seen 3 m East and 4 m
+    // South, make (203, 290), held until the fix at 800 s ends its frame. Each moves by the
+    // mean of its lost points' shares of the jump that ends its frame, (16 + 1e-4 t T) /
+    // (32 + 1e-4 T^2) at the defaults (fix_error_m 4, fix_drift_mps 0.01), t into a stretch of T;
+    // their mean is declared at the fix.
+    let p = AmpParams {
+        declaration_confirm_m: 0.0,
+        ..AmpParams::default()
+    };
+    assert_eq!(
+        (p.fix_error_m, p.fix_drift_mps),
+        (4.0, 0.01),
+        "the defaults"
+    );
+    let (j1, j2) = (Vec2::new(3.0, -4.0), Vec2::new(4.0, 2.0));
+    let nav = move |mut s: SensorSnapshot| {
+        let (fix, offset) = match s.time_s {
+            t if t >= 800.0 => (Some(800.0), j1 + j2),
+            t if t >= 400.0 => (Some(400.0), j1),
+            t if t >= 5.0 => (Some(5.0), Vec2::zeros()),
+            _ => (None, Vec2::zeros()),
+        };
+        s.nav.last_fix_s = fix;
+        s.nav.pos_m = s.nav.pos_m.map(|q| q + offset);
+        s
+    };
+    let mut a = amp_with(p);
+    // Records every second from `from` up to (not including) `to`, standing still.
+    let wait = |a: &mut Amp, from: f64, to: f64| {
+        let mut events = Vec::new();
+        let mut t = from;
+        while t < to {
+            events.extend(a.decide(&nav(snap(t, (150.0, 250.0), 90.0, false))).events);
+            t += 1.0;
+        }
+        events
+    };
+    let (mut events, t) = three_losses(&mut a, &nav);
+    assert!(declared_at(&events).is_empty(), "the first point is held");
+    // The fix's record where the records before it were: the jump is measured against them.
+    events.extend(wait(&mut a, t, 401.0));
+    let mut t = 401.0;
+    for at in THREE_LOSSES {
+        events.extend(lose_edited(&mut a, &mut t, at, &nav));
+    }
+    events.extend(wait(&mut a, t, 800.0));
+    assert!(
+        declared_at(&events).is_empty(),
+        "the second point waits for the fix that ends its frame"
+    );
+    let at_fix = a.decide(&nav(snap(800.0, (150.0, 250.0), 90.0, false)));
+    let declared = declared_at(&at_fix.events);
+    assert_eq!(
+        declared.len(),
+        1,
+        "declared at the fix: {:?}",
+        at_fix.events
+    );
+    let share = |saved: [f64; 3], span: f64| {
+        saved
+            .iter()
+            .map(|t| (16.0 + 1e-4 * t * span) / (32.0 + 1e-4 * span * span))
+            .sum::<f64>()
+            / 3.0
+    };
+    let first = Vec2::new(200.0, 294.0) + j1 * share([51.0, 68.0, 85.0], 395.0);
+    let second = Vec2::new(203.0, 290.0) + j2 * share([7.0, 24.0, 41.0], 400.0);
+    let expected = (first + second) / 2.0;
+    assert!(
+        (declared[0] - expected).norm() < 1e-9,
+        "expected {expected:?}, declared {declared:?}"
+    );
+    assert!((expected - Vec2::new(201.5, 292.0)).norm() > 1.0, "moved");
 }
 
 #[test]

@@ -153,12 +153,18 @@ plumetrace_core::params! {
         flow_gate_deg: f64 = 90.0, "deg", Bounds::closed(1.0, 180.0);
         /// How long implausible flow readings must persist to be believed.
         flow_gate_persist_s: f64 = 1800.0, "s", Bounds::non_negative(1e6);
-        /// At each position fix after flow readings were held back (flow_gate_deg), move the lost points saved since the fix before by the share of the fix's jump the navigation had drifted by when each was saved: the share of the held-back time that had passed by then (false: lost points stay where the navigation put them, as flown in the field). A vehicle that dead-reckons with its current meter drifts while the readings are held back (with the last plausible one, by however much the current has changed since): on the faults family's tuning sites by up to 54 m before the next fix. The jump is measured between navigation records at most 5 s apart (over longer gaps nothing is moved), and it includes the fix's own error; a vehicle that bottom-tracks does not drift with its current meter and gains nothing. On the tuning sites the correction raised declarations within 10 m from 262 to 269 of 300.
+        /// At each position fix, move the lost points saved since the fix before, and the points held for later fix frames, by the share of the fix's jump that was their own navigation error when they were saved, under what fix_error_m, fix_drift_mps and held_back_drift_mps say of the navigation (false: lost points stay where the navigation put them, as flown in the field). Each fix puts a dead-reckoned estimate back on the truth within the fix's own error; the jump it makes is that error less the stretch's own (the fix before's, and the drift since), so it tells how far a point saved part-way through was off. A vehicle that dead-reckons with its current meter also drifts while the readings are held back (with the last plausible one, by however much the current has changed since): on the faults family's tuning sites by up to 54 m before the next fix. The jump is measured between navigation records at most 5 s apart (over longer gaps nothing is moved). On 24 of the faults family's tuning sites the navigation error at the 889 lost points saved had a median of 6.2 m as saved and 3.7 m as moved.
         fix_smoothing: bool = true, "", Bounds::Any;
-        /// With fix_smoothing, when flow readings were held back since the last position fix, the declaration check does not declare until the next fix (which places the lost points) for at most this long, counted from the first check it held back; tracing goes on meanwhile, and the check runs again at the next Track-Out's end (0: declare at once). Only a navigation that has reported a fix is waited for. On the faults family's tuning sites 600 s raised declarations within 10 m from 269 to 274 of 300, at a median 226 s later; 300 s gave 267, 900 and 1200 s 274 with one mission without a declaration.
-        fix_wait_s: f64 = 600.0, "s", Bounds::non_negative(1e5);
+        /// With fix_smoothing, how long the declaration waits for the fix that places its points. When flow readings were held back since the last fix, the declaration check does not declare until the next fix, for at most this long counted from the first check it held back (tracing goes on meanwhile, and the check runs again at the next Track-Out's end). When the model moves the points of every stretch (fix_error_m or fix_drift_mps above 0), the held points are declared at the fix that ends the frame of the last one's lost points, or this long after it was held (0: declare at once, unplaced). Only a navigation that has reported a fix is waited for. On the faults family's tuning sites 900 s declared 197 of 200 within 10 m, 600 s 195 and 1200 s the same as 900 s.
+        fix_wait_s: f64 = 900.0, "s", Bounds::non_negative(1e5);
         /// How many points, each from its own position-fix frame, the declared point is the mean of. Each fix puts the navigation back on the truth within the fix's own error, a new error each time, and the lost points saved until the next fix carry it (with the drift since): a point declared from one frame's lost points is off by that frame's error (3-5 m a side on the faults family). Above 1, the point a lost-point rule would declare (after its confirming Track-Out) is held and tracing goes on; the check then counts only the lost points saved after the next fix, and the point it makes then is averaged with the held one (and so on); their mean is declared (1: the first point, as in the field). A navigation that has reported no fix is not waited for, nor are multi-source searches or the source map's points. Chosen on the three families' tuning sites (2 raised declarations within 10 m from 184, 192 and 193 of 200 to 194, 197 and 199; 3 gained nothing more on the faults family). On their test sites the default's share within 10 m went from 98.0, 87.5 and 98.0 % (coastal, faults, duck-like) to 97.5, 94.5 and 99.0 %, and its median declaration time from 1347, 1663 and 1250 s to 2818, 3689 and 2514 s.
         declaration_fix_frames: u32 = 2, "", Bounds::whole(1, 10);
+        /// With fix_smoothing, the error of a position fix that the smoothing assumes, a standard deviation per axis. A point saved at time t into a stretch of length T between fixes is moved by (f^2 + d^2 t T + h^2 b B) / (2 f^2 + d^2 T^2 + h^2 B^2) of the jump that ends the stretch (f: this key, d: fix_drift_mps, h: held_back_drift_mps, b and B: held-back time by then and in the whole stretch; the first stretch, which starts on the truth, has no f^2 of its own): the share of the jump that was its own error, given the jump. With this key and fix_drift_mps both 0 only held-back stretches move, by held-back time. Chosen on the tuning sites (seed 3211) of the faults, coastal and duck-like families, 200 each: with 4 m and 0.01 m/s, declarations within 10 m went from 194, 197 and 199 to 197, 199 and 200, the median error from 4.5, 3.2 and 3.5 m to 3.6, 2.3 and 2.8 m, and the median declaration time from 3551, 2876 and 2343 s to 3420, 3013 and 2413 s; 2 or 3 m, 0.005 or 0.02 m/s did no better on any family.
+        fix_error_m: f64 = 4.0, "m", Bounds::non_negative(1000.0);
+        /// With fix_smoothing, the dead-reckoning drift between fixes that the smoothing assumes: a velocity error per axis that holds over a stretch (see fix_error_m).
+        fix_drift_mps: f64 = 0.01, "m/s", Bounds::non_negative(10.0);
+        /// With fix_smoothing, the drift while flow readings are held back that the smoothing assumes, per axis (see fix_error_m).
+        held_back_drift_mps: f64 = 0.03, "m/s", Bounds::non_negative(10.0);
         /// With declaration_fix_frames above 1, the longest wait from the first held point: then the mean of the points so far is declared (a fix that never comes, or a plume the vehicle does not trace again). Held points are also declared in the mission's last minute, when the mission's end is known (the scenario's time limit; onboard, run.time_limit_s). On the tuning sites 1800 s declared 192 of 200 fault sites within 10 m against 194 with 3600 s, and 7200 s gained nothing over 3600.
         declaration_frame_wait_s: f64 = 3600.0, "s", Bounds::non_negative(1e5);
         /// Without a current meter (no flow reading yet), the current is estimated from the vehicle's own track, one sample per this window: the drift of the navigation positions against the water track (heading and water speed) plus the jumps at position fixes spread over the time since the fix before; the samples go through the flow estimate (flow_average_s, flow_gate_deg from the prior) as a meter's readings would (0: the prior direction alone).
@@ -265,6 +271,15 @@ impl AmpParams {
             length_m: self.mapping_length_m,
             spacing_m: self.mapping_spacing_m,
         })
+    }
+
+    /// What the fix smoothing assumes of the navigation's errors.
+    fn drift_model(&self) -> fixes::DriftModel {
+        fixes::DriftModel {
+            fix_m: self.fix_error_m,
+            drift_mps: self.fix_drift_mps,
+            held_back_mps: self.held_back_drift_mps,
+        }
     }
 
     fn line_params(&self) -> LineParams {
@@ -382,6 +397,15 @@ impl PlannerParams for AmpParams {
                  moving lost points with it (set fix_smoothing = true, or leave fix_wait_s out)"
                     .to_string(),
             ));
+            for key in ["fix_error_m", "fix_drift_mps", "held_back_drift_mps"] {
+                out.push((
+                    key,
+                    format!(
+                        "has no effect with fix_smoothing = false: it says how far the next fix \
+                         moves lost points (set fix_smoothing = true, or leave {key} out)"
+                    ),
+                ));
+            }
         }
         out
     }
@@ -472,6 +496,9 @@ struct Candidate {
     /// The fix frame it was made in.
     frame: u64,
     t_s: f64,
+    /// The lost points it was made from (the rule's three most upflow), as they were saved:
+    /// each fix moves it by the mean of their shares of its jump (`fix_smoothing`).
+    points: Vec<LostPoint>,
 }
 
 /// A declaration held back while the confirming Track-Out flies upflow of it
@@ -553,8 +580,9 @@ impl Memory {
 
     /// Moves the lost points saved since the fix before `fix` by their share of its jump.
     fn smooth_lost(&mut self, fix: &fixes::Fix) {
+        let model = self.p.drift_model();
         for l in &mut self.lost {
-            let share = fix.share(l.t_s, l.held_back_s);
+            let share = fix.share(l.t_s, l.held_back_s, &model);
             if share > 0.0 {
                 l.pos += fix.jump_m * share;
             }
@@ -645,25 +673,100 @@ impl Memory {
     /// when it is held for a later fix frame.
     fn hold_for_frames(&mut self, at: Vec2, rule: DeclarationKind, t: f64) -> Option<Vec2> {
         let wanted = self.p.declaration_fix_frames as usize;
+        let smoothing = self.places_held_points();
         // The map's points pool every frame's detections: only the lost-point rules' are held.
         let lost_point_rule =
             rule == declaration::ALONG_FLOW || rule == declaration::ALONG_AND_CROSS_FLOW;
-        if wanted <= 1 || self.multi_region() || self.fixes.count() == 0 || !lost_point_rule {
+        if (wanted <= 1 && !smoothing)
+            || self.multi_region()
+            || self.fixes.count() == 0
+            || !lost_point_rule
+        {
             return Some(at);
         }
-        if self.held_in_this_frame() {
+        if self.candidates.len() >= wanted || self.held_in_this_frame() {
             return None;
         }
+        let points = self.top_checked();
+        let frame = points
+            .iter()
+            .map(|l| l.frame)
+            .max()
+            .unwrap_or_else(|| self.fixes.count());
         self.candidates.push(Candidate {
             at,
             rule,
-            frame: self.fixes.count(),
+            frame,
             t_s: t,
+            points,
         });
-        if self.candidates.len() < wanted {
+        if self.candidates.len() < wanted || (smoothing && !self.candidates_placed()) {
             return None;
         }
         self.candidate_mean()
+    }
+
+    /// Whether held points wait for the fix that ends their frame, which moves them
+    /// (`fix_smoothing` with a drift model that moves points of every stretch).
+    fn places_held_points(&self) -> bool {
+        self.p.fix_smoothing
+            && self.p.fix_wait_s > 0.0
+            && self.p.drift_model().moves_every_stretch()
+    }
+
+    /// Every held point has been placed by the fixes that end its lost points' frames.
+    fn candidates_placed(&self) -> bool {
+        let count = self.fixes.count();
+        self.candidates
+            .iter()
+            .all(|c| c.points.iter().all(|l| l.frame < count))
+    }
+
+    /// The three most upflow lost points the declaration check counts, most upflow first.
+    fn top_checked(&self) -> Vec<LostPoint> {
+        let after = self.candidates.last().map(|c| c.frame);
+        let u = self.flow.upflow().unit();
+        let mut points: Vec<LostPoint> = self
+            .lost
+            .iter()
+            .filter(|l| after.is_none_or(|f| l.frame > f))
+            .copied()
+            .collect();
+        points.sort_by(|a, b| b.pos.dot(&u).total_cmp(&a.pos.dot(&u)));
+        points.truncate(3);
+        points
+    }
+
+    /// Moves each held point by the mean of its lost points' shares of `fix`'s jump (those
+    /// from before the stretch it ends have none).
+    fn place_candidates(&mut self, fix: &fixes::Fix) {
+        let model = self.p.drift_model();
+        for c in &mut self.candidates {
+            if c.points.is_empty() {
+                continue;
+            }
+            let share = c
+                .points
+                .iter()
+                .map(|l| fix.share(l.t_s, l.held_back_s, &model))
+                .sum::<f64>()
+                / c.points.len() as f64;
+            c.at += fix.jump_m * share;
+        }
+    }
+
+    /// The held points' mean and the last one's rule, once all `declaration_fix_frames` are held
+    /// and placed by their fixes, or `fix_wait_s` after the last was held.
+    fn candidates_ready(&self, t: f64) -> Option<(Vec2, DeclarationKind)> {
+        let last = self.candidates.last()?;
+        let wanted = self.p.declaration_fix_frames as usize;
+        if self.candidates.len() < wanted || !self.places_held_points() {
+            return None;
+        }
+        if !self.candidates_placed() && t - last.t_s <= self.p.fix_wait_s {
+            return None;
+        }
+        self.held()
     }
 
     /// The held points' mean and the last one's rule (`None`: none is held).
@@ -1045,7 +1148,10 @@ impl Switching {
 impl Arbiter<Memory> for Switching {
     fn arbitrate(&mut self, p: &Percept, m: &mut Memory) -> Option<Steer> {
         m.prune_lost(p.t_s);
-        if let Some((at, rule)) = m.frames_timed_out(p.t_s) {
+        if let Some((at, rule)) = m
+            .frames_timed_out(p.t_s)
+            .or_else(|| m.candidates_ready(p.t_s))
+        {
             self.declare_now(m, at, rule, RegionEvent::Declared, p.t_s);
         }
         // On the way to the search start: its corner follows the flow estimate as it settles
@@ -1329,6 +1435,9 @@ impl Planner for Amp {
             && self.m.p.fix_smoothing
         {
             self.m.smooth_lost(&fix);
+            if self.m.places_held_points() {
+                self.m.place_candidates(&fix);
+            }
         }
         let Some(pos) = s.nav.pos_m else {
             // Without a position estimate the AMP can only hold its course (the registry refuses
