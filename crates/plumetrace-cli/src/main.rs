@@ -30,6 +30,7 @@ mod args;
 mod bench;
 mod benchmark;
 mod campaign;
+mod check_other;
 mod frontseat;
 mod load;
 mod mission;
@@ -77,8 +78,9 @@ enum Command {
         #[arg(long)]
         markdown: bool,
     },
-    /// Validate a scenario file or preset (planners included) and print the first error with its
-    /// key path and line, and a warning for each key that has no effect.
+    /// Validate a scenario file or preset (planners included), a campaign file or a family file,
+    /// and print the first error with its key path and line, and a warning for each key that has
+    /// no effect.
     Check(load::ScenarioArgs),
     /// Feed a snapshot log (`snapshots.jsonl` of a run) to fresh planners and report the
     /// decisions that differ from the logged ones.
@@ -313,6 +315,13 @@ fn flow_steps(flow: &dyn plumetrace_env::FlowField, dt_s: f64) -> String {
 /// `plumetrace check FILE` (or `--preset NAME`, with `--planner` and `--set` as for `run`):
 /// everything `run` would reject, rejected here with the same message, and the same warnings.
 fn check(args: &load::ScenarioArgs) -> Result<()> {
+    if let Some(path) = &args.scenario {
+        let kind = check_other::FileKind::of(path);
+        if kind != check_other::FileKind::Scenario {
+            let overrides = args.planner.is_some() || !args.set.is_empty();
+            return check_other::check(path, kind, overrides);
+        }
+    }
     let load::Loaded { built, place } = load::load(args, None)?;
     let file = &built.origin.clone();
     let (steps, dt) = (built.steps, built.dt_s);

@@ -510,3 +510,77 @@ fn the_readme_has_the_preset_table() {
         assert!(md.contains(&format!("| `{}` | {} |", p.name, p.summary)));
     }
 }
+
+#[test]
+fn check_takes_campaign_and_family_files_too() {
+    let dir = tempfile::tempdir().unwrap();
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+    let family = root.join("examples/families/faults.family.toml");
+    let family_text = std::fs::read_to_string(&family).unwrap();
+    // Every example campaign and family checks, and says how to run it.
+    for (path, says) in [
+        (
+            root.join("examples/campaigns/amp-fix-smoothing.toml"),
+            "ok (campaign 'amp-fix-smoothing': 27 groups of 200 seeds, 5400 runs); run it with \
+             `plumetrace campaign ",
+        ),
+        (
+            family.clone(),
+            "ok (family 'faults'; the first 8 sites at seed 1 build)",
+        ),
+    ] {
+        let (status, out, err) = plumetrace(dir.path(), &["check", path.to_str().unwrap()]);
+        assert_eq!(status, 0, "{}: {err}", path.display());
+        assert!(out.contains(says), "{out}");
+    }
+    // A benchmark's test-seed campaign is told how it runs.
+    let bench = root.join("benchmarks/campaigns/amp-unbiased-faults.toml");
+    let (status, out, _) = plumetrace(dir.path(), &["check", bench.to_str().unwrap()]);
+    assert_eq!(status, 0);
+    assert!(
+        out.contains("--out DIR --test-seeds` (it flies a benchmark task's test seeds)"),
+        "{out}"
+    );
+
+    // Errors name the file's line and key, as `campaign` and `family` do.
+    let campaign = format!(
+        "name = \"c\"\nseed = 1\nseedz = 2\nscenarios = [\"{}\"]\n",
+        family.display()
+    );
+    let (ok, err) = check(dir.path(), "c.toml", &campaign);
+    assert!(!ok);
+    assert!(
+        err.contains("c.toml line 3: seedz: unknown field `seedz`"),
+        "{err}"
+    );
+    let campaign = format!(
+        "name = \"c\"\nseed = 1\nseeds = 2\nscenarios = [\"{}\"]\n\n[[configs]]\nname = \"x\"\n\
+         [configs.set]\nfix_wiat_s = 1.0\n",
+        family.display()
+    );
+    let (ok, err) = check(dir.path(), "c.toml", &campaign);
+    assert!(!ok);
+    assert!(
+        err.contains("c.toml line 9:") && err.contains("did you mean `fix_wait_s`?"),
+        "{err}"
+    );
+    let swapped = family_text.replace("speed_mps = [0.1, 0.3]", "speed_mps = [0.3, 0.1]");
+    assert_ne!(swapped, family_text);
+    let (ok, err) = check(dir.path(), "f.family.toml", &swapped);
+    assert!(!ok);
+    assert!(
+        err.contains("f.family.toml:")
+            && err.contains("flow.speed_mps: [low, high] needs low <= high"),
+        "{err}"
+    );
+    // --set and --planner are for scenarios.
+    let (status, _, err) = plumetrace(
+        dir.path(),
+        &["check", family.to_str().unwrap(), "--set", "beta_deg=3"],
+    );
+    assert_eq!(status, 1);
+    assert!(
+        err.contains("is a family file: --planner and --set apply to scenario files"),
+        "{err}"
+    );
+}
