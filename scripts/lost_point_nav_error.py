@@ -6,8 +6,10 @@ finds the position fixes in the trajectory (the estimate's error steps by more t
 two rows), and for every lost point saved between two fixes prints nothing but adds to the
 totals: its navigation error as saved (estimate less truth at its time), and after moving it by
 the share of the next fix's jump that the AMP's smoothing gives it (`fix_error_m`,
-`fix_drift_mps`; stretches with held-back flow readings are treated as any other). Lost points
-after the last fix are left out. Standard library only.
+`fix_drift_mps`). The trajectory does not say when the planner held flow readings back, so the
+share here leaves out the held-back term (`held_back_drift_mps`): on a stretch with held-back
+readings the planner moves points by more of the jump. Lost points after the last fix are left
+out. Standard library only.
 
     plumetrace family examples/families/faults.family.toml --sample 24 --seed 3211 --out out/sites
     for f in out/sites/*.toml; do
@@ -80,7 +82,7 @@ def main():
                 continue
             a0, b = starts[k], starts[k + 1]
             jump = (e[b][0] - e[b - 1][0], e[b][1] - e[b - 1][1])
-            s = share(t[i] - t[a0], t[b - 1] - t[a0], a0 > 0, a.fix_error, a.drift)
+            s = share(t[i] - t[a0], t[b] - t[a0], a0 > 0, a.fix_error, a.drift)
             saved.append(math.hypot(*e[i]))
             moved.append(math.hypot(e[i][0] + s * jump[0], e[i][1] + s * jump[1]))
     if not saved:

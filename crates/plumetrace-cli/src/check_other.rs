@@ -12,23 +12,45 @@ pub enum FileKind {
     Family,
 }
 
+/// Top-level keys only a campaign file has.
+const CAMPAIGN_KEYS: [&str; 5] = ["scenarios", "seeds", "configs", "sweep", "success_radius_m"];
+
+/// Top-level keys only a family file has.
+const FAMILY_KEYS: [&str; 11] = [
+    "base",
+    "area",
+    "source",
+    "start",
+    "nav",
+    "faults",
+    "team",
+    "regions",
+    "time_limit_s",
+    "domain_margin_m",
+    "prior_flow_error_deg",
+];
+
 impl FileKind {
-    /// Reads `path`'s top-level keys: `scenarios` or `configs` make a campaign, `base` (or a
-    /// name ending in `.family.toml`) a family; anything else, or a file that does not read or
-    /// parse, is left to the scenario check, which says what is wrong with it.
+    /// Reads `path`'s top-level keys: one only a campaign has (`scenarios`, `seeds`,
+    /// `configs`, ...) makes a campaign, one only a family has (`base`, `area`, ...) or a name
+    /// ending in `.family.toml` a family; anything else, or a file that does not read (a
+    /// directory, a pipe, too big) or parse, is left to the scenario check, which says what is
+    /// wrong with it.
     pub fn of(path: &Path) -> FileKind {
         if path.to_string_lossy().ends_with(".family.toml") {
             return FileKind::Family;
         }
-        let Ok(text) = std::fs::read_to_string(path) else {
+        let Ok(text) =
+            plumetrace_env::input::read_text(path, plumetrace_env::input::MAX_TEXT_BYTES)
+        else {
             return FileKind::Scenario;
         };
         let Ok(table) = text.parse::<toml::Table>() else {
             return FileKind::Scenario;
         };
-        if table.contains_key("scenarios") || table.contains_key("configs") {
+        if CAMPAIGN_KEYS.iter().any(|k| table.contains_key(*k)) {
             FileKind::Campaign
-        } else if table.contains_key("base") {
+        } else if FAMILY_KEYS.iter().any(|k| table.contains_key(*k)) {
             FileKind::Family
         } else {
             FileKind::Scenario
@@ -74,16 +96,20 @@ fn campaign(path: &Path) -> Result<()> {
     }
     let groups = c.scenarios.len() * c.configs.len() * c.points.len();
     let runs = c.runs().len();
+    let plural =
+        |n: usize, one: &str, many: &str| format!("{n} {}", if n == 1 { one } else { many });
     let (flag, note) = match c.refuse_test_seeds() {
         Ok(()) => ("", ""),
         Err(_) => (" --test-seeds", " (it flies a benchmark task's test seeds)"),
     };
     crate::outln!(
-        "{}: ok (campaign '{}': {groups} groups of {} seeds, {runs} runs); run it with \
-         `plumetrace campaign {} --out DIR{flag}`{note}",
+        "{}: ok (campaign '{}': {} of {}, {}); run it with `plumetrace campaign {} --out \
+         DIR{flag}`{note}",
         path.display(),
         c.file.name,
-        c.file.seeds,
+        plural(groups, "group", "groups"),
+        plural(c.file.seeds as usize, "seed", "seeds"),
+        plural(runs, "run", "runs"),
         path.display()
     );
     Ok(())
@@ -94,13 +120,25 @@ fn family(path: &Path) -> Result<()> {
     for k in 0..FAMILY_SITES {
         let seed = plumetrace_env::derive_seed(1, k);
         let site = f.draw(seed);
-        let name = format!("{}-site-{k:03}", f.file.name);
-        let text = site.to_toml(&f.file, &f.base, seed, &name);
-        let origin = plumetrace_scenario::Origin::File(path.join(format!("site-{k:03}.toml")));
-        let cfg = plumetrace_scenario::parse(&text, &origin)
-            .map_err(|e| anyhow::anyhow!("site {k} drawn at seed 1: {e}"))?;
-        plumetrace_scenario::build(&cfg, &origin, None)
-            .map_err(|e| anyhow::anyhow!("site {k} drawn at seed 1: {e}"))?;
+        let file = format!("site-{k:03}.toml");
+        let text = site.to_toml(
+            &f.file,
+            &f.base,
+            seed,
+            &format!("{}-site-{k:03}", f.file.name),
+        );
+        let origin = plumetrace_scenario::Origin::File(file.clone().into());
+        let built = plumetrace_scenario::parse(&text, &origin)
+            .and_then(|cfg| plumetrace_scenario::build(&cfg, &origin, None));
+        if let Err(e) = built {
+            bail!(
+                "{}: site {k} drawn at seed 1 cannot be built ({file} as `plumetrace family {} \
+                 --sample {} --out DIR` writes it): {e}",
+                path.display(),
+                path.display(),
+                k + 1
+            );
+        }
     }
     crate::outln!(
         "{}: ok (family '{}'; the first {FAMILY_SITES} sites at seed 1 build); draw sites with \

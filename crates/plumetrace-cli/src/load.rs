@@ -9,7 +9,8 @@ use std::path::{Path, PathBuf};
 /// Which scenario, and what to change in it.
 #[derive(Debug, Clone, Default, clap::Args)]
 pub struct ScenarioArgs {
-    /// Scenario file (TOML); give this or --preset.
+    /// Scenario file (TOML; `check` also takes campaign and family files); give this or
+    /// --preset.
     pub scenario: Option<PathBuf>,
     /// Built-in scenario (see `plumetrace presets`).
     #[arg(long, conflicts_with = "scenario")]

@@ -518,21 +518,46 @@ fn check_takes_campaign_and_family_files_too() {
     let family = root.join("examples/families/faults.family.toml");
     let family_text = std::fs::read_to_string(&family).unwrap();
     // Every example campaign and family checks, and says how to run it.
-    for (path, says) in [
-        (
-            root.join("examples/campaigns/amp-fix-smoothing.toml"),
-            "ok (campaign 'amp-fix-smoothing': 27 groups of 200 seeds, 5400 runs); run it with \
-             `plumetrace campaign ",
-        ),
-        (
-            family.clone(),
-            "ok (family 'faults'; the first 8 sites at seed 1 build)",
-        ),
-    ] {
-        let (status, out, err) = plumetrace(dir.path(), &["check", path.to_str().unwrap()]);
-        assert_eq!(status, 0, "{}: {err}", path.display());
-        assert!(out.contains(says), "{out}");
+    let mut checked = 0;
+    for sub in ["examples/campaigns", "examples/families"] {
+        for entry in std::fs::read_dir(root.join(sub)).unwrap() {
+            let path = entry.unwrap().path();
+            if path.extension().is_none_or(|e| e != "toml") {
+                continue;
+            }
+            let (status, out, err) = plumetrace(dir.path(), &["check", path.to_str().unwrap()]);
+            assert_eq!(status, 0, "{}: {err}", path.display());
+            let says = if sub.ends_with("families") {
+                ": ok (family '"
+            } else {
+                ": ok (campaign '"
+            };
+            assert!(out.contains(says), "{}: {out}", path.display());
+            checked += 1;
+        }
     }
+    assert!(checked > 30, "{checked}");
+    let (_, out, _) = plumetrace(
+        dir.path(),
+        &[
+            "check",
+            root.join("examples/campaigns/amp-fix-smoothing.toml")
+                .to_str()
+                .unwrap(),
+        ],
+    );
+    assert!(
+        out.contains(
+            "ok (campaign 'amp-fix-smoothing': 33 groups of 200 seeds, 6600 runs); run it with \
+             `plumetrace campaign "
+        ),
+        "{out}"
+    );
+    let (_, out, _) = plumetrace(dir.path(), &["check", family.to_str().unwrap()]);
+    assert!(
+        out.contains("ok (family 'faults'; the first 8 sites at seed 1 build)"),
+        "{out}"
+    );
     // A benchmark's test-seed campaign is told how it runs.
     let bench = root.join("benchmarks/campaigns/amp-unbiased-faults.toml");
     let (status, out, _) = plumetrace(dir.path(), &["check", bench.to_str().unwrap()]);
@@ -571,6 +596,19 @@ fn check_takes_campaign_and_family_files_too() {
     assert!(
         err.contains("f.family.toml:")
             && err.contains("flow.speed_mps: [low, high] needs low <= high"),
+        "{err}"
+    );
+    // A campaign without `scenarios` is still read as one (by its `seeds`), and says what it
+    // misses; so does a family without `base`.
+    let (ok, err) = check(dir.path(), "c2.toml", "name = \"c\"\nseed = 1\nseeds = 2\n");
+    assert!(!ok);
+    assert!(err.contains("missing field `scenarios`"), "{err}");
+    let no_base = family_text.replace("base = \"duck-2003-st\"\n", "");
+    assert_ne!(no_base, family_text);
+    let (ok, err) = check(dir.path(), "f2.toml", &no_base);
+    assert!(!ok);
+    assert!(
+        err.contains("missing field `base`") && !err.contains("line 1, column 1"),
         "{err}"
     );
     // --set and --planner are for scenarios.

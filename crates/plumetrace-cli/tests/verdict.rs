@@ -128,7 +128,7 @@ fn several_sources_and_formations_say_it_too() {
     assert!(
         line.starts_with(
             "duck-2003-mt: located: 2 of 2 sources declared within the success radius (50 m); \
-             4 declarations, nearest declaration per source: 2.1 m, 2.5 m"
+             4 declarations, nearest declaration per source: 0.9 m, 2.5 m"
         ),
         "{line}"
     );

@@ -398,6 +398,10 @@ pub const CAMPAIGNS: &[(&str, &str)] = &[
         include_str!("../../../examples/campaigns/amp-fix-frames.toml"),
     ),
     (
+        "amp-fix-smoothing",
+        include_str!("../../../examples/campaigns/amp-fix-smoothing.toml"),
+    ),
+    (
         "moth-comparison",
         include_str!("../../../examples/campaigns/moth-comparison.toml"),
     ),
@@ -508,6 +512,10 @@ pub const FAMILIES: &[(&str, &str)] = &[
     (
         "formation",
         include_str!("../../../examples/families/formation.family.toml"),
+    ),
+    (
+        "multi-source",
+        include_str!("../../../examples/families/multi-source.family.toml"),
     ),
 ];
 

@@ -1314,10 +1314,12 @@ fn the_declared_point_is_the_mean_of_points_from_two_fix_frames() {
         "the mean of (200, 294) and (203, 290): {declared:?}"
     );
 
-    // One frame: declared at once, at the first point.
+    // One frame: declared at once, at the first point (at the defaults too: the point is not
+    // held for the fix that ends its frame).
     let mut once = amp_with(AmpParams {
         declaration_fix_frames: 1,
-        ..p.clone()
+        declaration_confirm_m: 0.0,
+        ..AmpParams::default()
     });
     let (events, _) = three_losses(&mut once, &nav);
     let declared = declared_at(&events);
@@ -1402,6 +1404,69 @@ fn each_held_point_moves_with_the_fix_that_ends_its_frame() {
         "expected {expected:?}, declared {declared:?}"
     );
     assert!((expected - Vec2::new(201.5, 292.0)).norm() > 1.0, "moved");
+}
+
+#[test]
+fn a_fix_during_the_confirming_track_out_moves_the_point_it_confirms() {
+    // One frame (declared once the confirming Track-Out ends), a fix at 5 s and another at
+    // 300 s that jumps the estimate by j = (6, -3). The three losses (saved at 56, 73 and 90 s)
+    // make (200, 294); the confirming leg starts, and the fix during it moves that point by the
+    // mean of its lost points' shares of j, (16 + 1e-4 t T) / (32 + 1e-4 T^2) with T = 295 s;
+    // the leg then flown to its end declares the moved point.
+    let p = AmpParams {
+        declaration_fix_frames: 1,
+        ..AmpParams::default()
+    };
+    assert!(p.declaration_confirm_m > 0.0, "the default confirms");
+    let j = Vec2::new(6.0, -3.0);
+    let offset = move |t: f64| if t >= 300.0 { j } else { Vec2::zeros() };
+    let nav = move |mut s: SensorSnapshot| {
+        s.nav.last_fix_s = match s.time_s {
+            t if t >= 300.0 => Some(300.0),
+            t if t >= 5.0 => Some(5.0),
+            _ => None,
+        };
+        s.nav.pos_m = s.nav.pos_m.map(|q| q + offset(s.time_s));
+        s
+    };
+    let mut a = amp_with(p);
+    let (events, t) = three_losses(&mut a, &nav);
+    assert!(declared_at(&events).is_empty());
+    let (at, _) = a.confirming().expect("the confirming leg flies");
+    assert!((at - Vec2::new(200.0, 294.0)).norm() < 1e-9, "{at:?}");
+    // Standing still (records every second) until the fix: its jump is measured against them.
+    let here = (150.0, 250.0);
+    let mut t = t;
+    while t <= 300.0 {
+        a.decide(&nav(snap(t, here, 90.0, false)));
+        t += 1.0;
+    }
+    let share = [51.0, 68.0, 85.0]
+        .iter()
+        .map(|s| (16.0 + 1e-4 * s * 295.0) / (32.0 + 1e-4 * 295.0 * 295.0))
+        .sum::<f64>()
+        / 3.0;
+    let moved = at + j * share;
+    let (now, goals) = a.confirming().expect("still confirming");
+    assert!(
+        (now - moved).norm() < 1e-9,
+        "expected {moved:?}, confirming {now:?}"
+    );
+    // Fly the legs to their ends (in the estimate's frame, which the fix moved by j).
+    let goals = goals.to_vec();
+    let mut events = Vec::new();
+    for g in goals {
+        let true_pos = g - j;
+        events.extend(
+            a.decide(&nav(snap(t, (true_pos.x, true_pos.y), 90.0, false)))
+                .events,
+        );
+        t += 1.0;
+    }
+    let declared = declared_at(&events);
+    assert_eq!(declared.len(), 1, "{events:?}");
+    assert!((declared[0] - moved).norm() < 1e-9, "{declared:?}");
+    assert!((moved - at).norm() > 1.0, "the fix moved it");
 }
 
 #[test]

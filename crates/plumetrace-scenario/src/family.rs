@@ -82,6 +82,9 @@ pub struct FamilyFile {
     /// A formation team's draws (see [`crate::family_team`]).
     #[serde(default)]
     pub team: Option<crate::family_team::TeamDraw>,
+    /// Several sources, one per subregion of a grid (see [`crate::family_regions`]).
+    #[serde(default)]
+    pub regions: Option<crate::family_regions::RegionsDraw>,
 }
 
 fn default_margin() -> f64 {
@@ -273,6 +276,9 @@ pub struct Site {
     pub spinup_s: f64,
     /// A formation team's draws, if the family has `[team]`.
     pub team: Option<crate::family_team::TeamSite>,
+    /// The subregions and their sources, if the family has `[regions]` (then `source`,
+    /// `source_edge_m` and `mass_rate_per_s` are the first source's).
+    pub regions: Option<crate::family_regions::RegionsSite>,
 }
 
 /// A loaded, checked family.
@@ -447,6 +453,30 @@ pub const FAMILY_LIMITS: &[(&str, f64, f64, &str)] = &[
     ("team.deaf_probability", 0.0, 1.0, "a probability"),
     ("team.deaf_s[]", 0.0, 1e6, "a window within the mission"),
     ("team.deaf_start_s[]", 0.0, 1e6, "a time within the mission"),
+    (
+        "regions.along",
+        1.0,
+        6.0,
+        "cells along the op-area's axis (a whole number; along x across at least 2)",
+    ),
+    (
+        "regions.across",
+        1.0,
+        6.0,
+        "cells across the op-area's axis (a whole number)",
+    ),
+    (
+        "regions.sources[]",
+        1.0,
+        36.0,
+        "sources per site, whole numbers, at most one per cell",
+    ),
+    (
+        "regions.inset_m",
+        0.0,
+        50_000.0,
+        "inside a cell, leaving it room: 2 x inset + 10 m within the smallest cell",
+    ),
 ];
 
 /// The bound of a family key (`[]` for a range's ends) from [`FAMILY_LIMITS`]: low, high and why.
@@ -491,7 +521,10 @@ impl Family {
             let inner = e.into_inner();
             // With a key path the message alone, at the key's line; without one, the parser's
             // whole report, which shows where.
-            if key == "." {
+            if key == "." && inner.message().starts_with("missing field") {
+                // A key missing at the top needs no excerpt of the file.
+                invalid(path, "", crate::locate::suggest(inner.message()))
+            } else if key == "." {
                 invalid(path, "", plumetrace_core::toml_message(&inner, false))
             } else {
                 invalid(path, &key, crate::locate::suggest(inner.message())).located(text)
@@ -643,7 +676,15 @@ fn check(f: &FamilyFile, path: &Path) -> Result<(), ScenarioError> {
         num("faults.flow_sensor_probability", x.flow_sensor_probability)?;
         range("faults.duration_s", Some(x.duration_s))?;
     }
-    Ok(())
+    if f.regions.is_some() && f.team.is_some() {
+        return Err(invalid(
+            path,
+            "regions",
+            "[regions] places sources for one vehicle's search; a formation team's outlets come              from [team]: give one or the other"
+                .into(),
+        ));
+    }
+    crate::family_regions::check(f, path)
 }
 
 /// Builds sites at the ends of the ranges that decide whether a site can be built at all (the
@@ -721,7 +762,7 @@ pub(crate) fn unit(deg: f64) -> Vec2 {
 }
 
 /// Distance from `p` to the nearest edge of the polygon `v` (positive inside for a convex one).
-fn edge_distance(v: &[[f64; 2]], p: Vec2) -> f64 {
+pub(crate) fn edge_distance(v: &[[f64; 2]], p: Vec2) -> f64 {
     let mut best = f64::INFINITY;
     for k in 0..v.len() {
         let a = Vec2::new(v[k][0], v[k][1]);
@@ -907,7 +948,7 @@ fn draw(f: &FamilyFile, seed: u64) -> Site {
         let d = (toward - axis).rem_euclid(180.0);
         if d > 90.0 { 180.0 - d } else { d }
     };
-    Site {
+    let mut site = Site {
         flow_toward_deg: toward,
         flow_speed_mps: speed,
         tidal_swing_deg: swing,
@@ -931,7 +972,12 @@ fn draw(f: &FamilyFile, seed: u64) -> Site {
         flow_fault_s: fault,
         spinup_s,
         team: None,
+        regions: None,
+    };
+    if let Some(r) = &f.regions {
+        crate::family_regions::draw(r, f, &mut site, seed);
     }
+    site
 }
 
 /// `t[key]` as a table, made (or replacing a value of another type) if needed.
@@ -1160,6 +1206,9 @@ impl Site {
         {
             sim.insert("duration_s".into(), float(l));
         }
+        if let Some(r) = &self.regions {
+            crate::family_regions::apply(r, &mut t);
+        }
         t.remove("output");
         if let Some(team) = &self.team {
             crate::family_team::apply(team, f, self, base, &mut t);
@@ -1187,6 +1236,11 @@ impl Site {
             .team
             .iter()
             .flat_map(crate::family_team::TeamSite::values)
+            .chain(
+                self.regions
+                    .iter()
+                    .flat_map(crate::family_regions::RegionsSite::values),
+            )
         {
             out.push_str(&format!("#   {k} = {v}\n"));
         }

@@ -10,6 +10,7 @@ pub mod build;
 pub mod config;
 pub mod error;
 pub mod family;
+pub mod family_regions;
 pub mod family_team;
 mod geographic;
 pub mod limits;

@@ -153,17 +153,17 @@ plumetrace_core::params! {
         flow_gate_deg: f64 = 90.0, "deg", Bounds::closed(1.0, 180.0);
         /// How long implausible flow readings must persist to be believed.
         flow_gate_persist_s: f64 = 1800.0, "s", Bounds::non_negative(1e6);
-        /// At each position fix, move the lost points saved since the fix before, and the points held for later fix frames, by the share of the fix's jump that was their own navigation error when they were saved, under what fix_error_m, fix_drift_mps and held_back_drift_mps say of the navigation (false: lost points stay where the navigation put them, as flown in the field). Each fix puts a dead-reckoned estimate back on the truth within the fix's own error; the jump it makes is that error less the stretch's own (the fix before's, and the drift since), so it tells how far a point saved part-way through was off. A vehicle that dead-reckons with its current meter also drifts while the readings are held back (with the last plausible one, by however much the current has changed since): on the faults family's tuning sites by up to 54 m before the next fix. The jump is measured between navigation records at most 5 s apart (over longer gaps nothing is moved). On 24 of the faults family's tuning sites (seed 3211) the navigation error at the 923 lost points saved between fixes had a median of 6.2 m (p90 13.3 m) as saved and 3.9 m (7.7 m) as moved (scripts/lost_point_nav_error.py).
+        /// At each position fix, move the lost points saved since the fix before, and the points held for later fix frames, by the share of the fix's jump that was their own navigation error when they were saved, under what fix_error_m, fix_drift_mps and held_back_drift_mps say of the navigation (false: lost points stay where the navigation put them, as flown in the field). Each fix puts a dead-reckoned estimate back on the truth within the fix's own error; the jump it makes is that error less the stretch's own (the fix before's, and the drift since), so it tells how far a point saved part-way through was off. A vehicle that dead-reckons with its current meter also drifts while the readings are held back (with the last plausible one, by however much the current has changed since): on the faults family's tuning sites by up to 54 m before the next fix. The jump is measured between navigation records at most 5 s apart (over longer gaps nothing is moved). On 24 of the faults family's tuning sites (seed 3211) the navigation error at the 923 lost points saved between fixes had a median of 6.2 m (p90 13.3 m) as saved and 3.9 m (7.7 m) as moved without the held-back term (scripts/lost_point_nav_error.py).
         fix_smoothing: bool = true, "", Bounds::Any;
-        /// With fix_smoothing, how long the declaration waits for the fix that places its points. When flow readings were held back since the last fix, the declaration check does not declare until the next fix, for at most this long counted from the first check it held back (tracing goes on meanwhile, and the check runs again at the next Track-Out's end). When the model moves the points of every stretch (fix_error_m or fix_drift_mps above 0), the held points are declared at the fix that ends the frame of the last one's lost points, or this long after it was held (0: declare at once, unplaced). Only a navigation that has reported a fix is waited for. On the faults family's tuning sites 900 s declared 197 of 200 within 10 m, 600 s 195 and 1200 s the same as 900 s.
+        /// With fix_smoothing, how long the declaration waits for the fix that places its points. When flow readings were held back since the last fix, the declaration check does not declare until the next fix, for at most this long counted from the first check it held back (tracing goes on meanwhile, and the check runs again at the next Track-Out's end). When the model moves the points of every stretch (fix_error_m or fix_drift_mps above 0) and declaration_fix_frames is above 1, the held points are declared at the fix that ends the frame of the last one's lost points, or this long after it was held (0: as soon as the last is held, as the fixes so far have placed them). Only a navigation that has reported a fix is waited for. On the faults family's tuning sites 900 s declared 198 of 200 within 10 m, 600 s 197 and 1200 s the same as 900 s.
         fix_wait_s: f64 = 900.0, "s", Bounds::non_negative(1e5);
         /// How many points, each from its own position-fix frame, the declared point is the mean of. Each fix puts the navigation back on the truth within the fix's own error, a new error each time, and the lost points saved until the next fix carry it (with the drift since): a point declared from one frame's lost points is off by that frame's error (3-5 m a side on the faults family). Above 1, the point a lost-point rule would declare (after its confirming Track-Out) is held and tracing goes on; the check then counts only the lost points saved after the next fix, and the point it makes then is averaged with the held one (and so on); their mean is declared (1: the first point, as in the field). A navigation that has reported no fix is not waited for, nor are multi-source searches or the source map's points. Chosen on the three families' tuning sites (2 raised declarations within 10 m from 184, 192 and 193 of 200 to 194, 197 and 199; 3 gained nothing more on the faults family). On their test sites the default's share within 10 m went from 98.0, 87.5 and 98.0 % (coastal, faults, duck-like) to 97.5, 94.5 and 99.0 %, and its median declaration time from 1347, 1663 and 1250 s to 2818, 3689 and 2514 s.
         declaration_fix_frames: u32 = 2, "", Bounds::whole(1, 10);
-        /// With fix_smoothing, the error of a position fix that the smoothing assumes, a standard deviation per axis. A point saved at time t into a stretch of length T between fixes is moved by (f^2 + d^2 t T + h^2 b B) / (2 f^2 + d^2 T^2 + h^2 B^2) of the jump that ends the stretch (f: this key, d: fix_drift_mps, h: held_back_drift_mps, b and B: held-back time by then and in the whole stretch; the first stretch, which starts on the truth, has no f^2 of its own): the share of the jump that was its own error, given the jump. With this key and fix_drift_mps both 0 only held-back stretches move, by held-back time. Chosen on the tuning sites (seed 3211) of the faults, coastal and duck-like families, 200 each (examples/campaigns/amp-fix-smoothing.toml): with 4 m and 0.01 m/s, declarations within 10 m went from 194, 197 and 199 (held-back stretches alone) to 197, 199 and 200, the median error from 4.5, 3.3 and 3.5 m to 3.6, 2.3 and 2.8 m, and the median declaration time from 3376, 2726 and 2237 s to 3420, 3013 and 2413 s; 2 or 3 m, 0.005 or 0.02 m/s declared fewer within 10 m on at least one family (191-198).
+        /// With fix_smoothing, the error of a position fix that the smoothing assumes, a standard deviation per axis. A point saved at time t into a stretch of length T between fixes is moved by (f^2 + d^2 t T + h^2 b B) / (2 f^2 + d^2 T^2 + h^2 B^2) of the jump that ends the stretch (f: this key, d: fix_drift_mps, h: held_back_drift_mps, b and B: held-back time by then and in the whole stretch; the first stretch, which starts on the truth, has no f^2 of its own): the share of the jump that was its own error, given the jump. Without held-back readings only the ratio of this key to fix_drift_mps counts (the time over which the drift grows as large as a fix's error: 400 s at the defaults). With this key and fix_drift_mps both 0 only held-back stretches move, by held-back time. Chosen on the tuning sites (seed 3211) of the faults, coastal and duck-like families, 200 each (examples/campaigns/amp-fix-smoothing.toml): with 4 m and 0.01 m/s, declarations within 10 m went from 194, 196 and 199 (held-back stretches alone) to 198, 199 and 199, the median error from 4.5, 3.3 and 3.5 m to 3.5, 2.3 and 2.7 m, and the median declaration time from 3376, 2714 and 2237 s to 3420, 3013 and 2413 s; ratios of 200, 300 and 800 s declared fewer within 10 m on at least one family (192-198).
         fix_error_m: f64 = 4.0, "m", Bounds::non_negative(1000.0);
         /// With fix_smoothing, the dead-reckoning drift between fixes that the smoothing assumes: a velocity error per axis that holds over a stretch (see fix_error_m).
         fix_drift_mps: f64 = 0.01, "m/s", Bounds::non_negative(10.0);
-        /// With fix_smoothing, the drift while flow readings are held back that the smoothing assumes, per axis (see fix_error_m).
+        /// With fix_smoothing, the drift while flow readings are held back that the smoothing assumes, per axis (see fix_error_m). On the tuning sites 0.015 and 0.06 m/s declared 197 and 198 of 200 fault sites within 10 m against 198, at medians of 3.4 and 3.5 m.
         held_back_drift_mps: f64 = 0.03, "m/s", Bounds::non_negative(10.0);
         /// With declaration_fix_frames above 1, the longest wait from the first held point: then the mean of the points so far is declared (a fix that never comes, or a plume the vehicle does not trace again). Held points are also declared in the mission's last minute, when the mission's end is known (the scenario's time limit; onboard, run.time_limit_s). On the tuning sites 1800 s declared 192 of 200 fault sites within 10 m against 194 with 3600 s, and 7200 s gained nothing over 3600.
         declaration_frame_wait_s: f64 = 3600.0, "s", Bounds::non_negative(1e5);
@@ -502,7 +502,7 @@ struct Candidate {
 }
 
 /// A declaration held back while the confirming Track-Out flies upflow of it
-/// (`declaration_confirm_m`).
+/// (`declaration_confirm_m`), or taken at once.
 #[derive(Debug, Clone, PartialEq)]
 struct Confirm {
     /// The point to declare.
@@ -511,6 +511,8 @@ struct Confirm {
     rule: DeclarationKind,
     /// The confirming legs' ends, in order.
     goals: Vec<Vec2>,
+    /// The lost points it was placed from (each fix during the leg moves it with them).
+    points: Vec<LostPoint>,
 }
 
 /// What the AMP's behaviours share: parameters, areas, the flow estimate, LHS, the lost points
@@ -671,23 +673,23 @@ impl Memory {
     /// Takes the point a declaration would make at `t`: `Some` point to declare now (the mean of
     /// the held points with it, once `declaration_fix_frames` frames have given one), or `None`
     /// when it is held for a later fix frame.
-    fn hold_for_frames(&mut self, at: Vec2, rule: DeclarationKind, t: f64) -> Option<Vec2> {
+    fn hold_for_frames(
+        &mut self,
+        at: Vec2,
+        rule: DeclarationKind,
+        t: f64,
+        points: Vec<LostPoint>,
+    ) -> Option<Vec2> {
         let wanted = self.p.declaration_fix_frames as usize;
-        let smoothing = self.places_held_points();
         // The map's points pool every frame's detections: only the lost-point rules' are held.
         let lost_point_rule =
             rule == declaration::ALONG_FLOW || rule == declaration::ALONG_AND_CROSS_FLOW;
-        if (wanted <= 1 && !smoothing)
-            || self.multi_region()
-            || self.fixes.count() == 0
-            || !lost_point_rule
-        {
+        if wanted <= 1 || self.multi_region() || self.fixes.count() == 0 || !lost_point_rule {
             return Some(at);
         }
         if self.candidates.len() >= wanted || self.held_in_this_frame() {
             return None;
         }
-        let points = self.top_checked();
         let frame = points
             .iter()
             .map(|l| l.frame)
@@ -700,18 +702,27 @@ impl Memory {
             t_s: t,
             points,
         });
-        if self.candidates.len() < wanted || (smoothing && !self.candidates_placed()) {
+        if self.candidates.len() < wanted || (self.waits_for_fixes() && !self.candidates_placed()) {
             return None;
         }
         self.candidate_mean()
     }
 
-    /// Whether held points wait for the fix that ends their frame, which moves them
-    /// (`fix_smoothing` with a drift model that moves points of every stretch).
-    fn places_held_points(&self) -> bool {
-        self.p.fix_smoothing
-            && self.p.fix_wait_s > 0.0
-            && self.p.drift_model().moves_every_stretch()
+    /// Whether fixes move held points (and a point awaiting its confirming Track-Out):
+    /// `fix_smoothing` with a drift model that moves points of every stretch.
+    fn moves_held_points(&self) -> bool {
+        self.p.fix_smoothing && self.p.drift_model().moves_every_stretch()
+    }
+
+    /// Whether the held points wait for the fixes that end their frames (`fix_wait_s` above 0).
+    fn waits_for_fixes(&self) -> bool {
+        self.moves_held_points() && self.p.fix_wait_s > 0.0
+    }
+
+    /// Every frame has given its point, and they wait for the fixes that place them.
+    fn holding_all_frames(&self) -> bool {
+        let wanted = self.p.declaration_fix_frames as usize;
+        wanted > 1 && self.candidates.len() >= wanted
     }
 
     /// Every held point has been placed by the fixes that end its lost points' frames.
@@ -737,21 +748,25 @@ impl Memory {
         points
     }
 
-    /// Moves each held point by the mean of its lost points' shares of `fix`'s jump (those
-    /// from before the stretch it ends have none).
-    fn place_candidates(&mut self, fix: &fixes::Fix) {
+    /// Moves each held point, and a point awaiting its confirming Track-Out, by the mean of
+    /// its lost points' shares of `fix`'s jump (those from before the stretch it ends have none).
+    fn place_held(&mut self, fix: &fixes::Fix) {
         let model = self.p.drift_model();
-        for c in &mut self.candidates {
-            if c.points.is_empty() {
-                continue;
+        let mean_share = |points: &[LostPoint]| {
+            if points.is_empty() {
+                return 0.0;
             }
-            let share = c
-                .points
+            points
                 .iter()
                 .map(|l| fix.share(l.t_s, l.held_back_s, &model))
                 .sum::<f64>()
-                / c.points.len() as f64;
-            c.at += fix.jump_m * share;
+                / points.len() as f64
+        };
+        for c in &mut self.candidates {
+            c.at += fix.jump_m * mean_share(&c.points);
+        }
+        if let Some(c) = self.confirm.as_mut() {
+            c.at += fix.jump_m * mean_share(&c.points);
         }
     }
 
@@ -760,7 +775,7 @@ impl Memory {
     fn candidates_ready(&self, t: f64) -> Option<(Vec2, DeclarationKind)> {
         let last = self.candidates.last()?;
         let wanted = self.p.declaration_fix_frames as usize;
-        if self.candidates.len() < wanted || !self.places_held_points() {
+        if self.candidates.len() < wanted || !self.waits_for_fixes() {
             return None;
         }
         if !self.candidates_placed() && t - last.t_s <= self.p.fix_wait_s {
@@ -971,16 +986,11 @@ impl Switching {
 
     /// Declares `at`, or holds it for a later fix frame (`declaration_fix_frames`) while
     /// Reacquire goes on tracing from `pos`.
-    fn declare(
-        &mut self,
-        m: &mut Memory,
-        at: Vec2,
-        rule: DeclarationKind,
-        what: RegionEvent,
-        pos: Vec2,
-        t: f64,
-    ) {
-        match m.hold_for_frames(at, rule.clone(), t) {
+    fn declare(&mut self, m: &mut Memory, c: Confirm, what: RegionEvent, pos: Vec2, t: f64) {
+        let Confirm {
+            at, rule, points, ..
+        } = c;
+        match m.hold_for_frames(at, rule.clone(), t, points) {
             Some(at) => self.declare_now(m, at, rule, what, t),
             None => {
                 m.confirm = None;
@@ -1031,12 +1041,24 @@ impl Switching {
     fn confirm_or_declare(&mut self, m: &mut Memory, at: Vec2, rule: DeclarationKind, p: &Percept) {
         let t = p.t_s;
         let goals = m.confirm_goals(at, p.pos_m);
+        let points = m.top_checked();
         if goals.is_empty() {
-            self.declare(m, at, rule, RegionEvent::Declared, p.pos_m, t);
+            let c = Confirm {
+                at,
+                rule,
+                goals,
+                points,
+            };
+            self.declare(m, c, RegionEvent::Declared, p.pos_m, t);
             return;
         }
         let leg = ConfirmLeg::new(goals.iter().map(|g| m.p.go_to(*g)).collect());
-        m.confirm = Some(Confirm { at, rule, goals });
+        m.confirm = Some(Confirm {
+            at,
+            rule,
+            goals,
+            points,
+        });
         self.set(m, Box::new(leg));
     }
 
@@ -1059,6 +1081,10 @@ impl Switching {
     fn try_declare(&mut self, m: &mut Memory, p: &Percept) -> bool {
         let t = p.t_s;
         if m.p.map_declaration == MapDeclaration::Instead {
+            return false;
+        }
+        if m.holding_all_frames() {
+            // Every frame's point is held and waits for its fix: no new point is wanted.
             return false;
         }
         if m.p.fix_smoothing && m.p.fix_wait_s > 0.0 && m.fixes.awaiting_fix(t, m.p.fix_wait_s) {
@@ -1130,7 +1156,7 @@ impl Switching {
             (BehaviourKind::TrackOut, AmpDone::Reached) => {
                 if let Some(c) = m.confirm.take() {
                     // The confirming leg met no plume upflow of the point.
-                    self.declare(m, c.at, c.rule, RegionEvent::Declared, p.pos_m, p.t_s);
+                    self.declare(m, c, RegionEvent::Declared, p.pos_m, p.t_s);
                 } else if !self.try_declare(m, p) {
                     self.enter_reacquire(m, p.pos_m);
                 }
@@ -1394,14 +1420,14 @@ impl Amp {
             // The next subregion's search starts from the prior.
             tracker.reset();
         }
-        self.switching.declare(
-            &mut self.m,
-            read.estimate_m,
-            crate::estimate::tracker::SOURCE_MAP,
-            RegionEvent::Declared,
-            pos,
-            t,
-        );
+        let map_point = Confirm {
+            at: read.estimate_m,
+            rule: crate::estimate::tracker::SOURCE_MAP,
+            goals: Vec::new(),
+            points: Vec::new(),
+        };
+        self.switching
+            .declare(&mut self.m, map_point, RegionEvent::Declared, pos, t);
     }
 
     /// The source estimate: the last declaration, else the mean of the held points, else the
@@ -1435,8 +1461,8 @@ impl Planner for Amp {
             && self.m.p.fix_smoothing
         {
             self.m.smooth_lost(&fix);
-            if self.m.places_held_points() {
-                self.m.place_candidates(&fix);
+            if self.m.moves_held_points() {
+                self.m.place_held(&fix);
             }
         }
         let Some(pos) = s.nav.pos_m else {

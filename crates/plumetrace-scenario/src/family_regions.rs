@@ -1,0 +1,270 @@
+//! Several sources at a family's sites: `[regions]` splits a rectangular op-area into a grid of
+//! subregions, searched in turn as a multi-source mission's are, and puts a source in some of
+//! them.
+//!
+//! The grid is `along` cells along the op-area's main axis by `across` cells across it. The
+//! search order goes column by column across the axis, and within a column from the cell
+//! furthest downflow to the one furthest upflow (as the Duck 2003 multi-source mission flew its
+//! four). A site holds between `sources[0]` and `sources[1]` sources (whole numbers, drawn
+//! evenly), each in its own cell (the cells drawn at random), uniformly at least `inset_m` from
+//! that cell's edges, each with its own release rate when `[source] mass_rate_per_s` is given.
+//! The draws come from a random stream of their own, after everything else of the site, so a
+//! family without `[regions]` draws the same sites as before.
+
+use crate::ScenarioError;
+use crate::family::{FamilyFile, Shape, Site, float, invalid, round, unit};
+use plumetrace_core::Vec2;
+use plumetrace_env::{StreamId, stream_rng};
+use rand::Rng;
+use serde::{Deserialize, Serialize};
+use std::path::Path;
+
+/// The random stream of the regions' draws.
+const REGIONS_STREAM: u64 = 0x7265_6769;
+
+/// The most cells along or across.
+pub const MAX_CELLS: u32 = 6;
+
+/// `[regions]`: the subregions and the sources in them.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RegionsDraw {
+    /// Cells along the op-area's main axis.
+    pub along: u32,
+    /// Cells across it.
+    pub across: u32,
+    /// How many cells hold a source, `[low, high]` (whole numbers, drawn evenly).
+    pub sources: [u32; 2],
+    /// Least distance of a source from its cell's edges, m.
+    #[serde(default = "default_inset")]
+    pub inset_m: f64,
+}
+
+fn default_inset() -> f64 {
+    40.0
+}
+
+/// The regions of one site.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct RegionsSite {
+    /// The subregions in search order, each a rectangle's four vertices, m.
+    pub cells: Vec<Vec<[f64; 2]>>,
+    /// The sources: position (m), the index of its cell in `cells`, and its release rate when
+    /// drawn.
+    pub sources: Vec<RegionSource>,
+}
+
+/// One source of a site with regions.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct RegionSource {
+    /// Position, m.
+    pub pos: [f64; 2],
+    /// Its subregion (an index into the search order).
+    pub cell: usize,
+    /// Release rate, if drawn.
+    pub mass_rate_per_s: Option<f64>,
+}
+
+/// Checks `[regions]` against the rest of the family; errors name the key.
+pub(crate) fn check(f: &FamilyFile, path: &Path) -> Result<(), ScenarioError> {
+    let Some(r) = &f.regions else { return Ok(()) };
+    for (key, n) in [("regions.along", r.along), ("regions.across", r.across)] {
+        if !(1..=MAX_CELLS).contains(&n) {
+            return Err(invalid(
+                path,
+                key,
+                format!("must be a whole number from 1 to {MAX_CELLS}, got {n}"),
+            ));
+        }
+    }
+    let cells = r.along * r.across;
+    if cells < 2 {
+        return Err(invalid(
+            path,
+            "regions",
+            "a grid of 1 x 1 is the op-area itself: give at least two cells (along or across 2 \
+             or more), or leave [regions] out for one source"
+                .into(),
+        ));
+    }
+    let [lo, hi] = r.sources;
+    if lo < 1 || lo > hi || hi > cells {
+        return Err(invalid(
+            path,
+            "regions.sources",
+            format!(
+                "[low, high] needs 1 <= low <= high <= {cells} (the cells of the {} x {} grid), \
+                 got [{lo}, {hi}]",
+                r.along, r.across
+            ),
+        ));
+    }
+    if f.area.shapes.iter().any(|s| *s != Shape::Rectangle) {
+        return Err(invalid(
+            path,
+            "area.shapes",
+            "[regions] splits a rectangle into its grid: set area.shapes = [\"rectangle\"]".into(),
+        ));
+    }
+    let (cell_l, cell_w) = (
+        f.area.length_m[0] / f64::from(r.along),
+        f.area.width_m[0] / f64::from(r.across),
+    );
+    if !(r.inset_m.is_finite() && r.inset_m >= 0.0 && 2.0 * r.inset_m + 10.0 <= cell_l.min(cell_w))
+    {
+        return Err(invalid(
+            path,
+            "regions.inset_m",
+            format!(
+                "must be a number >= 0 that leaves room in the smallest cell ({cell_l:.1} m x \
+                 {cell_w:.1} m: at most {:.1} m), got {}; lower it, use fewer cells or enlarge \
+                 area.length_m / area.width_m",
+                ((cell_l.min(cell_w) - 10.0) / 2.0).max(0.0),
+                r.inset_m
+            ),
+        ));
+    }
+    Ok(())
+}
+
+/// Draws the regions of `site` (drawn from `seed` without them), and moves the site's source,
+/// its distance from the edge and its spin-up to the sources drawn (the spin-up long enough for
+/// the most upflow source's plume to cross the op-area).
+pub(crate) fn draw(r: &RegionsDraw, f: &FamilyFile, site: &mut Site, seed: u64) {
+    let mut rng = stream_rng(seed, StreamId::Custom(REGIONS_STREAM));
+    let (u, w) = (unit(site.axis_deg), unit(site.axis_deg + 90.0));
+    let down = unit(site.flow_toward_deg);
+    let (l, h) = (site.length_m, site.width_m);
+    let (dl, dw) = (l / f64::from(r.along), h / f64::from(r.across));
+    let at = |a: f64, b: f64| {
+        let p = u * a + w * b;
+        [p.x, p.y]
+    };
+    // (across index, downflow order key, cell corners in the axis frame)
+    let mut cells: Vec<(u32, f64, [f64; 4])> = Vec::new();
+    for j in 0..r.across {
+        for i in 0..r.along {
+            let (a0, b0) = (-l / 2.0 + dl * f64::from(i), -h / 2.0 + dw * f64::from(j));
+            let centre = u * (a0 + dl / 2.0) + w * (b0 + dw / 2.0);
+            cells.push((j, -centre.dot(&down), [a0, a0 + dl, b0, b0 + dw]));
+        }
+    }
+    cells.sort_by(|x, y| x.0.cmp(&y.0).then(x.1.total_cmp(&y.1)));
+    let polygons: Vec<Vec<[f64; 2]>> = cells
+        .iter()
+        .map(|(_, _, [a0, a1, b0, b1])| {
+            vec![at(*a0, *b0), at(*a1, *b0), at(*a1, *b1), at(*a0, *b1)]
+        })
+        .collect();
+    let n = rng.random_range(r.sources[0]..=r.sources[1]) as usize;
+    // The first n of a random permutation of the cells.
+    let mut order: Vec<usize> = (0..polygons.len()).collect();
+    for k in 0..n.min(order.len()) {
+        let pick = rng.random_range(k..order.len());
+        order.swap(k, pick);
+    }
+    let mut chosen: Vec<usize> = order[..n.min(order.len())].to_vec();
+    chosen.sort_unstable();
+    let sources: Vec<RegionSource> = chosen
+        .into_iter()
+        .map(|cell| {
+            let [a0, a1, b0, b1] = cells[cell].2;
+            let inset = r.inset_m.min((a1 - a0).min(b1 - b0) / 2.0);
+            let a = rng.random_range((a0 + inset)..=(a1 - inset));
+            let b = rng.random_range((b0 + inset)..=(b1 - inset));
+            let mass = f.source.mass_rate_per_s.map(|[lo, hi]| {
+                if hi > lo {
+                    rng.random_range(lo.ln()..=hi.ln()).exp()
+                } else {
+                    lo
+                }
+            });
+            RegionSource {
+                pos: at(a, b),
+                cell,
+                mass_rate_per_s: mass,
+            }
+        })
+        .collect();
+    if let Some(first) = sources.first() {
+        site.source = first.pos;
+        site.source_edge_m = crate::family::edge_distance(&site.op_area, v(first.pos));
+        site.mass_rate_per_s = first.mass_rate_per_s;
+    }
+    let reach = sources
+        .iter()
+        .flat_map(|s| {
+            site.op_area
+                .iter()
+                .map(move |c| (v(*c) - v(s.pos)).dot(&down))
+        })
+        .fold(0.0_f64, f64::max)
+        .max(l.max(h) * if site.tidal_swing_deg > 0.0 { 1.0 } else { 0.0 });
+    site.spinup_s = (1.2 * (reach + 50.0) / site.flow_speed_mps).clamp(600.0, 100_000.0);
+    site.regions = Some(RegionsSite {
+        cells: polygons,
+        sources,
+    });
+}
+
+fn v(p: [f64; 2]) -> Vec2 {
+    Vec2::new(p[0], p[1])
+}
+
+fn polygon(p: &[[f64; 2]]) -> toml::Value {
+    toml::Value::Array(
+        p.iter()
+            // `+ 0.0` writes a corner on an axis as 0.0, not -0.0.
+            .map(|q| {
+                toml::Value::Array(vec![
+                    float(round(q[0], 2) + 0.0),
+                    float(round(q[1], 2) + 0.0),
+                ])
+            })
+            .collect(),
+    )
+}
+
+/// Writes the regions into the site's scenario table `t`: one source table per source (each a
+/// copy of the base's first, moved), and the subregions.
+pub(crate) fn apply(r: &RegionsSite, t: &mut toml::Table) {
+    let template = t
+        .get("sources")
+        .and_then(toml::Value::as_array)
+        .and_then(|a| a.first())
+        .and_then(toml::Value::as_table)
+        .cloned()
+        .unwrap_or_default();
+    let sources = r
+        .sources
+        .iter()
+        .map(|s| {
+            let mut table = template.clone();
+            table.insert("x_m".into(), float(round(s.pos[0], 2)));
+            table.insert("y_m".into(), float(round(s.pos[1], 2)));
+            if let Some(q) = s.mass_rate_per_s {
+                table.insert("mass_rate_per_s".into(), float(round(q, 4)));
+            }
+            toml::Value::Table(table)
+        })
+        .collect();
+    t.insert("sources".into(), toml::Value::Array(sources));
+    if let Some(mission) = crate::family::table_at(t, "mission") {
+        mission.insert(
+            "subregions".into(),
+            toml::Value::Array(r.cells.iter().map(|c| polygon(c)).collect()),
+        );
+    }
+}
+
+impl RegionsSite {
+    /// What was drawn, as `(name, value)` lines of a site file's header.
+    pub fn values(&self) -> Vec<(&'static str, String)> {
+        let cells: Vec<String> = self.sources.iter().map(|s| s.cell.to_string()).collect();
+        vec![
+            ("regions_subregions", self.cells.len().to_string()),
+            ("regions_sources", self.sources.len().to_string()),
+            ("regions_source_subregions", cells.join(", ")),
+        ]
+    }
+}
