@@ -67,6 +67,10 @@ pub struct GroupSummary {
     pub sources: u64,
     /// Of them, located.
     pub sources_located: u64,
+    /// Declarations over all runs.
+    pub declarations: u64,
+    /// Of them, farther than the success radius from every true source.
+    pub declarations_off_source: u64,
     /// Distance from each located source to its nearest declaration: median, m.
     pub located_error_median_m: f64,
     /// 90th percentile, m.
@@ -162,6 +166,11 @@ fn summarise_group(c: &Campaign, key: &RunKey, rows: &[&RunRow]) -> GroupSummary
             .iter()
             .map(|r| u64::from(r.metrics.sources_located))
             .sum(),
+        declarations: rows.iter().map(|r| u64::from(r.metrics.declarations)).sum(),
+        declarations_off_source: rows
+            .iter()
+            .map(|r| u64::from(r.metrics.declarations_off_source))
+            .sum(),
         located_error_median_m: quantile(&located, 0.5),
         located_error_p90_m: quantile(&located, 0.9),
         error_median_m: quantile(&err, 0.5),
@@ -204,6 +213,8 @@ pub fn summary_csv(groups: &[GroupSummary]) -> String {
         "success_ci_high",
         "sources",
         "sources_located",
+        "declarations",
+        "declarations_off_source",
         "located_error_median_m",
         "located_error_p90_m",
         "error_median_m",
@@ -235,6 +246,8 @@ pub fn summary_csv(groups: &[GroupSummary]) -> String {
             num(g.success_ci_high, 4),
             g.sources.to_string(),
             g.sources_located.to_string(),
+            g.declarations.to_string(),
+            g.declarations_off_source.to_string(),
             num(g.located_error_median_m, 2),
             num(g.located_error_p90_m, 2),
             num(g.error_median_m, 2),
@@ -298,8 +311,10 @@ pub fn summary_md(c: &Campaign, groups: &[GroupSummary], expected_runs: u64) -> 
             s,
             "Several sources: the first declaration is often at the edge of a subregion, so \
              its error says little; `sources located` counts sources with a declaration \
-             {within}, and `located error` is the distance from each located source to its \
-             nearest declaration (all runs' sources pooled).\n"
+             {within}, `located error` is the distance from each located source to its \
+             nearest declaration (all runs' sources pooled), and `declarations (off a source)` \
+             counts every declaration of the runs and, in brackets, those {within} of no \
+             source (a subregion's declaration at its upflow edge among them).\n"
         );
     }
     let multi_scenario = c.scenarios.len() > 1;
@@ -316,6 +331,7 @@ pub fn summary_md(c: &Campaign, groups: &[GroupSummary], expected_runs: u64) -> 
     if multi_source {
         head.push("sources located");
         head.push("located error median / p90");
+        head.push("declarations (off a source)");
     }
     head.extend([
         "error median / p90",
@@ -366,6 +382,10 @@ pub fn summary_md(c: &Campaign, groups: &[GroupSummary], expected_runs: u64) -> 
                 "{} / {}",
                 cell(g.located_error_median_m, 1),
                 cell(g.located_error_p90_m, 1)
+            ));
+            row.push(format!(
+                "{} ({})",
+                g.declarations, g.declarations_off_source
             ));
         }
         row.extend([
@@ -494,6 +514,24 @@ pub fn sites_md(c: &Campaign, rows: &[(RunKey, RunRow)]) -> String {
                         Box::new(|r: &RunRow| r.site.site_flow_fault == Some(true)),
                     ),
                 ],
+            });
+        }
+        let mut counts: Vec<u32> = runs.iter().map(|(_, r)| r.metrics.sources).collect();
+        counts.sort_unstable();
+        counts.dedup();
+        if counts.iter().any(|n| *n > 1) {
+            splits.push(SiteSplit {
+                title: "sources at the site",
+                bins: counts
+                    .into_iter()
+                    .map(|n| {
+                        (
+                            n.to_string(),
+                            Box::new(move |r: &RunRow| r.metrics.sources == n)
+                                as Box<dyn Fn(&RunRow) -> bool>,
+                        )
+                    })
+                    .collect(),
             });
         }
         let _ = writeln!(

@@ -402,6 +402,10 @@ pub const CAMPAIGNS: &[(&str, &str)] = &[
         include_str!("../../../examples/campaigns/amp-fix-smoothing.toml"),
     ),
     (
+        "multi-source",
+        include_str!("../../../examples/campaigns/multi-source.toml"),
+    ),
+    (
         "moth-comparison",
         include_str!("../../../examples/campaigns/moth-comparison.toml"),
     ),

@@ -385,6 +385,15 @@ crate::columns! {
         sources: u32 = count(s.sources.len());
         /// Sources with a declaration within the success radius.
         sources_located: u32 = count(s.located_within(cx.located_radius_m(s)));
+        /// Declarations farther than the success radius from every true source (with several
+        /// sources, a subregion's declaration at its upflow edge counts when no source is near).
+        declarations_off_source: u32 = count(
+            s.declarations
+                .iter()
+                // A NaN error (none known) counts as off a source.
+                .filter(|d| d.error_m.is_nan() || d.error_m > cx.located_radius_m(s))
+                .count(),
+        );
         /// First declared position, m.
         declared_x: Option<f64> ["m"] = first(s).map(|d| d.x_m);
         /// First declared position, m.

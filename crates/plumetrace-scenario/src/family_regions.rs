@@ -268,3 +268,170 @@ impl RegionsSite {
         ]
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::family::Family;
+    use crate::{Origin, ScenarioError};
+
+    const MULTI: &str = include_str!("../../../examples/families/multi-source.family.toml");
+
+    fn family(text: &str) -> Result<Family, ScenarioError> {
+        Family::parse(
+            text,
+            Path::new("examples/families/multi-source.family.toml"),
+        )
+    }
+
+    fn inside(cell: &[[f64; 2]], p: [f64; 2], inset: f64) -> bool {
+        // A convex polygon: the point lies at least `inset` inside every edge (the sign of the
+        // polygon's area says which side is inside).
+        let n = cell.len();
+        let orientation = (0..n)
+            .map(|k| {
+                let (a, b) = (cell[k], cell[(k + 1) % n]);
+                a[0] * b[1] - b[0] * a[1]
+            })
+            .sum::<f64>()
+            .signum();
+        (0..n).all(|k| {
+            let (a, b) = (v(cell[k]), v(cell[(k + 1) % n]));
+            let (e, q) = (b - a, v(p) - a);
+            (e.x * q.y - e.y * q.x) * orientation / e.norm() >= inset - 1e-9
+        })
+    }
+
+    #[test]
+    fn sites_hold_one_to_three_sources_each_in_its_own_subregion() {
+        let f = family(MULTI).unwrap_or_else(|e| panic!("{e}"));
+        let mut counts = [0_usize; 4];
+        for seed in 0..60 {
+            let site = f.draw(seed);
+            let r = site.regions.as_ref().expect("regions drawn");
+            assert_eq!(r.cells.len(), 4);
+            let n = r.sources.len();
+            assert!((1..=3).contains(&n), "seed {seed}: {n} sources");
+            counts[n] += 1;
+            let mut cells: Vec<usize> = r.sources.iter().map(|s| s.cell).collect();
+            cells.dedup();
+            assert_eq!(cells.len(), n, "seed {seed}: one source per cell");
+            for s in &r.sources {
+                assert!(inside(&r.cells[s.cell], s.pos, 60.0), "seed {seed}: {s:?}");
+                let q = s.mass_rate_per_s.expect("drawn");
+                assert!((10.0..=40.0).contains(&q), "{q}");
+            }
+            // The cells tile the op-area: their areas add up to its area.
+            let area = |p: &[[f64; 2]]| {
+                (0..p.len())
+                    .map(|k| {
+                        let (a, b) = (p[k], p[(k + 1) % p.len()]);
+                        a[0] * b[1] - b[0] * a[1]
+                    })
+                    .sum::<f64>()
+                    .abs()
+                    / 2.0
+            };
+            let total: f64 = r.cells.iter().map(|c| area(c)).sum();
+            assert!(
+                (total - area(&site.op_area)).abs() < 1e-6 * total,
+                "seed {seed}"
+            );
+            // Within each column, the downflow cell comes first.
+            let down = unit(site.flow_toward_deg);
+            let centre = |c: &[[f64; 2]]| c.iter().fold(Vec2::zeros(), |s, p| s + v(*p)) / 4.0;
+            for pair in [(0, 1), (2, 3)] {
+                assert!(
+                    centre(&r.cells[pair.0]).dot(&down) >= centre(&r.cells[pair.1]).dot(&down),
+                    "seed {seed}"
+                );
+            }
+            // The site's first source is the first drawn.
+            assert_eq!(site.source, r.sources[0].pos);
+            // It builds, with every source and the four subregions.
+            let table = site.apply(&f.file, &f.base);
+            let origin = Origin::Preset("multi-source".into());
+            let cfg = crate::from_table(table, &origin).unwrap_or_else(|e| panic!("{e}"));
+            let built = crate::build(&cfg, &origin, Some(seed)).unwrap_or_else(|e| panic!("{e}"));
+            let mission = built.mission.as_ref().expect("a mission");
+            assert_eq!(mission.subregions.len(), 4, "seed {seed}");
+            assert_eq!(cfg.sources.len(), n, "seed {seed}");
+        }
+        assert!(
+            counts[1] > 5 && counts[2] > 5 && counts[3] > 5,
+            "{counts:?}"
+        );
+    }
+
+    #[test]
+    fn regions_leave_the_rest_of_a_site_as_drawn_without_them() {
+        let with = family(MULTI).unwrap_or_else(|e| panic!("{e}"));
+        let without_text = MULTI[..MULTI.find("[regions]").expect("a [regions] table")].to_string();
+        let without = family(&without_text).unwrap_or_else(|e| panic!("{e}"));
+        for seed in 0..20 {
+            let (a, b) = (with.draw(seed), without.draw(seed));
+            assert!(b.regions.is_none());
+            let strip = |s: &Site| Site {
+                source: [0.0; 2],
+                source_edge_m: 0.0,
+                mass_rate_per_s: None,
+                spinup_s: 0.0,
+                regions: None,
+                ..s.clone()
+            };
+            assert_eq!(strip(&a), strip(&b), "seed {seed}");
+        }
+    }
+
+    #[test]
+    fn bad_regions_are_refused_naming_the_key() {
+        let refused = |from: &str, to: &str, key: &str, says: &str| {
+            assert!(MULTI.contains(from), "{from}");
+            let e = family(&MULTI.replace(from, to)).expect_err(to).to_string();
+            assert!(e.contains(key) && e.contains(says), "{to}: {e}");
+        };
+        refused(
+            "sources = [1, 3]",
+            "sources = [1, 5]",
+            "regions.sources",
+            "<= 4",
+        );
+        refused(
+            "sources = [1, 3]",
+            "sources = [0, 2]",
+            "regions.sources",
+            "1 <= low",
+        );
+        refused(
+            "sources = [1, 3]",
+            "sources = [3, 2]",
+            "regions.sources",
+            "low <= high",
+        );
+        refused("along = 2", "along = 7", "regions.along", "from 1 to 6");
+        refused(
+            "along = 2\nacross = 2",
+            "along = 1\nacross = 1",
+            "regions",
+            "at least two cells",
+        );
+        refused(
+            "shapes = [\"rectangle\"]",
+            "shapes = [\"rectangle\", \"convex\"]",
+            "area.shapes",
+            "splits a rectangle",
+        );
+        refused(
+            "inset_m = 60.0\n",
+            "inset_m = 200.0\n",
+            "regions.inset_m",
+            "at most 145.0 m",
+        );
+        refused(
+            "sources = [1, 3]",
+            "sources = [1, 3]\nsoruces = 2",
+            "regions",
+            "unknown field",
+        );
+    }
+}

@@ -43,18 +43,44 @@ fn corner_family(p: &mut Pick) -> String {
     let length = p.end(10.0, 100_000.0);
     let width = p.end(10.0, 100_000.0);
     let inset = p.end(0.0, ((length.min(width) - 10.0) / 2.0).floor());
+    let shape = p.next() % 3;
     let shapes = [
         "[\"rectangle\"]",
         "[\"convex\"]",
         "[\"rectangle\", \"convex\"]",
-    ][(p.next() % 3) as usize];
+    ][shape as usize];
     let kinds = [
         "[\"downflow_corner\"]",
         "[\"edge\"]",
         "[\"inside\"]",
         "[\"downflow_corner\", \"edge\", \"inside\"]",
     ][(p.next() % 4) as usize];
-    format!(
+    // Several sources in a grid of subregions, on rectangles only, half the time.
+    let regions = if shape == 0 && p.next().is_multiple_of(2) {
+        let along = [1_u32, 2, 6][(p.next() % 3) as usize];
+        let across = if along == 1 {
+            [2_u32, 6][(p.next() % 2) as usize]
+        } else {
+            [1_u32, 2, 6][(p.next() % 3) as usize]
+        };
+        let cell = (length / f64::from(along)).min(width / f64::from(across));
+        if cell >= 10.0 {
+            let cells = f64::from(along * across);
+            let (a, b) = (p.end(1.0, cells), p.end(1.0, cells));
+            format!(
+                "[regions]\nalong = {along}\nacross = {across}\nsources = [{}, {}]\n\
+                 inset_m = {:?}\n",
+                a.min(b),
+                a.max(b),
+                p.end(0.0, ((cell - 10.0) / 2.0).floor())
+            )
+        } else {
+            String::new()
+        }
+    } else {
+        String::new()
+    };
+    let text = format!(
         "name = \"corner\"\nbase = \"{base}\"\ntime_limit_s = {tl:?}\ndomain_margin_m = {dm:?}\n\
          prior_flow_error_deg = {pe}\nvertical_mixing_length_m = {vm:?}\n\
          [flow]\ntoward_deg = {to}\nspeed_mps = {sp}\ntidal_swing_deg = {sw}\ntidal_period_s = {tp:?}\n\
@@ -80,7 +106,8 @@ fn corner_family(p: &mut Pick) -> String {
         fs = p.range(0.0, 10_000.0),
         fp = p.end(0.0, 1.0),
         fd = p.range(0.0, 1e6),
-    )
+    );
+    text + &regions
 }
 
 /// Sites of families at the bounds' corners; `families` families of `sites` sites each.
