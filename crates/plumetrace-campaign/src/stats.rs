@@ -298,9 +298,9 @@ pub fn summary_md(c: &Campaign, groups: &[GroupSummary], expected_runs: u64) -> 
         c.file.seeds,
         if multi_source {
             format!(
-                "with one source, a declaration {within}; with several, every source located \
-                 (a declaration {within} of it; edge declarations of subregions count for the \
-                 source they are nearest to)"
+                "with one source, a declaration {within}; with several, or with subregions \
+                 searched in turn, every source located (a declaration {within} of it; edge \
+                 declarations of subregions count for the source they are nearest to)"
             )
         } else {
             format!("a declaration {within} of a true source")

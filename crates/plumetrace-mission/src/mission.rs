@@ -577,6 +577,7 @@ impl Flight {
                 .collect(),
             sources: &self.sources,
             success_radius_m: self.success_radius_m,
+            subregions: self.subregions.len(),
             mean_flow_mps: mean_flow,
             team: self.team.summary(),
         });

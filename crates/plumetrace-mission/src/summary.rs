@@ -97,7 +97,8 @@ pub struct Summary {
     /// Whether any source was declared.
     pub declared: bool,
     /// Whether the mission found what it looked for: with one true source, its first
-    /// declaration lies within `success_radius_m` of it; with several, every source is located.
+    /// declaration lies within `success_radius_m` of it; with several, or with subregions
+    /// searched in turn, every source is located.
     pub success: bool,
     /// The first declaration (its time against `ended.t_s` tells which came first).
     pub first_declaration: Option<DeclarationRecord>,
@@ -121,6 +122,11 @@ pub struct Summary {
     pub sources_located: usize,
     /// Every true source, with its nearest declaration.
     pub sources: Vec<SourceRecord>,
+    /// Subregions searched in turn (`mission.subregions`; absent without them): such a search
+    /// declares once per subregion, at a source or at the subregion's edge, so it is judged by
+    /// the sources it located, not by its first declaration.
+    #[serde(skip_serializing_if = "is_zero")]
+    pub subregions: usize,
     /// The longest any vehicle with a planner spent in one behaviour without a detection, s.
     pub longest_quiet_s: Option<f64>,
     /// The farthest any vehicle with a planner went outside the op-area (true position), m.
@@ -143,6 +149,7 @@ pub(crate) struct SummaryInput<'a> {
     pub vehicles: Vec<(String, VehicleKind, Option<PlannerKind>)>,
     pub sources: &'a [Vec3],
     pub success_radius_m: f64,
+    pub subregions: usize,
     pub mean_flow_mps: Vec2,
     pub team: Option<crate::team::TeamSummary>,
 }
@@ -238,6 +245,7 @@ impl Summary {
             success_radius_m: i.success_radius_m,
             sources_located: sources.iter().filter(|s| s.located).count(),
             sources,
+            subregions: i.subregions,
             longest_quiet_s,
             max_outside_m,
             vehicles,
@@ -255,11 +263,17 @@ impl Summary {
             .count()
     }
 
+    /// Judged by the sources located rather than by the first declaration: several sources,
+    /// or subregions searched in turn.
+    pub fn judged_by_sources(&self) -> bool {
+        self.sources.len() > 1 || self.subregions > 1
+    }
+
     /// Whether the mission succeeded with this success radius: with one true source, its first
-    /// declaration lies within `radius_m` of it; with several, every source has a declaration
-    /// within `radius_m`.
+    /// declaration lies within `radius_m` of it; with several (or subregions searched in turn),
+    /// every source has a declaration within `radius_m`.
     pub fn success_within(&self, radius_m: f64) -> bool {
-        if self.sources.len() > 1 {
+        if self.judged_by_sources() {
             self.located_within(radius_m) == self.sources.len()
         } else {
             self.first_declaration
@@ -283,11 +297,16 @@ impl Summary {
             let why = plumetrace_core::variant_name(&self.ended.reason).unwrap_or("?");
             return format!("{word}: no declaration ({})", why.replace('_', " "));
         };
-        if self.sources.len() > 1 {
+        if self.judged_by_sources() {
             format!(
-                "{word}: {} of {} sources declared within the success radius ({r} m)",
+                "{word}: {} of {} {} declared within the success radius ({r} m)",
                 self.sources_located,
-                self.sources.len()
+                self.sources.len(),
+                if self.sources.len() == 1 {
+                    "source"
+                } else {
+                    "sources"
+                }
             )
         } else {
             format!(
@@ -427,4 +446,9 @@ mod tests {
         assert!((r.error_along_m - 10.0).abs() < 1e-12);
         assert!((r.error_cross_m - 3.0).abs() < 1e-12);
     }
+}
+
+/// Serde's test for a count left out of `summary.json` when 0.
+fn is_zero(n: &usize) -> bool {
+    *n == 0
 }
