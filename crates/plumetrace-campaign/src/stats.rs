@@ -71,6 +71,8 @@ pub struct GroupSummary {
     pub declarations: u64,
     /// Of them, farther than the success radius from every true source.
     pub declarations_off_source: u64,
+    /// Runs that searched several subregions in turn (judged by the sources they located).
+    pub subregion_runs: u64,
     /// Distance from each located source to its nearest declaration: median, m.
     pub located_error_median_m: f64,
     /// 90th percentile, m.
@@ -101,10 +103,13 @@ pub struct GroupSummary {
     pub outcomes: Vec<u64>,
 }
 
-/// Whether some run had several sources: success then means every source located, and the
-/// tables and charts show the sources rather than the first declaration.
+/// Whether some run had several sources or searched several subregions in turn: success then
+/// means every source located, and the tables and charts show the sources rather than the
+/// first declaration.
 pub fn multi_source(groups: &[GroupSummary]) -> bool {
-    groups.iter().any(|g| g.sources > g.runs)
+    groups
+        .iter()
+        .any(|g| g.sources > g.runs || g.subregion_runs > 0)
 }
 
 /// Summarises sorted rows group by group, in campaign order; groups without rows are left out.
@@ -171,6 +176,7 @@ fn summarise_group(c: &Campaign, key: &RunKey, rows: &[&RunRow]) -> GroupSummary
             .iter()
             .map(|r| u64::from(r.metrics.declarations_off_source))
             .sum(),
+        subregion_runs: rows.iter().filter(|r| r.metrics.subregions > 1).count() as u64,
         located_error_median_m: quantile(&located, 0.5),
         located_error_p90_m: quantile(&located, 0.9),
         error_median_m: quantile(&err, 0.5),
@@ -516,7 +522,11 @@ pub fn sites_md(c: &Campaign, rows: &[(RunKey, RunRow)]) -> String {
                 ],
             });
         }
-        let mut counts: Vec<u32> = runs.iter().map(|(_, r)| r.metrics.sources).collect();
+        let mut counts: Vec<u32> = runs
+            .iter()
+            .map(|(_, r)| r.metrics.sources)
+            .filter(|n| *n > 0)
+            .collect();
         counts.sort_unstable();
         counts.dedup();
         if counts.iter().any(|n| *n > 1) {
@@ -613,6 +623,8 @@ pub(crate) mod tests {
                     success: located == 2,
                     sources: 2,
                     sources_located: located,
+                    declarations: 3,
+                    declarations_off_source: 3 - located,
                     source_errors_m: errors.into(),
                     error_m: Some(313.0),
                     ..Default::default()
@@ -638,8 +650,28 @@ pub(crate) mod tests {
         assert_eq!(g[0].located_error_median_m, 4.0);
         let md = summary_md(&c, &g, 2);
         assert!(md.contains("| sources located |"), "{md}");
-        assert!(md.contains("| 3/4 | 4.0 / 5.6 |"), "{md}");
+        assert!(md.contains("| 3/4 | 4.0 / 5.6 | 6 (3) |"), "{md}");
         assert!(md.contains("every source located"), "{md}");
+    }
+
+    #[test]
+    fn one_source_searched_by_subregions_is_shown_by_its_sources() {
+        let (c, mut rows) = multi_source_fixture();
+        for (_, r) in &mut rows {
+            r.metrics.sources = 1;
+            r.metrics.sources_located = 1;
+        }
+        assert!(
+            !multi_source(&summarise(&c, &rows)),
+            "one source each, no subregions"
+        );
+        for (_, r) in &mut rows {
+            r.metrics.subregions = 4;
+        }
+        let g = summarise(&c, &rows);
+        assert_eq!(g[0].subregion_runs, 2);
+        assert!(multi_source(&g));
+        assert!(summary_md(&c, &g, 2).contains("| 2/2 |"));
     }
 
     #[test]

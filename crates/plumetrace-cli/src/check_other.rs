@@ -12,6 +12,25 @@ pub enum FileKind {
     Family,
 }
 
+/// Top-level keys only a scenario file has: one of them makes a file a scenario, whatever else
+/// it holds (a stray `seeds` or `[source]` there is a scenario's mistake, named as such).
+/// (`flow` is a family's key too.)
+const SCENARIO_KEYS: [&str; 13] = [
+    "sim",
+    "domain",
+    "bathymetry",
+    "plume",
+    "sources",
+    "obstacles",
+    "kelp",
+    "vehicles",
+    "mission",
+    "planner",
+    "planners",
+    "comms",
+    "output",
+];
+
 /// Top-level keys only a campaign file has.
 const CAMPAIGN_KEYS: [&str; 5] = ["scenarios", "seeds", "configs", "sweep", "success_radius_m"];
 
@@ -31,11 +50,11 @@ const FAMILY_KEYS: [&str; 11] = [
 ];
 
 impl FileKind {
-    /// Reads `path`'s top-level keys: one only a campaign has (`scenarios`, `seeds`,
-    /// `configs`, ...) makes a campaign, one only a family has (`base`, `area`, ...) or a name
-    /// ending in `.family.toml` a family; anything else, or a file that does not read (a
-    /// directory, a pipe, too big) or parse, is left to the scenario check, which says what is
-    /// wrong with it.
+    /// Reads `path`'s top-level keys: one only a scenario has (`domain`, `vehicles`, ...) keeps
+    /// it a scenario; else one only a campaign has (`scenarios`, `seeds`, `configs`, ...) makes
+    /// a campaign, one only a family has (`base`, `area`, ...) or a name ending in
+    /// `.family.toml` a family; anything else, or a file that does not read (a directory, a
+    /// pipe, too big) or parse, is left to the scenario check, which says what is wrong with it.
     pub fn of(path: &Path) -> FileKind {
         if path.to_string_lossy().ends_with(".family.toml") {
             return FileKind::Family;
@@ -48,7 +67,9 @@ impl FileKind {
         let Ok(table) = text.parse::<toml::Table>() else {
             return FileKind::Scenario;
         };
-        if CAMPAIGN_KEYS.iter().any(|k| table.contains_key(*k)) {
+        if SCENARIO_KEYS.iter().any(|k| table.contains_key(*k)) {
+            FileKind::Scenario
+        } else if CAMPAIGN_KEYS.iter().any(|k| table.contains_key(*k)) {
             FileKind::Campaign
         } else if FAMILY_KEYS.iter().any(|k| table.contains_key(*k)) {
             FileKind::Family

@@ -374,8 +374,8 @@ crate::columns! {
     /// outcome. Missing numbers (no declaration, no detection, no team) are `None`.
     pub struct RunMetrics from (s: &Summary, cx: &MetricContext) {
         /// Single source: the first declaration lies within the success radius (the campaign's,
-        /// or the scenario's `mission.success_radius_m`). Several sources: every source located
-        /// (`sources_located == sources`).
+        /// or the scenario's `mission.success_radius_m`). Several sources, or subregions
+        /// searched in turn: every source located (`sources_located == sources`).
         success: bool = s.success_within(cx.located_radius_m(s));
         /// Declared at all.
         declared: bool = s.declared;
@@ -390,10 +390,12 @@ crate::columns! {
         declarations_off_source: u32 = count(
             s.declarations
                 .iter()
-                // A NaN error (none known) counts as off a source.
-                .filter(|d| d.error_m.is_nan() || d.error_m > cx.located_radius_m(s))
+                .filter(|d| d.error_m > cx.located_radius_m(s))
                 .count(),
         );
+        /// Subregions searched in turn (`mission.subregions`; 0 without them). With more than
+        /// one the run is judged by the sources it located, as with several sources.
+        subregions: u32 = count(s.subregions);
         /// First declared position, m.
         declared_x: Option<f64> ["m"] = first(s).map(|d| d.x_m);
         /// First declared position, m.
@@ -520,8 +522,8 @@ mod tests {
         assert_eq!(
             cols[0].description(),
             "Single source: the first declaration lies within the success radius (the \
-             campaign's, or the scenario's `mission.success_radius_m`). Several sources: every \
-             source located (`sources_located == sources`)."
+             campaign's, or the scenario's `mission.success_radius_m`). Several sources, or \
+             subregions searched in turn: every source located (`sources_located == sources`)."
         );
         let m = RunMetrics {
             error_m: Some(2.5),

@@ -122,9 +122,9 @@ pub struct Summary {
     pub sources_located: usize,
     /// Every true source, with its nearest declaration.
     pub sources: Vec<SourceRecord>,
-    /// Subregions searched in turn (`mission.subregions`; absent without them): such a search
-    /// declares once per subregion, at a source or at the subregion's edge, so it is judged by
-    /// the sources it located, not by its first declaration.
+    /// Subregions searched in turn (`mission.subregions`; absent without them). A search of
+    /// more than one declares once per subregion, at a source or at the subregion's edge, so it
+    /// is judged by the sources it located, not by its first declaration.
     #[serde(skip_serializing_if = "is_zero")]
     pub subregions: usize,
     /// The longest any vehicle with a planner spent in one behaviour without a detection, s.
@@ -390,9 +390,86 @@ fn source_records(
         .collect()
 }
 
+/// Serde's test for a count left out of `summary.json` when 0.
+fn is_zero(n: &usize) -> bool {
+    *n == 0
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// One vehicle's summary of a mission with one source at the origin, declared first 300 m
+    /// away at a subregion's upflow edge and then 2 m from it, searching `subregions`.
+    fn one_source_two_declarations(subregions: usize) -> Summary {
+        let mut track = VehicleTrack::default();
+        track.declarations = vec![
+            (
+                100.0,
+                Vec2::new(0.0, 300.0),
+                DeclarationKind::new("upflow_edge"),
+            ),
+            (
+                900.0,
+                Vec2::new(2.0, 0.0),
+                DeclarationKind::new("along_flow"),
+            ),
+        ];
+        Summary::new(SummaryInput {
+            scenario: "s".into(),
+            seed: 1,
+            end: MissionEnd {
+                reason: EndReason::PlannersDone,
+                t_s: 1000.0,
+            },
+            first_failure: None,
+            statuses: &[VehicleStatus::Finished],
+            tracks: &[track],
+            vehicles: vec![("auv".into(), VehicleKind::Auv, None)],
+            sources: &[Vec3::new(0.0, 0.0, 0.0)],
+            success_radius_m: 50.0,
+            subregions,
+            mean_flow_mps: Vec2::new(0.0, -0.2),
+            team: None,
+        })
+    }
+
+    #[test]
+    fn a_search_of_subregions_is_judged_by_the_sources_it_located() {
+        let plain = one_source_two_declarations(0);
+        assert!(
+            !plain.success,
+            "one source: the first declaration, 300 m away"
+        );
+        assert!(
+            plain.verdict().starts_with("NOT located: declared 300.0 m"),
+            "{}",
+            plain.verdict()
+        );
+        let json = serde_json::to_string(&plain).unwrap_or_default();
+        assert!(!json.contains("subregions"), "{json}");
+        let one = one_source_two_declarations(1);
+        assert!(!one.success, "a single subregion is the op-area");
+        let searched = one_source_two_declarations(4);
+        assert!(searched.success);
+        assert_eq!(
+            searched.verdict(),
+            "located: 1 of 1 source declared within the success radius (50 m)"
+        );
+        let json = serde_json::to_string(&searched).unwrap_or_default();
+        assert!(json.contains("\"subregions\":4"), "{json}");
+        // The campaign's columns: the edge declaration is off the source.
+        let m =
+            crate::metrics::RunMetrics::new(&searched, &crate::metrics::MetricContext::default());
+        assert_eq!(
+            (m.declarations, m.declarations_off_source, m.subregions),
+            (2, 1, 4)
+        );
+        assert!(m.success);
+        let m = crate::metrics::RunMetrics::new(&plain, &crate::metrics::MetricContext::default());
+        assert_eq!((m.declarations_off_source, m.subregions), (1, 0));
+        assert!(!m.success);
+    }
 
     #[test]
     fn declarations_are_attributed_to_their_nearest_source() {
@@ -446,9 +523,4 @@ mod tests {
         assert!((r.error_along_m - 10.0).abs() < 1e-12);
         assert!((r.error_cross_m - 3.0).abs() < 1e-12);
     }
-}
-
-/// Serde's test for a count left out of `summary.json` when 0.
-fn is_zero(n: &usize) -> bool {
-    *n == 0
 }

@@ -563,6 +563,7 @@ impl Family {
             ));
         }
         crate::family_team::check(&file, &base, &base_origin, path)?;
+        crate::family_regions::check_base(&file, &base, path).map_err(|e| e.located(text))?;
         let family = Family {
             file,
             path: path.to_path_buf(),
@@ -650,7 +651,10 @@ fn check(f: &FamilyFile, path: &Path) -> Result<(), ScenarioError> {
     }
     num("source.inset_m", f.source.inset_m)?;
     range("source.mass_rate_per_s", f.source.mass_rate_per_s)?;
-    if 2.0 * f.source.inset_m + 10.0 > f.area.width_m[0].min(f.area.length_m[0]) {
+    // With [regions] each source keeps regions.inset_m inside its cell instead.
+    if f.regions.is_none()
+        && 2.0 * f.source.inset_m + 10.0 > f.area.width_m[0].min(f.area.length_m[0])
+    {
         return Err(invalid(
             path,
             "source.inset_m",
@@ -680,7 +684,8 @@ fn check(f: &FamilyFile, path: &Path) -> Result<(), ScenarioError> {
         return Err(invalid(
             path,
             "regions",
-            "[regions] places sources for one vehicle's search; a formation team's outlets come              from [team]: give one or the other"
+            "[regions] places sources for one vehicle's search; a formation team's outlets \
+             come from [team]: give one or the other"
                 .into(),
         ));
     }

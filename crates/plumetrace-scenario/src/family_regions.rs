@@ -3,9 +3,11 @@
 //! them.
 //!
 //! The grid is `along` cells along the op-area's main axis by `across` cells across it. The
-//! search order goes column by column across the axis, and within a column from the cell
-//! furthest downflow to the one furthest upflow (as the Duck 2003 multi-source mission flew its
-//! four). A site holds between `sources[0]` and `sources[1]` sources (whole numbers, drawn
+//! search goes column by column, a column being a strip of cells along whichever grid axis lies
+//! nearer the flow: within a column from the cell furthest downflow to the one furthest upflow,
+//! and the columns in the order of their most downflow cell (as the Duck 2003 multi-source
+//! mission flew its four, and so that the first subregion holds the op-area's most downflow
+//! corner, where a search begins). A site holds between `sources[0]` and `sources[1]` sources (whole numbers, drawn
 //! evenly), each in its own cell (the cells drawn at random), uniformly at least `inset_m` from
 //! that cell's edges, each with its own release rate when `[source] mass_rate_per_s` is given.
 //! The draws come from a random stream of their own, after everything else of the site, so a
@@ -23,18 +25,18 @@ use std::path::Path;
 const REGIONS_STREAM: u64 = 0x7265_6769;
 
 /// The most cells along or across.
-pub const MAX_CELLS: u32 = 6;
+pub const MAX_CELLS: i64 = 6;
 
 /// `[regions]`: the subregions and the sources in them.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct RegionsDraw {
-    /// Cells along the op-area's main axis.
-    pub along: u32,
+    /// Cells along the op-area's main axis (1 to [`MAX_CELLS`]).
+    pub along: i64,
     /// Cells across it.
-    pub across: u32,
+    pub across: i64,
     /// How many cells hold a source, `[low, high]` (whole numbers, drawn evenly).
-    pub sources: [u32; 2],
+    pub sources: [i64; 2],
     /// Least distance of a source from its cell's edges, m.
     #[serde(default = "default_inset")]
     pub inset_m: f64,
@@ -107,8 +109,8 @@ pub(crate) fn check(f: &FamilyFile, path: &Path) -> Result<(), ScenarioError> {
         ));
     }
     let (cell_l, cell_w) = (
-        f.area.length_m[0] / f64::from(r.along),
-        f.area.width_m[0] / f64::from(r.across),
+        f.area.length_m[0] / r.along as f64,
+        f.area.width_m[0] / r.across as f64,
     );
     if !(r.inset_m.is_finite() && r.inset_m >= 0.0 && 2.0 * r.inset_m + 10.0 <= cell_l.min(cell_w))
     {
@@ -127,6 +129,31 @@ pub(crate) fn check(f: &FamilyFile, path: &Path) -> Result<(), ScenarioError> {
     Ok(())
 }
 
+/// Checks that the base scenario can hold several sources: a Gaussian plume takes one.
+pub(crate) fn check_base(
+    f: &FamilyFile,
+    base: &toml::Table,
+    path: &Path,
+) -> Result<(), ScenarioError> {
+    let gaussian = base
+        .get("plume")
+        .and_then(|p| p.get("model"))
+        .and_then(toml::Value::as_str)
+        == Some("gaussian");
+    if f.regions.is_some() && gaussian {
+        return Err(invalid(
+            path,
+            "regions",
+            format!(
+                "the base '{}' has a Gaussian plume, which takes one source: give a base with a \
+                 filament plume (duck-2003-mt, say) or leave [regions] out",
+                f.base
+            ),
+        ));
+    }
+    Ok(())
+}
+
 /// Draws the regions of `site` (drawn from `seed` without them), and moves the site's source,
 /// its distance from the edge and its spin-up to the sources drawn (the spin-up long enough for
 /// the most upflow source's plume to cross the op-area).
@@ -135,28 +162,57 @@ pub(crate) fn draw(r: &RegionsDraw, f: &FamilyFile, site: &mut Site, seed: u64) 
     let (u, w) = (unit(site.axis_deg), unit(site.axis_deg + 90.0));
     let down = unit(site.flow_toward_deg);
     let (l, h) = (site.length_m, site.width_m);
-    let (dl, dw) = (l / f64::from(r.along), h / f64::from(r.across));
+    // The check kept both within 1..=MAX_CELLS.
+    let (along, across) = (
+        r.along.clamp(1, MAX_CELLS) as u32,
+        r.across.clamp(1, MAX_CELLS) as u32,
+    );
+    let (dl, dw) = (l / f64::from(along), h / f64::from(across));
     let at = |a: f64, b: f64| {
         let p = u * a + w * b;
         [p.x, p.y]
     };
-    // (across index, downflow order key, cell corners in the axis frame)
+    // Columns run along whichever grid axis lies nearer the flow; within a column the cells go
+    // downflow first, and the columns go in the order of their most downflow cell.
+    let flow_along_axis = down.dot(&u).abs() >= down.dot(&w).abs();
+    // (column, downflow order key, cell corners in the axis frame)
     let mut cells: Vec<(u32, f64, [f64; 4])> = Vec::new();
-    for j in 0..r.across {
-        for i in 0..r.along {
+    for j in 0..across {
+        for i in 0..along {
             let (a0, b0) = (-l / 2.0 + dl * f64::from(i), -h / 2.0 + dw * f64::from(j));
             let centre = u * (a0 + dl / 2.0) + w * (b0 + dw / 2.0);
-            cells.push((j, -centre.dot(&down), [a0, a0 + dl, b0, b0 + dw]));
+            let column = if flow_along_axis { j } else { i };
+            cells.push((column, -centre.dot(&down), [a0, a0 + dl, b0, b0 + dw]));
         }
     }
-    cells.sort_by(|x, y| x.0.cmp(&y.0).then(x.1.total_cmp(&y.1)));
+    let columns = if flow_along_axis { across } else { along };
+    let lead: Vec<f64> = (0..columns)
+        .map(|c| {
+            cells
+                .iter()
+                .filter(|x| x.0 == c)
+                .map(|x| x.1)
+                .fold(f64::INFINITY, f64::min)
+        })
+        .collect();
+    cells.sort_by(|x, y| {
+        lead[x.0 as usize]
+            .total_cmp(&lead[y.0 as usize])
+            .then(x.0.cmp(&y.0))
+            .then(x.1.total_cmp(&y.1))
+    });
     let polygons: Vec<Vec<[f64; 2]>> = cells
         .iter()
         .map(|(_, _, [a0, a1, b0, b1])| {
             vec![at(*a0, *b0), at(*a1, *b0), at(*a1, *b1), at(*a0, *b1)]
         })
         .collect();
-    let n = rng.random_range(r.sources[0]..=r.sources[1]) as usize;
+    let cells_n = i64::from(along * across);
+    let (lo, hi) = (
+        r.sources[0].clamp(1, cells_n),
+        r.sources[1].clamp(1, cells_n),
+    );
+    let n = rng.random_range(lo..=hi.max(lo)) as usize;
     // The first n of a random permutation of the cells.
     let mut order: Vec<usize> = (0..polygons.len()).collect();
     for k in 0..n.min(order.len()) {
@@ -337,8 +393,19 @@ mod tests {
                 (total - area(&site.op_area)).abs() < 1e-6 * total,
                 "seed {seed}"
             );
-            // Within each column, the downflow cell comes first.
+            // The first subregion holds the op-area's most downflow corner (where the search
+            // begins), and within each column the downflow cell comes first.
             let down = unit(site.flow_toward_deg);
+            let corner = site
+                .op_area
+                .iter()
+                .copied()
+                .max_by(|a, b| v(*a).dot(&down).total_cmp(&v(*b).dot(&down)))
+                .expect("corners");
+            assert!(
+                r.cells[0].iter().any(|c| (v(*c) - v(corner)).norm() < 1e-6),
+                "seed {seed}: the first subregion misses the downflow corner"
+            );
             let centre = |c: &[[f64; 2]]| c.iter().fold(Vec2::zeros(), |s, p| s + v(*p)) / 4.0;
             for pair in [(0, 1), (2, 3)] {
                 assert!(
@@ -433,5 +500,22 @@ mod tests {
             "regions",
             "unknown field",
         );
+        refused("along = 2", "along = 2.0", "regions.along", "invalid type");
+        refused(
+            "base = \"duck-2003-mt\"",
+            "base = \"soares-freshwater\"",
+            "regions",
+            "Gaussian plume, which takes one source",
+        );
+        // regions.inset_m replaces [source] inset_m: a small area with a 2 x 1 grid of 50 m
+        // cells and 20 m insets is read, though the default source inset (60 m) would not fit.
+        let small = MULTI
+            .replace("length_m = [700.0, 1000.0]", "length_m = [100.0, 100.0]")
+            .replace("width_m = [600.0, 900.0]", "width_m = [100.0, 100.0]")
+            .replace("across = 2", "across = 1")
+            .replace("sources = [1, 3]", "sources = [1, 2]")
+            .replace("inset_m = 60.0\n", "inset_m = 20.0\n");
+        let f = family(&small).unwrap_or_else(|e| panic!("{e}"));
+        assert!(f.draw(3).regions.is_some_and(|r| r.cells.len() == 2));
     }
 }
