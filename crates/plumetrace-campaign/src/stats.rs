@@ -419,6 +419,28 @@ struct SiteSplit {
     bins: Vec<Bin>,
 }
 
+/// One bin per distinct value of `get` over `runs` (in order; runs where it gives `None` fall in
+/// none), labelled with the value.
+fn value_bins<T>(runs: &[&(RunKey, RunRow)], get: fn(&RunRow) -> Option<T>) -> Vec<Bin>
+where
+    T: Ord + Clone + std::fmt::Display + 'static,
+{
+    let mut values: Vec<T> = runs.iter().filter_map(|(_, r)| get(r)).collect();
+    values.sort();
+    values.dedup();
+    values
+        .into_iter()
+        .map(|v| {
+            let label = v.to_string();
+            (
+                label,
+                Box::new(move |r: &RunRow| get(r).as_ref() == Some(&v))
+                    as Box<dyn Fn(&RunRow) -> bool>,
+            )
+        })
+        .collect()
+}
+
 /// Bins of a drawn number at the given edges (`[a, b)`, the last closed), labelled with `unit`.
 fn number_bins(
     get: fn(&RunRow) -> Option<f64>,
@@ -484,25 +506,9 @@ pub fn sites_md(c: &Campaign, rows: &[(RunKey, RunRow)]) -> String {
                 bins: number_bins(|r| r.site.site_source_edge_m, &e, 0, "m"),
             });
         }
-        let mut starts: Vec<String> = runs
-            .iter()
-            .map(|(_, r)| r.site.site_start.clone())
-            .collect();
-        starts.sort();
-        starts.dedup();
         splits.push(SiteSplit {
             title: "start",
-            bins: starts
-                .into_iter()
-                .map(|k| {
-                    let key = k.clone();
-                    (
-                        k,
-                        Box::new(move |r: &RunRow| r.site.site_start == key)
-                            as Box<dyn Fn(&RunRow) -> bool>,
-                    )
-                })
-                .collect(),
+            bins: value_bins(&runs, |r| Some(r.site.site_start.clone())),
         });
         if runs
             .iter()
@@ -522,26 +528,11 @@ pub fn sites_md(c: &Campaign, rows: &[(RunKey, RunRow)]) -> String {
                 ],
             });
         }
-        let mut counts: Vec<u32> = runs
-            .iter()
-            .map(|(_, r)| r.metrics.sources)
-            .filter(|n| *n > 0)
-            .collect();
-        counts.sort_unstable();
-        counts.dedup();
-        if counts.iter().any(|n| *n > 1) {
+        if runs.iter().any(|(_, r)| r.metrics.sources > 1) {
             splits.push(SiteSplit {
                 title: "sources at the site",
-                bins: counts
-                    .into_iter()
-                    .map(|n| {
-                        (
-                            n.to_string(),
-                            Box::new(move |r: &RunRow| r.metrics.sources == n)
-                                as Box<dyn Fn(&RunRow) -> bool>,
-                        )
-                    })
-                    .collect(),
+                // Runs that ended in an error report no sources: no bin of their own.
+                bins: value_bins(&runs, |r| Some(r.metrics.sources).filter(|n| *n > 0)),
             });
         }
         let _ = writeln!(

@@ -139,19 +139,9 @@ fn campaign(path: &Path) -> Result<()> {
 fn family(path: &Path) -> Result<()> {
     let f = plumetrace_scenario::Family::load(path)?;
     for k in 0..FAMILY_SITES {
-        let seed = plumetrace_env::derive_seed(1, k);
-        let site = f.draw(seed);
-        let file = format!("site-{k:03}.toml");
-        let text = site.to_toml(
-            &f.file,
-            &f.base,
-            seed,
-            &format!("{}-site-{k:03}", f.file.name),
-        );
+        let (file, text) = f.site_file(1, k, 3);
         let origin = plumetrace_scenario::Origin::File(file.clone().into());
-        let built = plumetrace_scenario::parse(&text, &origin)
-            .and_then(|cfg| plumetrace_scenario::build(&cfg, &origin, None));
-        if let Err(e) = built {
+        if let Err(e) = plumetrace_scenario::builds(&text, &origin) {
             bail!(
                 "{}: site {k} drawn at seed 1 cannot be built ({file} as `plumetrace family {} \
                  --sample {} --out DIR` writes it): {e}",

@@ -244,14 +244,9 @@ fn family(a: &FamilyArgs) -> Result<()> {
     let width = (a.sample.max(1) - 1).to_string().len().max(3);
     let mut sites = Vec::new();
     for k in 0..a.sample {
-        let seed = plumetrace_env::derive_seed(a.seed, k);
-        let site = f.draw(seed);
-        let site_name = format!("{}-site-{k:0width$}", f.file.name);
-        let text = site.to_toml(&f.file, &f.base, seed, &site_name);
-        let path = a.out.join(format!("site-{k:0width$}.toml"));
-        let origin = plumetrace_scenario::Origin::File(path.clone());
-        let cfg = plumetrace_scenario::parse(&text, &origin)?;
-        plumetrace_scenario::build(&cfg, &origin, None)?;
+        let (file, text) = f.site_file(a.seed, k, width);
+        let path = a.out.join(file);
+        plumetrace_scenario::builds(&text, &plumetrace_scenario::Origin::File(path.clone()))?;
         sites.push((path, text));
     }
     std::fs::create_dir_all(&a.out).with_context(|| format!("creating {}", a.out.display()))?;

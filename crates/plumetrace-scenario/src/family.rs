@@ -584,6 +584,18 @@ impl Family {
         site
     }
 
+    /// Site `k` of a campaign with seed `seed`, as `plumetrace family` writes it: its file name
+    /// (`site-K.toml`, K padded to `width` digits) and its text (named `NAME-site-K`, carrying
+    /// its run seed).
+    pub fn site_file(&self, seed: u64, k: u64, width: usize) -> (String, String) {
+        let run_seed = plumetrace_env::derive_seed(seed, k);
+        let name = format!("{}-site-{k:0width$}", self.file.name);
+        let text = self
+            .draw(run_seed)
+            .to_toml(&self.file, &self.base, run_seed, &name);
+        (format!("site-{k:0width$}.toml"), text)
+    }
+
     /// The scenario table of the site of `seed`.
     pub fn scenario(&self, seed: u64) -> toml::Table {
         self.draw(seed).apply(&self.file, &self.base)
@@ -731,9 +743,7 @@ fn check_extremes(family: &Family) -> Result<(), ScenarioError> {
             }
             let text = site.to_toml(&g, &family.base, seed, &g.name);
             let origin = Origin::File(family.path.clone());
-            let built = crate::parse(&text, &origin)
-                .and_then(|cfg| crate::build(&cfg, &origin, None).map(|_| ()));
-            if let Err(e) = built {
+            if let Err(e) = builds(&text, &origin) {
                 let e = e.to_string();
                 let what = e.strip_prefix(&format!("{origin}: ")).unwrap_or(&e);
                 return Err(invalid(
@@ -1252,6 +1262,12 @@ impl Site {
         out.push_str(&toml::to_string(&table).unwrap_or_default());
         out
     }
+}
+
+/// Reads and builds a site's scenario text, as `plumetrace run` would the file (`origin` names
+/// it in errors).
+pub fn builds(text: &str, origin: &Origin) -> Result<(), ScenarioError> {
+    crate::parse(text, origin).and_then(|cfg| crate::build(&cfg, origin, None).map(|_| ()))
 }
 
 /// Whether a campaign's scenario entry names a family (a path ending in `.family.toml`).

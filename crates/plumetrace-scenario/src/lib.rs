@@ -24,7 +24,7 @@ pub use build::{
 };
 pub use config::ScenarioConfig;
 pub use error::ScenarioError;
-pub use family::{Family, Site, is_family_path};
+pub use family::{Family, Site, builds, is_family_path};
 pub use overrides::{OverrideError, set_key};
 pub use presets::{PRESETS, Preset, find_preset};
 

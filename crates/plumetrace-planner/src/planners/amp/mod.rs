@@ -645,15 +645,18 @@ impl Memory {
         self.lost.iter().map(|l| l.pos).collect()
     }
 
+    /// Where the lost points the declaration check counts lie ([`Memory::checked`]).
+    fn checked_positions(&self) -> Vec<Vec2> {
+        self.checked().map(|l| l.pos).collect()
+    }
+
     /// The lost points the declaration check counts, oldest first: while a point is held
     /// (`declaration_fix_frames`), only those saved in a later fix frame than its own.
-    fn checked_positions(&self) -> Vec<Vec2> {
+    fn checked(&self) -> impl Iterator<Item = &LostPoint> {
         let after = self.candidates.last().map(|c| c.frame);
         self.lost
             .iter()
-            .filter(|l| after.is_none_or(|f| l.frame > f))
-            .map(|l| l.pos)
-            .collect()
+            .filter(move |l| after.is_none_or(|f| l.frame > f))
     }
 
     /// The mean of the held points (`None`: none is held).
@@ -687,7 +690,7 @@ impl Memory {
         if wanted <= 1 || self.multi_region() || self.fixes.count() == 0 || !lost_point_rule {
             return Some(at);
         }
-        if self.candidates.len() >= wanted || self.held_in_this_frame() {
+        if self.holding_all_frames() || self.held_in_this_frame() {
             return None;
         }
         let frame = points
@@ -735,14 +738,8 @@ impl Memory {
 
     /// The three most upflow lost points the declaration check counts, most upflow first.
     fn top_checked(&self) -> Vec<LostPoint> {
-        let after = self.candidates.last().map(|c| c.frame);
         let u = self.flow.upflow().unit();
-        let mut points: Vec<LostPoint> = self
-            .lost
-            .iter()
-            .filter(|l| after.is_none_or(|f| l.frame > f))
-            .copied()
-            .collect();
+        let mut points: Vec<LostPoint> = self.checked().copied().collect();
         points.sort_by(|a, b| b.pos.dot(&u).total_cmp(&a.pos.dot(&u)));
         points.truncate(3);
         points
@@ -774,8 +771,7 @@ impl Memory {
     /// and placed by their fixes, or `fix_wait_s` after the last was held.
     fn candidates_ready(&self, t: f64) -> Option<(Vec2, DeclarationKind)> {
         let last = self.candidates.last()?;
-        let wanted = self.p.declaration_fix_frames as usize;
-        if self.candidates.len() < wanted || !self.waits_for_fixes() {
+        if !self.holding_all_frames() || !self.waits_for_fixes() {
             return None;
         }
         if !self.candidates_placed() && t - last.t_s <= self.p.fix_wait_s {
