@@ -292,11 +292,20 @@ impl<'a> WorldView<'a> {
     }
 }
 
-fn timed<T>(acc: &mut f64, f: impl FnOnce() -> T) -> T {
-    let t0 = Instant::now();
-    let out = f();
-    *acc += t0.elapsed().as_secs_f64();
-    out
+/// A stopwatch read once between stages.
+struct Lap(Instant);
+
+impl Lap {
+    fn start() -> Self {
+        Lap(Instant::now())
+    }
+
+    /// Adds the time since the last reading to `acc`.
+    fn to(&mut self, acc: &mut f64) {
+        let now = Instant::now();
+        *acc += (now - self.0).as_secs_f64();
+        self.0 = now;
+    }
 }
 
 impl World {
@@ -693,20 +702,20 @@ impl Fleet {
             t_s: t,
             ..StepReport::default()
         };
-        timed(&mut times.sense_s, || self.sense(env, t));
-        timed(&mut times.communicate_s, || {
-            self.communicate(t, &mut report.events)
-        });
-        timed(&mut times.decide_s, || {
-            self.decide(t, env.seabed(), planners, &mut report)
-        });
-        timed(&mut times.control_s, || {
-            self.control(&report.decisions, &mut report.events)
-        });
-        timed(&mut times.integrate_s, || {
-            self.integrate(env, t, &mut report.events)
-        });
-        timed(&mut times.check_s, || self.check(env, &mut report.events));
+        // One clock reading between stages: each stage's time runs to the next one's start.
+        let mut lap = Lap::start();
+        self.sense(env, t);
+        lap.to(&mut times.sense_s);
+        self.communicate(t, &mut report.events);
+        lap.to(&mut times.communicate_s);
+        self.decide(t, env.seabed(), planners, &mut report);
+        lap.to(&mut times.decide_s);
+        self.control(&report.decisions, &mut report.events);
+        lap.to(&mut times.control_s);
+        self.integrate(env, t, &mut report.events);
+        lap.to(&mut times.integrate_s);
+        self.check(env, &mut report.events);
+        lap.to(&mut times.check_s);
         self.step += 1;
         self.times = times;
         Ok(report)

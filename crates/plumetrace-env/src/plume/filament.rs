@@ -1,5 +1,6 @@
 //! Filament storage, release, transport and growth.
 
+use super::column::Column;
 use super::index::{CellIndex, TermExp};
 use crate::error::{EnvError, require_finite, require_non_negative, require_positive};
 use crate::field::ConcentrationField;
@@ -163,18 +164,18 @@ pub struct FilamentPlume {
     sources: Vec<Source>,
     release: Vec<Option<Poisson<f64>>>,
     release_dt_s: f64,
-    pub(crate) x: Vec<f64>,
-    pub(crate) y: Vec<f64>,
-    pub(crate) z: Vec<f64>,
+    pub(crate) x: Column<f64>,
+    pub(crate) y: Column<f64>,
+    pub(crate) z: Column<f64>,
     /// Release time of each filament, s: `r^2 = r0^2 + gamma (t - birth)` is computed when
     /// needed, so stepping never touches it.
-    pub(crate) birth_s: Vec<f64>,
-    pub(crate) mass: Vec<f64>,
-    pub(crate) source: Vec<u16>,
+    pub(crate) birth_s: Column<f64>,
+    pub(crate) mass: Column<f64>,
+    pub(crate) source: Column<u16>,
     /// Each filament's noise key, drawn at its release: its random walk at transport step `n`
     /// comes from `key + n` alone (see [`FilamentPlume::step`]), so it does not depend on which
     /// other filaments exist.
-    key: Vec<u64>,
+    key: Column<u64>,
     /// The seed of the keys ([`FilamentPlume::set_key_seed`]).
     key_seed: u64,
     /// Keys given so far.
@@ -303,13 +304,13 @@ impl FilamentPlume {
             release: vec![None; sources.len()],
             sources,
             release_dt_s: f64::NAN,
-            x: Vec::new(),
-            y: Vec::new(),
-            z: Vec::new(),
-            birth_s: Vec::new(),
-            mass: Vec::new(),
-            source: Vec::new(),
-            key: Vec::new(),
+            x: Column::new(),
+            y: Column::new(),
+            z: Column::new(),
+            birth_s: Column::new(),
+            mass: Column::new(),
+            source: Column::new(),
+            key: Column::new(),
             key_seed: 0,
             keys_given: 0,
             transport_steps: 0,
@@ -331,13 +332,13 @@ impl FilamentPlume {
             sources: self.sources.clone(),
             release: self.release.clone(),
             release_dt_s: self.release_dt_s,
-            x: self.x.clone(),
-            y: self.y.clone(),
-            z: self.z.clone(),
-            birth_s: self.birth_s.clone(),
-            mass: self.mass.clone(),
-            source: self.source.clone(),
-            key: self.key.clone(),
+            x: self.x.copy_live(),
+            y: self.y.copy_live(),
+            z: self.z.copy_live(),
+            birth_s: self.birth_s.copy_live(),
+            mass: self.mass.copy_live(),
+            source: self.source.copy_live(),
+            key: self.key.copy_live(),
             key_seed: self.key_seed,
             keys_given: self.keys_given,
             transport_steps: self.transport_steps,
@@ -409,8 +410,14 @@ impl FilamentPlume {
     /// Squared radius of filament `k` now.
     #[inline]
     pub(crate) fn radius_sq(&self, k: usize) -> f64 {
+        self.radius_sq_born(self.birth_s[k])
+    }
+
+    /// Squared radius now of a filament released at `birth_s`.
+    #[inline]
+    pub(crate) fn radius_sq_born(&self, birth_s: f64) -> f64 {
         let r0 = self.params.init_radius_m;
-        r0 * r0 + self.params.growth_rate_m2ps * (self.time_s - self.birth_s[k]).max(0.0)
+        r0 * r0 + self.params.growth_rate_m2ps * (self.time_s - birth_s).max(0.0)
     }
 
     /// Plume time, s.
@@ -586,24 +593,15 @@ impl FilamentPlume {
         {
             // The pass above reflected at the datum (the seabed's lowest point); here each
             // filament reflects at the seabed where it is.
-            for k in 0..self.z.len() {
-                let f = sb.height_at(self.x[k], self.y[k]);
-                if self.z[k] < f {
-                    self.z[k] = reflect(self.z[k], f, ceiling);
+            let (xs, ys, zs) = (&*self.x, &*self.y, &mut *self.z);
+            for k in 0..zs.len() {
+                let f = sb.height_at(xs[k], ys[k]);
+                if zs[k] < f {
+                    zs[k] = reflect(zs[k], f, ceiling);
                 }
             }
         }
         (left, beyond)
-    }
-
-    /// Whether filament `k`'s cut-off sphere lies beyond `sink`.
-    #[inline]
-    fn is_beyond(&self, sink: &DownflowSink, k: usize) -> bool {
-        let along = sink.dir[0] * self.x[k] + sink.dir[1] * self.y[k];
-        along > sink.beyond_m && {
-            let reach = self.params.cutoff_radii * self.radius_sq(k).sqrt();
-            along - reach > sink.beyond_m
-        }
     }
 
     /// Releases the step's filaments at uniformly drawn birth times within it, each placed where
@@ -652,41 +650,89 @@ impl FilamentPlume {
 
     /// Removes the filaments outside the domain or beyond the sink, keeping the others in
     /// order.
+    ///
+    /// The filaments that go are nearly all among the oldest, at the columns' front: the kept
+    /// filaments before the last one that goes move back over the gaps and the columns start
+    /// later, so the filaments behind it are not moved (see [`Column`]).
     fn remove_outside(&mut self) {
         let d = self.domain;
-        let sink = self.sink;
-        let mut keep = 0usize;
-        for k in 0..self.x.len() {
-            let outside = !d.contains_xy(self.x[k], self.y[k]);
-            let beyond = !outside && sink.is_some_and(|s| self.is_beyond(&s, k));
-            if outside {
-                self.stats.exited += 1;
-                self.stats.exited_mass += self.mass[k];
-            } else if beyond {
-                self.stats.dropped += 1;
-                self.stats.dropped_mass += self.mass[k];
-            } else {
-                self.x[keep] = self.x[k];
-                self.y[keep] = self.y[k];
-                self.z[keep] = self.z[k];
-                self.birth_s[keep] = self.birth_s[k];
-                self.mass[keep] = self.mass[k];
-                self.source[keep] = self.source[k];
-                self.key[keep] = self.key[k];
-                keep += 1;
+        // Without a sink nothing lies beyond it.
+        let (dir, beyond_m) = self
+            .sink
+            .map_or(([0.0, 0.0], f64::INFINITY), |s| (s.dir, s.beyond_m));
+        let cut = self.params.cutoff_radii;
+        // The filaments that go, in order, each with whether it left the domain (else it lies
+        // beyond the sink); most filaments are passed by comparisons alone.
+        let mut gone: Vec<(usize, bool)> = Vec::new();
+        // A run of filaments is passed at once when none of them is out of the domain or past
+        // the sink's line (a test without branches, which the compiler vectorises).
+        const RUN: usize = 64;
+        let (xs, ys) = (&*self.x, &*self.y);
+        let stays = |x: f64, y: f64| {
+            (x >= d.x_min_m)
+                & (x <= d.x_max_m)
+                & (y >= d.y_min_m)
+                & (y <= d.y_max_m)
+                & (dir[0] * x + dir[1] * y <= beyond_m)
+        };
+        for (run, (rx, ry)) in xs.chunks(RUN).zip(ys.chunks(RUN)).enumerate() {
+            if rx
+                .iter()
+                .zip(ry)
+                .fold(true, |all, (&x, &y)| all & stays(x, y))
+            {
+                continue;
+            }
+            for (i, (&x, &y)) in rx.iter().zip(ry).enumerate() {
+                if stays(x, y) {
+                    continue;
+                }
+                let k = run * RUN + i;
+                if !d.contains_xy(x, y) {
+                    gone.push((k, true));
+                } else if dir[0] * x + dir[1] * y - cut * self.radius_sq(k).sqrt() > beyond_m {
+                    gone.push((k, false));
+                }
             }
         }
-        for v in [
-            &mut self.x,
-            &mut self.y,
-            &mut self.z,
-            &mut self.birth_s,
-            &mut self.mass,
-        ] {
-            v.truncate(keep);
+        let Some(&(last, _)) = gone.last() else {
+            return;
+        };
+        for &(k, exited) in &gone {
+            if exited {
+                self.stats.exited += 1;
+                self.stats.exited_mass += self.mass[k];
+            } else {
+                self.stats.dropped += 1;
+                self.stats.dropped_mass += self.mass[k];
+            }
         }
-        self.source.truncate(keep);
-        self.key.truncate(keep);
+        // The kept filaments of 0..=last, last first, to the back of that range.
+        let mut goes = gone.iter().rev().map(|g| g.0).peekable();
+        let mut to = last;
+        for k in (0..=last).rev() {
+            if goes.next_if_eq(&k).is_some() {
+                continue;
+            }
+            if to != k {
+                self.x.copy(k, to);
+                self.y.copy(k, to);
+                self.z.copy(k, to);
+                self.birth_s.copy(k, to);
+                self.mass.copy(k, to);
+                self.source.copy(k, to);
+                self.key.copy(k, to);
+            }
+            to = to.wrapping_sub(1);
+        }
+        let n = gone.len();
+        self.x.drop_front(n);
+        self.y.drop_front(n);
+        self.z.drop_front(n);
+        self.birth_s.drop_front(n);
+        self.mass.drop_front(n);
+        self.source.drop_front(n);
+        self.key.drop_front(n);
     }
 
     /// The Poisson release counts for a step of `dt_s` (rebuilt when the step changes).
@@ -729,20 +775,11 @@ impl FilamentPlume {
     /// The blocks' and groups' bounding boxes, built on first use after a change.
     fn boxes(&self) -> &ScanBoxes {
         self.boxes.get_or_init(|| {
-            let n = self.x.len();
-            let blocks: Vec<BlockBox> = (0..n.div_ceil(SCAN_BLOCK))
-                .map(|b| {
-                    let mut bb = BlockBox::EMPTY;
-                    for k in b * SCAN_BLOCK..((b + 1) * SCAN_BLOCK).min(n) {
-                        bb.x_min = bb.x_min.min(self.x[k]);
-                        bb.x_max = bb.x_max.max(self.x[k]);
-                        bb.y_min = bb.y_min.min(self.y[k]);
-                        bb.y_max = bb.y_max.max(self.y[k]);
-                        bb.birth_min_s = bb.birth_min_s.min(self.birth_s[k]);
-                    }
-                    bb
-                })
-                .collect();
+            let blocks = crate::simd::best().dispatch(BlockBoxes {
+                x: &self.x,
+                y: &self.y,
+                birth_s: &self.birth_s,
+            });
             let groups = blocks
                 .chunks(SCAN_GROUP)
                 .map(|g| g.iter().fold(BlockBox::EMPTY, |a, b| a.union(*b)))
@@ -804,21 +841,23 @@ impl FilamentPlume {
             VerticalBoundary::Reflecting { depth_m } => (Some(0.0), depth_m),
             VerticalBoundary::Unbounded => (None, None),
         };
+        let (xs, ys, zs, births, masses) =
+            (&*self.x, &*self.y, &*self.z, &*self.birth_s, &*self.mass);
         for k in range {
-            let dx = p.x - self.x[k];
-            let dy = p.y - self.y[k];
+            let dx = p.x - xs[k];
+            let dy = p.y - ys[k];
             let dxy2 = dx * dx + dy * dy;
-            let r2 = r0sq + gamma * (t - self.birth_s[k]).max(0.0);
+            let r2 = r0sq + gamma * (t - births[k]).max(0.0);
             let lim2 = cut2 * r2;
             if dxy2 > lim2 {
                 continue;
             }
-            let amp = self.mass[k] / (norm * r2 * r2.sqrt());
+            let amp = masses[k] / (norm * r2 * r2.sqrt());
             let k2 = -0.5 / r2;
-            let z = self.z[k];
+            let z = zs[k];
             // Over a seabed, the image is in the seabed where the filament is.
             let floor = match (&self.seabed, floor) {
-                (Some(sb), Some(_)) => Some(sb.height_at(self.x[k], self.y[k])),
+                (Some(sb), Some(_)) => Some(sb.height_at(xs[k], ys[k])),
                 _ => floor,
             };
             for zc in [
@@ -843,6 +882,78 @@ impl FilamentPlume {
     /// benchmark time the build apart from the queries.
     pub fn prepare_queries(&self) {
         let _ = self.index();
+    }
+}
+
+/// The bounding boxes of consecutive blocks of [`SCAN_BLOCK`] filaments (see
+/// [`FilamentPlume::boxes`]), as a [`pulp::WithSimd`] operation: each block's extremes are kept
+/// in eight lanes, then folded.
+struct BlockBoxes<'a> {
+    x: &'a [f64],
+    y: &'a [f64],
+    birth_s: &'a [f64],
+}
+
+impl pulp::WithSimd for BlockBoxes<'_> {
+    type Output = Vec<BlockBox>;
+
+    #[inline(always)]
+    fn with_simd<S: pulp::Simd>(self, _simd: S) -> Vec<BlockBox> {
+        const LANES: usize = 8;
+        // The smaller (larger) of two values, written so that it compiles to a vector minimum
+        // (maximum); the columns hold no NaN, so it is `f64::min` (`f64::max`).
+        #[inline(always)]
+        fn lo(a: f64, b: f64) -> f64 {
+            if b < a { b } else { a }
+        }
+        #[inline(always)]
+        fn hi(a: f64, b: f64) -> f64 {
+            if b > a { b } else { a }
+        }
+        let BlockBoxes { x, y, birth_s } = self;
+        let mut out = Vec::with_capacity(x.len().div_ceil(SCAN_BLOCK));
+        for ((bx, by), bb) in x
+            .chunks(SCAN_BLOCK)
+            .zip(y.chunks(SCAN_BLOCK))
+            .zip(birth_s.chunks(SCAN_BLOCK))
+        {
+            let mut x_min = [f64::INFINITY; LANES];
+            let mut x_max = [f64::NEG_INFINITY; LANES];
+            let mut y_min = [f64::INFINITY; LANES];
+            let mut y_max = [f64::NEG_INFINITY; LANES];
+            let mut b_min = [f64::INFINITY; LANES];
+            let whole = bx.len() / LANES * LANES;
+            for ((cx, cy), cb) in bx[..whole]
+                .chunks_exact(LANES)
+                .zip(by[..whole].chunks_exact(LANES))
+                .zip(bb[..whole].chunks_exact(LANES))
+            {
+                for l in 0..LANES {
+                    x_min[l] = lo(x_min[l], cx[l]);
+                    x_max[l] = hi(x_max[l], cx[l]);
+                    y_min[l] = lo(y_min[l], cy[l]);
+                    y_max[l] = hi(y_max[l], cy[l]);
+                    b_min[l] = lo(b_min[l], cb[l]);
+                }
+            }
+            for k in whole..bx.len() {
+                x_min[0] = lo(x_min[0], bx[k]);
+                x_max[0] = hi(x_max[0], bx[k]);
+                y_min[0] = lo(y_min[0], by[k]);
+                y_max[0] = hi(y_max[0], by[k]);
+                b_min[0] = lo(b_min[0], bb[k]);
+            }
+            let mut b = BlockBox::EMPTY;
+            for l in 0..LANES {
+                b.x_min = lo(b.x_min, x_min[l]);
+                b.x_max = hi(b.x_max, x_max[l]);
+                b.y_min = lo(b.y_min, y_min[l]);
+                b.y_max = hi(b.y_max, y_max[l]);
+                b.birth_min_s = lo(b.birth_min_s, b_min[l]);
+            }
+            out.push(b);
+        }
+        out
     }
 }
 
@@ -976,6 +1087,59 @@ mod tests {
     use super::*;
     use crate::flow::{FarrellFlow, FarrellParams, MeanFlow};
     use crate::{StreamId, stream_rng};
+
+    #[test]
+    fn removal_keeps_the_others_in_order_wherever_the_leavers_are() {
+        // 300 filaments along x in a 0-100 m square with a sink at x = 80 m: those out of the
+        // square or beyond the sink go, at the front, in the middle and last; the rest keep
+        // their order and every column stays aligned, over several removals in a row.
+        let region = Rect::new(0.0, 100.0, 0.0, 100.0).unwrap_or_else(|e| panic!("{e}"));
+        let source = Source {
+            pos_m: Vec3::new(50.0, 50.0, 1.0),
+            mass_rate_per_s: 1.0,
+            filament_rate_hz: 1.0,
+        };
+        let mut p = FilamentPlume::new(region, vec![source], FilamentParams::default())
+            .unwrap_or_else(|e| panic!("{e}"));
+        p.set_sink(Some(DownflowSink {
+            dir: [1.0, 0.0],
+            beyond_m: 80.0,
+        }));
+        for round in 0..3 {
+            p.release_at_source(0, 300 - p.len() as u64);
+            let n = p.len();
+            let mut kept = Vec::new();
+            for k in 0..n {
+                let (x, y) = match (k + round) % 7 {
+                    0 => (-1.0, 50.0),
+                    3 => (90.0, 50.0),
+                    _ => (10.0 + (k % 60) as f64, 50.0),
+                };
+                p.x[k] = x;
+                p.y[k] = y;
+                p.mass[k] = k as f64;
+                if (k + round) % 7 != 0 && (k + round) % 7 != 3 {
+                    kept.push((x, k as f64, p.key[k]));
+                }
+            }
+            let before = p.stats();
+            p.remove_outside();
+            let after = p.stats();
+            let now: Vec<_> = (0..p.len())
+                .map(|k| (p.x[k], p.mass[k], p.key[k]))
+                .collect();
+            assert_eq!(now, kept, "round {round}");
+            let exited = (0..n).filter(|k| (k + round) % 7 == 0).count() as u64;
+            assert_eq!(after.exited - before.exited, exited);
+            assert_eq!(
+                after.dropped - before.dropped,
+                (n - kept.len()) as u64 - exited
+            );
+            assert_eq!(p.y.len(), p.len());
+            assert_eq!(p.birth_s.len(), p.len());
+            assert_eq!(p.source.len(), p.len());
+        }
+    }
 
     #[test]
     fn every_vector_unit_steps_the_filaments_to_the_same_bits() {

@@ -53,11 +53,18 @@ impl CellIndex {
         seabed: Option<&crate::seabed::Seabed>,
     ) -> Self {
         let n = plume.x.len();
+        let (px, py, pz, pb, pm) = (
+            &*plume.x,
+            &*plume.y,
+            &*plume.z,
+            &*plume.birth_s,
+            &*plume.mass,
+        );
         // Over a seabed each filament's image in the seabed where it is joins the index as an
         // entry of its own (after the filaments), and no image is taken at z = 0.
         let images: Vec<f64> = match (seabed, vertical) {
             (Some(sb), VerticalBoundary::Reflecting { .. }) => (0..n)
-                .map(|k| 2.0 * sb.height_at(plume.x[k], plume.y[k]) - plume.z[k])
+                .map(|k| 2.0 * sb.height_at(px[k], py[k]) - pz[k])
                 .collect(),
             _ => Vec::new(),
         };
@@ -65,13 +72,15 @@ impl CellIndex {
         // Entry `e`'s filament and height.
         let of = |e: usize| -> (usize, f64) {
             if e < n {
-                (e, plume.z[e])
+                (e, pz[e])
             } else {
                 (e - n, images[e - n])
             }
         };
         // The oldest filament is the largest (radii only grow).
-        let r2_max = (0..n).map(|k| plume.radius_sq(k)).fold(0.0_f64, f64::max);
+        let r2_max = (0..n)
+            .map(|k| plume.radius_sq_born(pb[k]))
+            .fold(0.0_f64, f64::max);
         let search_m = cutoff_radii * r2_max.sqrt();
         let (w, h) = (domain.width_m(), domain.height_m());
         let mut cell = search_m.max(w.max(h) / 1024.0);
@@ -90,7 +99,7 @@ impl CellIndex {
         let mut cells = Vec::with_capacity(total);
         for e in 0..total {
             let k = of(e).0;
-            let c = cell_of(plume.x[k], plume.y[k]);
+            let c = cell_of(px[k], py[k]);
             cells.push(c as u32);
             starts[c + 1] += 1;
         }
@@ -114,13 +123,13 @@ impl CellIndex {
             let slot = fill[c] as usize;
             fill[c] += 1;
             let (k, z) = of(e);
-            let r2 = plume.radius_sq(k);
+            let r2 = plume.radius_sq_born(pb[k]);
             entries[slot] = Entry {
-                x: plume.x[k],
-                y: plume.y[k],
+                x: px[k],
+                y: py[k],
                 z,
                 lim2: cut2 * r2,
-                amp: plume.mass[k] / (norm * r2 * r2.sqrt()),
+                amp: pm[k] / (norm * r2 * r2.sqrt()),
                 neg_inv_2r2: -0.5 / r2,
             };
         }

@@ -26,6 +26,7 @@
 //! lazily on the first query after a step (so stepping never pays for it), with filaments sorted
 //! by cell into contiguous arrays. A query visits only the cells within the largest cut-off radius.
 
+mod column;
 mod exp_lanes;
 mod filament;
 mod index;
