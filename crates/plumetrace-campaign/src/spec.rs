@@ -234,7 +234,8 @@ pub fn parse_campaign(text: &str, path: &Path) -> Result<CampaignFile, CampaignE
         if key == "." {
             // A key missing at the top needs no excerpt of the file.
             let message = if inner.message().starts_with("missing field") {
-                plumetrace_scenario::locate::suggest(inner.message())
+                missing_keys(text)
+                    .unwrap_or_else(|| plumetrace_scenario::locate::suggest(inner.message()))
             } else {
                 plumetrace_core::toml_message(&inner, false)
             };
@@ -268,6 +269,39 @@ pub fn parse_campaign(text: &str, path: &Path) -> Result<CampaignFile, CampaignE
     }
     parsed.sweep = dotted(std::mem::take(&mut parsed.sweep));
     Ok(parsed)
+}
+
+/// The keys every campaign file has, each with what it is for.
+const REQUIRED: [(&str, &str); 4] = [
+    ("name", "the campaign's title"),
+    ("seed", "the campaign seed its runs' seeds derive from"),
+    ("seeds", "seeds per group"),
+    ("scenarios", "preset names or scenario and family files"),
+];
+
+/// Every required key a campaign's text lacks at its top, in one message (serde names only the
+/// first), or `None` when the text is not a table or lacks none.
+fn missing_keys(text: &str) -> Option<String> {
+    let table = text.parse::<toml::Table>().ok()?;
+    let missing: Vec<&str> = REQUIRED
+        .iter()
+        .filter(|(k, _)| !table.contains_key(*k))
+        .map(|(k, _)| *k)
+        .collect();
+    if missing.is_empty() {
+        return None;
+    }
+    let listed: Vec<String> = missing.iter().map(|k| format!("`{k}`")).collect();
+    let every: Vec<String> = REQUIRED
+        .iter()
+        .map(|(k, what)| format!("`{k}` ({what})"))
+        .collect();
+    Some(format!(
+        "missing {} {}: every campaign file has {}; see docs/campaigns.md",
+        if missing.len() == 1 { "key" } else { "keys" },
+        listed.join(", "),
+        every.join(", ")
+    ))
 }
 
 /// `set` and `sweep` keys as dotted paths: `plume.vertical_diffusivity_m2ps = 0.002` written
@@ -1046,6 +1080,26 @@ pub(crate) fn fnv1a(bytes: &[u8]) -> u64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_campaign_missing_its_keys_names_them_all_at_once() {
+        let path = Path::new("c.toml");
+        let message = |text: &str| match parse_campaign(text, path) {
+            Err(e) => e.to_string(),
+            Ok(_) => panic!("{text:?} parsed"),
+        };
+        let m = message("scenarios = [\"demo\"]\nseeds = 2\n");
+        assert!(m.contains("c.toml: missing keys `name`, `seed`: every campaign file has `name` (the campaign's title), `seed` ("), "{m}");
+        assert!(m.contains("docs/campaigns.md"), "{m}");
+        let m = message("name = \"c\"\nseed = 1\nscenarios = [\"demo\"]\n");
+        assert!(m.contains("missing key `seeds`:"), "{m}");
+        // A field missing deeper is serde's message, with its place.
+        let m = message(
+            "name = \"c\"\nseed = 1\nseeds = 1\nscenarios = [\"demo\"]\n[[configs]]\nset = {}\n",
+        );
+        assert!(m.contains("missing field `name`"), "{m}");
+        assert!(m.contains("configs"), "{m}");
+    }
 
     #[test]
     fn the_campaigns_success_radius_replaces_the_scenarios() {
