@@ -602,7 +602,10 @@ fn check_takes_campaign_and_family_files_too() {
     // misses; so does a family without `base`.
     let (ok, err) = check(dir.path(), "c2.toml", "name = \"c\"\nseed = 1\nseeds = 2\n");
     assert!(!ok);
-    assert!(err.contains("missing field `scenarios`"), "{err}");
+    assert!(
+        err.contains("c2.toml: missing key `scenarios`: every campaign file has"),
+        "{err}"
+    );
     let no_base = family_text.replace("base = \"duck-2003-st\"\n", "");
     assert_ne!(no_base, family_text);
     let (ok, err) = check(dir.path(), "f2.toml", &no_base);

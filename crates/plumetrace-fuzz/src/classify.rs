@@ -7,7 +7,8 @@
 //!
 //! 1. a position: `line N`, `column N`, `byte N` or `offset N` (N digits; TOML syntax errors,
 //!    and byte offsets for invalid UTF-8);
-//! 2. a key named by serde: ``field `NAME` `` (`missing field`, `unknown field`);
+//! 2. a key named by serde, ``field `NAME` `` (`missing field`, `unknown field`), or by a campaign's
+//!    list of missing keys, ``key `NAME` `` or ``keys `NAME` ``;
 //! 3. a key path: a `": "`-separated part of the message that starts with a key path,
 //!    `IDENT` followed by `.segment` or `[N]` steps (`sources[0].x_m`, `sweep.beta_deg`,
 //!    `configs.paper.set.mapping`), where a path of one key (`seeds`), or a path whose first
@@ -88,7 +89,11 @@ pub fn is_located(message: &str, file_name: &str, input: &str) -> bool {
     if !names_file(message, file_name) {
         return false;
     }
-    if has_position(message) || message.contains("field `") {
+    if has_position(message)
+        || ["field `", "key `", "keys `"]
+            .iter()
+            .any(|w| message.contains(w))
+    {
         return true;
     }
     message
@@ -225,6 +230,8 @@ mod tests {
             "/tmp/c/fuzz-campaign.toml: configs.my config.set.x: not a key",
             "/tmp/c/fuzz-campaign.toml: scenarios[2]: 'nope' is neither a preset nor a path",
             "/tmp/c/fuzz-campaign.toml: a b: is a date/time",
+            "/tmp/c/fuzz-campaign.toml: missing keys `name`, `seed`: every campaign file has ...",
+            "/tmp/c/fuzz-campaign.toml: missing key `seeds`: every campaign file has ...",
         ] {
             assert!(is_located(m, "fuzz-campaign.toml", INPUT), "{m}");
         }
