@@ -12,7 +12,7 @@ pub enum CampaignError {
         message: String,
     },
     /// The campaign file is malformed or has a bad value.
-    #[error("{file}{}: {}{message}", line.map(|l| format!(" line {l}")).unwrap_or_default(), if key.is_empty() { String::new() } else { format!("{key}: ") })]
+    #[error("{file}{}: {}{message}", line.map(|l| format!(":{l}")).unwrap_or_default(), if key.is_empty() { String::new() } else { format!("{key}: ") })]
     Invalid {
         /// The campaign file.
         file: String,
@@ -24,7 +24,7 @@ pub enum CampaignError {
         message: String,
     },
     /// A scenario with a configuration and sweep point does not build.
-    #[error("{file}{}: {group}: {message}", line.map(|l| format!(" line {l}")).unwrap_or_default())]
+    #[error("{file}{}: {group}: {message}", line.map(|l| format!(":{l}")).unwrap_or_default())]
     Group {
         /// The campaign file.
         file: String,
@@ -37,7 +37,7 @@ pub enum CampaignError {
         message: String,
     },
     /// A results file is damaged or belongs to another campaign.
-    #[error("{path}{}: {message}", line.map(|l| format!(" line {l}")).unwrap_or_default())]
+    #[error("{path}{}: {message}", line.map(|l| format!(":{l}")).unwrap_or_default())]
     Results {
         /// The file.
         path: String,

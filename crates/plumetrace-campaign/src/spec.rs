@@ -1174,27 +1174,27 @@ mod tests {
         let cases = [
             (
                 "[[configs]]\nname = \"b\"\n[configs.planner]\nkind = \"amp\"\nbeta_dgs = 3.0\n",
-                "c.toml line 13: scenario 'demo', config 'b'",
+                "c.toml:13: scenario 'demo', config 'b'",
                 "planner.beta_dgs: unknown field",
             ),
             (
                 "[[configs]]\nname = \"b\"\nset = { beta_deg = 300.0 }\n",
-                "c.toml line 11: scenario 'demo', config 'b'",
+                "c.toml:11: scenario 'demo', config 'b'",
                 "planner.beta_deg: must be >= 0",
             ),
             (
                 "[[configs]]\nname = \"b\"\nset = { \"planner.l_u_m\" = \"x\" }\n",
-                "c.toml line 11: scenario 'demo', config 'b'",
+                "c.toml:11: scenario 'demo', config 'b'",
                 "planner.l_u_m: invalid type",
             ),
             (
                 "[[configs]]\nname = \"b\"\nset = { \"plume.vertical_diffusivity_m2ps\" = -1.0 }\n",
-                "c.toml line 11: scenario 'demo', config 'b'",
+                "c.toml:11: scenario 'demo', config 'b'",
                 "plume.vertical_diffusivity_m2ps: must be >= 0",
             ),
             (
                 "[sweep]\nl_c_m = [\n  10.0,\n  -1.0,\n]\n",
-                "c.toml line 10: scenario 'demo', config 'ok', sweep l_c_m=-1.0",
+                "c.toml:10: scenario 'demo', config 'ok', sweep l_c_m=-1.0",
                 "planner.l_c_m: must be >= 0",
             ),
             // More places: an index the error writes `sources[0]`, a table whose key is at
@@ -1202,28 +1202,28 @@ mod tests {
             // in one, a planner table without `kind` (its own line).
             (
                 "[[configs]]\nname = \"b\"\nset = { \"sources.0.z_m\" = -3.0 }\n",
-                "c.toml line 11: scenario 'demo', config 'b'",
+                "c.toml:11: scenario 'demo', config 'b'",
                 "sources[0].z_m: must be >= 0",
             ),
             (
                 "[[configs]]\nname = \"b\"\n\
                  set = { \"flow.mean\" = { speed_mps = -1.0, toward_deg = 80.0 } }\n",
-                "c.toml line 11: scenario 'demo', config 'b'",
+                "c.toml:11: scenario 'demo', config 'b'",
                 "flow.mean.speed_mps: must be >= 0",
             ),
             (
                 "[[configs]]\nname = \"b\"\n[configs.set]\nplume.vertical_diffusivity_m2s = 1.0\n",
-                "c.toml line 12: scenario 'demo', config 'b'",
+                "c.toml:12: scenario 'demo', config 'b'",
                 "plume.vertical_diffusivity_m2s: unknown field",
             ),
             (
                 "[[configs]]\nname = \"b\"\nset = { \"plumes.vertical_diffusivity_m2ps\" = 1.0 }\n",
-                "c.toml line 11: scenario 'demo', config 'b'",
+                "c.toml:11: scenario 'demo', config 'b'",
                 "plumes: unknown field",
             ),
             (
                 "[[configs]]\nname = \"b\"\n[configs.planner]\nbeta_deg = 30.0\n",
-                "c.toml line 11: scenario 'demo', config 'b'",
+                "c.toml:11: scenario 'demo', config 'b'",
                 "planner.kind: missing",
             ),
         ];
@@ -1294,15 +1294,15 @@ mod tests {
         assert!(!e.contains("c.toml line"), "{e}");
         // The campaign file's own bad values name their lines.
         for (bad, want) in [
-            ("seeds = 0", "c.toml line 3: seeds: must be 1 to"),
+            ("seeds = 0", "c.toml:3: seeds: must be 1 to"),
             (
                 "seeds = 2.5",
-                "c.toml line 3: seeds: invalid type: floating point `2.5`, expected a whole \
+                "c.toml:3: seeds: invalid type: floating point `2.5`, expected a whole \
                  number from 1 to 1000000",
             ),
             (
                 "seeds = 1\nsuccess_radius_m = -5.0",
-                "c.toml line 4: success_radius_m:",
+                "c.toml:4: success_radius_m:",
             ),
         ] {
             std::fs::write(&path, text.replace("seeds = 1", bad)).unwrap();

@@ -208,7 +208,7 @@ fn a_directory_of_another_campaign_or_a_damaged_file_is_refused_without_touching
     let c = Campaign::load(&file, Some(1)).unwrap();
     let e = run_campaign(&c, &dir, RunOptions::default(), &|_, _| {}).unwrap_err();
     let msg = e.to_string();
-    assert!(msg.contains("runs.csv line 2"), "{msg}");
+    assert!(msg.contains("runs.csv:2"), "{msg}");
     assert_eq!(read(&dir.join("runs.csv")), damaged);
 
     // Another version's columns (here without the source counts): refused, file kept.

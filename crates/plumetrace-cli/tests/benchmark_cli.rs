@@ -269,7 +269,7 @@ fn benchmark_errors_name_what_is_wrong() {
             "--out",
             o,
         ],
-        "mine.toml line 1: kind: 'mot' is not a planner (did you mean 'moth'?)",
+        "mine.toml:1: kind: 'mot' is not a planner (did you mean 'moth'?)",
     );
     std::fs::write(&bad, "kind = \"moth\"\nspeed_mp = 3.0\n").unwrap();
     fails_with(
@@ -282,7 +282,7 @@ fn benchmark_errors_name_what_is_wrong() {
             "--out",
             o,
         ],
-        "mine.toml line 2: speed_mp: unknown field `speed_mp`; did you mean `speed_mps`?",
+        "mine.toml:2: speed_mp: unknown field `speed_mp`; did you mean `speed_mps`?",
     );
     let foreign = tmp.path().join("foreign");
     std::fs::create_dir_all(&foreign).unwrap();

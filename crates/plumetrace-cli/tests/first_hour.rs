@@ -575,7 +575,7 @@ fn check_takes_campaign_and_family_files_too() {
     let (ok, err) = check(dir.path(), "c.toml", &campaign);
     assert!(!ok);
     assert!(
-        err.contains("c.toml line 3: seedz: unknown field `seedz`"),
+        err.contains("c.toml:3: seedz: unknown field `seedz`"),
         "{err}"
     );
     let campaign = format!(
@@ -586,7 +586,7 @@ fn check_takes_campaign_and_family_files_too() {
     let (ok, err) = check(dir.path(), "c.toml", &campaign);
     assert!(!ok);
     assert!(
-        err.contains("c.toml line 9:") && err.contains("did you mean `fix_wait_s`?"),
+        err.contains("c.toml:9:") && err.contains("did you mean `fix_wait_s`?"),
         "{err}"
     );
     let swapped = family_text.replace("speed_mps = [0.1, 0.3]", "speed_mps = [0.3, 0.1]");

@@ -6,7 +6,7 @@
 //! `fuzz-campaign.toml`) **and** at least one of:
 //!
 //! 1. a position: `line N`, `column N`, `byte N` or `offset N` (N digits; TOML syntax errors,
-//!    and byte offsets for invalid UTF-8);
+//!    and byte offsets for invalid UTF-8), or the file's name followed by `:N` (`fuzz.toml:3:`);
 //! 2. a key named by serde, ``field `NAME` `` (`missing field`, `unknown field`), or by a campaign's
 //!    list of missing keys, ``key `NAME` `` or ``keys `NAME` ``;
 //! 3. a key path: a `": "`-separated part of the message that starts with a key path,
@@ -90,6 +90,7 @@ pub fn is_located(message: &str, file_name: &str, input: &str) -> bool {
         return false;
     }
     if has_position(message)
+        || at_line(message, file_name)
         || ["field `", "key `", "keys `"]
             .iter()
             .any(|w| message.contains(w))
@@ -110,6 +111,14 @@ fn names_file(message: &str, file_name: &str) -> bool {
 }
 
 /// `line N`, `column N`, `byte N` or `offset N`, case-insensitively.
+/// Whether `message` gives a line as `FILE:N`.
+fn at_line(message: &str, file_name: &str) -> bool {
+    let named = format!("{file_name}:");
+    message
+        .match_indices(&named)
+        .any(|(i, _)| message[i + named.len()..].starts_with(|c: char| c.is_ascii_digit()))
+}
+
 fn has_position(message: &str) -> bool {
     let lower = message.to_lowercase();
     ["line ", "column ", "byte ", "offset "].iter().any(|w| {
@@ -232,6 +241,7 @@ mod tests {
             "/tmp/c/fuzz-campaign.toml: a b: is a date/time",
             "/tmp/c/fuzz-campaign.toml: missing keys `name`, `seed`: every campaign file has ...",
             "/tmp/c/fuzz-campaign.toml: missing key `seeds`: every campaign file has ...",
+            "/tmp/c/fuzz-campaign.toml:13: scenario 'demo', config 'b': preset 'demo': must be positive",
         ] {
             assert!(is_located(m, "fuzz-campaign.toml", INPUT), "{m}");
         }
