@@ -8,7 +8,7 @@
 //! 1. a position: `line N`, `column N`, `byte N` or `offset N` (N digits; TOML syntax errors,
 //!    and byte offsets for invalid UTF-8), or the file's name followed by `:N` (`fuzz.toml:3:`);
 //! 2. a key named by serde, ``field `NAME` `` (`missing field`, `unknown field`), or by a campaign's
-//!    list of missing keys, ``key `NAME` `` or ``keys `NAME` ``;
+//!    list of missing keys, ``missing key `NAME` `` or ``missing keys `NAME` ``;
 //! 3. a key path: a `": "`-separated part of the message that starts with a key path,
 //!    `IDENT` followed by `.segment` or `[N]` steps (`sources[0].x_m`, `sweep.beta_deg`,
 //!    `configs.paper.set.mapping`), where a path of one key (`seeds`), or a path whose first
@@ -91,7 +91,7 @@ pub fn is_located(message: &str, file_name: &str, input: &str) -> bool {
     }
     if has_position(message)
         || at_line(message, file_name)
-        || ["field `", "key `", "keys `"]
+        || ["field `", "missing key `", "missing keys `"]
             .iter()
             .any(|w| message.contains(w))
     {
@@ -110,15 +110,19 @@ fn names_file(message: &str, file_name: &str) -> bool {
     })
 }
 
-/// `line N`, `column N`, `byte N` or `offset N`, case-insensitively.
-/// Whether `message` gives a line as `FILE:N`.
+/// Whether `message` gives a line as `FILE:N`, `FILE` named whole as in [`names_file`].
 fn at_line(message: &str, file_name: &str) -> bool {
-    let named = format!("{file_name}:");
-    message
-        .match_indices(&named)
-        .any(|(i, _)| message[i + named.len()..].starts_with(|c: char| c.is_ascii_digit()))
+    message.match_indices(file_name).any(|(i, _)| {
+        let before = message[..i].chars().next_back();
+        let rest = &message[i + file_name.len()..];
+        before.is_none_or(|c| !(c.is_alphanumeric() || c == '-' || c == '_' || c == '.'))
+            && rest
+                .strip_prefix(':')
+                .is_some_and(|r| r.starts_with(|c: char| c.is_ascii_digit()))
+    })
 }
 
+/// `line N`, `column N`, `byte N` or `offset N`, case-insensitively.
 fn has_position(message: &str) -> bool {
     let lower = message.to_lowercase();
     ["line ", "column ", "byte ", "offset "].iter().any(|w| {
@@ -258,6 +262,9 @@ mod tests {
             "/tmp/x/fuzz.toml: stream did not contain valid UTF-8",
             "/tmp/x/fuzz.toml: : the flow diverged",
             "/tmp/x/fuzz.toml: error: something went wrong",
+            // Another file's line, and a key not said to be missing.
+            "/tmp/x/fuzz.toml: see /tmp/x/notfuzz.toml:3: it failed",
+            "/tmp/x/fuzz.toml: the key `x` failed",
             "/tmp/x/fuzz.toml: invalid type: integer `5`, expected a string",
             // An empty key segment is not a path.
             "/tmp/x/fuzz.toml: output.: is a date/time",

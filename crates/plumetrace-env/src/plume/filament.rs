@@ -1092,7 +1092,8 @@ mod tests {
     fn removal_keeps_the_others_in_order_wherever_the_leavers_are() {
         // 300 filaments along x in a 0-100 m square with a sink at x = 80 m: those out of the
         // square or beyond the sink go, at the front, in the middle and last; the rest keep
-        // their order and every column stays aligned, over several removals in a row.
+        // their order and every column stays aligned, over several removals in a row, and
+        // without the sink.
         let region = Rect::new(0.0, 100.0, 0.0, 100.0).unwrap_or_else(|e| panic!("{e}"));
         let source = Source {
             pos_m: Vec3::new(50.0, 50.0, 1.0),
@@ -1105,20 +1106,27 @@ mod tests {
             dir: [1.0, 0.0],
             beyond_m: 80.0,
         }));
-        for round in 0..3 {
+        // Round 3 has no sink: a filament beyond its line then stays.
+        for round in 0..4 {
+            if round == 3 {
+                p.set_sink(None);
+            }
             p.release_at_source(0, 300 - p.len() as u64);
             let n = p.len();
             let mut kept = Vec::new();
             for k in 0..n {
-                let (x, y) = match (k + round) % 7 {
-                    0 => (-1.0, 50.0),
-                    3 => (90.0, 50.0),
-                    _ => (10.0 + (k % 60) as f64, 50.0),
+                // Out of the square; beyond the sink; past its line but reaching back over it
+                // (a filament's cut-off is about 0.1 m); inside.
+                let (x, y, stays) = match (k + round) % 7 {
+                    0 => (-1.0, 50.0, false),
+                    3 => (90.0, 50.0, round == 3),
+                    5 => (80.05, 50.0, true),
+                    _ => (10.0 + (k % 60) as f64, 50.0, true),
                 };
                 p.x[k] = x;
                 p.y[k] = y;
                 p.mass[k] = k as f64;
-                if (k + round) % 7 != 0 && (k + round) % 7 != 3 {
+                if stays {
                     kept.push((x, k as f64, p.key[k]));
                 }
             }
@@ -1135,6 +1143,11 @@ mod tests {
                 after.dropped - before.dropped,
                 (n - kept.len()) as u64 - exited
             );
+            // Summed in order, as before.
+            let mass = (0..n)
+                .filter(|k| (k + round) % 7 == 0)
+                .fold(before.exited_mass, |m, k| m + k as f64);
+            assert_eq!(after.exited_mass, mass);
             assert_eq!(p.y.len(), p.len());
             assert_eq!(p.birth_s.len(), p.len());
             assert_eq!(p.source.len(), p.len());
