@@ -1,5 +1,7 @@
 //! What can go wrong with a campaign, with the file, key or line it concerns.
 
+use plumetrace_scenario::locate::at_line;
+
 /// A campaign error.
 #[derive(Debug, thiserror::Error)]
 pub enum CampaignError {
@@ -12,7 +14,7 @@ pub enum CampaignError {
         message: String,
     },
     /// The campaign file is malformed or has a bad value.
-    #[error("{file}{}: {}{message}", line.map(|l| format!(":{l}")).unwrap_or_default(), if key.is_empty() { String::new() } else { format!("{key}: ") })]
+    #[error("{file}{}: {}{message}", at_line(*line), if key.is_empty() { String::new() } else { format!("{key}: ") })]
     Invalid {
         /// The campaign file.
         file: String,
@@ -24,7 +26,7 @@ pub enum CampaignError {
         message: String,
     },
     /// A scenario with a configuration and sweep point does not build.
-    #[error("{file}{}: {group}: {message}", line.map(|l| format!(":{l}")).unwrap_or_default())]
+    #[error("{file}{}: {group}: {message}", at_line(*line))]
     Group {
         /// The campaign file.
         file: String,
@@ -37,7 +39,7 @@ pub enum CampaignError {
         message: String,
     },
     /// A results file is damaged or belongs to another campaign.
-    #[error("{path}{}: {message}", line.map(|l| format!(":{l}")).unwrap_or_default())]
+    #[error("{path}{}: {message}", at_line(*line))]
     Results {
         /// The file.
         path: String,

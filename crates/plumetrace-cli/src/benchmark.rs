@@ -86,7 +86,7 @@ fn given(set: &TaskSet, a: &BenchmarkArgs) -> Result<Vec<Given>> {
             let line = [error.key.clone(), format!("planner.{}", error.key)]
                 .iter()
                 .find_map(|k| plumetrace_scenario::locate::line_of_key(&text, k));
-            let at = line.map(|l| format!(":{l}")).unwrap_or_default();
+            let at = plumetrace_scenario::locate::at_line(line);
             return Err(anyhow::anyhow!("{}{at}: {error}", f.display()));
         }
         given.push(Given::file(e));

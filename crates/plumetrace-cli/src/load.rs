@@ -115,10 +115,7 @@ impl Place {
             if shortened && w.path == "sim.duration_s" {
                 continue;
             }
-            let line = self
-                .line(&w.path)
-                .map(|l| format!(":{l}"))
-                .unwrap_or_default();
+            let line = plumetrace_scenario::locate::at_line(self.line(&w.path));
             eprintln!("warning: {}{line}: {w}", built.origin);
         }
     }

@@ -76,7 +76,7 @@ pub fn load(path: &std::path::Path) -> Result<Onboard> {
         .map_err(anyhow::Error::msg)
         .with_context(|| format!("reading {}", path.display()))?;
     let line = |key: &str| plumetrace_scenario::locate::line_of(&text, key);
-    let at = |line: Option<usize>| line.map(|l| format!(":{l}")).unwrap_or_default();
+    let at = plumetrace_scenario::locate::at_line::<usize>;
     let onboard = Onboard::from_toml(&text)
         .map_err(|e| anyhow::anyhow!("{}{}: {e}", path.display(), at(line(&e.key))))?;
     // Keys with no effect: flown as written, but said before the vehicle goes, in the file's

@@ -93,9 +93,9 @@ pub fn run(args: &ReplayArgs) -> Result<bool> {
             // Checked here so that errors name this file (and the key's line), not the log's
             // planner.
             plumetrace_planner::PlannerConfig::from_table(&table, &prefix).map_err(|e| {
-                let line = plumetrace_scenario::locate::line_of(&text, &e.key)
-                    .map(|l| format!(":{l}"))
-                    .unwrap_or_default();
+                let line = plumetrace_scenario::locate::at_line(
+                    plumetrace_scenario::locate::line_of(&text, &e.key),
+                );
                 anyhow::anyhow!("{}{line}: {e}", p.display())
             })?;
             Some(table)

@@ -102,23 +102,27 @@ pub fn is_located(message: &str, file_name: &str, input: &str) -> bool {
         .any(|part| key_path_part(part.trim(), input))
 }
 
-/// Whether `message` names `file_name` as a whole file name (not a longer name ending in it).
-fn names_file(message: &str, file_name: &str) -> bool {
-    message.match_indices(file_name).any(|(i, _)| {
+/// What follows each place `message` names `file_name` as a whole file name (not a longer name
+/// ending in it).
+fn after_file<'a>(message: &'a str, file_name: &'a str) -> impl Iterator<Item = &'a str> + 'a {
+    message.match_indices(file_name).filter_map(move |(i, _)| {
         let before = message[..i].chars().next_back();
-        before.is_none_or(|c| !(c.is_alphanumeric() || c == '-' || c == '_' || c == '.'))
+        before
+            .is_none_or(|c| !(c.is_alphanumeric() || c == '-' || c == '_' || c == '.'))
+            .then(|| &message[i + file_name.len()..])
     })
 }
 
-/// Whether `message` gives a line as `FILE:N`, `FILE` named whole as in [`names_file`].
+/// Whether `message` names `file_name` as a whole file name.
+fn names_file(message: &str, file_name: &str) -> bool {
+    after_file(message, file_name).next().is_some()
+}
+
+/// Whether `message` gives a line of `file_name` as `FILE:N`.
 fn at_line(message: &str, file_name: &str) -> bool {
-    message.match_indices(file_name).any(|(i, _)| {
-        let before = message[..i].chars().next_back();
-        let rest = &message[i + file_name.len()..];
-        before.is_none_or(|c| !(c.is_alphanumeric() || c == '-' || c == '_' || c == '.'))
-            && rest
-                .strip_prefix(':')
-                .is_some_and(|r| r.starts_with(|c: char| c.is_ascii_digit()))
+    after_file(message, file_name).any(|rest| {
+        rest.strip_prefix(':')
+            .is_some_and(|r| r.starts_with(|c: char| c.is_ascii_digit()))
     })
 }
 

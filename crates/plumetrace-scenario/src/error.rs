@@ -1,5 +1,7 @@
 //! Scenario errors: every one names where (file or preset) and what (key path).
 
+use crate::locate::at_line;
+
 /// What can go wrong reading or building a scenario.
 #[derive(Debug, thiserror::Error)]
 pub enum ScenarioError {
@@ -45,11 +47,6 @@ pub enum ScenarioError {
         /// The known names.
         known: String,
     },
-}
-
-/// `:LINE` after a file name, or nothing.
-fn at_line(line: Option<usize>) -> String {
-    line.map(|l| format!(":{l}")).unwrap_or_default()
 }
 
 impl ScenarioError {

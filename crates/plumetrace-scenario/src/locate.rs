@@ -116,6 +116,11 @@ pub fn message_with_line(error: &toml::de::Error, text: &str) -> String {
     format!("{}{line}", suggest(error.message()))
 }
 
+/// `:LINE` after a file name (`site.toml:12: ...`, the form editors jump to), or nothing.
+pub fn at_line<L: std::fmt::Display>(line: Option<L>) -> String {
+    line.map(|l| format!(":{l}")).unwrap_or_default()
+}
+
 /// serde's message for an unknown key or name (`unknown field `dtt_s`, expected `dt_s` or
 /// `duration_s``, `unknown variant ...`) with the nearest known one suggested in place of the
 /// list when one is near; Rust's type names in plain words ([`plumetrace_core::plain_types`]).

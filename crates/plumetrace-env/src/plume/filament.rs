@@ -775,11 +775,20 @@ impl FilamentPlume {
     /// The blocks' and groups' bounding boxes, built on first use after a change.
     fn boxes(&self) -> &ScanBoxes {
         self.boxes.get_or_init(|| {
-            let blocks = crate::simd::best().dispatch(BlockBoxes {
-                x: &self.x,
-                y: &self.y,
-                birth_s: &self.birth_s,
-            });
+            let (xs, ys, births) = (&*self.x, &*self.y, &*self.birth_s);
+            let blocks: Vec<BlockBox> = (0..xs.len().div_ceil(SCAN_BLOCK))
+                .map(|b| {
+                    let mut bb = BlockBox::EMPTY;
+                    for k in b * SCAN_BLOCK..((b + 1) * SCAN_BLOCK).min(xs.len()) {
+                        bb.x_min = bb.x_min.min(xs[k]);
+                        bb.x_max = bb.x_max.max(xs[k]);
+                        bb.y_min = bb.y_min.min(ys[k]);
+                        bb.y_max = bb.y_max.max(ys[k]);
+                        bb.birth_min_s = bb.birth_min_s.min(births[k]);
+                    }
+                    bb
+                })
+                .collect();
             let groups = blocks
                 .chunks(SCAN_GROUP)
                 .map(|g| g.iter().fold(BlockBox::EMPTY, |a, b| a.union(*b)))
@@ -882,78 +891,6 @@ impl FilamentPlume {
     /// benchmark time the build apart from the queries.
     pub fn prepare_queries(&self) {
         let _ = self.index();
-    }
-}
-
-/// The bounding boxes of consecutive blocks of [`SCAN_BLOCK`] filaments (see
-/// [`FilamentPlume::boxes`]), as a [`pulp::WithSimd`] operation: each block's extremes are kept
-/// in eight lanes, then folded.
-struct BlockBoxes<'a> {
-    x: &'a [f64],
-    y: &'a [f64],
-    birth_s: &'a [f64],
-}
-
-impl pulp::WithSimd for BlockBoxes<'_> {
-    type Output = Vec<BlockBox>;
-
-    #[inline(always)]
-    fn with_simd<S: pulp::Simd>(self, _simd: S) -> Vec<BlockBox> {
-        const LANES: usize = 8;
-        // The smaller (larger) of two values, written so that it compiles to a vector minimum
-        // (maximum); the columns hold no NaN, so it is `f64::min` (`f64::max`).
-        #[inline(always)]
-        fn lo(a: f64, b: f64) -> f64 {
-            if b < a { b } else { a }
-        }
-        #[inline(always)]
-        fn hi(a: f64, b: f64) -> f64 {
-            if b > a { b } else { a }
-        }
-        let BlockBoxes { x, y, birth_s } = self;
-        let mut out = Vec::with_capacity(x.len().div_ceil(SCAN_BLOCK));
-        for ((bx, by), bb) in x
-            .chunks(SCAN_BLOCK)
-            .zip(y.chunks(SCAN_BLOCK))
-            .zip(birth_s.chunks(SCAN_BLOCK))
-        {
-            let mut x_min = [f64::INFINITY; LANES];
-            let mut x_max = [f64::NEG_INFINITY; LANES];
-            let mut y_min = [f64::INFINITY; LANES];
-            let mut y_max = [f64::NEG_INFINITY; LANES];
-            let mut b_min = [f64::INFINITY; LANES];
-            let whole = bx.len() / LANES * LANES;
-            for ((cx, cy), cb) in bx[..whole]
-                .chunks_exact(LANES)
-                .zip(by[..whole].chunks_exact(LANES))
-                .zip(bb[..whole].chunks_exact(LANES))
-            {
-                for l in 0..LANES {
-                    x_min[l] = lo(x_min[l], cx[l]);
-                    x_max[l] = hi(x_max[l], cx[l]);
-                    y_min[l] = lo(y_min[l], cy[l]);
-                    y_max[l] = hi(y_max[l], cy[l]);
-                    b_min[l] = lo(b_min[l], cb[l]);
-                }
-            }
-            for k in whole..bx.len() {
-                x_min[0] = lo(x_min[0], bx[k]);
-                x_max[0] = hi(x_max[0], bx[k]);
-                y_min[0] = lo(y_min[0], by[k]);
-                y_max[0] = hi(y_max[0], by[k]);
-                b_min[0] = lo(b_min[0], bb[k]);
-            }
-            let mut b = BlockBox::EMPTY;
-            for l in 0..LANES {
-                b.x_min = lo(b.x_min, x_min[l]);
-                b.x_max = hi(b.x_max, x_max[l]);
-                b.y_min = lo(b.y_min, y_min[l]);
-                b.y_max = hi(b.y_max, y_max[l]);
-                b.birth_min_s = lo(b.birth_min_s, b_min[l]);
-            }
-            out.push(b);
-        }
-        out
     }
 }
 
