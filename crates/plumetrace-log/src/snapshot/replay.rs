@@ -124,7 +124,17 @@ pub fn replay(
 
 /// [`replay`], showing every replayed decision to `on` (e.g. to draw the replay page).
 pub fn replay_with(
-    log: impl BufRead,
+    mut log: impl BufRead,
+    tables: &dyn Fn(u32) -> Option<toml::Table>,
+    on: &mut dyn FnMut(Replayed<'_>),
+) -> Result<ReplayReport, ReplayError> {
+    replay_dyn(&mut log, tables, on)
+}
+
+/// [`replay_with`]'s work, compiled here once (not in each caller, at the caller's optimisation
+/// level: the command line is built at `opt-level = 0`).
+fn replay_dyn(
+    log: &mut dyn BufRead,
     tables: &dyn Fn(u32) -> Option<toml::Table>,
     on: &mut dyn FnMut(Replayed<'_>),
 ) -> Result<ReplayReport, ReplayError> {
