@@ -263,9 +263,9 @@ fn onboard(input: &Input, path: &Path) -> Result<String, Stop> {
         ))
     })?;
     let o = plumetrace_onboard::config::Onboard::from_toml(text).map_err(|e| {
-        let line = plumetrace_scenario::locate::line_of(text, &e.key)
-            .map(|l| format!(":{l}"))
-            .unwrap_or_default();
+        let line = plumetrace_scenario::locate::at_line(plumetrace_scenario::locate::line_of(
+            text, &e.key,
+        ));
         rejected(format!("{}{line}: {e}", path.display()))
     })?;
     Ok(format!("onboard: {} checked", o.planner.kind().name()))
@@ -353,12 +353,11 @@ fn scenario(input: &Input, path: &Path, deadline: Instant) -> Result<String, Sto
         let text = String::from_utf8_lossy(&input.bytes).into_owned();
         return plume_run(built, deadline).map_err(|stop| match stop {
             Stop::Rejected(m) => {
-                let line = m
-                    .contains("flow.farrell: the field diverged")
-                    .then(|| plumetrace_scenario::locate::line_of(&text, "flow.farrell"))
-                    .flatten()
-                    .map(|l| format!(":{l}"))
-                    .unwrap_or_default();
+                let line = plumetrace_scenario::locate::at_line(
+                    m.contains("flow.farrell: the field diverged")
+                        .then(|| plumetrace_scenario::locate::line_of(&text, "flow.farrell"))
+                        .flatten(),
+                );
                 Stop::Rejected(format!("{}{line}: {m}", path.display()))
             }
             other => other,
