@@ -775,20 +775,11 @@ impl FilamentPlume {
     /// The blocks' and groups' bounding boxes, built on first use after a change.
     fn boxes(&self) -> &ScanBoxes {
         self.boxes.get_or_init(|| {
-            let (xs, ys, births) = (&*self.x, &*self.y, &*self.birth_s);
-            let blocks: Vec<BlockBox> = (0..xs.len().div_ceil(SCAN_BLOCK))
-                .map(|b| {
-                    let mut bb = BlockBox::EMPTY;
-                    for k in b * SCAN_BLOCK..((b + 1) * SCAN_BLOCK).min(xs.len()) {
-                        bb.x_min = bb.x_min.min(xs[k]);
-                        bb.x_max = bb.x_max.max(xs[k]);
-                        bb.y_min = bb.y_min.min(ys[k]);
-                        bb.y_max = bb.y_max.max(ys[k]);
-                        bb.birth_min_s = bb.birth_min_s.min(births[k]);
-                    }
-                    bb
-                })
-                .collect();
+            let blocks = crate::simd::best().dispatch(BlockBoxes {
+                x: &self.x,
+                y: &self.y,
+                birth_s: &self.birth_s,
+            });
             let groups = blocks
                 .chunks(SCAN_GROUP)
                 .map(|g| g.iter().fold(BlockBox::EMPTY, |a, b| a.union(*b)))
@@ -891,6 +882,59 @@ impl FilamentPlume {
     /// benchmark time the build apart from the queries.
     pub fn prepare_queries(&self) {
         let _ = self.index();
+    }
+}
+
+/// The bounding boxes of consecutive blocks of [`SCAN_BLOCK`] filaments (see
+/// [`FilamentPlume::boxes`]), as a [`pulp::WithSimd`] operation: each column's extremes over a
+/// block are kept in one vector, then folded.
+struct BlockBoxes<'a> {
+    x: &'a [f64],
+    y: &'a [f64],
+    birth_s: &'a [f64],
+}
+
+impl pulp::WithSimd for BlockBoxes<'_> {
+    type Output = Vec<BlockBox>;
+
+    #[inline(always)]
+    fn with_simd<S: pulp::Simd>(self, simd: S) -> Vec<BlockBox> {
+        // The least and the greatest of `v` (a NaN is passed over: the vector minimum gives its
+        // second operand where either is NaN, and the running extreme is never NaN).
+        #[inline(always)]
+        fn extremes<S: pulp::Simd>(simd: S, v: &[f64], want_most: bool) -> (f64, f64) {
+            let (head, tail) = S::as_simd_f64s(v);
+            let mut least = simd.splat_f64s(f64::INFINITY);
+            let mut most = simd.splat_f64s(f64::NEG_INFINITY);
+            for &c in head {
+                least = simd.min_f64s(c, least);
+                if want_most {
+                    most = simd.max_f64s(c, most);
+                }
+            }
+            let (mut l, mut m) = (simd.reduce_min_f64s(least), simd.reduce_max_f64s(most));
+            for &t in tail {
+                l = l.min(t);
+                m = m.max(t);
+            }
+            (l, m)
+        }
+        let BlockBoxes { x, y, birth_s } = self;
+        x.chunks(SCAN_BLOCK)
+            .zip(y.chunks(SCAN_BLOCK))
+            .zip(birth_s.chunks(SCAN_BLOCK))
+            .map(|((bx, by), bb)| {
+                let (x_min, x_max) = extremes(simd, bx, true);
+                let (y_min, y_max) = extremes(simd, by, true);
+                BlockBox {
+                    x_min,
+                    x_max,
+                    y_min,
+                    y_max,
+                    birth_min_s: extremes(simd, bb, false).0,
+                }
+            })
+            .collect()
     }
 }
 
@@ -1088,6 +1132,63 @@ mod tests {
             assert_eq!(p.y.len(), p.len());
             assert_eq!(p.birth_s.len(), p.len());
             assert_eq!(p.source.len(), p.len());
+        }
+    }
+
+    #[test]
+    fn every_vector_unit_boxes_the_blocks_as_a_plain_loop() {
+        use rand::Rng;
+        let mut rng = stream_rng(17, StreamId::Plume);
+        // Lengths short of a vector, of a block, and with a partial last block; values with
+        // both zeros, infinities and NaN among them (a NaN is passed over, as `f64::min` does).
+        for n in [1_usize, 7, 64, 65, 200, 1031] {
+            let mut column = |special: bool| -> Vec<f64> {
+                (0..n)
+                    .map(|k| match (special, k % 97) {
+                        (true, 3) => f64::NAN,
+                        (true, 5) => -0.0,
+                        (true, 6) => 0.0,
+                        (true, 50) => f64::INFINITY,
+                        _ => rng.random::<f64>() * 2000.0 - 1000.0,
+                    })
+                    .collect()
+            };
+            let (x, y, birth_s) = (column(true), column(true), column(false));
+            let plain: Vec<BlockBox> = (0..n.div_ceil(SCAN_BLOCK))
+                .map(|b| {
+                    let mut bb = BlockBox::EMPTY;
+                    for k in b * SCAN_BLOCK..((b + 1) * SCAN_BLOCK).min(n) {
+                        bb.x_min = bb.x_min.min(x[k]);
+                        bb.x_max = bb.x_max.max(x[k]);
+                        bb.y_min = bb.y_min.min(y[k]);
+                        bb.y_max = bb.y_max.max(y[k]);
+                        bb.birth_min_s = bb.birth_min_s.min(birth_s[k]);
+                    }
+                    bb
+                })
+                .collect();
+            for arch in crate::simd::every() {
+                let boxes = arch.dispatch(BlockBoxes {
+                    x: &x,
+                    y: &y,
+                    birth_s: &birth_s,
+                });
+                assert_eq!(boxes.len(), plain.len());
+                for (b, p) in boxes.iter().zip(&plain) {
+                    // Equal as numbers (a zero's sign may differ; the scan's test reads it
+                    // either way alike).
+                    let same = [
+                        (b.x_min, p.x_min),
+                        (b.x_max, p.x_max),
+                        (b.y_min, p.y_min),
+                        (b.y_max, p.y_max),
+                        (b.birth_min_s, p.birth_min_s),
+                    ]
+                    .iter()
+                    .all(|(u, v)| u == v);
+                    assert!(same, "{arch:?}, {n} filaments: {b:?} against {p:?}");
+                }
+            }
         }
     }
 
