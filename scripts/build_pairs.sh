@@ -13,8 +13,8 @@
 #   `pip install` runs).
 # `--after` defaults to HEAD; `--what` to both. Run it on an otherwise idle machine: the two
 # commits share the machine's state of the moment only if nothing else is running. Every crate
-# must already be in cargo's download cache (run a build of each commit once first), so that no
-# download is timed.
+# must already be in cargo's download cache (run a build of each commit once first, or
+# `cargo fetch` in a checkout of each), so that no download is timed.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -67,6 +67,7 @@ cleanup() {
     git worktree remove --force "$work/before" 2>/dev/null || true
     git worktree remove --force "$work/after" 2>/dev/null || true
     rm -rf "$work"
+    git worktree prune
 }
 trap cleanup EXIT
 git worktree add --detach --quiet "$work/before" "$b"
@@ -76,9 +77,10 @@ git worktree add --detach --quiet "$work/after" "$a"
 build() {
     local tree="$1" kind="$2" target="$work/target"
     rm -rf "$target"
-    local args=(build --release --bin plumetrace)
+    # `--locked`: each commit builds what its lockfile names.
+    local args=(build --locked --release --bin plumetrace)
     if [ "$kind" = python ]; then
-        args=(build --release --manifest-path crates/plumetrace-py/Cargo.toml)
+        args=(build --locked --release --manifest-path crates/plumetrace-py/Cargo.toml)
     fi
     (cd "$tree" && CARGO_TARGET_DIR="$target" /usr/bin/time -o "$work/time" -f '%U %S %e' \
         cargo "${args[@]}" >"$work/log" 2>&1) || {

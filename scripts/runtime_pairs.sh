@@ -35,7 +35,7 @@ while [ $# -gt 0 ]; do
         --before) before="$2"; shift 2 ;;
         --after) after="$2"; shift 2 ;;
         --pairs) pairs="$2"; shift 2 ;;
-        -h|--help) sed -n '2,20p' "$0"; exit 0 ;;
+        -h|--help) sed -n '2,19p' "$0"; exit 0 ;;
         *) echo "runtime_pairs.sh: unknown argument $1 (see --help)" >&2; exit 2 ;;
     esac
 done
@@ -85,7 +85,7 @@ command_of() {
 fingerprint() {
     local which="$1" out="$2"
     case "$which" in
-        bench) echo "(timings only)" ;;
+        bench) grep -E '"(preset|runs|threads|mean_mission_s|outcomes)"' "$out/bench.json" ;;
         run) (cd "$out/run" && for f in trajectory.csv events.jsonl plot.svg replay.html; do
                 md5sum "$f"; done) ;;
         campaign) md5sum <"$out/campaign/runs.csv" ;;
@@ -98,8 +98,11 @@ fingerprint() {
 export -f command_of
 export root work
 cpu_of() {
-    /usr/bin/time -o "$work/time" -f '%U %S' bash -c 'command_of "$@"' _ "$1" "$2" "$3"
-    awk '{ printf "%.3f", $1 + $2 }' "$work/time"
+    if ! /usr/bin/time -o "$work/time" -f '%U %S' bash -c 'command_of "$@"' _ "$1" "$2" "$3"; then
+        echo "runtime_pairs.sh: $1 failed with $2" >&2
+        return 1
+    fi
+    tail -1 "$work/time" | awk '{ printf "%.3f", $1 + $2 }'
 }
 
 # A build is named by its directory when the file is `plumetrace` (`../at-COMMIT/target/release`

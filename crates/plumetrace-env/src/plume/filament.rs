@@ -899,17 +899,19 @@ impl pulp::WithSimd for BlockBoxes<'_> {
 
     #[inline(always)]
     fn with_simd<S: pulp::Simd>(self, simd: S) -> Vec<BlockBox> {
-        // The least and the greatest of `v` (a NaN is passed over: the vector minimum gives its
-        // second operand where either is NaN, and the running extreme is never NaN).
+        // The least and the greatest of `v`, a NaN passed over as `f64::min` does: each lane
+        // takes a value only where it compares below (above) the lane's extreme, which a NaN
+        // never does, so no lane is ever NaN (a vector minimum instruction would not do: some
+        // give NaN back, as Arm's does).
         #[inline(always)]
         fn extremes<S: pulp::Simd>(simd: S, v: &[f64], want_most: bool) -> (f64, f64) {
             let (head, tail) = S::as_simd_f64s(v);
             let mut least = simd.splat_f64s(f64::INFINITY);
             let mut most = simd.splat_f64s(f64::NEG_INFINITY);
             for &c in head {
-                least = simd.min_f64s(c, least);
+                least = simd.select_f64s(simd.less_than_f64s(c, least), c, least);
                 if want_most {
-                    most = simd.max_f64s(c, most);
+                    most = simd.select_f64s(simd.greater_than_f64s(c, most), c, most);
                 }
             }
             let (mut l, mut m) = (simd.reduce_min_f64s(least), simd.reduce_max_f64s(most));
@@ -1139,21 +1141,26 @@ mod tests {
     fn every_vector_unit_boxes_the_blocks_as_a_plain_loop() {
         use rand::Rng;
         let mut rng = stream_rng(17, StreamId::Plume);
-        // Lengths short of a vector, of a block, and with a partial last block; values with
-        // both zeros, infinities and NaN among them (a NaN is passed over, as `f64::min` does).
+        // Lengths short of a vector, of a block, and with a partial last block; every column
+        // with zeros, infinities and NaN among its values (a NaN is passed over, as
+        // `f64::min` does).
         for n in [1_usize, 7, 64, 65, 200, 1031] {
-            let mut column = |special: bool| -> Vec<f64> {
+            // Special values at several places in a block (in its vectors and in its tail),
+            // the others so drawn that zeros are a block's least or greatest in some blocks.
+            let mut column = |shift: usize| -> Vec<f64> {
                 (0..n)
-                    .map(|k| match (special, k % 97) {
-                        (true, 3) => f64::NAN,
-                        (true, 5) => -0.0,
-                        (true, 6) => 0.0,
-                        (true, 50) => f64::INFINITY,
-                        _ => rng.random::<f64>() * 2000.0 - 1000.0,
+                    .map(|k| match ((k + shift) % 300, (k + shift) % 37) {
+                        (150, _) => f64::INFINITY,
+                        (250, _) => f64::NEG_INFINITY,
+                        (_, 3 | 30) => f64::NAN,
+                        (_, 5) => -0.0,
+                        (_, 6) => 0.0,
+                        _ if k % 128 < 64 => rng.random::<f64>() * 1000.0,
+                        _ => -rng.random::<f64>() * 1000.0,
                     })
                     .collect()
             };
-            let (x, y, birth_s) = (column(true), column(true), column(false));
+            let (x, y, birth_s) = (column(0), column(9), column(20));
             let plain: Vec<BlockBox> = (0..n.div_ceil(SCAN_BLOCK))
                 .map(|b| {
                     let mut bb = BlockBox::EMPTY;

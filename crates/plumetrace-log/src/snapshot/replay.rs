@@ -131,8 +131,9 @@ pub fn replay_with(
     replay_dyn(&mut log, tables, on)
 }
 
-/// [`replay_with`]'s work, compiled here once (not in each caller, at the caller's optimisation
-/// level: the command line is built at `opt-level = 0`).
+/// [`replay_with`]'s work, compiled here once at this crate's optimisation level (a generic body
+/// would be compiled in each caller at the caller's level, and the command line is built at
+/// `opt-level = 0`); only the reader's own calls stay the caller's.
 fn replay_dyn(
     log: &mut dyn BufRead,
     tables: &dyn Fn(u32) -> Option<toml::Table>,
