@@ -44,7 +44,7 @@ if [ -z "$before" ] || [ -z "$after" ]; then
     exit 2
 fi
 for b in "$before" "$after"; do
-    if ! [ -x "$b" ] || ! "$b" --version >/dev/null 2>&1; then
+    if ! [ -x "$b" ] || ! "$b" --version 2>/dev/null | grep -q '^plumetrace '; then
         echo "runtime_pairs.sh: $b is not an executable plumetrace build" >&2
         exit 2
     fi
