@@ -17,6 +17,7 @@
 # `cargo fetch` in a checkout of each), so that no download is timed.
 set -euo pipefail
 cd "$(dirname "$0")/.."
+. scripts/pairs_common.sh
 
 before=""
 after="HEAD"
@@ -24,11 +25,7 @@ pairs=3
 what=both
 while [ $# -gt 0 ]; do
     case "$1" in
-        --before|--after|--pairs|--what)
-            if [ $# -lt 2 ]; then
-                echo "build_pairs.sh: $1 needs a value (see --help)" >&2
-                exit 2
-            fi ;;
+        --before|--after|--pairs|--what) needs_value build_pairs.sh "$1" $# ;;
     esac
     case "$1" in
         --before) before="$2"; shift 2 ;;
@@ -43,10 +40,7 @@ if [ -z "$before" ]; then
     echo "build_pairs.sh: --before COMMIT is needed: the commit to compare against (see --help)" >&2
     exit 2
 fi
-if ! [[ "$pairs" =~ ^[1-9][0-9]*$ ]]; then
-    echo "build_pairs.sh: --pairs takes a whole number from 1, not '$pairs'" >&2
-    exit 2
-fi
+whole_count build_pairs.sh --pairs "$pairs"
 case "$what" in
     binary) kinds=(binary) ;;
     python) kinds=(python) ;;
@@ -114,9 +108,6 @@ for kind in "${kinds[@]}"; do
                 printf "| %s | %d | %.1f s (%.1f + %.1f), %.0f s | %.1f s (%.1f + %.1f), %.0f s | %s |\n",
                     (k == 1 ? l : ""), k, bu + bs, bu, bs, bw, au + as, au, as, aw, r }'
     done
-    median=$(printf '%s\n' "${ratios[@]}" | sort -n | awk '{ v[NR] = $1 } END {
-        if (NR % 2) print v[(NR + 1) / 2]; else printf "%.3f", (v[NR / 2] + v[NR / 2 + 1]) / 2 }')
-    lo=$(printf '%s\n' "${ratios[@]}" | sort -n | head -1)
-    hi=$(printf '%s\n' "${ratios[@]}" | sort -n | tail -1)
-    echo "| $label: median | | | | **$median** ($lo-$hi) |"
+    read -r median range <<<"$(median_range "${ratios[@]}")"
+    echo "| $label: median | | | | **$median** $range |"
 done

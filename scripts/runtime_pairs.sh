@@ -19,17 +19,14 @@
 # - `replay` of the seed-7 run's snapshot log (23,580 decisions).
 set -euo pipefail
 cd "$(dirname "$0")/.."
+. scripts/pairs_common.sh
 
 before=""
 after=""
 pairs=5
 while [ $# -gt 0 ]; do
     case "$1" in
-        --before|--after|--pairs)
-            if [ $# -lt 2 ]; then
-                echo "runtime_pairs.sh: $1 needs a value (see --help)" >&2
-                exit 2
-            fi ;;
+        --before|--after|--pairs) needs_value runtime_pairs.sh "$1" $# ;;
     esac
     case "$1" in
         --before) before="$2"; shift 2 ;;
@@ -49,10 +46,7 @@ for b in "$before" "$after"; do
         exit 2
     fi
 done
-if ! [[ "$pairs" =~ ^[1-9][0-9]*$ ]]; then
-    echo "runtime_pairs.sh: --pairs takes a whole number from 1, not '$pairs'" >&2
-    exit 2
-fi
+whole_count runtime_pairs.sh --pairs "$pairs"
 before=$(realpath "$before")
 after=$(realpath "$after")
 root=$(pwd)
@@ -130,9 +124,5 @@ for which in bench run campaign check family replay; do
         as+=("$a")
         rs+=("$(awk -v a="$a" -v b="$b" 'BEGIN { printf "%.3f", a / b }')")
     done
-    med() { printf '%s\n' "$@" | sort -g | awk '{ v[NR] = $1 } END {
-        if (NR % 2) print v[(NR + 1) / 2]; else printf "%.3f", (v[NR / 2] + v[NR / 2 + 1]) / 2 }'; }
-    lo=$(printf '%s\n' "${rs[@]}" | sort -g | head -1)
-    hi=$(printf '%s\n' "${rs[@]}" | sort -g | tail -1)
-    echo "| $which | $(med "${bs[@]}") s | $(med "${as[@]}") s | $(med "${rs[@]}") ($lo-$hi) |"
+    echo "| $which | $(median "${bs[@]}") s | $(median "${as[@]}") s | $(median_range "${rs[@]}") |"
 done
