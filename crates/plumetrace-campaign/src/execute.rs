@@ -443,6 +443,8 @@ fn prepare(c: &Campaign, key: &RunKey) -> Result<(MissionSetup, MissionOptions),
         mean_plume: false,
         trajectory: example,
         plume_frames_every_s: example.then_some(plumetrace_mission::PLUME_FRAME_EVERY_S),
+        // Nothing a campaign writes shows the stage times.
+        stage_times: false,
     };
     let setup = MissionSetup::new(sc)?;
     Ok((setup, options))

@@ -383,6 +383,7 @@ fn scenario(input: &Input, path: &Path, deadline: Instant) -> Result<String, Sto
         mean_plume: false,
         trajectory: true,
         plume_frames_every_s: Some(plumetrace_mission::PLUME_FRAME_EVERY_S),
+        stage_times: false,
     };
     let mut mission = Mission::new(setup, options).map_err(|e| in_run(&e))?;
     let alog_dir = alog_observer(&mut mission, path)?;

@@ -9,6 +9,7 @@ use crate::{DoneReason, ModeStatus, Steer};
 use dubins_paths::PathType;
 use dubins_paths::f64::{DubinsPath, PosRot};
 use plumetrace_core::{Heading, Vec2, bearing_between};
+use std::collections::VecDeque;
 use std::f64::consts::FRAC_PI_2;
 
 /// A position and a compass heading.
@@ -149,30 +150,100 @@ pub fn shortest_csc(start: Pose, end: Pose, radius_m: f64) -> Option<CscPath> {
 const SAMPLE_STEP_M: f64 = 0.5;
 
 /// The sample of `path` nearest `pos`, among those every [`SAMPLE_STEP_M`] from `progress_m`
-/// over `window_m` (clamped to the path's end): `(distance along, distance away)`.
+/// over `window_m` (clamped to the path's end): `(distance along, distance away)`. The samples'
+/// positions come from `samples` where it holds them (see [`PathSamples`]).
 ///
 /// Every fourth sample first, then the samples around the nearest of those: the same sample as
 /// scanning them all wherever the distance has one minimum in the window (the path does not
 /// come back near `pos` within the window), for about a third of the samples.
-fn nearest_sample(path: &CscPath, progress_m: f64, window_m: f64, pos: Vec2) -> (f64, f64) {
+fn nearest_sample(
+    path: &CscPath,
+    progress_m: f64,
+    window_m: f64,
+    pos: Vec2,
+    samples: &mut PathSamples,
+) -> (f64, f64) {
     const COARSE: usize = 4;
     let len = path.length_m();
     let steps = (window_m / SAMPLE_STEP_M).ceil() as usize;
-    let at = |k: usize| {
+    let first = PathSamples::index_of(progress_m);
+    let mut at = |k: usize| {
         let s_m = (progress_m + k as f64 * SAMPLE_STEP_M).min(len);
-        (s_m, (path.sample(s_m).pos_m - pos).norm())
+        // Below the end, `s_m` is sample `first + k`'s distance along, exactly.
+        let p = match first {
+            Some(n) if s_m < len => samples.position(path, n + k as u64),
+            _ => path.sample(s_m).pos_m,
+        };
+        (s_m, (p - pos).norm())
     };
-    // The first strictly nearest, as a scan in order finds it.
-    let nearest = |ks: &mut dyn Iterator<Item = usize>| {
-        ks.map(|k| (k, at(k)))
-            .fold((0, (progress_m, f64::INFINITY)), |best, c| {
-                if c.1.1 < best.1.1 { c } else { best }
-            })
-    };
-    let (kc, _) = nearest(&mut (0..=steps).step_by(COARSE).chain([steps]));
+    let (kc, _) = first_nearest(
+        (0..=steps).step_by(COARSE).chain([steps]),
+        progress_m,
+        &mut at,
+    );
     let lo = kc.saturating_sub(COARSE - 1);
     let hi = (kc + COARSE - 1).min(steps);
-    nearest(&mut (lo..=hi)).1
+    first_nearest(lo..=hi, progress_m, &mut at).1
+}
+
+/// The first strictly nearest of the samples `ks` (`at(k)`: distance along, distance away), as
+/// a scan in order finds it; `(0, (progress_m, inf))` if none is nearer than infinity.
+fn first_nearest(
+    ks: impl Iterator<Item = usize>,
+    progress_m: f64,
+    at: &mut impl FnMut(usize) -> (f64, f64),
+) -> (usize, (f64, f64)) {
+    ks.map(|k| (k, at(k)))
+        .fold((0, (progress_m, f64::INFINITY)), |best, c| {
+            if c.1.1 < best.1.1 { c } else { best }
+        })
+}
+
+/// The positions of a path's samples `n` (at `n` [`SAMPLE_STEP_M`] along it) from `first` on,
+/// each worked out once while the path is followed: the nearest-sample search of successive
+/// decisions reads nearly the same window of samples (a vehicle at 2 m/s deciding at 10 Hz moves
+/// 0.4 samples a decision), so a decision works out about one new sample instead of about 30.
+/// A position is the one [`CscPath::sample`] gives at that distance, bit for bit.
+#[derive(Debug, Clone, Default)]
+struct PathSamples {
+    first: u64,
+    positions: VecDeque<Vec2>,
+}
+
+impl PathSamples {
+    /// The sample whose distance along is `s_m`, if `s_m` is a whole number of samples (below
+    /// 2^50 of them, so every sum of such distances is exact).
+    fn index_of(s_m: f64) -> Option<u64> {
+        let n = s_m / SAMPLE_STEP_M;
+        (n >= 0.0 && n < (1u64 << 50) as f64 && n.fract() == 0.0).then_some(n as u64)
+    }
+
+    /// Sample `n`'s position on `path`.
+    fn position(&mut self, path: &CscPath, n: u64) -> Vec2 {
+        let at = |n: u64| path.sample(n as f64 * SAMPLE_STEP_M).pos_m;
+        if n < self.first {
+            return at(n);
+        }
+        while self.first + (self.positions.len() as u64) <= n {
+            let next = self.first + self.positions.len() as u64;
+            self.positions.push_back(at(next));
+        }
+        self.positions[(n - self.first) as usize]
+    }
+
+    /// Forgets the samples before `n` (the search never goes back).
+    fn forget_before(&mut self, n: u64) {
+        while self.first < n && self.positions.pop_front().is_some() {
+            self.first += 1;
+        }
+        self.first = self.first.max(n);
+    }
+
+    /// Forgets every sample (a new path).
+    fn clear(&mut self) {
+        self.first = 0;
+        self.positions.clear();
+    }
 }
 
 /// Drive to a position with a given heading on arrival, along the shortest CSC path with the
@@ -205,6 +276,8 @@ pub struct GoToPointWithHeading {
     /// Distance along the path of the point nearest the vehicle, m.
     progress_m: f64,
     plans: u32,
+    /// The positions of the path's samples the search reads.
+    samples: PathSamples,
 }
 
 impl GoToPointWithHeading {
@@ -223,6 +296,7 @@ impl GoToPointWithHeading {
             plan: None,
             progress_m: 0.0,
             plans: 0,
+            samples: PathSamples::default(),
         }
     }
 
@@ -244,6 +318,7 @@ impl GoToPointWithHeading {
         self.plan = shortest_csc(pose, self.target, self.min_turn_radius_m);
         self.progress_m = 0.0;
         self.plans += 1;
+        self.samples.clear();
     }
 
     /// The mode's decision at the vehicle's estimated pose.
@@ -259,9 +334,13 @@ impl GoToPointWithHeading {
             // Nearest point within a window ahead of the progress so far (the window keeps it from
             // jumping to a later part of the path that passes close by); cost is constant.
             let window = 4.0 * self.min_turn_radius_m.max(self.radius_m);
-            let (best_s, best_d) = nearest_sample(path, self.progress_m, window, pose.pos_m);
+            let (best_s, best_d) =
+                nearest_sample(path, self.progress_m, window, pose.pos_m, &mut self.samples);
             let len = path.length_m();
             self.progress_m = best_s;
+            if let Some(n) = PathSamples::index_of(best_s) {
+                self.samples.forget_before(n);
+            }
             need_plan = best_d > self.replan_offtrack_m || best_s >= len - SAMPLE_STEP_M;
         }
         if need_plan {
@@ -317,11 +396,59 @@ mod tests {
                         (progress, f64::INFINITY),
                         |b, c| if c.1 < b.1 { c } else { b },
                     );
-                assert_eq!(nearest_sample(&path, progress, window, p), full, "at {p:?}");
+                let mut samples = PathSamples::default();
+                let found = nearest_sample(&path, progress, window, p, &mut samples);
+                assert_eq!(found, full, "at {p:?}");
                 checked += 1;
             }
         }
         assert_eq!(checked, 1000);
+    }
+
+    #[test]
+    fn samples_kept_between_searches_are_the_ones_worked_out_afresh() {
+        // Progress on whole samples, moving ahead (as decisions move it), standing still and
+        // going back; one store of samples across the searches, forgetting those behind as a
+        // mode does: every search finds what it finds with a fresh store, bit for bit, and the
+        // store holds no sample it did not need.
+        let path = shortest_csc(pose(5.0, -3.0, 40.0), pose(-50.0, 70.0, 250.0), 12.0)
+            .unwrap_or_else(|| panic!("no path"));
+        let len = path.length_m();
+        let window = 48.0;
+        let mut samples = PathSamples::default();
+        let mut n = 0u64;
+        let mut searched = 0;
+        for step in 0..400u64 {
+            // Ahead by 0-2 samples, and back by 3 every 50th search.
+            n = if step % 50 == 49 {
+                n.saturating_sub(3)
+            } else {
+                n + step % 3
+            };
+            let progress = n as f64 * SAMPLE_STEP_M;
+            if progress >= len {
+                break;
+            }
+            let on = path.sample((progress + 2.0).min(len)).pos_m;
+            let p = Vec2::new(on.x + 3.0, on.y - 2.0);
+            let kept = nearest_sample(&path, progress, window, p, &mut samples);
+            let fresh = nearest_sample(&path, progress, window, p, &mut PathSamples::default());
+            assert_eq!(kept.0.to_bits(), fresh.0.to_bits(), "step {step}");
+            assert_eq!(kept.1.to_bits(), fresh.1.to_bits(), "step {step}");
+            let held = samples.positions.len() as f64;
+            // The window's samples from the last index forgotten (at most 2 behind this search).
+            assert!(held <= window / SAMPLE_STEP_M + 3.0, "{held} samples held");
+            if let Some(k) = PathSamples::index_of(kept.0) {
+                samples.forget_before(k);
+            }
+            searched += 1;
+        }
+        assert!(searched > 200, "{searched} searches");
+        // A distance along that is not a whole number of samples has no index.
+        assert_eq!(PathSamples::index_of(3.5), Some(7));
+        assert_eq!(PathSamples::index_of(3.25), None);
+        assert_eq!(PathSamples::index_of(-0.5), None);
+        assert_eq!(PathSamples::index_of(f64::NAN), None);
     }
 
     fn pose(x: f64, y: f64, h: f64) -> Pose {

@@ -145,6 +145,41 @@ fn same_seed_same_summary_and_trajectory() {
 }
 
 #[test]
+fn a_mission_that_does_not_time_its_stages_flies_the_same() {
+    // Stage timing off (as campaigns fly): the same summary and trajectory, every stage at zero;
+    // on, the stages that run every step took some time.
+    let fly = |stage_times: bool| {
+        let setup = MissionSetup::new(shortened("demo", 600.0, 300.0, 7)).unwrap();
+        let options = MissionOptions {
+            stage_times,
+            ..MissionOptions::default()
+        };
+        let mut m = Mission::new(setup, options).unwrap();
+        m.run(&mut |_, _| {}).unwrap();
+        m.finish().unwrap()
+    };
+    let (on, off) = (fly(true), fly(false));
+    let digest = |r: &plumetrace_mission::MissionRun| {
+        (
+            serde_json::to_string(&r.summary).unwrap(),
+            serde_json::to_string(&r.trajectory).unwrap(),
+        )
+    };
+    assert_eq!(digest(&on), digest(&off));
+    // Every stage, by name.
+    let all = |t: &plumetrace_sim::StageTimes| -> Vec<(String, f64)> {
+        let v = serde_json::to_value(t).unwrap();
+        let fields = v.as_object().unwrap().iter();
+        fields.map(|(k, s)| (k.clone(), s.as_f64().unwrap())).collect()
+    };
+    let (timed, untimed) = (all(&on.stage_times), all(&off.stage_times));
+    assert_eq!(timed.len(), 8);
+    assert!(untimed.iter().all(|(_, s)| *s == 0.0), "{untimed:?}");
+    assert!(timed.iter().all(|(_, s)| s.is_finite() && *s >= 0.0), "{timed:?}");
+    assert!(on.stage_times.advance_environment_s > 0.0 && on.stage_times.sense_s > 0.0);
+}
+
+#[test]
 fn the_demo_finds_the_plume_and_traces_it_towards_the_source() {
     let run = run_mission(shortened("demo", 3500.0, 900.0, 1), &mut |_, _| {}).unwrap();
     let s = &run.summary;

@@ -364,6 +364,7 @@ impl Maker {
                 mean_plume: false,
                 trajectory: false,
                 plume_frames_every_s: None,
+                stage_times: false,
             },
         )
         .map_err(|e| crate::error::located(&e))?;

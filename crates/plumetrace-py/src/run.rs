@@ -135,6 +135,8 @@ pub fn run<'py>(
             mean_plume: false,
             trajectory,
             plume_frames_every_s: None,
+            // `summary.json` shows them.
+            stage_times: true,
         }
     };
     let mut mission = py.detach(|| Mission::new(setup, options)).map_err(to_py)?;

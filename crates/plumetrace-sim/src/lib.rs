@@ -34,6 +34,6 @@ pub use sensors::{
 };
 pub use vehicle::{Vehicle, VehicleParams, VehicleState};
 pub use world::{
-    Fleet, Incident, SimVehicle, StageTimes, StepReport, World, WorldEvent, WorldView,
+    Fleet, Incident, Lap, SimVehicle, StageTimes, StepReport, World, WorldEvent, WorldView,
     steps_per_env_step,
 };
