@@ -170,12 +170,17 @@ fn a_mission_that_does_not_time_its_stages_flies_the_same() {
     let all = |t: &plumetrace_sim::StageTimes| -> Vec<(String, f64)> {
         let v = serde_json::to_value(t).unwrap();
         let fields = v.as_object().unwrap().iter();
-        fields.map(|(k, s)| (k.clone(), s.as_f64().unwrap())).collect()
+        fields
+            .map(|(k, s)| (k.clone(), s.as_f64().unwrap()))
+            .collect()
     };
     let (timed, untimed) = (all(&on.stage_times), all(&off.stage_times));
     assert_eq!(timed.len(), 8);
     assert!(untimed.iter().all(|(_, s)| *s == 0.0), "{untimed:?}");
-    assert!(timed.iter().all(|(_, s)| s.is_finite() && *s >= 0.0), "{timed:?}");
+    assert!(
+        timed.iter().all(|(_, s)| s.is_finite() && *s >= 0.0),
+        "{timed:?}"
+    );
     assert!(on.stage_times.advance_environment_s > 0.0 && on.stage_times.sense_s > 0.0);
 }
 
