@@ -688,42 +688,159 @@ struct Velocities<'a> {
     v: &'a mut [f64],
 }
 
+/// Points per batch of a batch lookup: small enough for the batch to stay in L1 cache.
+const BATCH: usize = 64;
+
+/// The first pass of a batch lookup: per point, its cell's index (a whole `f64`) and its
+/// fractions across the cell, in floating point only (a loop the compiler vectorises); the same
+/// numbers as `interp`. Returns how many points (at most [`BATCH`]).
+#[inline(always)]
+fn cells_and_fractions(
+    flow: &FarrellFlow,
+    xs: &[f64],
+    ys: &[f64],
+    cell: &mut [f64; BATCH],
+    tx: &mut [f64; BATCH],
+    ty: &mut [f64; BATCH],
+) -> usize {
+    let (nx, ny) = (flow.params.nx, flow.params.ny);
+    let (x0, y0) = (flow.region.x_min_m, flow.region.y_min_m);
+    let (lx, ly) = ((nx - 1) as f64, (ny - 1) as f64);
+    let row = (nx - 1) as f64;
+    let (inv_dx, inv_dy) = (flow.inv_dx, flow.inv_dy);
+    let m = xs.len().min(ys.len()).min(BATCH);
+    for k in 0..m {
+        let (i, fx) = grid_floor(xs[k], x0, inv_dx, lx);
+        let (j, fy) = grid_floor(ys[k], y0, inv_dy, ly);
+        cell[k] = j * row + i;
+        tx[k] = fx;
+        ty[k] = fy;
+    }
+    m
+}
+
+/// A batch lookup's points and their velocities' places, [`BATCH`] at a time.
+#[inline(always)]
+fn batches<'b>(
+    x: &'b [f64],
+    y: &'b [f64],
+    u: &'b mut [f64],
+    v: &'b mut [f64],
+) -> impl Iterator<Item = (&'b [f64], &'b [f64], &'b mut [f64], &'b mut [f64])> {
+    let points = x.chunks(BATCH).zip(y.chunks(BATCH));
+    let places = u.chunks_mut(BATCH).zip(v.chunks_mut(BATCH));
+    points.zip(places).map(|((x, y), (u, v))| (x, y, u, v))
+}
+
+/// The cell of whole-number index `at` (below the cell count, exactly).
+#[inline(always)]
+fn cell_at(cells: &[Cell], at: f64) -> &Cell {
+    &cells[(at as usize).min(cells.len() - 1)]
+}
+
 impl pulp::WithSimd for Velocities<'_> {
     type Output = ();
 
     #[inline(always)]
     fn with_simd<S: pulp::Simd>(self, _simd: S) {
-        // Two passes per batch: the cells and fractions first, in floating point only (a loop
-        // the compiler vectorises), then the lookups; the same numbers as `interp`.
-        const BATCH: usize = 64;
+        // Two passes per batch: the cells and fractions first, then the lookups.
         let Velocities { flow, x, y, u, v } = self;
-        let (nx, ny) = (flow.params.nx, flow.params.ny);
         let mut cell = [0.0; BATCH];
         let mut tx = [0.0; BATCH];
         let mut ty = [0.0; BATCH];
-        let (x0, y0) = (flow.region.x_min_m, flow.region.y_min_m);
-        let (lx, ly) = ((nx - 1) as f64, (ny - 1) as f64);
-        let row = (nx - 1) as f64;
-        let (inv_dx, inv_dy) = (flow.inv_dx, flow.inv_dy);
         let cells = &flow.cells[..];
-        for (((xs, ys), us), vs) in x
-            .chunks(BATCH)
-            .zip(y.chunks(BATCH))
-            .zip(u.chunks_mut(BATCH))
-            .zip(v.chunks_mut(BATCH))
-        {
-            let m = xs.len().min(ys.len());
-            for k in 0..m {
-                let (i, fx) = grid_floor(xs[k], x0, inv_dx, lx);
-                let (j, fy) = grid_floor(ys[k], y0, inv_dy, ly);
-                cell[k] = j * row + i;
-                tx[k] = fx;
-                ty[k] = fy;
-            }
+        for (xs, ys, us, vs) in batches(x, y, u, v) {
+            let m = cells_and_fractions(flow, xs, ys, &mut cell, &mut tx, &mut ty);
             for (k, (u, v)) in us.iter_mut().zip(vs.iter_mut()).enumerate().take(m) {
-                // A whole number below the cell count, exactly.
-                let c = &cells[(cell[k] as usize).min(cells.len() - 1)];
-                (*u, *v) = bilinear(c, tx[k], ty[k]);
+                (*u, *v) = bilinear(cell_at(cells, cell[k]), tx[k], ty[k]);
+            }
+        }
+    }
+}
+
+/// [`Velocities`] on AVX-512: the second pass takes eight points at a time, reads their eight
+/// cells as eight vectors and transposes them, so that each coefficient is one vector and
+/// [`bilinear`]'s sums are taken in lanes, the same operations in the same order (so the same
+/// bits); the points past the last eight are looked up one by one.
+#[cfg(target_arch = "x86_64")]
+struct VelocitiesV4<'a> {
+    simd: pulp::x86::V4,
+    inner: Velocities<'a>,
+}
+
+#[cfg(target_arch = "x86_64")]
+impl pulp::WithSimd for VelocitiesV4<'_> {
+    type Output = ();
+
+    #[inline(always)]
+    fn with_simd<S: pulp::Simd>(self, _simd: S) {
+        use core::arch::x86_64::__m512d;
+        let VelocitiesV4 {
+            simd,
+            inner: Velocities { flow, x, y, u, v },
+        } = self;
+        let f = simd.avx512f;
+        let mut cell = [0.0; BATCH];
+        let mut tx = [0.0; BATCH];
+        let mut ty = [0.0; BATCH];
+        let cells = &flow.cells[..];
+        let last = f._mm512_set1_epi64(cells.len().saturating_sub(1) as i64);
+        for (xs, ys, us, vs) in batches(x, y, u, v) {
+            let m = cells_and_fractions(flow, xs, ys, &mut cell, &mut tx, &mut ty);
+            let (us, vs) = (&mut us[..m], &mut vs[..m]);
+            let (cell8, _) = cell[..m].as_chunks::<8>();
+            let (tx8, _) = tx[..m].as_chunks::<8>();
+            let (ty8, _) = ty[..m].as_chunks::<8>();
+            let (u8s, _) = us.as_chunks_mut::<8>();
+            let (v8s, _) = vs.as_chunks_mut::<8>();
+            let eights = cell8.iter().zip(tx8).zip(ty8).zip(u8s).zip(v8s);
+            for ((((at, &tx), &ty), u), v) in eights {
+                // The cells' indices converted in lanes (whole numbers below the cell count,
+                // as in `cell_at`).
+                let at = simd.avx512dq._mm512_cvttpd_epu64(pulp::cast(*at));
+                let at: [u64; 8] = pulp::cast(f._mm512_min_epu64(at, last));
+                let r: [__m512d; 8] = core::array::from_fn(|l| pulp::cast(cells[at[l] as usize].0));
+                // Transposed: c[j] holds coefficient j of the eight cells.
+                let t: [__m512d; 8] = core::array::from_fn(|l| {
+                    let (a, b) = (r[l & !1], r[l | 1]);
+                    if l & 1 == 0 {
+                        f._mm512_unpacklo_pd(a, b)
+                    } else {
+                        f._mm512_unpackhi_pd(a, b)
+                    }
+                });
+                // t[0] = (r0, r1) at 0 2 4 6, t[1] at 1 3 5 7, t[2], t[3] (r2, r3), ...
+                let q = |a: __m512d, b: __m512d, odd: bool| {
+                    if odd {
+                        f._mm512_shuffle_f64x2::<0xDD>(a, b)
+                    } else {
+                        f._mm512_shuffle_f64x2::<0x88>(a, b)
+                    }
+                };
+                // s[0]: 0 and 4 of r0-r3, s[1]: 2 and 6, s[2]: 1 and 5, s[3]: 3 and 7 (from
+                // t[0] with t[2], and t[1] with t[3]); s[4..] the same of r4-r7.
+                let s: [__m512d; 8] = core::array::from_fn(|l| {
+                    let a = (l >> 1 & 1) + (l >> 2) * 4;
+                    q(t[a], t[a + 2], l & 1 == 1)
+                });
+                // c[j]: coefficient j of r0-r7, from s[0, 2, 1, 3] with s[4, 6, 5, 7].
+                let c: [__m512d; 8] = core::array::from_fn(|j| {
+                    let a = [0, 2, 1, 3][j & 3];
+                    q(s[a], s[a + 4], j >= 4)
+                });
+                let (x, y): (__m512d, __m512d) = (pulp::cast(tx), pulp::cast(ty));
+                let xy = f._mm512_mul_pd(x, y);
+                // `a + b x + c y + d x y`, summed left to right as `bilinear` does.
+                let sum = |k: usize| {
+                    let a = f._mm512_add_pd(c[k], f._mm512_mul_pd(c[k + 1], x));
+                    let a = f._mm512_add_pd(a, f._mm512_mul_pd(c[k + 2], y));
+                    f._mm512_add_pd(a, f._mm512_mul_pd(c[k + 3], xy))
+                };
+                *u = pulp::cast(sum(0));
+                *v = pulp::cast(sum(4));
+            }
+            for k in m / 8 * 8..m {
+                (us[k], vs[k]) = bilinear(cell_at(cells, cell[k]), tx[k], ty[k]);
             }
         }
     }
@@ -732,13 +849,18 @@ impl pulp::WithSimd for Velocities<'_> {
 impl FarrellFlow {
     /// [`FlowField::velocities`] on the vector unit `arch` (see [`crate::simd`]).
     fn velocities_on(&self, arch: pulp::Arch, x: &[f64], y: &[f64], u: &mut [f64], v: &mut [f64]) {
-        arch.dispatch(Velocities {
+        let inner = Velocities {
             flow: self,
             x,
             y,
             u,
             v,
-        });
+        };
+        match arch {
+            #[cfg(target_arch = "x86_64")]
+            pulp::Arch::V4(simd) => pulp::Simd::vectorize(simd, VelocitiesV4 { simd, inner }),
+            _ => arch.dispatch(inner),
+        }
     }
 }
 
