@@ -415,7 +415,7 @@ impl FarrellFlow {
             max_speed_mps: v0.norm(),
         };
         flow.max_stable_dt_s = flow.stable_dt_limit(dt_s);
-        flow.build_cells();
+        flow.build_cells_on(crate::simd::best());
         Ok(flow)
     }
 
@@ -600,8 +600,17 @@ impl FarrellFlow {
         }
     }
 
+    /// [`FarrellFlow::build_cells`] on the vector unit `arch`: AVX-512's own version
+    /// ([`BuildCellsV4`]), else the plain loop compiled for any CPU.
+    fn build_cells_on(&mut self, arch: pulp::Arch) {
+        match arch {
+            #[cfg(target_arch = "x86_64")]
+            pulp::Arch::V4(simd) => pulp::Simd::vectorize(simd, BuildCellsV4 { simd, flow: self }),
+            _ => self.build_cells(),
+        }
+    }
+
     /// Rebuilds the cells' bilinear coefficients from the interior nodes.
-    #[inline(always)]
     fn build_cells(&mut self) {
         let (nx, ny) = (self.params.nx, self.params.ny);
         let nx2 = nx + 2;
@@ -620,18 +629,7 @@ impl FarrellFlow {
                 .zip(un.windows(2))
                 .zip(vs.windows(2).zip(vn.windows(2)));
             for (cell, ((a, b), (c, d))) in cells.iter_mut().zip(pairs) {
-                // Each component's `f00, f10 - f00, f01 - f00, f11 - f10 - f01 + f00` from the
-                // pairs of neighbours along rows j and j + 1.
-                cell.0 = [
-                    a[0],
-                    a[1] - a[0],
-                    b[0] - a[0],
-                    b[1] - a[1] - b[0] + a[0],
-                    c[0],
-                    c[1] - c[0],
-                    d[0] - c[0],
-                    d[1] - c[1] - d[0] + c[0],
-                ];
+                cell.0 = cell_coefficients([a[0], a[1]], [b[0], b[1]], [c[0], c[1]], [d[0], d[1]]);
             }
         }
     }
@@ -643,6 +641,23 @@ impl FarrellFlow {
         let (j, ty) = axis_weight(y, self.region.y_min_m, self.inv_dy, ny);
         bilinear(&self.cells[j * (nx - 1) + i], tx, ty)
     }
+}
+
+/// A cell's coefficients from the pairs of neighbouring nodes along rows j (`us`, `vs`) and
+/// j + 1 (`un`, `vn`): each component's `f00, f10 - f00, f01 - f00, f11 - f10 - f01 + f00`.
+#[inline(always)]
+fn cell_coefficients(us: [f64; 2], un: [f64; 2], vs: [f64; 2], vn: [f64; 2]) -> [f64; 8] {
+    let (a, b, c, d) = (us, un, vs, vn);
+    [
+        a[0],
+        a[1] - a[0],
+        b[0] - a[0],
+        b[1] - a[1] - b[0] + a[0],
+        c[0],
+        c[1] - c[0],
+        d[0] - c[0],
+        d[1] - c[1] - d[0] + c[0],
+    ]
 }
 
 /// `len` values of `f` from `start`.
@@ -762,6 +777,45 @@ impl pulp::WithSimd for Velocities<'_> {
 /// cells as eight vectors and transposes them, so that each coefficient is one vector and
 /// [`bilinear`]'s sums are taken in lanes, the same operations in the same order (so the same
 /// bits); the points past the last eight are looked up one by one.
+/// The 8 x 8 transpose of `r` (`r[i]` lane `j` becomes lane `i` of the `j`-th vector), in
+/// three rounds of eight shuffles.
+#[cfg(target_arch = "x86_64")]
+#[inline(always)]
+fn transpose8(
+    f: pulp::core_arch::x86::Avx512f,
+    r: [core::arch::x86_64::__m512d; 8],
+) -> [core::arch::x86_64::__m512d; 8] {
+    use core::arch::x86_64::__m512d;
+    // t[0] = (r0, r1) at lanes 0 2 4 6, t[1] at 1 3 5 7, t[2], t[3] (r2, r3), ...
+    let t: [__m512d; 8] = core::array::from_fn(|l| {
+        let (a, b) = (r[l & !1], r[l | 1]);
+        if l & 1 == 0 {
+            f._mm512_unpacklo_pd(a, b)
+        } else {
+            f._mm512_unpackhi_pd(a, b)
+        }
+    });
+    // Lanes pairs 0 and 2 of `a`, then of `b` (or 1 and 3).
+    let q = |a: __m512d, b: __m512d, odd: bool| {
+        if odd {
+            f._mm512_shuffle_f64x2::<0xDD>(a, b)
+        } else {
+            f._mm512_shuffle_f64x2::<0x88>(a, b)
+        }
+    };
+    // s[0]: lanes 0 and 4 of r0-r3, s[1]: 2 and 6, s[2]: 1 and 5, s[3]: 3 and 7 (from t[0]
+    // with t[2], and t[1] with t[3]); s[4..] the same of r4-r7.
+    let s: [__m512d; 8] = core::array::from_fn(|l| {
+        let a = (l >> 1 & 1) + (l >> 2) * 4;
+        q(t[a], t[a + 2], l & 1 == 1)
+    });
+    // Vector j: lane j of r0-r7, from s[0, 2, 1, 3] with s[4, 6, 5, 7].
+    core::array::from_fn(|j| {
+        let a = [0, 2, 1, 3][j & 3];
+        q(s[a], s[a + 4], j >= 4)
+    })
+}
+
 #[cfg(target_arch = "x86_64")]
 struct VelocitiesV4<'a> {
     simd: pulp::x86::V4,
@@ -801,33 +855,7 @@ impl pulp::WithSimd for VelocitiesV4<'_> {
                 let at: [u64; 8] = pulp::cast(f._mm512_min_epu64(at, last));
                 let r: [__m512d; 8] = core::array::from_fn(|l| pulp::cast(cells[at[l] as usize].0));
                 // Transposed: c[j] holds coefficient j of the eight cells.
-                let t: [__m512d; 8] = core::array::from_fn(|l| {
-                    let (a, b) = (r[l & !1], r[l | 1]);
-                    if l & 1 == 0 {
-                        f._mm512_unpacklo_pd(a, b)
-                    } else {
-                        f._mm512_unpackhi_pd(a, b)
-                    }
-                });
-                // t[0] = (r0, r1) at 0 2 4 6, t[1] at 1 3 5 7, t[2], t[3] (r2, r3), ...
-                let q = |a: __m512d, b: __m512d, odd: bool| {
-                    if odd {
-                        f._mm512_shuffle_f64x2::<0xDD>(a, b)
-                    } else {
-                        f._mm512_shuffle_f64x2::<0x88>(a, b)
-                    }
-                };
-                // s[0]: 0 and 4 of r0-r3, s[1]: 2 and 6, s[2]: 1 and 5, s[3]: 3 and 7 (from
-                // t[0] with t[2], and t[1] with t[3]); s[4..] the same of r4-r7.
-                let s: [__m512d; 8] = core::array::from_fn(|l| {
-                    let a = (l >> 1 & 1) + (l >> 2) * 4;
-                    q(t[a], t[a + 2], l & 1 == 1)
-                });
-                // c[j]: coefficient j of r0-r7, from s[0, 2, 1, 3] with s[4, 6, 5, 7].
-                let c: [__m512d; 8] = core::array::from_fn(|j| {
-                    let a = [0, 2, 1, 3][j & 3];
-                    q(s[a], s[a + 4], j >= 4)
-                });
+                let c = transpose8(f, r);
                 let (x, y): (__m512d, __m512d) = (pulp::cast(tx), pulp::cast(ty));
                 let xy = f._mm512_mul_pd(x, y);
                 // `a + b x + c y + d x y`, summed left to right as `bilinear` does.
@@ -864,6 +892,78 @@ impl FarrellFlow {
     }
 }
 
+/// The cells' rebuild on AVX-512: eight cells of a row at a time, each coefficient of the eight
+/// taken in lanes (the same operations in the same order as [`FarrellFlow::build_cells`], so the
+/// same bits), then transposed into the eight cells; the cells past the last eight of a row one
+/// by one. (Compiled for AVX-512 without this, the plain loop writes each coefficient to its
+/// eight cells with scattered stores, slower than one cell at a time.)
+#[cfg(target_arch = "x86_64")]
+struct BuildCellsV4<'a> {
+    simd: pulp::x86::V4,
+    flow: &'a mut FarrellFlow,
+}
+
+#[cfg(target_arch = "x86_64")]
+impl pulp::WithSimd for BuildCellsV4<'_> {
+    type Output = ();
+
+    #[inline(always)]
+    fn with_simd<S: pulp::Simd>(self, _simd: S) {
+        use core::arch::x86_64::__m512d;
+        let f = self.simd.avx512f;
+        let flow = self.flow;
+        let (nx, ny) = (flow.params.nx, flow.params.ny);
+        let nx2 = nx + 2;
+        let row = nx - 1;
+        flow.cells.resize(row * (ny - 1), Cell([0.0; 8]));
+        let (u, v) = (&flow.u, &flow.v);
+        for (j, cells) in flow.cells.chunks_exact_mut(row).enumerate() {
+            let lo = (j + 1) * nx2 + 1;
+            let hi = lo + nx2;
+            // Node i and node i + 1 of rows j and j + 1, eight cells at a time.
+            fn eights(f: &[f64], start: usize, len: usize) -> &[[f64; 8]] {
+                span(f, start, len).as_chunks::<8>().0
+            }
+            let (us0, us1) = (eights(u, lo, row), eights(u, lo + 1, row));
+            let (un0, un1) = (eights(u, hi, row), eights(u, hi + 1, row));
+            let (vs0, vs1) = (eights(v, lo, row), eights(v, lo + 1, row));
+            let (vn0, vn1) = (eights(v, hi, row), eights(v, hi + 1, row));
+            let (groups, _) = cells.as_chunks_mut::<8>();
+            for (g, group) in groups.iter_mut().enumerate() {
+                let coefficients = |s0: &[f64; 8], s1: &[f64; 8], n0: &[f64; 8], n1: &[f64; 8]| {
+                    let (a0, a1): (__m512d, __m512d) = (pulp::cast(*s0), pulp::cast(*s1));
+                    let (b0, b1): (__m512d, __m512d) = (pulp::cast(*n0), pulp::cast(*n1));
+                    // `f00, f10 - f00, f01 - f00, f11 - f10 - f01 + f00`, left to right.
+                    let d = f._mm512_sub_pd(f._mm512_sub_pd(b1, a1), b0);
+                    [
+                        a0,
+                        f._mm512_sub_pd(a1, a0),
+                        f._mm512_sub_pd(b0, a0),
+                        f._mm512_add_pd(d, a0),
+                    ]
+                };
+                let [c0, c1, c2, c3] = coefficients(&us0[g], &us1[g], &un0[g], &un1[g]);
+                let [c4, c5, c6, c7] = coefficients(&vs0[g], &vs1[g], &vn0[g], &vn1[g]);
+                let rows = transpose8(f, [c0, c1, c2, c3, c4, c5, c6, c7]);
+                for (cell, r) in group.iter_mut().zip(rows) {
+                    cell.0 = pulp::cast(r);
+                }
+            }
+            let done = row / 8 * 8;
+            let (us, un) = (span(u, lo, nx), span(u, hi, nx));
+            let (vs, vn) = (span(v, lo, nx), span(v, hi, nx));
+            for (i, cell) in cells.iter_mut().enumerate().skip(done) {
+                cell.0 = cell_coefficients(
+                    [us[i], us[i + 1]],
+                    [un[i], un[i + 1]],
+                    [vs[i], vs[i + 1]],
+                    [vn[i], vn[i + 1]],
+                );
+            }
+        }
+    }
+}
+
 /// The interior's step and the cells' rebuild, as a [`pulp::WithSimd`] operation (see
 /// [`crate::simd`]).
 struct GridStep<'a> {
@@ -877,7 +977,6 @@ impl pulp::WithSimd for GridStep<'_> {
     #[inline(always)]
     fn with_simd<S: pulp::Simd>(self, _simd: S) {
         self.flow.step_interior(self.dt_s);
-        self.flow.build_cells();
     }
 }
 
@@ -898,7 +997,9 @@ impl FlowField for FarrellFlow {
     fn advance(&mut self, t_new_s: f64, dt_s: f64, rng: &mut SimRng) -> Result<(), EnvError> {
         self.noise.update(dt_s, rng);
         self.apply_boundary(self.mean.velocity_at(t_new_s));
-        crate::simd::best().dispatch(GridStep { flow: self, dt_s });
+        let arch = crate::simd::best();
+        arch.dispatch(GridStep { flow: self, dt_s });
+        self.build_cells_on(arch);
         self.time_s = t_new_s;
         // A runaway field is a bug or an unstable set-up: stop rather than emit garbage.
         let limit = 100.0 * (1.0 + self.mean.max_speed_mps());
@@ -1310,6 +1411,8 @@ mod tests {
                 flow: &mut g,
                 dt_s: 0.01,
             });
+            // Rows of 20 cells: two groups of eight and four cells one by one on AVX-512.
+            g.build_cells_on(arch);
             let got = (bits(&g), g.max_speed_mps.to_bits());
             match &reference {
                 None => {

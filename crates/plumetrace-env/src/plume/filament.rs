@@ -194,6 +194,37 @@ pub struct FilamentPlume {
     /// for the sensor's scan (built by the first scan after a change, so stepping alone never
     /// pays for them).
     boxes: OnceLock<ScanBoxes>,
+    /// The transport's working columns, kept between steps so that a step does not clear them
+    /// (12 kB: a sizeable part of a step of a few hundred filaments).
+    scratch: Box<TransportScratch>,
+}
+
+/// Filaments per velocity batch of the transport: small enough for the batch to stay in L1
+/// cache.
+const TRANSPORT_CHUNK: usize = 256;
+
+/// The transport's working columns for one batch of filaments (see [`Transport`]).
+#[derive(Debug, Clone)]
+struct TransportScratch {
+    u: [f64; TRANSPORT_CHUNK],
+    v: [f64; TRANSPORT_CHUNK],
+    words: [u64; TRANSPORT_CHUNK],
+    n0: [f64; TRANSPORT_CHUNK],
+    n1: [f64; TRANSPORT_CHUNK],
+    n2: [f64; TRANSPORT_CHUNK],
+}
+
+impl TransportScratch {
+    fn new() -> Box<Self> {
+        Box::new(TransportScratch {
+            u: [0.0; TRANSPORT_CHUNK],
+            v: [0.0; TRANSPORT_CHUNK],
+            words: [0; TRANSPORT_CHUNK],
+            n0: [0.0; TRANSPORT_CHUNK],
+            n1: [0.0; TRANSPORT_CHUNK],
+            n2: [0.0; TRANSPORT_CHUNK],
+        })
+    }
 }
 
 /// Filaments per block of the sensor scan's pruning boxes.
@@ -320,6 +351,7 @@ impl FilamentPlume {
             stats: PlumeStats::default(),
             index: OnceLock::new(),
             boxes: OnceLock::new(),
+            scratch: TransportScratch::new(),
         })
     }
 
@@ -348,6 +380,7 @@ impl FilamentPlume {
             stats: self.stats,
             index: OnceLock::new(),
             boxes: OnceLock::new(),
+            scratch: TransportScratch::new(),
         }
     }
 
@@ -587,6 +620,7 @@ impl FilamentPlume {
             domain: self.domain,
             offset,
             sink: (sink_dir, sink_line),
+            scratch: &mut self.scratch,
         });
         if let (Some(sb), VerticalBoundary::Reflecting { .. }) =
             (&self.seabed, self.params.vertical)
@@ -1047,6 +1081,7 @@ struct Transport<'a> {
     domain: Rect,
     offset: u64,
     sink: ([f64; 2], f64),
+    scratch: &'a mut TransportScratch,
 }
 
 impl pulp::WithSimd for Transport<'_> {
@@ -1054,8 +1089,7 @@ impl pulp::WithSimd for Transport<'_> {
 
     #[inline(always)]
     fn with_simd<S: pulp::Simd>(self, _simd: S) -> (bool, usize) {
-        /// Filaments per velocity batch: small enough for the batch to stay in L1 cache.
-        const CHUNK: usize = 256;
+        const CHUNK: usize = TRANSPORT_CHUNK;
         let Transport {
             x,
             y,
@@ -1068,13 +1102,16 @@ impl pulp::WithSimd for Transport<'_> {
             domain: d,
             offset,
             sink: (sink_dir, sink_line),
+            scratch,
         } = self;
-        let mut u = [0.0; CHUNK];
-        let mut v = [0.0; CHUNK];
-        let mut words = [0u64; CHUNK];
-        let mut n0 = [0.0; CHUNK];
-        let mut n1 = [0.0; CHUNK];
-        let mut n2 = [0.0; CHUNK];
+        let TransportScratch {
+            u,
+            v,
+            words,
+            n0,
+            n1,
+            n2,
+        } = scratch;
         let mut left = false;
         let mut beyond = 0usize;
         for (((xs, ys), zs), keys) in x
@@ -1088,7 +1125,7 @@ impl pulp::WithSimd for Transport<'_> {
             for (w, k) in words.iter_mut().zip(keys) {
                 *w = splitmix64_mix(k.wrapping_add(offset));
             }
-            crate::normal::fill_normal_columns(&words[..m], &mut n0, &mut n1, &mut n2);
+            crate::normal::fill_normal_columns(&words[..m], &mut n0[..], &mut n1[..], &mut n2[..]);
             // Every column cut to the chunk's length, so the loop has no bounds checks.
             let (ys, zs, u, v) = (&mut ys[..m], &mut zs[..m], &u[..m], &v[..m]);
             let (n0, n1, n2) = (&n0[..m], &n1[..m], &n2[..m]);
