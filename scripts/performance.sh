@@ -17,7 +17,9 @@
 #   thread's time: the record stage's share is its time over the process's wall time;
 # - a campaign of `--seeds` seeds (default 1000) of `duck-2003-st`, `plumetrace campaign --jobs
 #   N` (default 2), whole process with runs.csv, summary and charts written;
-# - `plumetrace bench missions --runs 48 --threads J` once per build.
+# - `plumetrace bench missions --runs 48 --threads J` once per build;
+# - the filament step, `plumetrace bench plume` in pompy's case (5 puffs/s), at 50 puffs/s
+#   (`--release-rate 50`) and at field scale (`--case field`), once per build in each pair.
 # The two campaigns' runs.csv must be the same (apart from any run-time column); the script stops
 # if they are not.
 set -euo pipefail
@@ -44,7 +46,7 @@ while [ $# -gt 0 ]; do
         --pairs) pairs="$2"; shift 2 ;;
         --seeds) seeds="$2"; shift 2 ;;
         --jobs) jobs="$2"; shift 2 ;;
-        -h|--help) sed -n '2,22p' "$0"; exit 0 ;;
+        -h|--help) sed -n '2,24p' "$0"; exit 0 ;;
         *) echo "performance.sh: unknown argument $1 (see --help)" >&2; exit 2 ;;
     esac
 done
@@ -130,6 +132,27 @@ campaign() {
     python3 -c "print(f'{$user + $sys_:.2f} {$wall:.2f} {$seeds / $wall:.2f}')"
 }
 
+# The filament step's cost in the three cases: "pompy rate50 field", ns per filament-step (the
+# median of each call's blocks).
+kernel() {
+    local bin="$1" tag="$2" case
+    for case in pompy rate50 field; do
+        local args=()
+        [ "$case" = rate50 ] && args=(--release-rate 50)
+        [ "$case" = field ] && args=(--case field)
+        "$bin" bench plume "${args[@]}" > "$work/plume-$tag-$case.json" 2>"$work/plume-$tag-$case.err" || {
+            echo "performance.sh: failed: $bin bench plume ${args[*]}" >&2
+            cat "$work/plume-$tag-$case.err" >&2
+            exit 1
+        }
+    done
+    python3 - "$work/plume-$tag" <<'PY'
+import json, sys
+print(" ".join(f"{json.load(open(f'{sys.argv[1]}-{c}.json'))['ns_per_filament_step']:.2f}"
+               for c in ("pompy", "rate50", "field")))
+PY
+}
+
 # runs.csv without its run-time columns.
 strip_times() {
     python3 - "$1" <<'PY'
@@ -141,9 +164,10 @@ for r in rows:
 PY
 }
 
-echo "== $pairs pairs of single runs and of $seeds-seed campaigns, before and after" >&2
+echo "== $pairs pairs of single runs, of $seeds-seed campaigns and of filament steps, before and after" >&2
 : > "$work/single"
 : > "$work/camp"
+: > "$work/kernel"
 for k in $(seq 1 "$pairs"); do
     for side in before after; do
         bin="$before"
@@ -151,6 +175,7 @@ for k in $(seq 1 "$pairs"); do
         echo "$side $(single "$bin" "$side-$k")" >> "$work/single"
         echo "$side $(campaign "$bin" "$side-$k")" >> "$work/camp"
         tail -1 "$work/camp" >&2
+        echo "$side $(kernel "$bin" "$side-$k")" >> "$work/kernel"
     done
     if ! cmp -s <(strip_times "$work/runs-before-$k.csv") <(strip_times "$work/runs-after-$k.csv"); then
         echo "performance.sh: the two builds' runs.csv differ (pair $k): $work kept" >&2
@@ -179,7 +204,7 @@ def med(rows, k):
 def span(rows, k, fmt):
     vals = sorted(r[k] for r in rows)
     return f"{fmt.format(statistics.median(vals))} ({fmt.format(vals[0])}-{fmt.format(vals[-1])})"
-s, c = table("single"), table("camp")
+s, c, kern = table("single"), table("camp"), table("kernel")
 bench = {side: json.load(open(f"{work}/bench-{side}.json")) for side in ("before", "after")}
 def b(side, key):
     return bench[side]["results"][0][key]
@@ -195,6 +220,8 @@ out.append(f"| campaign: missions per second | {span(c['before'], 2, '{:.2f}')} 
 out.append(f"| campaign: CPU per mission | {med(c['before'], 0) / seeds:.3f} s | {med(c['after'], 0) / seeds:.3f} s | |")
 out.append(f"| `bench missions --runs 48 --threads {jobs}`: CPU per mission | {b('before', 'cpu_per_mission_s'):.3f} s | {b('after', 'cpu_per_mission_s'):.3f} s | {b('after', 'cpu_per_mission_s') / b('before', 'cpu_per_mission_s'):.2f} |")
 out.append(f"| `bench missions`: missions per second | {b('before', 'missions_per_s'):.2f} | {b('after', 'missions_per_s'):.2f} | {b('after', 'missions_per_s') / b('before', 'missions_per_s'):.2f} |")
+for k, what in enumerate(["`bench plume` (pompy's case, 5 puffs/s)", "`bench plume --release-rate 50`", "`bench plume --case field`"]):
+    out.append(f"| {what}: ns per filament-step | {span(kern['before'], k, '{:.2f}')} | {span(kern['after'], k, '{:.2f}')} | {med(kern['after'], k) / med(kern['before'], k):.2f} |")
 stages = bench["after"]["stages_s_per_mission"]
 total = sum(stages.values())
 split = ", ".join(f"{k.replace('_', ' ')} {v / total:.0%}" for k, v in stages.items() if v / total >= 0.005)
@@ -218,7 +245,9 @@ end="<!-- performance.sh end -->"
     echo "output; the campaign is \`plumetrace campaign FILE --out DIR --jobs $jobs\` over \`scenarios ="
     echo "[\"duck-2003-st\"]\`, \`seeds = $seeds\`, one configuration, timed as a whole process with"
     echo "its files written; the two builds' runs.csv are the same (the script compares them, any"
-    echo "column of run times set aside, and stops if they differ)."
+    echo "column of run times set aside, and stops if they differ). The filament step is \`plumetrace bench"
+    echo "plume\` in its three cases, once per build in each pair (each call's figure the median of its"
+    echo "five blocks)."
     echo
     echo "$section"
     echo

@@ -121,6 +121,17 @@ impl OpArea {
         self.crossing_inside(p) || self.edge_info(p).distance_m < 1e-9
     }
 
+    /// How far `p` lies outside the area (`None` inside it or on its boundary): the distance of
+    /// [`OpArea::edge_info`] where that says outside, found without the edges' distances for a
+    /// point inside.
+    pub fn outside_by(&self, p: Vec2) -> Option<f64> {
+        if self.crossing_inside(p) {
+            return None;
+        }
+        let e = self.edge_info(p);
+        (!e.inside).then_some(e.distance_m)
+    }
+
     /// Distance to the nearest edge and the outward normal there.
     ///
     /// The normal is the edge's outward normal when the nearest point is inside an edge, and the
@@ -295,6 +306,35 @@ mod tests {
             assert_eq!(e.inside, inside, "({x},{y})");
             assert_eq!(a.contains(Vec2::new(x, y)), inside);
         }
+        // How far outside: what the edges' distances say, on a grid over and around a concave
+        // area, its corners and edges among the points (on the boundary counts as inside).
+        let l = OpArea::new(vec![
+            Vec2::new(0.0, 0.0),
+            Vec2::new(40.0, 0.0),
+            Vec2::new(40.0, 10.0),
+            Vec2::new(10.0, 10.0),
+            Vec2::new(10.0, 30.0),
+            Vec2::new(0.0, 30.0),
+        ])
+        .unwrap();
+        let (mut outside, mut on) = (0, 0);
+        for i in -10..=50 {
+            for j in -10..=40 {
+                let p = Vec2::new(f64::from(i), f64::from(j));
+                let e = l.edge_info(p);
+                assert_eq!(
+                    l.outside_by(p),
+                    (!e.inside).then_some(e.distance_m),
+                    "{p:?}"
+                );
+                outside += usize::from(!e.inside);
+                on += usize::from(e.distance_m == 0.0);
+            }
+        }
+        assert!(
+            outside > 1000 && on > 50,
+            "{outside} outside, {on} on the boundary"
+        );
     }
 
     #[test]

@@ -391,11 +391,8 @@ impl Observer for TrackStats {
                 continue;
             };
             let p = v.vehicle.state.pos_m;
-            if let Some(a) = &self.op_area {
-                let e = a.edge_info(p);
-                if !e.inside {
-                    track.max_outside_m = track.max_outside_m.max(e.distance_m);
-                }
+            if let Some(outside_m) = self.op_area.as_ref().and_then(|a| a.outside_by(p)) {
+                track.max_outside_m = track.max_outside_m.max(outside_m);
             }
             if let Some((b, since)) = track.quiet_since {
                 let detected = threshold
