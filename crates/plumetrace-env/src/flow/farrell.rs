@@ -328,6 +328,10 @@ pub struct FarrellFlow {
     /// Per grid cell `(i, j)` (index `j * (nx - 1) + i`), its coefficients ([`Cell`]), rebuilt
     /// after every step.
     cells: Vec<Cell>,
+    /// The ring's fractions along a row (`i / (nx + 1)`, `i` in `0..nx + 2`) and along a
+    /// column (`j / (ny + 1)`), for the boundary's interpolation between the corners.
+    ring_x: Vec<f64>,
+    ring_y: Vec<f64>,
     noise: ColouredNoise,
     time_s: f64,
     max_stable_dt_s: f64,
@@ -409,6 +413,8 @@ impl FarrellFlow {
             u_next: vec![v0.x; n_all],
             v_next: vec![v0.y; n_all],
             cells: Vec::new(),
+            ring_x: fractions(params.nx + 2),
+            ring_y: fractions(params.ny + 2),
             noise,
             time_s: 0.0,
             max_stable_dt_s: 0.0,
@@ -500,13 +506,11 @@ impl FarrellFlow {
         let cv = [mean.y + n[4], mean.y + n[5], mean.y + n[6], mean.y + n[7]];
         for (field, c) in [(&mut self.u, cu), (&mut self.v, cv)] {
             let last_j = (ny2 - 1) * nx2;
-            for i in 0..nx2 {
-                let t = i as f64 / (nx2 - 1) as f64;
+            for (i, &t) in self.ring_x.iter().enumerate() {
                 field[i] = c[0] + t * (c[1] - c[0]);
                 field[last_j + i] = c[2] + t * (c[3] - c[2]);
             }
-            for j in 0..ny2 {
-                let t = j as f64 / (ny2 - 1) as f64;
+            for (j, &t) in self.ring_y.iter().enumerate() {
                 field[j * nx2] = c[0] + t * (c[2] - c[0]);
                 field[j * nx2 + nx2 - 1] = c[1] + t * (c[3] - c[1]);
             }
@@ -658,6 +662,11 @@ fn cell_coefficients(us: [f64; 2], un: [f64; 2], vs: [f64; 2], vn: [f64; 2]) -> 
         d[0] - c[0],
         d[1] - c[1] - d[0] + c[0],
     ]
+}
+
+/// `k / (n - 1)` for `k` in `0..n`: the places of `n` evenly spaced points from 0 to 1.
+fn fractions(n: usize) -> Vec<f64> {
+    (0..n).map(|k| k as f64 / (n - 1) as f64).collect()
 }
 
 /// `len` values of `f` from `start`.
