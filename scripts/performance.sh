@@ -172,10 +172,15 @@ for k in $(seq 1 "$pairs"); do
     for side in before after; do
         bin="$before"
         [ "$side" = after ] && bin="$after"
-        echo "$side $(single "$bin" "$side-$k")" >> "$work/single"
-        echo "$side $(campaign "$bin" "$side-$k")" >> "$work/camp"
+        # Each result is taken into a variable first, so that a failed measurement stops the
+        # script (`set -e`) instead of writing an empty row.
+        row="$(single "$bin" "$side-$k")"
+        echo "$side $row" >> "$work/single"
+        row="$(campaign "$bin" "$side-$k")"
+        echo "$side $row" >> "$work/camp"
         tail -1 "$work/camp" >&2
-        echo "$side $(kernel "$bin" "$side-$k")" >> "$work/kernel"
+        row="$(kernel "$bin" "$side-$k")"
+        echo "$side $row" >> "$work/kernel"
     done
     if ! cmp -s <(strip_times "$work/runs-before-$k.csv") <(strip_times "$work/runs-after-$k.csv"); then
         echo "performance.sh: the two builds' runs.csv differ (pair $k): $work kept" >&2

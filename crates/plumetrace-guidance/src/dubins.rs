@@ -204,10 +204,11 @@ fn first_nearest(
 /// decisions reads nearly the same window of samples (a vehicle at 2 m/s deciding at 10 Hz moves
 /// 0.4 samples a decision), so a decision works out about one new sample instead of about 30.
 /// A position is the one [`CscPath::sample`] gives at that distance, bit for bit.
+/// A sample is worked out when a search first reads it (the coarse search reads every fourth).
 #[derive(Debug, Clone, Default)]
 struct PathSamples {
     first: u64,
-    positions: VecDeque<Vec2>,
+    positions: VecDeque<Option<Vec2>>,
 }
 
 impl PathSamples {
@@ -224,11 +225,11 @@ impl PathSamples {
         if n < self.first {
             return at(n);
         }
-        while self.first + (self.positions.len() as u64) <= n {
-            let next = self.first + self.positions.len() as u64;
-            self.positions.push_back(at(next));
+        let k = (n - self.first) as usize;
+        if self.positions.len() <= k {
+            self.positions.resize(k + 1, None);
         }
-        self.positions[(n - self.first) as usize]
+        *self.positions[k].get_or_insert_with(|| at(n))
     }
 
     /// Forgets the samples before `n` (the search never goes back).

@@ -849,7 +849,9 @@ impl pulp::WithSimd for VelocitiesV4<'_> {
         let cells = &flow.cells[..];
         let last = f._mm512_set1_epi64(cells.len().saturating_sub(1) as i64);
         for (xs, ys, us, vs) in batches(x, y, u, v) {
+            // As many points as there are places for (the columns are as long as each other).
             let m = cells_and_fractions(flow, xs, ys, &mut cell, &mut tx, &mut ty);
+            let m = m.min(us.len()).min(vs.len());
             let (us, vs) = (&mut us[..m], &mut vs[..m]);
             let (cell8, _) = cell[..m].as_chunks::<8>();
             let (tx8, _) = tx[..m].as_chunks::<8>();
