@@ -24,6 +24,7 @@
 # if they are not.
 set -euo pipefail
 cd "$(dirname "$0")/.."
+. scripts/pairs_common.sh
 
 before=""
 before_commit=""
@@ -34,10 +35,7 @@ jobs=2
 while [ $# -gt 0 ]; do
     case "$1" in
         --before|--before-commit|--after|--pairs|--seeds|--jobs)
-            if [ $# -lt 2 ]; then
-                echo "performance.sh: $1 needs a value (see --help)" >&2
-                exit 2
-            fi ;;
+            needs_value performance.sh "$1" $# ;;
     esac
     case "$1" in
         --before) before="$2"; shift 2 ;;
@@ -50,12 +48,9 @@ while [ $# -gt 0 ]; do
         *) echo "performance.sh: unknown argument $1 (see --help)" >&2; exit 2 ;;
     esac
 done
-for n in "$pairs" "$seeds" "$jobs"; do
-    if ! [[ "$n" =~ ^[1-9][0-9]*$ ]]; then
-        echo "performance.sh: --pairs, --seeds and --jobs take a whole number from 1, not '$n'" >&2
-        exit 2
-    fi
-done
+whole_count performance.sh --pairs "$pairs"
+whole_count performance.sh --seeds "$seeds"
+whole_count performance.sh --jobs "$jobs"
 if [ -z "$before" ] || [ -z "$before_commit" ]; then
     echo "performance.sh: --before BIN and --before-commit HASH are needed: a build of the commit to compare against, and that commit (see --help)" >&2
     exit 2

@@ -200,11 +200,11 @@ fn first_nearest(
 }
 
 /// The positions of a path's samples `n` (at `n` [`SAMPLE_STEP_M`] along it) from `first` on,
-/// each worked out once while the path is followed: the nearest-sample search of successive
-/// decisions reads nearly the same window of samples (a vehicle at 2 m/s deciding at 10 Hz moves
-/// 0.4 samples a decision), so a decision works out about one new sample instead of about 30.
-/// A position is the one [`CscPath::sample`] gives at that distance, bit for bit.
-/// A sample is worked out when a search first reads it (the coarse search reads every fourth).
+/// each worked out once, when a search first reads it, while the path is followed: the
+/// nearest-sample search of successive decisions reads nearly the same window of samples (a
+/// vehicle at 2 m/s deciding at 10 Hz moves 0.4 samples a decision), so a decision works out
+/// about one new sample instead of about 30. A position is the one [`CscPath::sample`] gives at
+/// that distance, bit for bit.
 #[derive(Debug, Clone, Default)]
 struct PathSamples {
     first: u64,
@@ -234,9 +234,10 @@ impl PathSamples {
 
     /// Forgets the samples before `n` (the search never goes back).
     fn forget_before(&mut self, n: u64) {
-        while self.first < n && self.positions.pop_front().is_some() {
-            self.first += 1;
-        }
+        let behind = n
+            .saturating_sub(self.first)
+            .min(self.positions.len() as u64);
+        self.positions.drain(..behind as usize);
         self.first = self.first.max(n);
     }
 

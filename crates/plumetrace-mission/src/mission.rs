@@ -17,7 +17,7 @@ use plumetrace_core::{PlanStatus, Planner, Vec2, Vec3, VehicleId, VehicleKind};
 use plumetrace_env::Environment;
 use plumetrace_env::MeanConcentrationGrid;
 use plumetrace_planner::{MissionGeometry, PlannerKind};
-use plumetrace_sim::{Fleet, Lap, SimVehicle, StageTimes, WorldEvent, WorldView};
+use plumetrace_sim::{Fleet, SimVehicle, StageTimes, WorldEvent, WorldView};
 use std::time::Instant;
 
 /// What a mission records besides its summary and events.
@@ -511,7 +511,7 @@ impl Flight {
                 }
             }
         }
-        let mut lap = Lap::start(self.fleet.times_stages());
+        let mut lap = self.fleet.lap();
         let mut record_s = 0.0;
         {
             let view = StepView {
@@ -697,7 +697,7 @@ impl Mission {
             return Ok(self.flight.end);
         }
         if self.flight.fleet.env_due() {
-            let mut lap = Lap::start(self.flight.fleet.times_stages());
+            let mut lap = self.flight.fleet.lap();
             let mut env_s = 0.0;
             self.env
                 .step()

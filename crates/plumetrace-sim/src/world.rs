@@ -294,12 +294,12 @@ impl<'a> WorldView<'a> {
 }
 
 /// A stopwatch read once between stages, or never (a fleet that does not time its stages,
-/// [`Fleet::time_stages`]).
+/// [`Fleet::time_stages`]); a fleet hands one out ([`Fleet::lap`]).
 pub struct Lap(Option<Instant>);
 
 impl Lap {
     /// A stopwatch started now if `on`, else one that reads no clock.
-    pub fn start(on: bool) -> Self {
+    fn start(on: bool) -> Self {
         Lap(on.then(Instant::now))
     }
 
@@ -353,13 +353,6 @@ impl World {
     /// The fleet.
     pub fn fleet(&self) -> &Fleet {
         &self.fleet
-    }
-
-    /// Time each stage of the step (on at first): [`Fleet::stage_times`] stays at zero when
-    /// off, and a step reads no clock (seven readings a step when on, about 4 % of a
-    /// `duck-2003-st` mission's CPU).
-    pub fn time_stages(&mut self, on: bool) {
-        self.fleet.time_stages(on);
     }
 
     /// Keep every snapshot given to a planner in the step reports (for snapshot logs).
@@ -435,7 +428,7 @@ impl World {
         planners: &mut [Option<Box<dyn Planner>>],
     ) -> Result<StepReport, EnvError> {
         if self.fleet.env_due() {
-            let mut lap = Lap::start(self.fleet.times_stages());
+            let mut lap = self.fleet.lap();
             self.env.step()?;
             lap.to(&mut self.fleet.times.advance_environment_s);
         }
@@ -524,9 +517,10 @@ impl Fleet {
         self.timed = on;
     }
 
-    /// Whether the stages are timed ([`Fleet::time_stages`]).
-    pub fn times_stages(&self) -> bool {
-        self.timed
+    /// A stopwatch for a stage's time, started now: one that reads no clock when the stages are
+    /// not timed ([`Fleet::time_stages`]).
+    pub fn lap(&self) -> Lap {
+        Lap::start(self.timed)
     }
 
     /// Keep every snapshot given to a planner in the step reports (for snapshot logs).
@@ -731,7 +725,7 @@ impl Fleet {
             ..StepReport::default()
         };
         // One clock reading between stages: each stage's time runs to the next one's start.
-        let mut lap = Lap::start(self.timed);
+        let mut lap = self.lap();
         self.sense(env, t);
         lap.to(&mut times.sense_s);
         self.communicate(t, &mut report.events);

@@ -616,26 +616,35 @@ impl FarrellFlow {
 
     /// Rebuilds the cells' bilinear coefficients from the interior nodes.
     fn build_cells(&mut self) {
+        for (cells, nodes) in self.cell_rows() {
+            nodes.fill(cells, 0);
+        }
+    }
+
+    /// The cells (sized for the grid), row by row, each row with the nodes it reads.
+    #[inline(always)]
+    fn cell_rows(&mut self) -> impl Iterator<Item = (&mut [Cell], RowNodes<'_>)> {
         let (nx, ny) = (self.params.nx, self.params.ny);
         let nx2 = nx + 2;
         let row = nx - 1;
         self.cells.resize(row * (ny - 1), Cell([0.0; 8]));
         let (u, v) = (&self.u, &self.v);
-        for (j, cells) in self.cells.chunks_exact_mut(row).enumerate() {
-            // Interior node (i, j) sits at (i + 1, j + 1) in the ring-padded arrays; the cells of
-            // row j read nodes i and i + 1 of rows j and j + 1.
-            let lo = (j + 1) * nx2 + 1;
-            let hi = lo + nx2;
-            let at = |f, start| span(f, start, nx);
-            let (us, un, vs, vn) = (at(u, lo), at(u, hi), at(v, lo), at(v, hi));
-            let pairs = us
-                .windows(2)
-                .zip(un.windows(2))
-                .zip(vs.windows(2).zip(vn.windows(2)));
-            for (cell, ((a, b), (c, d))) in cells.iter_mut().zip(pairs) {
-                cell.0 = cell_coefficients([a[0], a[1]], [b[0], b[1]], [c[0], c[1]], [d[0], d[1]]);
-            }
-        }
+        self.cells
+            .chunks_exact_mut(row)
+            .enumerate()
+            .map(move |(j, cells)| {
+                // Interior node (i, j) sits at (i + 1, j + 1) in the ring-padded arrays; the
+                // cells of row j read nodes i and i + 1 of rows j and j + 1.
+                let lo = (j + 1) * nx2 + 1;
+                let hi = lo + nx2;
+                let nodes = RowNodes {
+                    us: span(u, lo, nx),
+                    un: span(u, hi, nx),
+                    vs: span(v, lo, nx),
+                    vn: span(v, hi, nx),
+                };
+                (cells, nodes)
+            })
     }
 
     #[inline(always)]
@@ -644,6 +653,30 @@ impl FarrellFlow {
         let (i, tx) = axis_weight(x, self.region.x_min_m, self.inv_dx, nx);
         let (j, ty) = axis_weight(y, self.region.y_min_m, self.inv_dy, ny);
         bilinear(&self.cells[j * (nx - 1) + i], tx, ty)
+    }
+}
+
+/// The nodes a row of cells reads: the row's nodes (`us`, `vs`) and the next row's (`un`, `vn`),
+/// `nx` of each; cell `i` reads nodes `i` and `i + 1`.
+struct RowNodes<'a> {
+    us: &'a [f64],
+    un: &'a [f64],
+    vs: &'a [f64],
+    vn: &'a [f64],
+}
+
+impl RowNodes<'_> {
+    /// Cells `from..` of the row, one at a time.
+    #[inline(always)]
+    fn fill(&self, cells: &mut [Cell], from: usize) {
+        let pairs = self
+            .us
+            .windows(2)
+            .zip(self.un.windows(2))
+            .zip(self.vs.windows(2).zip(self.vn.windows(2)));
+        for (cell, ((a, b), (c, d))) in cells.iter_mut().zip(pairs).skip(from) {
+            cell.0 = cell_coefficients([a[0], a[1]], [b[0], b[1]], [c[0], c[1]], [d[0], d[1]]);
+        }
     }
 }
 
@@ -782,10 +815,6 @@ impl pulp::WithSimd for Velocities<'_> {
     }
 }
 
-/// [`Velocities`] on AVX-512: the second pass takes eight points at a time, reads their eight
-/// cells as eight vectors and transposes them, so that each coefficient is one vector and
-/// [`bilinear`]'s sums are taken in lanes, the same operations in the same order (so the same
-/// bits); the points past the last eight are looked up one by one.
 /// The 8 x 8 transpose of `r` (`r[i]` lane `j` becomes lane `i` of the `j`-th vector), in
 /// three rounds of eight shuffles.
 #[cfg(target_arch = "x86_64")]
@@ -825,6 +854,10 @@ fn transpose8(
     })
 }
 
+/// [`Velocities`] on AVX-512: the second pass takes eight points at a time, reads their eight
+/// cells as eight vectors and transposes them, so that each coefficient is one vector and
+/// [`bilinear`]'s sums are taken in lanes, the same operations in the same order (so the same
+/// bits); the points past the last eight are looked up one by one.
 #[cfg(target_arch = "x86_64")]
 struct VelocitiesV4<'a> {
     simd: pulp::x86::V4,
@@ -922,23 +955,16 @@ impl pulp::WithSimd for BuildCellsV4<'_> {
     fn with_simd<S: pulp::Simd>(self, _simd: S) {
         use core::arch::x86_64::__m512d;
         let f = self.simd.avx512f;
-        let flow = self.flow;
-        let (nx, ny) = (flow.params.nx, flow.params.ny);
-        let nx2 = nx + 2;
-        let row = nx - 1;
-        flow.cells.resize(row * (ny - 1), Cell([0.0; 8]));
-        let (u, v) = (&flow.u, &flow.v);
-        for (j, cells) in flow.cells.chunks_exact_mut(row).enumerate() {
-            let lo = (j + 1) * nx2 + 1;
-            let hi = lo + nx2;
-            // Node i and node i + 1 of rows j and j + 1, eight cells at a time.
-            fn eights(f: &[f64], start: usize, len: usize) -> &[[f64; 8]] {
-                span(f, start, len).as_chunks::<8>().0
+        for (cells, n) in self.flow.cell_rows() {
+            fn eights(f: &[f64]) -> &[[f64; 8]] {
+                f.as_chunks::<8>().0
             }
-            let (us0, us1) = (eights(u, lo, row), eights(u, lo + 1, row));
-            let (un0, un1) = (eights(u, hi, row), eights(u, hi + 1, row));
-            let (vs0, vs1) = (eights(v, lo, row), eights(v, lo + 1, row));
-            let (vn0, vn1) = (eights(v, hi, row), eights(v, hi + 1, row));
+            // Nodes i and i + 1 of the two rows, eight cells at a time.
+            let row = cells.len();
+            let (us0, us1) = (eights(&n.us[..row]), eights(&n.us[1..]));
+            let (un0, un1) = (eights(&n.un[..row]), eights(&n.un[1..]));
+            let (vs0, vs1) = (eights(&n.vs[..row]), eights(&n.vs[1..]));
+            let (vn0, vn1) = (eights(&n.vn[..row]), eights(&n.vn[1..]));
             let (groups, _) = cells.as_chunks_mut::<8>();
             for (g, group) in groups.iter_mut().enumerate() {
                 let coefficients = |s0: &[f64; 8], s1: &[f64; 8], n0: &[f64; 8], n1: &[f64; 8]| {
@@ -960,17 +986,7 @@ impl pulp::WithSimd for BuildCellsV4<'_> {
                     cell.0 = pulp::cast(r);
                 }
             }
-            let done = row / 8 * 8;
-            let (us, un) = (span(u, lo, nx), span(u, hi, nx));
-            let (vs, vn) = (span(v, lo, nx), span(v, hi, nx));
-            for (i, cell) in cells.iter_mut().enumerate().skip(done) {
-                cell.0 = cell_coefficients(
-                    [us[i], us[i + 1]],
-                    [un[i], un[i + 1]],
-                    [vs[i], vs[i + 1]],
-                    [vn[i], vn[i + 1]],
-                );
-            }
+            n.fill(cells, row / 8 * 8);
         }
     }
 }

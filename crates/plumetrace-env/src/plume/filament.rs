@@ -883,7 +883,8 @@ impl FilamentPlume {
 
     /// `c` plus the contributions at `p` of the filaments in `range`, in order. The filaments
     /// beyond their cut-off in the plane (most of those a scan reaches) are found first, up to
-    /// 64 at a time and without a branch per filament; the others are then summed in order.
+    /// 64 at a time (one bit each) and without a branch per filament; the others are then summed
+    /// in order.
     #[inline(always)]
     fn sum_filaments(
         &self,
@@ -896,7 +897,7 @@ impl FilamentPlume {
         let (r0sq, gamma, t, cut2) = k.box_constants();
         let mut start = range.start;
         while start < range.end {
-            let end = (start + 64).min(range.end);
+            let end = (start + u64::BITS as usize).min(range.end);
             // Bit i: filament start + i is within its cut-off in the plane (or a NaN says
             // nothing either way, as in the test below).
             let mut near = 0u64;
@@ -1089,7 +1090,6 @@ impl pulp::WithSimd for Transport<'_> {
 
     #[inline(always)]
     fn with_simd<S: pulp::Simd>(self, _simd: S) -> (bool, usize) {
-        const CHUNK: usize = TRANSPORT_CHUNK;
         let Transport {
             x,
             y,
@@ -1115,10 +1115,10 @@ impl pulp::WithSimd for Transport<'_> {
         let mut left = false;
         let mut beyond = 0usize;
         for (((xs, ys), zs), keys) in x
-            .chunks_mut(CHUNK)
-            .zip(y.chunks_mut(CHUNK))
-            .zip(z.chunks_mut(CHUNK))
-            .zip(key.chunks(CHUNK))
+            .chunks_mut(TRANSPORT_CHUNK)
+            .zip(y.chunks_mut(TRANSPORT_CHUNK))
+            .zip(z.chunks_mut(TRANSPORT_CHUNK))
+            .zip(key.chunks(TRANSPORT_CHUNK))
         {
             let m = xs.len();
             flow.velocities(xs, ys, &mut u[..m], &mut v[..m]);
