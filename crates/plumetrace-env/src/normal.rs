@@ -51,32 +51,8 @@ struct Tables {
 fn tables() -> &'static Tables {
     static TABLES: OnceLock<Tables> = OnceLock::new();
     TABLES.get_or_init(|| {
-        let edge = |i: usize| inverse_normal_cdf(i as f64 / BUCKETS as f64);
-        let mut lines = vec![[0.0; 2]; BUCKETS];
-        for (i, l) in lines.iter_mut().enumerate().take(BUCKETS - 1).skip(1) {
-            let (a, b) = (edge(i), edge(i + 1));
-            let rise = (b - a) / PLACES as f64;
-            l[0] = a + 0.5 * rise;
-            l[1] = rise;
-        }
-        let n = (BUCKETS * PLACES) as f64;
-        let low_tail: Vec<f64> = (0..PLACES)
-            .map(|f| inverse_normal_cdf((f as f64 + 0.5) / n))
-            .collect();
-        // Scale to unit variance over all 2^21 values (computed in double precision).
-        let mut sum_sq = 0.0;
-        for k in 0..(1u32 << BITS) {
-            let (bucket, place) = (bucket(k), place(k));
-            let z = if bucket == 0 {
-                low_tail[place]
-            } else if bucket == BUCKETS - 1 {
-                -low_tail[PLACES - 1 - place]
-            } else {
-                lines[bucket][0] + lines[bucket][1] * place as f64
-            };
-            sum_sq += z * z;
-        }
-        let scale = (n / sum_sq).sqrt();
+        let (lines, low_tail) = unscaled();
+        let scale = UNIT_VARIANCE_SCALE;
         Tables {
             lines: Box::new(std::array::from_fn(|i| {
                 let a = (lines[i][0] * scale) as f32;
@@ -86,6 +62,50 @@ fn tables() -> &'static Tables {
             low_tail: Box::new(std::array::from_fn(|f| (low_tail[f] * scale) as f32)),
         }
     })
+}
+
+/// The tables before scaling: per bucket, the line through the inverse at its two edges `i /
+/// 2048` and `(i + 1) / 2048` as `[value at the middle of the first place, rise per place]`
+/// (the outer buckets' zero), and the inverse at the places of the lowest bucket.
+fn unscaled() -> (Vec<[f64; 2]>, Vec<f64>) {
+    let edge = |i: usize| inverse_normal_cdf(i as f64 / BUCKETS as f64);
+    let mut lines = vec![[0.0; 2]; BUCKETS];
+    for (i, l) in lines.iter_mut().enumerate().take(BUCKETS - 1).skip(1) {
+        let (a, b) = (edge(i), edge(i + 1));
+        let rise = (b - a) / PLACES as f64;
+        l[0] = a + 0.5 * rise;
+        l[1] = rise;
+    }
+    let n = (BUCKETS * PLACES) as f64;
+    let low_tail = (0..PLACES)
+        .map(|f| inverse_normal_cdf((f as f64 + 0.5) / n))
+        .collect();
+    (lines, low_tail)
+}
+
+/// What [`unit_variance_scale`] gives for the unscaled tables (the test
+/// `the_scale_is_the_sum_of_squares_one` works it out again): written down, so that a process
+/// does not sum 2^21 squares (about 8 ms) before its first draw.
+const UNIT_VARIANCE_SCALE: f64 = f64::from_bits(0x3fef_ff77_5058_c515);
+
+/// The factor that gives the 2^21 values of the unscaled `lines` (per bucket, the value at its
+/// first place's middle and the rise per place) and lowest bucket's `low_tail` a variance of 1,
+/// summed in double precision in the order of the numbers `k`.
+#[cfg(test)]
+fn unit_variance_scale(lines: &[[f64; 2]], low_tail: &[f64]) -> f64 {
+    let mut sum_sq = 0.0;
+    for k in 0..(1u32 << BITS) {
+        let (bucket, place) = (bucket(k), place(k));
+        let z = if bucket == 0 {
+            low_tail[place]
+        } else if bucket == BUCKETS - 1 {
+            -low_tail[PLACES - 1 - place]
+        } else {
+            lines[bucket][0] + lines[bucket][1] * place as f64
+        };
+        sum_sq += z * z;
+    }
+    ((BUCKETS * PLACES) as f64 / sum_sq).sqrt()
 }
 
 impl Tables {
@@ -231,6 +251,18 @@ mod tests {
     use super::*;
 
     #[test]
+    fn the_scale_is_the_sum_of_squares_one() {
+        let (lines, low_tail) = unscaled();
+        let scale = unit_variance_scale(&lines, &low_tail);
+        assert_eq!(
+            scale.to_bits(),
+            UNIT_VARIANCE_SCALE.to_bits(),
+            "the sum gives {scale:e} ({:#018x})",
+            scale.to_bits()
+        );
+    }
+
+    #[test]
     fn inverse_cdf_matches_known_quantiles() {
         // (p, z) pairs from standard tables.
         for (p, z) in [
@@ -326,16 +358,18 @@ mod tests {
         // at the bottom of the range.
         let [a, b, c] = normal_triple(w);
         assert!(a > 0.0 && b < -4.9 && c < -4.9, "{a} {b} {c}");
-        // The columns hold the triples of their words, row by row: 21 rows, the first group of
-        // eight with no draw in a tail bucket, the second with `w` (two tail draws) and the
-        // third partial.
-        let mut words: Vec<u64> = (1..=21u64)
+        // The columns hold the triples of their words, row by row: 150 rows, the first group
+        // of eight with no draw in a tail bucket, `w` (two tail draws) in the second group, in
+        // a middle one and in the last (partial) one.
+        let mut words: Vec<u64> = (1..=150u64)
             .map(|n| n.wrapping_mul(0x9e37_79b9_7f4a_7c15))
             .collect();
-        words[11] = w;
+        for k in [11, 70, 149] {
+            words[k] = w;
+        }
         assert!(!words[..8].iter().any(|w| in_a_tail(*w)));
         assert!(in_a_tail(w));
-        let mut cols = [[0.0; 21]; 3];
+        let mut cols = [[0.0; 150]; 3];
         let [c0, c1, c2] = &mut cols;
         fill_normal_columns(&words, c0, c1, c2);
         for (k, w) in words.iter().enumerate() {

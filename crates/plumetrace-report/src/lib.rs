@@ -21,6 +21,7 @@
 //! - [`error`]: what can go wrong ([`ReportError`]).
 
 pub mod chart;
+pub mod decimal;
 pub mod error;
 pub mod figure;
 pub mod geo_outputs;

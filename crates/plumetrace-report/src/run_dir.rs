@@ -6,10 +6,10 @@
 //! snapshot log (`snapshots.jsonl.gz`) is written while the mission flies, by the mission crate's
 //! observer, under [`SNAPSHOT_LOG`]. Every file goes through a temporary file and a rename.
 
+use crate::decimal::{push_fixed, push_whole};
 use plumetrace_mission::MissionRun;
 use plumetrace_mission::output::{first_non_finite, write_atomic};
 use serde::Serialize;
-use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
 /// The replay page's file name in a run's output directory.
@@ -66,11 +66,6 @@ struct SummaryFile<'a> {
     stage_times: plumetrace_sim::StageTimes,
 }
 
-/// `x` with `digits` decimals, or an empty field.
-fn opt(x: Option<f64>, digits: usize) -> String {
-    x.map_or(String::new(), |v| format!("{v:.digits$}"))
-}
-
 /// `trajectory.csv`: every step of every vehicle.
 pub fn trajectory_csv(run: &MissionRun) -> Result<String, RunDirError> {
     let mut csv = String::from(
@@ -97,24 +92,30 @@ pub fn trajectory_csv(run: &MissionRun) -> Result<String, RunDirError> {
                 t_s: r.t_s,
             });
         }
-        let _ = writeln!(
-            csv,
-            "{:.1},{},{:.2},{:.2},{:.2},{},{},{:.1},{:.2},{},{:.3},{}",
-            r.t_s,
-            r.vehicle,
-            r.true_x_m,
-            r.true_y_m,
-            r.true_z_m,
-            opt(r.est_x_m, 2),
-            opt(r.est_y_m, 2),
-            r.heading_deg,
-            r.speed_mps,
-            r.behaviour
-                .and_then(|b| plumetrace_core::variant_name(&b))
-                .unwrap_or(""),
-            r.reading_v,
-            u8::from(r.detection)
-        );
+        let fixed = |csv: &mut String, v: f64, places: usize| {
+            push_fixed(csv, v, places);
+            csv.push(',');
+        };
+        fixed(&mut csv, r.t_s, 1);
+        push_whole(&mut csv, u64::from(r.vehicle));
+        csv.push(',');
+        fixed(&mut csv, r.true_x_m, 2);
+        fixed(&mut csv, r.true_y_m, 2);
+        fixed(&mut csv, r.true_z_m, 2);
+        for est in [r.est_x_m, r.est_y_m] {
+            if let Some(v) = est {
+                push_fixed(&mut csv, v, 2);
+            }
+            csv.push(',');
+        }
+        fixed(&mut csv, r.heading_deg, 1);
+        fixed(&mut csv, r.speed_mps, 2);
+        let behaviour = r.behaviour.and_then(|b| plumetrace_core::variant_name(&b));
+        csv.push_str(behaviour.unwrap_or(""));
+        csv.push(',');
+        fixed(&mut csv, r.reading_v, 3);
+        csv.push(if r.detection { '1' } else { '0' });
+        csv.push('\n');
     }
     Ok(csv)
 }
