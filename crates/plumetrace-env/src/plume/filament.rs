@@ -197,7 +197,23 @@ pub struct FilamentPlume {
     /// The transport's working columns, kept between steps so that a step does not clear them
     /// (12 kB: a sizeable part of a step of a few hundred filaments).
     scratch: Box<TransportScratch>,
+    /// Which runs of the last transport's filaments hold one that may go, for the removal that
+    /// follows it.
+    strays: Strays,
 }
+
+/// Per run of [`STRAY_RUN`] filaments moved by the last transport (from the first), whether any
+/// of them is outside the domain or past the sink's line, as [`FilamentPlume::remove_outside`]
+/// tests them; the removal reads them instead of testing every filament again, and runs past
+/// `moved` (filaments released after the transport) are tested in full.
+#[derive(Debug, Clone, Default)]
+struct Strays {
+    runs: Vec<bool>,
+    moved: usize,
+}
+
+/// Filaments per run of the removal's test.
+const STRAY_RUN: usize = 64;
 
 /// Filaments per velocity batch of the transport: small enough for the batch to stay in L1
 /// cache.
@@ -212,6 +228,8 @@ struct TransportScratch {
     n0: [f64; TRANSPORT_CHUNK],
     n1: [f64; TRANSPORT_CHUNK],
     n2: [f64; TRANSPORT_CHUNK],
+    /// Per filament, whether it may go (see [`Strays`]).
+    strays: [bool; TRANSPORT_CHUNK],
 }
 
 impl TransportScratch {
@@ -223,6 +241,7 @@ impl TransportScratch {
             n0: [0.0; TRANSPORT_CHUNK],
             n1: [0.0; TRANSPORT_CHUNK],
             n2: [0.0; TRANSPORT_CHUNK],
+            strays: [false; TRANSPORT_CHUNK],
         })
     }
 }
@@ -352,6 +371,7 @@ impl FilamentPlume {
             index: OnceLock::new(),
             boxes: OnceLock::new(),
             scratch: TransportScratch::new(),
+            strays: Strays::default(),
         })
     }
 
@@ -381,6 +401,7 @@ impl FilamentPlume {
             index: OnceLock::new(),
             boxes: OnceLock::new(),
             scratch: TransportScratch::new(),
+            strays: Strays::default(),
         }
     }
 
@@ -608,6 +629,9 @@ impl FilamentPlume {
             }
             None => ([0.0, 0.0], f64::INFINITY),
         };
+        let stray_line = self.sink.map_or(f64::INFINITY, |s| s.beyond_m);
+        self.strays.runs.clear();
+        self.strays.moved = self.x.len();
         let (left, beyond) = arch.dispatch(Transport {
             x: &mut self.x,
             y: &mut self.y,
@@ -619,8 +643,9 @@ impl FilamentPlume {
             floor_ceiling: (floor, ceiling),
             domain: self.domain,
             offset,
-            sink: (sink_dir, sink_line),
+            sink: (sink_dir, sink_line, stray_line),
             scratch: &mut self.scratch,
+            stray_runs: &mut self.strays.runs,
         });
         if let (Some(sb), VerticalBoundary::Reflecting { .. }) =
             (&self.seabed, self.params.vertical)
@@ -699,8 +724,11 @@ impl FilamentPlume {
         // beyond the sink); most filaments are passed by comparisons alone.
         let mut gone: Vec<(usize, bool)> = Vec::new();
         // A run of filaments is passed at once when none of them is out of the domain or past
-        // the sink's line (a test without branches, which the compiler vectorises).
-        const RUN: usize = 64;
+        // the sink's line: as the transport found it for the filaments it moved, else by a
+        // test without branches, which the compiler vectorises. (The transport's test is this
+        // one, on the same positions.)
+        const RUN: usize = STRAY_RUN;
+        let strays = std::mem::take(&mut self.strays);
         let (xs, ys) = (&*self.x, &*self.y);
         let stays = |x: f64, y: f64| {
             (x >= d.x_min_m)
@@ -710,11 +738,14 @@ impl FilamentPlume {
                 & (dir[0] * x + dir[1] * y <= beyond_m)
         };
         for (run, (rx, ry)) in xs.chunks(RUN).zip(ys.chunks(RUN)).enumerate() {
-            if rx
-                .iter()
-                .zip(ry)
-                .fold(true, |all, (&x, &y)| all & stays(x, y))
-            {
+            let passed = match strays.runs.get(run) {
+                Some(&any) if run * RUN + rx.len() <= strays.moved => !any,
+                _ => rx
+                    .iter()
+                    .zip(ry)
+                    .fold(true, |all, (&x, &y)| all & stays(x, y)),
+            };
+            if passed {
                 continue;
             }
             for (i, (&x, &y)) in rx.iter().zip(ry).enumerate() {
@@ -1081,8 +1112,11 @@ struct Transport<'a> {
     floor_ceiling: (f64, f64),
     domain: Rect,
     offset: u64,
-    sink: ([f64; 2], f64),
+    /// The sink's direction, the line beyond which a filament certainly lies past it, and its
+    /// own line (see [`Strays`]).
+    sink: ([f64; 2], f64, f64),
     scratch: &'a mut TransportScratch,
+    stray_runs: &'a mut Vec<bool>,
 }
 
 impl pulp::WithSimd for Transport<'_> {
@@ -1101,8 +1135,9 @@ impl pulp::WithSimd for Transport<'_> {
             floor_ceiling: (floor, ceiling),
             domain: d,
             offset,
-            sink: (sink_dir, sink_line),
+            sink: (sink_dir, sink_line, stray_line),
             scratch,
+            stray_runs,
         } = self;
         let TransportScratch {
             u,
@@ -1111,6 +1146,7 @@ impl pulp::WithSimd for Transport<'_> {
             n0,
             n1,
             n2,
+            strays,
         } = scratch;
         let mut left = false;
         let mut beyond = 0usize;
@@ -1129,14 +1165,20 @@ impl pulp::WithSimd for Transport<'_> {
             // Every column cut to the chunk's length, so the loop has no bounds checks.
             let (ys, zs, u, v) = (&mut ys[..m], &mut zs[..m], &u[..m], &v[..m]);
             let (n0, n1, n2) = (&n0[..m], &n1[..m], &n2[..m]);
+            let strays = &mut strays[..m];
             for k in 0..m {
                 let (x, y, z) = (&mut xs[k], &mut ys[k], &mut zs[k]);
                 *x += u[k] * dt_s + sx * n0[k];
                 *y += v[k] * dt_s + sy * n1[k];
                 *z = reflect(*z + sz * n2[k], floor, ceiling);
-                left |= !d.contains_xy(*x, *y);
-                beyond += usize::from(sink_dir[0] * *x + sink_dir[1] * *y > sink_line);
+                let inside = d.contains_xy(*x, *y);
+                let along = sink_dir[0] * *x + sink_dir[1] * *y;
+                left |= !inside;
+                beyond += usize::from(along > sink_line);
+                strays[k] = !(inside & (along <= stray_line));
             }
+            // The chunk's runs (chunks are whole runs but for the last).
+            stray_runs.extend(strays.chunks(STRAY_RUN).map(|r| r.contains(&true)));
         }
         (left, beyond)
     }
@@ -1265,6 +1307,76 @@ mod tests {
             assert_eq!(p.birth_s.len(), p.len());
             assert_eq!(p.source.len(), p.len());
         }
+    }
+
+    #[test]
+    fn the_removal_after_a_transport_is_the_removal_of_a_full_test() {
+        // A current of 1 m/s carries filaments from x = 40 m past a sink at x = 55 m, over 400
+        // steps of 0.1 s; after each transport a few filaments are released and one of them put
+        // outside the square (after the transport: its run is tested in full). The removal that reads
+        // the transport's runs and one on a copy that tests every filament keep the same
+        // filaments, bit for bit, and count the same leavers.
+        let region = Rect::new(0.0, 100.0, 0.0, 100.0).unwrap_or_else(|e| panic!("{e}"));
+        let mean = MeanFlow::Steady {
+            speed_mps: 1.0,
+            toward_deg: 80.0,
+        };
+        let dt = 0.1;
+        let mut flow = FarrellFlow::new(region, mean, FarrellParams::default(), dt)
+            .unwrap_or_else(|e| panic!("{e}"));
+        let source = Source {
+            pos_m: Vec3::new(40.0, 50.0, 1.0),
+            mass_rate_per_s: 1.0,
+            filament_rate_hz: 1.0,
+        };
+        let mut p = FilamentPlume::new(region, vec![source], FilamentParams::default())
+            .unwrap_or_else(|e| panic!("{e}"));
+        p.set_key_seed(3);
+        p.set_sink(Some(DownflowSink {
+            dir: [1.0, 0.0],
+            beyond_m: 55.0,
+        }));
+        let mut flow_rng = stream_rng(3, StreamId::Flow);
+        let (mut removed, mut flagged) = (0, 0);
+        for k in 1..=400u32 {
+            let t = f64::from(k) * dt;
+            flow.advance(t, dt, &mut flow_rng)
+                .unwrap_or_else(|e| panic!("{e}"));
+            p.release_at_source(0, 20);
+            p.transport(&flow, dt);
+            p.release_at_source(0, 3);
+            let last = p.len() - 1;
+            p.x[last] = -5.0;
+            flagged += p.strays.runs.iter().filter(|&&r| r).count();
+            let mut full = p.copy_state();
+            assert!(full.strays.runs.is_empty());
+            let before = p.len();
+            p.remove_outside();
+            full.remove_outside();
+            removed += before - p.len();
+            let columns = |q: &FilamentPlume| {
+                (0..q.len())
+                    .map(|k| {
+                        [q.x[k], q.y[k], q.z[k], q.birth_s[k], q.mass[k]]
+                            .map(f64::to_bits)
+                            .to_vec()
+                    })
+                    .zip(q.key.iter().copied())
+                    .collect::<Vec<_>>()
+            };
+            let (kept, all) = (columns(&p), columns(&full));
+            let first = kept.iter().zip(&all).position(|(a, b)| a != b);
+            assert!(
+                kept.len() == all.len() && first.is_none(),
+                "step {k}: {} filaments kept against {}, first difference at {first:?}",
+                kept.len(),
+                all.len()
+            );
+            assert_eq!(p.stats(), full.stats(), "step {k}");
+        }
+        let stats = p.stats();
+        assert!(stats.exited == 400 && stats.dropped > 2_000, "{stats:?}");
+        assert!(removed > 2_400 && flagged > 400, "{removed} {flagged}");
     }
 
     #[test]
