@@ -28,6 +28,57 @@ struct Entry {
     neg_inv_2r2: f64,
 }
 
+/// The entries, one column per field of [`Entry`] (so that a grid query's first pass over them
+/// runs in vector lanes).
+#[derive(Debug, Default)]
+struct Entries {
+    x: Vec<f64>,
+    y: Vec<f64>,
+    z: Vec<f64>,
+    lim2: Vec<f64>,
+    amp: Vec<f64>,
+    neg_inv_2r2: Vec<f64>,
+}
+
+impl Entries {
+    fn with_len(n: usize) -> Self {
+        let column = || vec![0.0; n];
+        Entries {
+            x: column(),
+            y: column(),
+            z: column(),
+            lim2: vec![-1.0; n],
+            amp: column(),
+            neg_inv_2r2: column(),
+        }
+    }
+
+    fn len(&self) -> usize {
+        self.x.len()
+    }
+
+    fn set(&mut self, k: usize, e: Entry) {
+        self.x[k] = e.x;
+        self.y[k] = e.y;
+        self.z[k] = e.z;
+        self.lim2[k] = e.lim2;
+        self.amp[k] = e.amp;
+        self.neg_inv_2r2[k] = e.neg_inv_2r2;
+    }
+
+    #[inline(always)]
+    fn get(&self, k: usize) -> Entry {
+        Entry {
+            x: self.x[k],
+            y: self.y[k],
+            z: self.z[k],
+            lim2: self.lim2[k],
+            amp: self.amp[k],
+            neg_inv_2r2: self.neg_inv_2r2[k],
+        }
+    }
+}
+
 /// The index: cells of size `cell_m` over the domain, row-major, with `starts[c]..starts[c + 1]`
 /// the entries of cell `c`.
 #[derive(Debug)]
@@ -39,7 +90,7 @@ pub(crate) struct CellIndex {
     ncy: usize,
     search_m: f64,
     starts: Vec<u32>,
-    entries: Vec<Entry>,
+    entries: Entries,
     floor: Option<f64>,
     ceiling: Option<f64>,
 }
@@ -107,15 +158,7 @@ impl CellIndex {
             starts[c + 1] += starts[c];
         }
         let mut fill = starts.clone();
-        let blank = Entry {
-            x: 0.0,
-            y: 0.0,
-            z: 0.0,
-            lim2: -1.0,
-            amp: 0.0,
-            neg_inv_2r2: 0.0,
-        };
-        let mut entries = vec![blank; total];
+        let mut entries = Entries::with_len(total);
         let norm = (2.0 * std::f64::consts::PI).powf(1.5);
         let cut2 = cutoff_radii * cutoff_radii;
         for (e, &cell) in cells.iter().enumerate() {
@@ -124,14 +167,17 @@ impl CellIndex {
             fill[c] += 1;
             let (k, z) = of(e);
             let r2 = plume.radius_sq_born(pb[k]);
-            entries[slot] = Entry {
-                x: px[k],
-                y: py[k],
-                z,
-                lim2: cut2 * r2,
-                amp: pm[k] / (norm * r2 * r2.sqrt()),
-                neg_inv_2r2: -0.5 / r2,
-            };
+            entries.set(
+                slot,
+                Entry {
+                    x: px[k],
+                    y: py[k],
+                    z,
+                    lim2: cut2 * r2,
+                    amp: pm[k] / (norm * r2 * r2.sqrt()),
+                    neg_inv_2r2: -0.5 / r2,
+                },
+            );
         }
         // (An image's own image in the surface lies above the surface by the water's depth
         // and more: out of reach of any point in the water but for filaments as wide as the
@@ -167,7 +213,7 @@ impl CellIndex {
     }
 
     pub(crate) fn concentration(&self, p: Vec3) -> f64 {
-        if self.entries.is_empty() {
+        if self.entries.len() == 0 {
             return 0.0;
         }
         let r = self.search_m;
@@ -181,7 +227,8 @@ impl CellIndex {
         for j in j0..=j1 {
             let a = self.starts[j * self.ncx + i0] as usize;
             let b = self.starts[j * self.ncx + i1 + 1] as usize;
-            for e in &self.entries[a..b] {
+            for k in a..b {
+                let e = self.entries.get(k);
                 let dx = p.x - e.x;
                 let dy = p.y - e.y;
                 let dxy2 = dx * dx + dy * dy;
@@ -228,12 +275,20 @@ struct GridAxes {
 
 /// The indices `lo..hi` along an axis of spacing `1 / inv_step` from `origin` that may lie
 /// within `half` of `c` (a millionth of a spacing to spare, far above the rounding of the
-/// coordinates; the exact test decides).
-fn axis_span(c: f64, half: f64, origin: f64, inv_step: f64) -> (usize, usize) {
+/// coordinates; the exact test decides), before they are made whole ([`whole_span`]): in
+/// floating point only, so that a loop of them runs in vector lanes.
+#[inline(always)]
+fn axis_span(c: f64, half: f64, origin: f64, inv_step: f64) -> [f64; 2] {
     let slack = 1e-6 + 1e-14 * (c.abs() + half + origin.abs()) * inv_step;
     let lo = (c - half - origin) * inv_step - slack;
     let hi = (c + half - origin) * inv_step + slack;
-    // Truncation is the floor of a value that is not negative.
+    [lo, hi]
+}
+
+/// The whole indices `a..b` of an [`axis_span`]: the floor of `lo` and one past the floor of
+/// `hi`, neither below zero (truncation is the floor of a value that is not negative).
+#[inline(always)]
+fn whole_span([lo, hi]: [f64; 2]) -> (usize, usize) {
     let a = if lo > 0.0 { lo as usize } else { 0 };
     let b = if hi >= 0.0 { hi as usize + 1 } else { 0 };
     (a, b)
@@ -343,6 +398,52 @@ impl Gathered {
     }
 }
 
+/// Entries per run of a grid query's first pass.
+const REACH_RUN: usize = 256;
+
+/// A run of entries' reach (see [`CellIndex::reaches`]).
+struct Reaches {
+    /// Heights in reach.
+    n: [usize; REACH_RUN],
+    /// Their squared distances, the first `n` of the three (a column each).
+    heights: [[f64; REACH_RUN]; 3],
+    /// The grid rows and columns in reach, as [`axis_span`]s (a column each for the rows'
+    /// ends and the columns').
+    spans: [[f64; REACH_RUN]; 4],
+}
+
+impl Default for Reaches {
+    fn default() -> Self {
+        Reaches {
+            n: [0; REACH_RUN],
+            heights: [[0.0; REACH_RUN]; 3],
+            spans: [[0.0; REACH_RUN]; 4],
+        }
+    }
+}
+
+/// One band of a grid query, as a [`pulp::WithSimd`] operation so that all of it is compiled
+/// for the vector unit chosen.
+struct Band<'a> {
+    index: &'a CellIndex,
+    axes: &'a GridAxes,
+    rows: (usize, usize),
+    out: &'a mut [f64],
+    how: TermExp,
+    arch: pulp::Arch,
+}
+
+impl pulp::WithSimd for Band<'_> {
+    type Output = ();
+
+    #[inline(always)]
+    fn with_simd<S: pulp::Simd>(self, _simd: S) {
+        let (j0, j1) = self.rows;
+        self.index
+            .scatter_band(self.axes, j0, j1, self.out, self.how, self.arch);
+    }
+}
+
 impl CellIndex {
     /// Concentrations at every point of `grid`, row by row with x fastest (the order of
     /// [`GridSpec::points`]): with [`TermExp::Standard`], bit for bit what
@@ -352,8 +453,10 @@ impl CellIndex {
     /// the filaments of a cell), which is one order for every point; so the filaments can be
     /// taken one at a time, each adding its terms to the grid points it reaches, and every point
     /// still sums the same terms in the same order. Each filament visits only the grid points
-    /// near it instead of every point scanning every filament of its 3 x 3 cells. The terms are
-    /// gathered first and their exponentials taken in batches, then added in the same order. A
+    /// near it instead of every point scanning every filament of its 3 x 3 cells. What each
+    /// filament reaches (its heights within the cut-off and its box of grid points) is worked
+    /// out for runs of filaments in vector lanes first; the terms are gathered and their
+    /// exponentials taken in batches, then added in the same order. A
     /// grid that is not a proper lattice (a single row or column, a spacing that is not finite
     /// and positive) is queried point by point.
     pub(crate) fn grid_concentrations(&self, grid: &GridSpec, out: &mut [f64], how: TermExp) {
@@ -375,13 +478,20 @@ impl CellIndex {
             .for_each(|(band, rows)| {
                 rows.fill(0.0);
                 let j0 = band * band_rows;
-                self.scatter_band(&axes, j0, j0 + rows.len() / grid.nx, rows, how, arch);
+                arch.dispatch(Band {
+                    index: self,
+                    axes: &axes,
+                    rows: (j0, j0 + rows.len() / grid.nx),
+                    out: rows,
+                    how,
+                    arch,
+                });
             });
     }
 
     /// The grid's axes and spans, or `None` for a grid that is not a proper lattice.
     fn grid_axes(&self, g: &GridSpec) -> Option<GridAxes> {
-        if g.nx < 2 || g.ny < 2 || self.entries.is_empty() {
+        if g.nx < 2 || g.ny < 2 || self.entries.len() == 0 {
             return None;
         }
         let dx = (g.x_max_m - g.x_min_m) / (g.nx - 1) as f64;
@@ -417,7 +527,11 @@ impl CellIndex {
     }
 
     /// Adds every filament's terms to the grid rows `j0..j1` (`out`, row by row), filament by
-    /// filament in the index's order.
+    /// filament in the index's order. Each row of cells is taken in runs of entries: a first
+    /// pass works out every entry's heights in reach and the grid rows and columns it may reach
+    /// (in vector lanes, [`CellIndex::reaches`]), then the entries visit their grid points in
+    /// order.
+    #[inline(always)]
     fn scatter_band(
         &self,
         axes: &GridAxes,
@@ -428,38 +542,53 @@ impl CellIndex {
         arch: pulp::Arch,
     ) {
         let nx = axes.xs.len();
-        let (x_origin, y_origin) = (axes.xs[0], axes.ys[0]);
         // Room for a few thousand terms, and for every term of a whole row.
         let mut terms_of = Gathered::with_room((3 * nx).max(4096));
+        let mut reach = Box::new(Reaches::default());
+        // The cell columns from the first to the last whose entries may reach the grid (a
+        // column between them that cannot has an empty span, which passes its entries over).
+        let reaches_grid = |s: &(usize, usize)| s.0 < s.1;
+        let (Some(ci0), Some(ci1)) = (
+            axes.col_span.iter().position(reaches_grid),
+            axes.col_span.iter().rposition(reaches_grid),
+        ) else {
+            return;
+        };
         for (cj, &(rs0, rs1)) in axes.row_span.iter().enumerate() {
             let (rs0, rs1) = (rs0.max(j0), rs1.min(j1));
             if rs0 >= rs1 {
                 continue;
             }
-            for (ci, &(cs0, cs1)) in axes.col_span.iter().enumerate() {
-                if cs0 >= cs1 {
-                    continue;
-                }
-                let c = cj * self.ncx + ci;
-                let (a, b) = (self.starts[c] as usize, self.starts[c + 1] as usize);
-                for e in &self.entries[a..b] {
-                    // d2 = dxy2 + dz2 is at least dz2: a term out of reach at this height
-                    // adds nothing anywhere (nor a filament with no term in reach).
-                    let (all_terms, n) = self.terms(e, axes.z, e.lim2);
+            let row_cells = cj * self.ncx;
+            let (a, b) = (
+                self.starts[row_cells + ci0] as usize,
+                self.starts[row_cells + ci1 + 1] as usize,
+            );
+            // The cell of the entry at hand.
+            let mut ci = ci0;
+            for start in (a..b).step_by(REACH_RUN) {
+                let m = (b - start).min(REACH_RUN);
+                self.reaches(start, m, axes, &mut reach);
+                for r in 0..m {
+                    let k = start + r;
+                    while k >= self.starts[row_cells + ci + 1] as usize {
+                        ci += 1;
+                    }
+                    let (cs0, cs1) = axes.col_span[ci];
+                    let n = reach.n[r];
                     if n == 0 {
                         continue;
                     }
-                    let near = all_terms[..n].iter().fold(f64::INFINITY, |m, &t| m.min(t));
-                    // At least the reach left in the plane (the rounding of the difference
-                    // is below the added billionth).
-                    let half = ((e.lim2 - near).max(0.0) + 1e-9 * e.lim2).sqrt();
-                    let (ra, rb) = axis_span(e.y, half, y_origin, axes.inv_dy);
+                    let [ra, rb, ca, cb] = [0, 1, 2, 3].map(|i| reach.spans[i][r]);
+                    let (ra, rb) = whole_span([ra, rb]);
+                    let (ca, cb) = whole_span([ca, cb]);
                     let (ra, rb) = (ra.max(rs0), rb.min(rs1));
-                    let (ca, cb) = axis_span(e.x, half, x_origin, axes.inv_dx);
                     let (ca, cb) = (ca.max(cs0), cb.min(cs1));
                     if ca >= cb {
                         continue;
                     }
+                    let e = self.entries.get(k);
+                    let all_terms = [0, 1, 2].map(|i| reach.heights[i][r]);
                     for j in ra..rb {
                         let dy = axes.ys[j] - e.y;
                         let dy2 = dy * dy;
@@ -473,9 +602,9 @@ impl CellIndex {
                         let row = (j - j0) * nx;
                         let xs = &axes.xs[ca..cb];
                         match n {
-                            1 => terms_of.row::<1>(e, xs, row + ca, dy2, &all_terms),
-                            2 => terms_of.row::<2>(e, xs, row + ca, dy2, &all_terms),
-                            _ => terms_of.row::<3>(e, xs, row + ca, dy2, &all_terms),
+                            1 => terms_of.row::<1>(&e, xs, row + ca, dy2, &all_terms),
+                            2 => terms_of.row::<2>(&e, xs, row + ca, dy2, &all_terms),
+                            _ => terms_of.row::<3>(&e, xs, row + ca, dy2, &all_terms),
                         }
                     }
                 }
@@ -484,27 +613,63 @@ impl CellIndex {
         terms_of.flush(how, arch, out);
     }
 
-    /// The squared vertical distances below `lim2` from height `z` to filament `e` and to its
-    /// images in the seabed and the surface, in the order [`CellIndex::concentration`] adds
-    /// them, and how many.
-    fn terms(&self, e: &Entry, z: f64, lim2: f64) -> ([f64; 3], usize) {
-        let mut t = [0.0; 3];
-        let mut n = 0;
-        for dz in [
-            Some(z - e.z),
-            self.floor.map(|f| z - (2.0 * f - e.z)),
-            self.ceiling.map(|s| z - (2.0 * s - e.z)),
-        ]
-        .into_iter()
-        .flatten()
-        {
-            let dz2 = dz * dz;
-            if dz2 < lim2 {
-                t[n] = dz2;
-                n += 1;
-            }
+    /// For the `m` entries from `start`: their squared vertical distances to the grid's height
+    /// below their cut-off (from the filament and its images in the seabed and the surface, in
+    /// the order [`CellIndex::concentration`] adds them) and how many, and the grid rows and
+    /// columns within their reach left in the plane (before the cells' windows cut them). A
+    /// loop without branches, so that compiled for a vector unit it takes several entries at
+    /// once; the same operations as one entry at a time.
+    #[inline(always)]
+    fn reaches(&self, start: usize, m: usize, axes: &GridAxes, out: &mut Reaches) {
+        let e = &self.entries;
+        let (x, y, z, lim2) = (
+            &e.x[start..start + m],
+            &e.y[start..start + m],
+            &e.z[start..start + m],
+            &e.lim2[start..start + m],
+        );
+        // A missing boundary's image is at NaN: its distance is never below the cut-off.
+        let floor = self.floor.unwrap_or(f64::NAN);
+        let ceiling = self.ceiling.unwrap_or(f64::NAN);
+        let (x_origin, y_origin) = (axes.xs[0], axes.ys[0]);
+        let n = &mut out.n[..m];
+        let [h0, h1, h2] = &mut out.heights;
+        let (h0, h1, h2) = (&mut h0[..m], &mut h1[..m], &mut h2[..m]);
+        let [ra, rb, ca, cb] = &mut out.spans;
+        let (ra, rb) = (&mut ra[..m], &mut rb[..m]);
+        let (ca, cb) = (&mut ca[..m], &mut cb[..m]);
+        for k in 0..m {
+            let all = [
+                axes.z - z[k],
+                axes.z - (2.0 * floor - z[k]),
+                axes.z - (2.0 * ceiling - z[k]),
+            ]
+            .map(|dz| dz * dz);
+            // The distances in reach, first, in order (by selects, so that the loop runs in
+            // lanes); the nearest of them.
+            let [d0, d1, d2] = all;
+            let [k0, k1, k2] = all.map(|d2| d2 < lim2[k]);
+            h0[k] = if k0 {
+                d0
+            } else if k1 {
+                d1
+            } else {
+                d2
+            };
+            h1[k] = if k0 && k1 { d1 } else { d2 };
+            h2[k] = d2;
+            n[k] = usize::from(k0) + usize::from(k1) + usize::from(k2);
+            let near = if k0 { d0 } else { f64::INFINITY };
+            let near = if k1 && d1 < near { d1 } else { near };
+            let near = if k2 && d2 < near { d2 } else { near };
+            // At least the reach left in the plane (the rounding of the difference is below
+            // the added billionth).
+            let left = lim2[k] - near;
+            let left = if left > 0.0 { left } else { 0.0 };
+            let half = (left + 1e-9 * lim2[k]).sqrt();
+            [ra[k], rb[k]] = axis_span(y[k], half, y_origin, axes.inv_dy);
+            [ca[k], cb[k]] = axis_span(x[k], half, x_origin, axes.inv_dx);
         }
-        (t, n)
     }
 }
 
