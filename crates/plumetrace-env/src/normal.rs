@@ -83,9 +83,10 @@ fn unscaled() -> (Vec<[f64; 2]>, Vec<f64>) {
     (lines, low_tail)
 }
 
-/// What [`unit_variance_scale`] gives for the unscaled tables (the test
-/// `the_scale_is_the_sum_of_squares_one` works it out again): written down, so that a process
-/// does not sum 2^21 squares (about 8 ms) before its first draw.
+/// The factor that gives the unscaled tables' 2^21 values a variance of 1 (the test
+/// `the_scale_is_the_sum_of_squares_one` sums their squares again and compares the bits):
+/// written down, so that a process does not sum 2^21 squares (about 8 ms) before its first
+/// draw.
 const UNIT_VARIANCE_SCALE: f64 = f64::from_bits(0x3fef_ff77_5058_c515);
 
 /// The factor that gives the 2^21 values of the unscaled `lines` (per bucket, the value at its

@@ -117,7 +117,7 @@ mod tests {
                     (f64::from(k) + 0.5) / 8.0,
                     (f64::from(k) + 0.5) / 1024.0,
                     f64::from(k) + 0.5,
-                    (f64::from(k) * 2.0 + 1.0) / 2f64.powi(-(places as i32)),
+                    (f64::from(k) * 2.0 + 1.0) / 2f64.powi(places as i32 + 1),
                 ] {
                     for v in [half, half.next_up(), half.next_down()] {
                         check(v, places);

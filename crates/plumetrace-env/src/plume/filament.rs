@@ -214,6 +214,8 @@ struct Strays {
 
 /// Filaments per run of the removal's test.
 const STRAY_RUN: usize = 64;
+// The transport notes whole runs in each of its chunks (but for the last chunk's last run).
+const _: () = assert!(TRANSPORT_CHUNK.is_multiple_of(STRAY_RUN));
 
 /// Filaments per velocity batch of the transport: small enough for the batch to stay in L1
 /// cache.
@@ -228,8 +230,6 @@ struct TransportScratch {
     n0: [f64; TRANSPORT_CHUNK],
     n1: [f64; TRANSPORT_CHUNK],
     n2: [f64; TRANSPORT_CHUNK],
-    /// Per filament, whether it may go (see [`Strays`]).
-    strays: [bool; TRANSPORT_CHUNK],
 }
 
 impl TransportScratch {
@@ -241,7 +241,6 @@ impl TransportScratch {
             n0: [0.0; TRANSPORT_CHUNK],
             n1: [0.0; TRANSPORT_CHUNK],
             n2: [0.0; TRANSPORT_CHUNK],
-            strays: [false; TRANSPORT_CHUNK],
         })
     }
 }
@@ -577,6 +576,8 @@ impl FilamentPlume {
         if left || beyond * 32 > self.x.len() {
             self.remove_outside();
         }
+        // The transport's findings hold for this step's removal only.
+        self.strays.moved = 0;
     }
 
     /// The random walk's standard deviations per axis over `dt_s`.
@@ -728,7 +729,7 @@ impl FilamentPlume {
         // test without branches, which the compiler vectorises. (The transport's test is this
         // one, on the same positions.)
         const RUN: usize = STRAY_RUN;
-        let strays = std::mem::take(&mut self.strays);
+        let strays = &self.strays;
         let (xs, ys) = (&*self.x, &*self.y);
         let stays = |x: f64, y: f64| {
             (x >= d.x_min_m)
@@ -1146,7 +1147,6 @@ impl pulp::WithSimd for Transport<'_> {
             n0,
             n1,
             n2,
-            strays,
         } = scratch;
         let mut left = false;
         let mut beyond = 0usize;
@@ -1165,20 +1165,22 @@ impl pulp::WithSimd for Transport<'_> {
             // Every column cut to the chunk's length, so the loop has no bounds checks.
             let (ys, zs, u, v) = (&mut ys[..m], &mut zs[..m], &u[..m], &v[..m]);
             let (n0, n1, n2) = (&n0[..m], &n1[..m], &n2[..m]);
-            let strays = &mut strays[..m];
-            for k in 0..m {
-                let (x, y, z) = (&mut xs[k], &mut ys[k], &mut zs[k]);
-                *x += u[k] * dt_s + sx * n0[k];
-                *y += v[k] * dt_s + sy * n1[k];
-                *z = reflect(*z + sz * n2[k], floor, ceiling);
-                let inside = d.contains_xy(*x, *y);
-                let along = sink_dir[0] * *x + sink_dir[1] * *y;
-                left |= !inside;
-                beyond += usize::from(along > sink_line);
-                strays[k] = !(inside & (along <= stray_line));
+            // Run by run (chunks are whole runs but for the last), whether any may go.
+            for start in (0..m).step_by(STRAY_RUN) {
+                let mut stray = false;
+                for k in start..(start + STRAY_RUN).min(m) {
+                    let (x, y, z) = (&mut xs[k], &mut ys[k], &mut zs[k]);
+                    *x += u[k] * dt_s + sx * n0[k];
+                    *y += v[k] * dt_s + sy * n1[k];
+                    *z = reflect(*z + sz * n2[k], floor, ceiling);
+                    let inside = d.contains_xy(*x, *y);
+                    let along = sink_dir[0] * *x + sink_dir[1] * *y;
+                    left |= !inside;
+                    beyond += usize::from(along > sink_line);
+                    stray |= !(inside & (along <= stray_line));
+                }
+                stray_runs.push(stray);
             }
-            // The chunk's runs (chunks are whole runs but for the last).
-            stray_runs.extend(strays.chunks(STRAY_RUN).map(|r| r.contains(&true)));
         }
         (left, beyond)
     }

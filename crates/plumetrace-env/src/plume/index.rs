@@ -290,7 +290,11 @@ fn axis_span(c: f64, half: f64, origin: f64, inv_step: f64) -> [f64; 2] {
 #[inline(always)]
 fn whole_span([lo, hi]: [f64; 2]) -> (usize, usize) {
     let a = if lo > 0.0 { lo as usize } else { 0 };
-    let b = if hi >= 0.0 { hi as usize + 1 } else { 0 };
+    let b = if hi >= 0.0 {
+        (hi as usize).saturating_add(1)
+    } else {
+        0
+    };
     (a, b)
 }
 
