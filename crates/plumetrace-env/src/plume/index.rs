@@ -28,53 +28,24 @@ struct Entry {
     neg_inv_2r2: f64,
 }
 
-/// The entries, one column per field of [`Entry`] (so that a grid query's first pass over them
-/// runs in vector lanes).
+/// The entries' positions and squared cut-offs, one column each, in the entries' order: what a
+/// grid query's first pass reads (so that it runs in vector lanes).
 #[derive(Debug, Default)]
-struct Entries {
+struct Columns {
     x: Vec<f64>,
     y: Vec<f64>,
     z: Vec<f64>,
     lim2: Vec<f64>,
-    amp: Vec<f64>,
-    neg_inv_2r2: Vec<f64>,
 }
 
-impl Entries {
-    fn with_len(n: usize) -> Self {
-        let column = || vec![0.0; n];
-        Entries {
-            x: column(),
-            y: column(),
-            z: column(),
-            lim2: vec![-1.0; n],
-            amp: column(),
-            neg_inv_2r2: column(),
-        }
-    }
-
-    fn len(&self) -> usize {
-        self.x.len()
-    }
-
-    fn set(&mut self, k: usize, e: Entry) {
-        self.x[k] = e.x;
-        self.y[k] = e.y;
-        self.z[k] = e.z;
-        self.lim2[k] = e.lim2;
-        self.amp[k] = e.amp;
-        self.neg_inv_2r2[k] = e.neg_inv_2r2;
-    }
-
-    #[inline(always)]
-    fn get(&self, k: usize) -> Entry {
-        Entry {
-            x: self.x[k],
-            y: self.y[k],
-            z: self.z[k],
-            lim2: self.lim2[k],
-            amp: self.amp[k],
-            neg_inv_2r2: self.neg_inv_2r2[k],
+impl Columns {
+    fn of(entries: &[Entry]) -> Self {
+        let column = |f: fn(&Entry) -> f64| entries.iter().map(f).collect();
+        Columns {
+            x: column(|e| e.x),
+            y: column(|e| e.y),
+            z: column(|e| e.z),
+            lim2: column(|e| e.lim2),
         }
     }
 }
@@ -90,7 +61,8 @@ pub(crate) struct CellIndex {
     ncy: usize,
     search_m: f64,
     starts: Vec<u32>,
-    entries: Entries,
+    entries: Vec<Entry>,
+    columns: Columns,
     floor: Option<f64>,
     ceiling: Option<f64>,
 }
@@ -158,7 +130,15 @@ impl CellIndex {
             starts[c + 1] += starts[c];
         }
         let mut fill = starts.clone();
-        let mut entries = Entries::with_len(total);
+        let blank = Entry {
+            x: 0.0,
+            y: 0.0,
+            z: 0.0,
+            lim2: -1.0,
+            amp: 0.0,
+            neg_inv_2r2: 0.0,
+        };
+        let mut entries = vec![blank; total];
         let norm = (2.0 * std::f64::consts::PI).powf(1.5);
         let cut2 = cutoff_radii * cutoff_radii;
         for (e, &cell) in cells.iter().enumerate() {
@@ -167,17 +147,14 @@ impl CellIndex {
             fill[c] += 1;
             let (k, z) = of(e);
             let r2 = plume.radius_sq_born(pb[k]);
-            entries.set(
-                slot,
-                Entry {
-                    x: px[k],
-                    y: py[k],
-                    z,
-                    lim2: cut2 * r2,
-                    amp: pm[k] / (norm * r2 * r2.sqrt()),
-                    neg_inv_2r2: -0.5 / r2,
-                },
-            );
+            entries[slot] = Entry {
+                x: px[k],
+                y: py[k],
+                z,
+                lim2: cut2 * r2,
+                amp: pm[k] / (norm * r2 * r2.sqrt()),
+                neg_inv_2r2: -0.5 / r2,
+            };
         }
         // (An image's own image in the surface lies above the surface by the water's depth
         // and more: out of reach of any point in the water but for filaments as wide as the
@@ -197,6 +174,7 @@ impl CellIndex {
             ncy,
             search_m,
             starts,
+            columns: Columns::of(&entries),
             entries,
             floor,
             ceiling,
@@ -213,7 +191,7 @@ impl CellIndex {
     }
 
     pub(crate) fn concentration(&self, p: Vec3) -> f64 {
-        if self.entries.len() == 0 {
+        if self.entries.is_empty() {
             return 0.0;
         }
         let r = self.search_m;
@@ -227,8 +205,7 @@ impl CellIndex {
         for j in j0..=j1 {
             let a = self.starts[j * self.ncx + i0] as usize;
             let b = self.starts[j * self.ncx + i1 + 1] as usize;
-            for k in a..b {
-                let e = self.entries.get(k);
+            for e in &self.entries[a..b] {
                 let dx = p.x - e.x;
                 let dy = p.y - e.y;
                 let dxy2 = dx * dx + dy * dy;
@@ -495,7 +472,7 @@ impl CellIndex {
 
     /// The grid's axes and spans, or `None` for a grid that is not a proper lattice.
     fn grid_axes(&self, g: &GridSpec) -> Option<GridAxes> {
-        if g.nx < 2 || g.ny < 2 || self.entries.len() == 0 {
+        if g.nx < 2 || g.ny < 2 || self.entries.is_empty() {
             return None;
         }
         let dx = (g.x_max_m - g.x_min_m) / (g.nx - 1) as f64;
@@ -591,7 +568,7 @@ impl CellIndex {
                     if ca >= cb {
                         continue;
                     }
-                    let e = self.entries.get(k);
+                    let e = &self.entries[k];
                     let all_terms = [0, 1, 2].map(|i| reach.heights[i][r]);
                     for j in ra..rb {
                         let dy = axes.ys[j] - e.y;
@@ -606,9 +583,9 @@ impl CellIndex {
                         let row = (j - j0) * nx;
                         let xs = &axes.xs[ca..cb];
                         match n {
-                            1 => terms_of.row::<1>(&e, xs, row + ca, dy2, &all_terms),
-                            2 => terms_of.row::<2>(&e, xs, row + ca, dy2, &all_terms),
-                            _ => terms_of.row::<3>(&e, xs, row + ca, dy2, &all_terms),
+                            1 => terms_of.row::<1>(e, xs, row + ca, dy2, &all_terms),
+                            2 => terms_of.row::<2>(e, xs, row + ca, dy2, &all_terms),
+                            _ => terms_of.row::<3>(e, xs, row + ca, dy2, &all_terms),
                         }
                     }
                 }
@@ -625,7 +602,7 @@ impl CellIndex {
     /// once; the same operations as one entry at a time.
     #[inline(always)]
     fn reaches(&self, start: usize, m: usize, axes: &GridAxes, out: &mut Reaches) {
-        let e = &self.entries;
+        let e = &self.columns;
         let (x, y, z, lim2) = (
             &e.x[start..start + m],
             &e.y[start..start + m],
