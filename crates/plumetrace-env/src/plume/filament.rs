@@ -1245,20 +1245,45 @@ mod tests {
     use crate::flow::{FarrellFlow, FarrellParams, MeanFlow};
     use crate::{StreamId, stream_rng};
 
+    /// The 0-100 m square most tests here use.
+    fn square() -> Rect {
+        Rect::new(0.0, 100.0, 0.0, 100.0).unwrap_or_else(|e| panic!("{e}"))
+    }
+
+    /// A plume over `region` with one source at `(x, y)`, 1 m above the seabed, releasing one
+    /// mass unit a second in `rate_hz` filaments a second.
+    fn plume_with_source(
+        region: Rect,
+        (x, y): (f64, f64),
+        rate_hz: f64,
+        params: FilamentParams,
+    ) -> FilamentPlume {
+        let source = Source {
+            pos_m: Vec3::new(x, y, 1.0),
+            mass_rate_per_s: 1.0,
+            filament_rate_hz: rate_hz,
+        };
+        FilamentPlume::new(region, vec![source], params).unwrap_or_else(|e| panic!("{e}"))
+    }
+
+    /// A Farrell flow over `region` with a mean of `speed_mps` toward 80 degrees, stepped at
+    /// `dt`.
+    fn farrell_toward_80(region: Rect, speed_mps: f64, dt: f64) -> FarrellFlow {
+        let mean = MeanFlow::Steady {
+            speed_mps,
+            toward_deg: 80.0,
+        };
+        FarrellFlow::new(region, mean, FarrellParams::default(), dt)
+            .unwrap_or_else(|e| panic!("{e}"))
+    }
+
     #[test]
     fn removal_keeps_the_others_in_order_wherever_the_leavers_are() {
         // 300 filaments along x in a 0-100 m square with a sink at x = 80 m: those out of the
         // square or beyond the sink go, at the front, in the middle and last; the rest keep
         // their order and every column stays aligned, over several removals in a row, and
         // without the sink.
-        let region = Rect::new(0.0, 100.0, 0.0, 100.0).unwrap_or_else(|e| panic!("{e}"));
-        let source = Source {
-            pos_m: Vec3::new(50.0, 50.0, 1.0),
-            mass_rate_per_s: 1.0,
-            filament_rate_hz: 1.0,
-        };
-        let mut p = FilamentPlume::new(region, vec![source], FilamentParams::default())
-            .unwrap_or_else(|e| panic!("{e}"));
+        let mut p = plume_with_source(square(), (50.0, 50.0), 1.0, FilamentParams::default());
         p.set_sink(Some(DownflowSink {
             dir: [1.0, 0.0],
             beyond_m: 80.0,
@@ -1318,21 +1343,9 @@ mod tests {
         // outside the square (after the transport: its run is tested in full). The removal that reads
         // the transport's runs and one on a copy that tests every filament keep the same
         // filaments, bit for bit, and count the same leavers.
-        let region = Rect::new(0.0, 100.0, 0.0, 100.0).unwrap_or_else(|e| panic!("{e}"));
-        let mean = MeanFlow::Steady {
-            speed_mps: 1.0,
-            toward_deg: 80.0,
-        };
         let dt = 0.1;
-        let mut flow = FarrellFlow::new(region, mean, FarrellParams::default(), dt)
-            .unwrap_or_else(|e| panic!("{e}"));
-        let source = Source {
-            pos_m: Vec3::new(40.0, 50.0, 1.0),
-            mass_rate_per_s: 1.0,
-            filament_rate_hz: 1.0,
-        };
-        let mut p = FilamentPlume::new(region, vec![source], FilamentParams::default())
-            .unwrap_or_else(|e| panic!("{e}"));
+        let mut flow = farrell_toward_80(square(), 1.0, dt);
+        let mut p = plume_with_source(square(), (40.0, 50.0), 1.0, FilamentParams::default());
         p.set_key_seed(3);
         p.set_sink(Some(DownflowSink {
             dir: [1.0, 0.0],
@@ -1389,20 +1402,13 @@ mod tests {
         // order, each tested on its own.
         use rand::Rng;
         let mut rng = stream_rng(5, StreamId::Plume);
-        let region = Rect::new(0.0, 100.0, 0.0, 100.0).unwrap_or_else(|e| panic!("{e}"));
-        let source = Source {
-            pos_m: Vec3::new(50.0, 50.0, 1.0),
-            mass_rate_per_s: 1.0,
-            filament_rate_hz: 1.0,
-        };
         let params = FilamentParams {
             vertical: VerticalBoundary::Reflecting {
                 depth_m: Some(12.0),
             },
             ..FilamentParams::default()
         };
-        let mut p =
-            FilamentPlume::new(region, vec![source], params).unwrap_or_else(|e| panic!("{e}"));
+        let mut p = plume_with_source(square(), (50.0, 50.0), 1.0, params);
         p.release_at_source(0, 1031);
         p.time_s = 600.0;
         for k in 0..p.len() {
@@ -1508,24 +1514,13 @@ mod tests {
         // at both the seabed and the surface) and a sink, so that every branch of the
         // step is taken; then one more step on each vector unit this CPU has.
         let region = Rect::new(0.0, 200.0, -100.0, 100.0).unwrap_or_else(|e| panic!("{e}"));
-        let mean = MeanFlow::Steady {
-            speed_mps: 0.5,
-            toward_deg: 80.0,
-        };
         let dt = 0.2;
-        let mut flow = FarrellFlow::new(region, mean, FarrellParams::default(), dt)
-            .unwrap_or_else(|e| panic!("{e}"));
+        let mut flow = farrell_toward_80(region, 0.5, dt);
         let params = FilamentParams {
             vertical: VerticalBoundary::Reflecting { depth_m: Some(3.0) },
             ..FilamentParams::default()
         };
-        let source = Source {
-            pos_m: Vec3::new(10.0, 0.0, 1.0),
-            mass_rate_per_s: 1.0,
-            filament_rate_hz: 40.0,
-        };
-        let mut plume =
-            FilamentPlume::new(region, vec![source], params).unwrap_or_else(|e| panic!("{e}"));
+        let mut plume = plume_with_source(region, (10.0, 0.0), 40.0, params);
         plume.set_key_seed(7);
         let mut flow_rng = stream_rng(7, StreamId::Flow);
         let mut rng = stream_rng(7, StreamId::Plume);
