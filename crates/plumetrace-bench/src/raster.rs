@@ -1,6 +1,7 @@
 //! The display rasters' cost (`plumetrace bench raster`): one query of the figure's
 //! time-averaged plume grid and of the replay page's frame grid, as a run of a mission preset
-//! draws them, on the preset's plume after its spin-up.
+//! draws them, on the preset's plume after its spin-up, and one build of the query index they
+//! read.
 
 use crate::BenchError;
 use cpu_time::ProcessTime;
@@ -45,6 +46,11 @@ pub struct RasterBench {
     pub filaments: usize,
     /// Queries timed per grid and precision.
     pub queries: u64,
+    /// CPU milliseconds per build of the query index the grids read (a run builds one for each
+    /// time it samples the two grids, as the first query after a step does).
+    pub ms_per_index_build: f64,
+    /// What one sample of a run costs: an index build and a display query of each grid, ms.
+    pub ms_per_sample: f64,
     /// The figure's time-averaged plume grid.
     pub figure: RasterGrid,
     /// The replay page's frame grid.
@@ -107,12 +113,26 @@ pub fn raster(a: &RasterBenchOptions) -> Result<RasterBench, BenchError> {
             }
         })
     };
+    let ms_per_index_build = match env.plume().filaments() {
+        Some(f) => {
+            let started = ProcessTime::now();
+            for _ in 0..a.queries {
+                f.build_query_index_apart();
+            }
+            started.elapsed().as_secs_f64() / a.queries as f64 * 1e3
+        }
+        // A steady plume has no index: its grids are computed point by point.
+        None => 0.0,
+    };
+    let (figure, page) = (time(&figure), time(&page));
     Ok(RasterBench {
         preset: a.preset.clone(),
         seed: a.seed,
         filaments: env.plume().filaments().map_or(0, |f| f.len()),
         queries: a.queries,
-        figure: time(&figure),
-        page: time(&page),
+        ms_per_index_build,
+        ms_per_sample: ms_per_index_build + figure.ms_per_query_display + page.ms_per_query_display,
+        figure,
+        page,
     })
 }

@@ -23,7 +23,8 @@ pub enum BenchCommand {
     /// Cost of one update of the source-likelihood map over a preset's op-area.
     Map(MapBenchArgs),
     /// Cost of one query of the display rasters a run draws (the figure's averaged plume, the
-    /// replay page's frames), on a preset's plume after its spin-up, on one thread.
+    /// replay page's frames) and of the index they read, on a preset's plume after its spin-up,
+    /// on one thread.
     Raster(RasterBenchArgs),
 }
 

@@ -214,6 +214,14 @@ fn bench_raster_times_the_grids_a_run_draws_in_both_precisions() {
         let d = g["max_relative_difference"].as_f64().unwrap();
         assert!((0.0..1e-15).contains(&d), "{g}");
     }
+    // A sample of a run: the index build and a display query of each grid.
+    let build = v["ms_per_index_build"].as_f64().unwrap();
+    assert!(build > 0.0, "{v}");
+    let parts = build
+        + v["figure"]["ms_per_query_display"].as_f64().unwrap()
+        + v["page"]["ms_per_query_display"].as_f64().unwrap();
+    let sample = v["ms_per_sample"].as_f64().unwrap();
+    assert!((sample - parts).abs() <= 1e-9 * parts, "{v}");
     let out = bin()
         .args(["bench", "raster", "--preset", "pompy"])
         .output()
