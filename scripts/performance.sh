@@ -253,17 +253,5 @@ end="<!-- performance.sh end -->"
     echo
     echo "$end"
 } > "$work/section"
-python3 - "$page" "$work/section" "$begin" "$end" <<'PY'
-import sys
-page, section, begin, end = sys.argv[1:5]
-text = open(page).read()
-new = open(section).read().rstrip("\n")
-if begin in text and end in text:
-    head, rest = text.split(begin, 1)
-    _, tail = rest.split(end, 1)
-    text = head + new + tail
-else:
-    text = text.rstrip("\n") + "\n\n## Outputs and campaign throughput, side by side\n\n" + new + "\n"
-open(page, "w").write(text)
-PY
+write_section "$page" "$work/section" "$begin" "$end" "Outputs and campaign throughput, side by side"
 echo "wrote the section of $page" >&2

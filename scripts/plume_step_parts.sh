@@ -1,0 +1,101 @@
+#!/usr/bin/env bash
+# Splits the filament step of pompy's case into what every step costs whatever the number of
+# filaments and what each filament adds, and writes the section "The filament step's fixed and
+# per-filament parts" of docs/results/performance.md (between its begin and end marks; never
+# edit its numbers by hand):
+#
+#   scripts/plume_step_parts.sh [--bin BIN] [--rates R,R,...] [--repeats N] [--duration S]
+#
+# For each release rate R (puffs per second; default 2.5,5,10,20,50, pompy's case being 5), it
+# runs `BIN bench plume --release-rate R --duration S --queries 1000` N times (default 3; S
+# default 500 simulated seconds) and takes the medians of the nanoseconds per step, of the
+# filaments alive on average and of the flow grid's share of a step. A straight line fitted to
+# the nanoseconds per step against the filaments alive (least squares over the rates) gives the
+# fixed part (its intercept) and each filament's part (its slope). BIN defaults to this
+# checkout's release build (built first).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+. scripts/pairs_common.sh
+
+bin=""
+rates="2.5,5,10,20,50"
+repeats=3
+duration=500
+while [ $# -gt 0 ]; do
+    case "$1" in
+        --bin|--rates|--repeats|--duration) needs_value plume_step_parts.sh "$1" $# ;;
+    esac
+    case "$1" in
+        --bin) bin="$2"; shift 2 ;;
+        --rates) rates="$2"; shift 2 ;;
+        --repeats) whole_count plume_step_parts.sh --repeats "$2"; repeats="$2"; shift 2 ;;
+        --duration) duration="$2"; shift 2 ;;
+        -h|--help) sed -n '2,15p' "$0"; exit 0 ;;
+        *) echo "plume_step_parts.sh: unknown option '$1' (see --help)" >&2; exit 2 ;;
+    esac
+done
+if [ -z "$bin" ]; then
+    cargo build --release --bin plumetrace >&2
+    bin=target/release/plumetrace
+fi
+if [ ! -x "$bin" ]; then
+    echo "plume_step_parts.sh: no program at '$bin' (--bin takes a built plumetrace)" >&2
+    exit 2
+fi
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+IFS=, read -r -a rate_list <<<"$rates"
+for r in "${rate_list[@]}"; do
+    for k in $(seq "$repeats"); do
+        echo "rate $r, run $k of $repeats" >&2
+        "$bin" bench plume --release-rate "$r" --duration "$duration" --queries 1000 >"$work/$r-$k.json"
+    done
+done
+commit=$(git rev-parse --short HEAD)
+cpu=$(grep -m1 "model name" /proc/cpuinfo | cut -d: -f2 | sed 's/^ *//')
+section="$(python3 - "$work" "$repeats" "${rate_list[@]}" <<'PY'
+import json, statistics, sys
+
+work, repeats, rates = sys.argv[1], int(sys.argv[2]), sys.argv[3:]
+rows = []
+for r in rates:
+    runs = [json.load(open(f"{work}/{r}-{k}.json")) for k in range(1, repeats + 1)]
+    med = lambda key: statistics.median(run[key] for run in runs)
+    rows.append((r, med("mean_live_filaments"), med("ns_per_step"), med("ns_per_filament_step"),
+                 med("flow_ns_per_step")))
+n = [row[1] for row in rows]
+t = [row[2] for row in rows]
+mn, mt = statistics.fmean(n), statistics.fmean(t)
+sxx = sum((a - mn) ** 2 for a in n)
+slope = sum((a - mn) * (b - mt) for a, b in zip(n, t)) / sxx if sxx > 0 else float("nan")
+fixed = mt - slope * mn
+flow = statistics.median(row[4] for row in rows)
+out = ["| puffs/s | filaments alive | ns a step | ns a filament-step | flow grid, ns a step |",
+       "| --- | --- | --- | --- | --- |"]
+for r, live, step, per, fl in rows:
+    out.append(f"| {r} | {live:.0f} | {step:.0f} | {per:.2f} | {fl:.0f} |")
+out.append("")
+out.append(f"A line through the {len(rows)} rates: **{fixed:.0f} ns a step whatever the number of "
+           f"filaments, and {slope:.2f} ns for each filament**. The flow grid's step (every fifth "
+           f"plume step in pompy's case, its cost spread over the five) is {flow:.0f} ns of the "
+           f"fixed part.")
+print("\n".join(out))
+PY
+)"
+page="docs/results/performance.md"
+begin="<!-- plume_step_parts.sh begin -->"
+end="<!-- plume_step_parts.sh end -->"
+{
+    echo "$begin"
+    echo
+    echo "**Measured** by \`scripts/plume_step_parts.sh --rates $rates --repeats $repeats --duration"
+    echo "$duration\` at commit \`$commit\` on $(date -u +%Y-%m-%d) ($(nproc) cores, $cpu): \`plumetrace"
+    echo "bench plume --release-rate R --duration $duration --queries 1000\` in pompy's case at each rate,"
+    echo "$repeats times, the medians."
+    echo
+    echo "$section"
+    echo
+    echo "$end"
+} >"$work/section"
+write_section "$page" "$work/section" "$begin" "$end" "The filament step's fixed and per-filament parts"
+echo "wrote the section of $page" >&2
