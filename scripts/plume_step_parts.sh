@@ -34,6 +34,11 @@ while [ $# -gt 0 ]; do
         *) echo "plume_step_parts.sh: unknown option '$1' (see --help)" >&2; exit 2 ;;
     esac
 done
+IFS=, read -r -a rate_list <<<"$rates"
+if [ "$(printf '%s\n' "${rate_list[@]}" | sort -u | wc -l)" -lt 2 ]; then
+    echo "plume_step_parts.sh: --rates needs two rates or more to fit a line, not '$rates'" >&2
+    exit 2
+fi
 if [ -z "$bin" ]; then
     cargo build --release --bin plumetrace >&2
     bin=target/release/plumetrace
@@ -44,7 +49,6 @@ if [ ! -x "$bin" ]; then
 fi
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
-IFS=, read -r -a rate_list <<<"$rates"
 for r in "${rate_list[@]}"; do
     for k in $(seq "$repeats"); do
         echo "rate $r, run $k of $repeats" >&2
@@ -67,7 +71,9 @@ n = [row[1] for row in rows]
 t = [row[2] for row in rows]
 mn, mt = statistics.fmean(n), statistics.fmean(t)
 sxx = sum((a - mn) ** 2 for a in n)
-slope = sum((a - mn) * (b - mt) for a, b in zip(n, t)) / sxx if sxx > 0 else float("nan")
+if sxx <= 0:
+    sys.exit("plume_step_parts.sh: every rate left the same number of filaments alive: no line to fit")
+slope = sum((a - mn) * (b - mt) for a, b in zip(n, t)) / sxx
 fixed = mt - slope * mn
 flow = statistics.median(row[4] for row in rows)
 out = ["| puffs/s | filaments alive | ns a step | ns a filament-step | flow grid, ns a step |",
