@@ -1,5 +1,5 @@
 # Sourced by the scripts that measure two builds side by side (build_pairs.sh, runtime_pairs.sh,
-# performance.sh):
+# performance.sh) and by plume_step_parts.sh:
 # - `needs_value NAME FLAG COUNT`: exits naming the calling script NAME when FLAG, an option that
 #   takes a value, is the last argument (COUNT: the arguments left, FLAG included);
 # - `whole_count NAME FLAG VALUE`: exits when VALUE is not a whole number from 1;

@@ -37,7 +37,7 @@ pub struct RasterBenchArgs {
     /// Run seed (the plume's realisation).
     #[arg(long, default_value_t = 7, allow_hyphen_values = true, value_parser = crate::args::seed)]
     seed: u64,
-    /// Queries of each grid to time, in each precision.
+    /// Queries of each grid to time, in each precision (and builds of the index they read).
     #[arg(long, default_value_t = 50, allow_hyphen_values = true, value_parser = crate::args::runs)]
     queries: u64,
 }
