@@ -113,7 +113,8 @@ pub fn raster(a: &RasterBenchOptions) -> Result<RasterBench, BenchError> {
             }
         })
     };
-    let ms_per_index_build = match env.plume().filaments() {
+    let filaments = env.plume().filaments();
+    let ms_per_index_build = match filaments {
         Some(f) => {
             // The plume's own index is built here, so the grids' first queries do not pay for it.
             f.prepare_queries();
@@ -132,7 +133,7 @@ pub fn raster(a: &RasterBenchOptions) -> Result<RasterBench, BenchError> {
     Ok(RasterBench {
         preset: a.preset.clone(),
         seed: a.seed,
-        filaments: env.plume().filaments().map_or(0, |f| f.len()),
+        filaments: filaments.map_or(0, |f| f.len()),
         queries: a.queries,
         ms_per_index_build,
         ms_per_sample: ms_per_index_build + figure.ms_per_query_display + page.ms_per_query_display,
