@@ -38,7 +38,9 @@ pub trait ConcentrationField: Send + Sync {
     /// the last place do not show: each of a point's terms may differ from the point query's by
     /// up to 2 units in its last place (the filament plume takes the exponentials in vector
     /// lanes, several times faster), and the result is the same bits on every CPU. A field
-    /// without a faster way gives [`ConcentrationField::grid_concentrations`]'s values.
+    /// without a faster way gives [`ConcentrationField::grid_concentrations`]'s values. Such a
+    /// grid is small and seldom sampled, so a field may compute it on the calling thread (the
+    /// filament plume does).
     fn display_grid_concentrations(&self, grid: &GridSpec, points: &[Vec3], out: &mut [f64]) {
         self.grid_concentrations(grid, points, out);
     }

@@ -945,11 +945,17 @@ fn a_grid_query_is_bit_for_bit_the_point_by_point_query() {
             (210.0, 400.0, -60.0, 60.0, 20, 20),
             (0.0, 200.0, 0.0, 1.0, 50, 1),
             (13.7, 151.3, -47.1, 33.3, 3, 2),
+            (-20.0, 220.0, -70.0, 70.0, 401, 201),
         ] {
             let spec = grid((x0, x1, y0, y1), (nx, ny), z);
             let pts = spec.points();
+            // In bands of rows taken by three threads, as on a machine with three cores.
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(3)
+                .build()
+                .unwrap();
             let mut grid = vec![f64::NAN; pts.len()];
-            env.plume().grid_concentrations(&spec, &pts, &mut grid);
+            pool.install(|| env.plume().grid_concentrations(&spec, &pts, &mut grid));
             for (p, g) in pts.iter().zip(&grid) {
                 let c = env.plume().concentration(*p);
                 assert_eq!(c.to_bits(), g.to_bits(), "{c} vs {g} at {p:?} of {spec:?}");

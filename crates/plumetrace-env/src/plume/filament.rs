@@ -1225,24 +1225,36 @@ impl ConcentrationField for FilamentPlume {
         self.index().concentration(p)
     }
     fn grid_concentrations(&self, grid: &crate::GridSpec, points: &[Vec3], out: &mut [f64]) {
-        self.grid_query(grid, points, out, TermExp::Standard);
+        let bands = rayon::current_num_threads();
+        self.grid_query(grid, points, out, TermExp::Standard, bands);
     }
+    /// On the calling thread: a run samples its figure's and page's grids (a millisecond or two
+    /// each) a few times a minute of mission, and waking the pool's threads for each, which then
+    /// spin for work while the run goes on, cost a `duck-2003-st` run about 7 % more CPU and 6 %
+    /// more wall time on 2 threads than it saved (docs/results/performance.md).
     fn display_grid_concentrations(
         &self,
         grid: &crate::GridSpec,
         points: &[Vec3],
         out: &mut [f64],
     ) {
-        self.grid_query(grid, points, out, TermExp::Lanes);
+        self.grid_query(grid, points, out, TermExp::Lanes, 1);
     }
 }
 
 impl FilamentPlume {
-    /// A grid query with the exponentials taken `how`; point by point if `points` and `out` are
-    /// not the grid's.
-    fn grid_query(&self, grid: &crate::GridSpec, points: &[Vec3], out: &mut [f64], how: TermExp) {
+    /// A grid query with the exponentials taken `how`, in `bands` bands of rows; point by point
+    /// if `points` and `out` are not the grid's.
+    fn grid_query(
+        &self,
+        grid: &crate::GridSpec,
+        points: &[Vec3],
+        out: &mut [f64],
+        how: TermExp,
+        bands: usize,
+    ) {
         if points.len() == grid.nx * grid.ny && out.len() == points.len() {
-            self.index().grid_concentrations(grid, out, how);
+            self.index().grid_concentrations(grid, out, how, bands);
         } else {
             self.concentrations(points, out);
         }

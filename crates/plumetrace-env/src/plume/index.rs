@@ -440,7 +440,16 @@ impl CellIndex {
     /// exponentials taken in batches, then added in the same order. A
     /// grid that is not a proper lattice (a single row or column, a spacing that is not finite
     /// and positive) is queried point by point.
-    pub(crate) fn grid_concentrations(&self, grid: &GridSpec, out: &mut [f64], how: TermExp) {
+    ///
+    /// The rows are split into `bands` bands taken in parallel (one: all on the calling thread);
+    /// every point sums the same terms in the same order whatever the number.
+    pub(crate) fn grid_concentrations(
+        &self,
+        grid: &GridSpec,
+        out: &mut [f64],
+        how: TermExp,
+        bands: usize,
+    ) {
         // A band's points are numbered in 32 bits (`Gathered::at`).
         let axes = self
             .grid_axes(grid)
@@ -452,22 +461,27 @@ impl CellIndex {
             return;
         };
         let arch = crate::simd::best();
-        // One band of rows per thread: a filament is visited once per band its cells reach.
-        let band_rows = grid.ny.div_ceil(rayon::current_num_threads().max(1));
-        out.par_chunks_mut(grid.nx * band_rows)
-            .enumerate()
-            .for_each(|(band, rows)| {
-                rows.fill(0.0);
-                let j0 = band * band_rows;
-                arch.dispatch(Band {
-                    index: self,
-                    axes: &axes,
-                    rows: (j0, j0 + rows.len() / grid.nx),
-                    out: rows,
-                    how,
-                    arch,
-                });
+        // A filament is visited once per band its cells reach.
+        let band_rows = grid.ny.div_ceil(bands.max(1));
+        let band = |(band, rows): (usize, &mut [f64])| {
+            rows.fill(0.0);
+            let j0 = band * band_rows;
+            arch.dispatch(Band {
+                index: self,
+                axes: &axes,
+                rows: (j0, j0 + rows.len() / grid.nx),
+                out: rows,
+                how,
+                arch,
             });
+        };
+        if band_rows >= grid.ny {
+            band((0, out));
+        } else {
+            out.par_chunks_mut(grid.nx * band_rows)
+                .enumerate()
+                .for_each(band);
+        }
     }
 
     /// The grid's axes and spans, or `None` for a grid that is not a proper lattice.
