@@ -1,8 +1,7 @@
 //! One example track per group (its seed index 0), kept for the trajectory chart.
 
 use crate::spec::{Campaign, RunKey};
-use plumetrace_core::PlannerEvent;
-use plumetrace_mission::{EventKind, MissionRun, Outcome};
+use plumetrace_mission::{MissionRun, Outcome, lost_points};
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 
@@ -88,13 +87,9 @@ impl ExampleRun {
                 .iter()
                 .map(|d| [d.x_m, d.y_m])
                 .collect(),
-            lost_points: run
-                .events
+            lost_points: lost_points(&run.events)
                 .iter()
-                .filter_map(|e| match &e.event {
-                    EventKind::Planner(PlannerEvent::LostPoint { pos_m }) => Some(xy(pos_m)),
-                    _ => None,
-                })
+                .map(|l| xy(&l.now_m()))
                 .collect(),
             track: rows
                 .iter()

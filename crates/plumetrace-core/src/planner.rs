@@ -128,6 +128,15 @@ pub enum PlannerEvent {
         /// Estimated position, m.
         pos_m: Vec2,
     },
+    /// A saved lost point was moved: a position fix showed how far the navigation was off when
+    /// it was saved (the AMP's `fix_smoothing`). The point is the one last at `from_m` (a saved
+    /// point's `pos_m` or an earlier move's `to_m`, the same bits).
+    LostPointMoved {
+        /// Where it was, m.
+        from_m: Vec2,
+        /// Where it is now, m.
+        to_m: Vec2,
+    },
     /// A source location was declared.
     Declared {
         /// Declared position, m.

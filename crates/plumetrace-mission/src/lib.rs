@@ -44,7 +44,8 @@ pub use plumetrace_planner::PlannerKind;
 pub use plumetrace_planner::planners::kind_name as planner_kind_name;
 pub use plumetrace_planner::registry_defaults as planner_defaults;
 pub use record::{
-    EventKind, EventRecord, Observer, PlumeFrame, PlumeFrames, RecordError, StepView, TrajectoryRow,
+    EventKind, EventRecord, LostPointTrack, Observer, PlumeFrame, PlumeFrames, RecordError,
+    StepView, TrajectoryRow, lost_points,
 };
 pub use setup::{MissionError, MissionSetup, PlannedVehicle};
 pub use shared::fly_shared;

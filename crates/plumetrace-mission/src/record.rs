@@ -134,6 +134,57 @@ pub struct EventRecord {
     pub event: EventKind,
 }
 
+/// A lost point of a run: saved by a [`PlannerEvent::LostPoint`], then moved by each
+/// [`PlannerEvent::LostPointMoved`] of the same vehicle from where it was.
+#[derive(Debug, Clone, PartialEq)]
+pub struct LostPointTrack {
+    /// The index of the event that saved it.
+    pub saved: usize,
+    /// Its vehicle.
+    pub vehicle: u32,
+    /// Where it was saved, m.
+    pub pos_m: Vec2,
+    /// Each move, in order: when (s) and where to (m).
+    pub moves: Vec<(f64, Vec2)>,
+}
+
+impl LostPointTrack {
+    /// Where its planner last put it, m.
+    pub fn now_m(&self) -> Vec2 {
+        self.moves.last().map_or(self.pos_m, |m| m.1)
+    }
+}
+
+/// Every lost point of `events`, in the order saved. A move is the latest point of its vehicle
+/// last at the move's `from_m` (the latest, should two have been saved at the same spot); a move
+/// from where no point is, is passed over.
+pub fn lost_points(events: &[EventRecord]) -> Vec<LostPointTrack> {
+    let mut points: Vec<LostPointTrack> = Vec::new();
+    for (k, e) in events.iter().enumerate() {
+        match &e.event {
+            EventKind::Planner(PlannerEvent::LostPoint { pos_m }) => {
+                points.push(LostPointTrack {
+                    saved: k,
+                    vehicle: e.vehicle,
+                    pos_m: *pos_m,
+                    moves: Vec::new(),
+                });
+            }
+            EventKind::Planner(PlannerEvent::LostPointMoved { from_m, to_m }) => {
+                if let Some(p) = points
+                    .iter_mut()
+                    .rev()
+                    .find(|p| p.vehicle == e.vehicle && p.now_m() == *from_m)
+                {
+                    p.moves.push((e.t_s, *to_m));
+                }
+            }
+            _ => {}
+        }
+    }
+    points
+}
+
 /// Records every event of every vehicle, in order.
 #[derive(Debug, Default)]
 pub struct EventRecorder {
@@ -657,6 +708,10 @@ mod tests {
             },
             PlannerEvent::Detection { pos_m: p },
             PlannerEvent::LostPoint { pos_m: p },
+            PlannerEvent::LostPointMoved {
+                from_m: p,
+                to_m: Vec2::new(1.0, 2.0),
+            },
             PlannerEvent::Declared {
                 pos_m: p,
                 rule: DeclarationKind::new("along_flow"),
@@ -680,6 +735,7 @@ mod tests {
                 PlannerEvent::Behaviour { .. }
                 | PlannerEvent::Detection { .. }
                 | PlannerEvent::LostPoint { .. }
+                | PlannerEvent::LostPointMoved { .. }
                 | PlannerEvent::Declared { .. }
                 | PlannerEvent::Region { .. }
                 | PlannerEvent::CageAbort { .. }
@@ -777,6 +833,55 @@ mod tests {
         assert_eq!(every(18000.0), 60.0);
         assert_eq!(every(f64::INFINITY), 20.0);
         assert_eq!(every(f64::NAN), 20.0);
+    }
+
+    #[test]
+    fn lost_points_follow_their_moves_by_vehicle_and_position() {
+        let at = |t_s: f64, vehicle: u32, e: PlannerEvent| EventRecord {
+            t_s,
+            vehicle,
+            event: EventKind::Planner(e),
+        };
+        let lost = |x: f64, y: f64| PlannerEvent::LostPoint {
+            pos_m: Vec2::new(x, y),
+        };
+        let moved = |from: (f64, f64), to: (f64, f64)| PlannerEvent::LostPointMoved {
+            from_m: Vec2::new(from.0, from.1),
+            to_m: Vec2::new(to.0, to.1),
+        };
+        let events = [
+            at(1.0, 0, lost(10.0, 0.0)),
+            at(2.0, 1, lost(10.0, 0.0)),
+            at(3.0, 0, lost(10.0, 0.0)),
+            at(4.0, 0, lost(50.0, 5.0)),
+            // Vehicle 0's latest point at (10, 0), then its other one there, then the first
+            // move's point again from where it went.
+            at(5.0, 0, moved((10.0, 0.0), (12.0, 1.0))),
+            at(5.0, 0, moved((10.0, 0.0), (11.0, -1.0))),
+            at(6.0, 0, moved((12.0, 1.0), (13.0, 1.5))),
+            // From where no point of that vehicle is: passed over.
+            at(7.0, 0, moved((50.0, 5.5), (0.0, 0.0))),
+            at(7.0, 2, moved((50.0, 5.0), (0.0, 0.0))),
+        ];
+        let points = lost_points(&events);
+        let got: Vec<(usize, u32, Vec2, usize)> = points
+            .iter()
+            .map(|l| (l.saved, l.vehicle, l.now_m(), l.moves.len()))
+            .collect();
+        assert_eq!(
+            got,
+            vec![
+                (0, 0, Vec2::new(11.0, -1.0), 1),
+                (1, 1, Vec2::new(10.0, 0.0), 0),
+                (2, 0, Vec2::new(13.0, 1.5), 2),
+                (3, 0, Vec2::new(50.0, 5.0), 0),
+            ]
+        );
+        assert_eq!(
+            points[2].moves,
+            vec![(5.0, Vec2::new(12.0, 1.0)), (6.0, Vec2::new(13.0, 1.5))]
+        );
+        assert_eq!(points[2].pos_m, Vec2::new(10.0, 0.0), "as saved");
     }
 
     #[test]

@@ -1372,6 +1372,32 @@ fn each_held_point_moves_with_the_fix_that_ends_its_frame() {
     assert!(declared_at(&events).is_empty(), "the first point is held");
     // The fix's record where the records before it were: the jump is measured against them.
     events.extend(wait(&mut a, t, 401.0));
+    // The fix at 400 s moved each of frame 1's lost points by its share of j1, an event each
+    // from where it was saved to where the planner now holds it.
+    let saved: Vec<Vec2> = events
+        .iter()
+        .filter_map(|e| match e {
+            PlannerEvent::LostPoint { pos_m } => Some(*pos_m),
+            _ => None,
+        })
+        .collect();
+    let moved: Vec<(Vec2, Vec2)> = events
+        .iter()
+        .filter_map(|e| match e {
+            PlannerEvent::LostPointMoved { from_m, to_m } => Some((*from_m, *to_m)),
+            _ => None,
+        })
+        .collect();
+    assert_eq!((saved.len(), moved.len()), (3, 3), "{events:?}");
+    for ((from, to), (p, since)) in moved.iter().zip(saved.iter().zip([51.0, 68.0, 85.0])) {
+        assert_eq!(from, p);
+        let share = (16.0 + 1e-4 * since * 395.0) / (32.0 + 1e-4 * 395.0 * 395.0);
+        assert!(
+            (*to - (*p + j1 * share)).norm() < 1e-9,
+            "{from:?} to {to:?}"
+        );
+        assert!(a.lost_points().contains(to), "{:?}", a.lost_points());
+    }
     let mut t = 401.0;
     for at in THREE_LOSSES {
         events.extend(lose_edited(&mut a, &mut t, at, &nav));

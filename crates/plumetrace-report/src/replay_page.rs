@@ -23,9 +23,10 @@ use crate::error::ReportError;
 use crate::figure::style::{behaviour_colour, behaviour_label};
 use plumetrace_core::{BehaviourKind, Vec2};
 use plumetrace_log::snapshot::Replayed;
-use plumetrace_mission::{EventKind, EventRecord, MissionRun, PlumeFrames};
+use plumetrace_mission::{EventKind, EventRecord, MissionRun, PlumeFrames, lost_points};
 use serde::Serialize;
 use serde_json::{Value, json};
+use std::collections::BTreeMap;
 
 /// The page template; `__PLUMETRACE_DATA__` is replaced by the data.
 const TEMPLATE: &str = include_str!("replay_page.html");
@@ -604,20 +605,34 @@ fn same_decision(a: &plumetrace_core::Decision, b: &plumetrace_core::Decision) -
 }
 
 /// Events as JSON values, numbers rounded for size; whole source-map rasters are left out (the
-/// page does not draw them, and each is a value per map cell).
+/// page does not draw them, and each is a value per map cell). A lost point that its planner
+/// moved carries its moves, `moved: [[t_s, x_m, y_m], ...]`, so that the page draws it where it
+/// was at the time shown.
 fn events_json(events: &[EventRecord]) -> Vec<Value> {
+    let mut moves: BTreeMap<usize, Vec<Value>> = BTreeMap::new();
+    for l in lost_points(events)
+        .into_iter()
+        .filter(|l| !l.moves.is_empty())
+    {
+        let m = l.moves.iter().map(|(t, p)| json!([round(*t, 1), p.x, p.y]));
+        moves.insert(l.saved, m.collect());
+    }
     events
         .iter()
-        .filter(|e| {
+        .enumerate()
+        .filter(|(_, e)| {
             !matches!(
                 e.event,
                 EventKind::Telemetry(plumetrace_core::Telemetry::SourceMapRaster { .. })
             )
         })
-        .filter_map(|e| serde_json::to_value(e).ok())
-        .map(|mut v| {
+        .filter_map(|(k, e)| Some((k, serde_json::to_value(e).ok()?)))
+        .map(|(k, mut v)| {
             if let Some(t) = v.get("t_s").and_then(Value::as_f64) {
                 v["t_s"] = json!(round(t, 1));
+            }
+            if let Some(m) = moves.remove(&k) {
+                v["moved"] = Value::Array(m);
             }
             v
         })
@@ -640,6 +655,46 @@ pub fn replay_page(run: &MissionRun, title: &str) -> Result<String, ReportError>
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_moved_lost_point_carries_its_moves_and_the_raster_is_left_out() {
+        use plumetrace_core::{PlannerEvent, Telemetry};
+        let at = |t_s: f64, event: EventKind| EventRecord {
+            t_s,
+            vehicle: 0,
+            event,
+        };
+        let p = |x: f64, y: f64| Vec2::new(x, y);
+        let lost = |t_s: f64, x: f64, y: f64| {
+            at(
+                t_s,
+                EventKind::Planner(PlannerEvent::LostPoint { pos_m: p(x, y) }),
+            )
+        };
+        let raster = Telemetry::SourceMapRaster {
+            origin_m: p(0.0, 0.0),
+            cell_m: 5.0,
+            nx: 1,
+            ny: 1,
+            log10_p: vec![0.0],
+        };
+        let moved = PlannerEvent::LostPointMoved {
+            from_m: p(5.0, 5.0),
+            to_m: p(6.5, 4.25),
+        };
+        let events = [
+            lost(10.0, 1.0, 2.0),
+            at(20.0, EventKind::Telemetry(raster)),
+            lost(30.0, 5.0, 5.0),
+            at(300.04, EventKind::Planner(moved)),
+        ];
+        let v = events_json(&events);
+        let kinds: Vec<&str> = v.iter().filter_map(|e| e["event"].as_str()).collect();
+        assert_eq!(kinds, ["lost_point", "lost_point", "lost_point_moved"]);
+        assert!(v[0].get("moved").is_none(), "{}", v[0]);
+        assert_eq!(v[1]["moved"], json!([[300.0, 6.5, 4.25]]), "{}", v[1]);
+        assert_eq!(v[2]["to_m"], json!([6.5, 4.25]));
+    }
 
     #[test]
     fn base64_matches_the_rfc_vectors() {

@@ -8,8 +8,8 @@
 //! `VIEW_SEGLIST` (its first vertex repeated at the end) under the same label instead.
 //!
 //! Labels: `cpt_op_area`, `cpt_subregion_K` (K from 0), `cpt_estimate` (one marker, moved as
-//! the estimate moves by more than 0.5 m), `cpt_lost_N` and `cpt_declared_N` (N from 1: every
-//! one stays on the map).
+//! the estimate moves by more than 0.5 m), `cpt_lost_N` (N from 1: every one stays on the map,
+//! posted again where the planner moves it) and `cpt_declared_N` (N from 1: every one stays).
 
 use plumetrace_core::{Decision, PlannerEvent, Telemetry, Vec2};
 
@@ -118,21 +118,31 @@ pub fn geometry(op_area: &[[f64; 2]], subregions: &[Vec<[f64; 2]>]) -> Vec<(&'st
 #[derive(Debug, Default)]
 pub struct Views {
     estimate: Option<Vec2>,
-    lost: u32,
+    /// Where each lost point drawn is now (`cpt_lost_N` is the N-th).
+    lost: Vec<Vec2>,
     declared: u32,
 }
 
 impl Views {
-    /// The postings decision `d` calls for: a new lost point or declaration, an estimate moved
-    /// by more than 0.5 m since it was last drawn.
+    /// The postings decision `d` calls for: a new lost point or declaration, a lost point moved
+    /// (posted again under its label), an estimate moved by more than 0.5 m since it was last
+    /// drawn.
     pub fn of(&mut self, d: &Decision) -> Vec<(&'static str, String)> {
         let mut out = Vec::new();
         for e in &d.events {
             match e {
                 PlannerEvent::LostPoint { pos_m } => {
-                    self.lost += 1;
-                    let label = format!("cpt_lost_{}", self.lost);
+                    self.lost.push(*pos_m);
+                    let label = format!("cpt_lost_{}", self.lost.len());
                     out.push(("VIEW_POINT", point(*pos_m, &label, "red", 4)));
+                }
+                PlannerEvent::LostPointMoved { from_m, to_m } => {
+                    // The latest point drawn there, as the events' readers take it.
+                    if let Some(k) = self.lost.iter().rposition(|p| p == from_m) {
+                        self.lost[k] = *to_m;
+                        let label = format!("cpt_lost_{}", k + 1);
+                        out.push(("VIEW_POINT", point(*to_m, &label, "red", 4)));
+                    }
                 }
                 PlannerEvent::Declared { pos_m, .. } => {
                     self.declared += 1;
@@ -298,6 +308,31 @@ mod tests {
         assert_eq!(
             v.of(&decision(vec![], Some(Vec2::new(131.0, 1.0)))).len(),
             1
+        );
+        // A fix moves the second lost point (the latest at that spot): posted again under its
+        // label; a move from where no point is drawn posts nothing.
+        let moved = PlannerEvent::LostPointMoved {
+            from_m: Vec2::new(100.0, -2.5),
+            to_m: Vec2::new(97.5, 1.25),
+        };
+        let stray = PlannerEvent::LostPointMoved {
+            from_m: Vec2::new(5.0, 5.0),
+            to_m: Vec2::new(6.0, 6.0),
+        };
+        assert_eq!(
+            v.of(&decision(vec![moved.clone(), stray], None)),
+            vec![(
+                "VIEW_POINT",
+                "x=97.50,y=1.25,label=cpt_lost_2,vertex_color=red,vertex_size=4".to_string()
+            )]
+        );
+        // The first is still where it was saved, and moves next.
+        assert_eq!(
+            v.of(&decision(vec![moved], None)),
+            vec![(
+                "VIEW_POINT",
+                "x=97.50,y=1.25,label=cpt_lost_1,vertex_color=red,vertex_size=4".to_string()
+            )]
         );
     }
 }

@@ -15,7 +15,7 @@ use crate::error::ReportError;
 use plotters::prelude::*;
 use plumetrace_core::{Heading, PlannerEvent, Vec2};
 use plumetrace_guidance::OpArea;
-use plumetrace_mission::{EventKind, MissionRun, TrajectoryRow};
+use plumetrace_mission::{EventKind, MissionRun, TrajectoryRow, lost_points};
 use std::collections::BTreeMap;
 use std::ops::Range;
 
@@ -207,13 +207,14 @@ fn map_bounds(run: &MissionRun) -> (Range<f64>, Range<f64>) {
     }
     for e in &run.events {
         if let EventKind::Planner(
-            PlannerEvent::LostPoint { pos_m }
-            | PlannerEvent::ReferenceTarget { pos_m }
-            | PlannerEvent::Declared { pos_m, .. },
+            PlannerEvent::ReferenceTarget { pos_m } | PlannerEvent::Declared { pos_m, .. },
         ) = &e.event
         {
             b.add(pos_m.x, pos_m.y);
         }
+    }
+    for l in lost_points(&run.events) {
+        b.add(l.now_m().x, l.now_m().y);
     }
     if b.x0 > b.x1 {
         return (-50.0..50.0, -50.0..50.0);

@@ -7,7 +7,7 @@ use super::style::{ABORT_MARK, Icon};
 use plotters::prelude::*;
 use plumetrace_core::{BehaviourKind, Heading, PlannerEvent, Vec2};
 use plumetrace_guidance::OpArea;
-use plumetrace_mission::{EventKind, MissionEvent, MissionRun, TrajectoryRow};
+use plumetrace_mission::{EventKind, MissionEvent, MissionRun, TrajectoryRow, lost_points};
 use plumetrace_sim::{Incident, WorldEvent};
 use std::collections::BTreeMap;
 
@@ -458,7 +458,7 @@ pub(super) struct Overlays {
     pub(super) virtual_paths: Vec<(Vec2, Heading, Vec2)>,
     /// Reference targets.
     pub(super) targets: Vec<(f64, f64)>,
-    /// Lost points.
+    /// Lost points, where their planner last put them.
     pub(super) lost: Vec<(f64, f64)>,
     /// Declared sources.
     pub(super) declared: Vec<(f64, f64)>,
@@ -472,7 +472,6 @@ impl Overlays {
         let marks = event_marks(run, rows);
         let mut virtual_paths: Vec<(Vec2, Heading, Vec2)> = Vec::new();
         let mut targets: Vec<(f64, f64)> = Vec::new();
-        let mut lost: Vec<(f64, f64)> = Vec::new();
         for e in &run.events {
             match &e.event {
                 EventKind::Planner(PlannerEvent::AvoidStart { pos_m, course_deg }) => {
@@ -483,9 +482,6 @@ impl Overlays {
                     if let Some((_, _, end)) = virtual_paths.last_mut() {
                         *end = *pos_m;
                     }
-                }
-                EventKind::Planner(PlannerEvent::LostPoint { pos_m }) => {
-                    lost.push((pos_m.x, pos_m.y));
                 }
                 _ => {}
             }
@@ -499,7 +495,10 @@ impl Overlays {
         Overlays {
             virtual_paths,
             targets,
-            lost,
+            lost: lost_points(&run.events)
+                .into_iter()
+                .map(|l| (l.now_m().x, l.now_m().y))
+                .collect(),
             declared,
             marks,
         }
@@ -511,8 +510,45 @@ mod tests {
     #![allow(clippy::unwrap_used, clippy::expect_used)]
 
     use super::super::DETECTION_GAP_S;
-    use super::super::test_support::row;
+    use super::super::test_support::{demo, row};
     use super::*;
+    use plumetrace_mission::EventRecord;
+
+    #[test]
+    fn a_lost_point_is_drawn_where_its_planner_last_moved_it() {
+        let mut run = demo(60.0);
+        run.events.retain(|e| {
+            !matches!(
+                e.event,
+                EventKind::Planner(
+                    PlannerEvent::LostPoint { .. } | PlannerEvent::LostPointMoved { .. }
+                )
+            )
+        });
+        let (saved, kept, moved) = (
+            Vec2::new(100.0, 5.0),
+            Vec2::new(90.0, 0.0),
+            Vec2::new(103.0, 1.0),
+        );
+        let planner = |t_s: f64, e: PlannerEvent| EventRecord {
+            t_s,
+            vehicle: 0,
+            event: EventKind::Planner(e),
+        };
+        run.events.extend([
+            planner(10.0, PlannerEvent::LostPoint { pos_m: saved }),
+            planner(15.0, PlannerEvent::LostPoint { pos_m: kept }),
+            planner(
+                20.0,
+                PlannerEvent::LostPointMoved {
+                    from_m: saved,
+                    to_m: moved,
+                },
+            ),
+        ]);
+        let over = Overlays::of(&run, &rows_by_vehicle(&run));
+        assert_eq!(over.lost, vec![(103.0, 1.0), (90.0, 0.0)]);
+    }
 
     #[test]
     fn time_marks_come_every_round_number_of_minutes() {

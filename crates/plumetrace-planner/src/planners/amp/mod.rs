@@ -580,13 +580,21 @@ impl Memory {
             .max_by(|a, b| a.pos.dot(&u).total_cmp(&b.pos.dot(&u)))
     }
 
-    /// Moves the lost points saved since the fix before `fix` by their share of its jump.
+    /// Moves the lost points saved since the fix before `fix` by their share of its jump, an
+    /// event for each point moved.
     fn smooth_lost(&mut self, fix: &fixes::Fix) {
         let model = self.p.drift_model();
         for l in &mut self.lost {
             let share = fix.share(l.t_s, l.held_back_s, &model);
             if share > 0.0 {
+                let from_m = l.pos;
                 l.pos += fix.jump_m * share;
+                if l.pos != from_m {
+                    self.events.push(PlannerEvent::LostPointMoved {
+                        from_m,
+                        to_m: l.pos,
+                    });
+                }
             }
         }
     }
