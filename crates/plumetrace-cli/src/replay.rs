@@ -164,7 +164,7 @@ pub fn run(args: &ReplayArgs) -> Result<bool> {
     }
     for d in &report.first {
         crate::outln!(
-            "  line {}, vehicle {}, t = {:.1} s: logged heading {:.2} deg, speed {:.2} m/s, {}; replayed heading {:.2} deg, speed {:.2} m/s, {}",
+            "  line {}, vehicle {}, t = {:.1} s: logged heading {:.2} deg, speed {:.2} m/s, {}; replayed heading {:.2} deg, speed {:.2} m/s, {}; {}",
             d.line,
             d.vehicle,
             d.t_s,
@@ -174,7 +174,39 @@ pub fn run(args: &ReplayArgs) -> Result<bool> {
             d.replayed.command.heading.deg(),
             d.replayed.command.speed_mps,
             variant_name(&d.replayed.status).unwrap_or("?"),
+            what_differs(d),
         );
     }
     Ok(report.differing == 0)
+}
+
+/// Which parts of a differing decision differ, the events' kinds on each side when they do
+/// (the command printed before may look the same to two decimals, or be the same).
+fn what_differs(d: &plumetrace_log::snapshot::Difference) -> String {
+    let parts = d.parts();
+    let mut text = format!("differs in {}", parts.join(", "));
+    if parts.contains(&"events") {
+        let kinds = |events: &[plumetrace_core::PlannerEvent]| -> String {
+            let names: Vec<String> = events
+                .iter()
+                .map(|e| {
+                    serde_json::to_value(e)
+                        .ok()
+                        .and_then(|v| v.get("event")?.as_str().map(String::from))
+                        .unwrap_or_else(|| "?".into())
+                })
+                .collect();
+            if names.is_empty() {
+                "none".into()
+            } else {
+                names.join(" ")
+            }
+        };
+        text += &format!(
+            " (logged: {}; replayed: {})",
+            kinds(&d.logged.events),
+            kinds(&d.replayed.events)
+        );
+    }
+    text
 }

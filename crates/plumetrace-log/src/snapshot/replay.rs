@@ -43,6 +43,30 @@ pub struct Difference {
     pub replayed: Decision,
 }
 
+impl Difference {
+    /// The parts of the two decisions that differ, by the same test as the whole ([`same`]):
+    /// any of "command", "status", "events", "telemetry" and "messages".
+    pub fn parts(&self) -> Vec<&'static str> {
+        fn differs<T: serde::Serialize>(a: &T, b: &T) -> bool {
+            !matches!(
+                (serde_json::to_string(a), serde_json::to_string(b)),
+                (Ok(x), Ok(y)) if x == y
+            )
+        }
+        let (a, b) = (&self.logged, &self.replayed);
+        [
+            ("command", differs(&a.command, &b.command)),
+            ("status", differs(&a.status, &b.status)),
+            ("events", differs(&a.events, &b.events)),
+            ("telemetry", differs(&a.telemetry, &b.telemetry)),
+            ("messages", differs(&a.outbox, &b.outbox)),
+        ]
+        .into_iter()
+        .filter_map(|(name, d)| d.then_some(name))
+        .collect()
+    }
+}
+
 /// What a replay found.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct ReplayReport {
@@ -294,5 +318,38 @@ mod tests {
             PlanStatus::Running,
         );
         assert!(!same(&other, &d));
+    }
+
+    #[test]
+    fn a_difference_names_the_parts_that_differ() {
+        let logged = Decision::new(
+            Command {
+                heading: Heading::from_deg(90.0),
+                speed_mps: 1.5,
+                vertical: VerticalCommand::Altitude(2.0),
+            },
+            PlanStatus::Running,
+        );
+        let diff = |replayed: Decision| Difference {
+            line: 2,
+            vehicle: 0,
+            t_s: 1.0,
+            logged: logged.clone(),
+            replayed,
+        };
+        assert!(diff(logged.clone()).parts().is_empty());
+        // The same command, an event more.
+        let mut moved = logged.clone();
+        moved
+            .events
+            .push(plumetrace_core::PlannerEvent::LostPointMoved {
+                from_m: plumetrace_core::Vec2::new(1.0, 2.0),
+                to_m: plumetrace_core::Vec2::new(1.5, 2.0),
+            });
+        assert_eq!(diff(moved.clone()).parts(), ["events"]);
+        // A heading a hundredth of a degree off (the same to two decimals) and finished.
+        moved.command.heading = Heading::from_deg(90.001);
+        moved.status = PlanStatus::Finished;
+        assert_eq!(diff(moved).parts(), ["command", "status", "events"]);
     }
 }
