@@ -949,17 +949,23 @@ fn a_grid_query_is_bit_for_bit_the_point_by_point_query() {
         ] {
             let spec = grid((x0, x1, y0, y1), (nx, ny), z);
             let pts = spec.points();
-            // In bands of rows taken by three threads, as on a machine with three cores.
-            let pool = rayon::ThreadPoolBuilder::new()
-                .num_threads(3)
-                .build()
-                .unwrap();
-            let mut grid = vec![f64::NAN; pts.len()];
-            pool.install(|| env.plume().grid_concentrations(&spec, &pts, &mut grid));
-            for (p, g) in pts.iter().zip(&grid) {
-                let c = env.plume().concentration(*p);
-                assert_eq!(c.to_bits(), g.to_bits(), "{c} vs {g} at {p:?} of {spec:?}");
-                nonzero += usize::from(c > 0.0);
+            // In one band on one thread, and in bands of rows taken by three threads.
+            for threads in [1, 3] {
+                let pool = rayon::ThreadPoolBuilder::new()
+                    .num_threads(threads)
+                    .build()
+                    .unwrap();
+                let mut grid = vec![f64::NAN; pts.len()];
+                pool.install(|| env.plume().grid_concentrations(&spec, &pts, &mut grid));
+                for (p, g) in pts.iter().zip(&grid) {
+                    let c = env.plume().concentration(*p);
+                    assert_eq!(
+                        c.to_bits(),
+                        g.to_bits(),
+                        "{c} vs {g} at {p:?} of {spec:?}, {threads} threads"
+                    );
+                    nonzero += usize::from(c > 0.0);
+                }
             }
         }
         assert!(
@@ -993,6 +999,8 @@ fn a_display_grid_is_within_a_few_units_in_the_last_place_and_the_same_whatever_
                 });
                 out
             };
+            // (The display query runs on the calling thread whatever the pool: this guards that
+            // it stays the same bits should it ever be split again.)
             let display = on(1);
             let bits = |v: &[f64]| v.iter().map(|c| c.to_bits()).collect::<Vec<_>>();
             assert_eq!(bits(&display), bits(&on(3)), "{spec:?}");

@@ -1228,10 +1228,11 @@ impl ConcentrationField for FilamentPlume {
         let bands = rayon::current_num_threads();
         self.grid_query(grid, points, out, TermExp::Standard, bands);
     }
-    /// On the calling thread: a run samples its figure's and page's grids (a millisecond or two
-    /// each) a few times a minute of mission, and waking the pool's threads for each, which then
-    /// spin for work while the run goes on, cost a `duck-2003-st` run about 7 % more CPU and 6 %
-    /// more wall time on 2 threads than it saved (docs/results/performance.md).
+    /// On the calling thread: a run samples its figure's and page's grids (about a millisecond
+    /// each) once a minute of mission, and waking the pool's threads for each, which then spin
+    /// for work while the run goes on, cost a `duck-2003-st` run about 7 % more CPU on 2 threads
+    /// (docs/results/performance.md). Points that are not the grid's are queried as a batch
+    /// ([`ConcentrationField::concentrations`], in parallel).
     fn display_grid_concentrations(
         &self,
         grid: &crate::GridSpec,
