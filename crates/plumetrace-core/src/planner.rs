@@ -129,8 +129,9 @@ pub enum PlannerEvent {
         pos_m: Vec2,
     },
     /// A saved lost point was moved: a position fix showed how far the navigation was off when
-    /// it was saved (the AMP's `fix_smoothing`). The point is the one last at `from_m` (a saved
-    /// point's `pos_m` or an earlier move's `to_m`, the same bits).
+    /// it was saved (the AMP's `fix_smoothing`). The point is the latest saved of those last at
+    /// `from_m` (a saved point's `pos_m` or an earlier move's `to_m`, the same bits): a planner
+    /// moving several points at one spot at once moves the latest saved first.
     LostPointMoved {
         /// Where it was, m.
         from_m: Vec2,

@@ -1373,7 +1373,7 @@ fn each_held_point_moves_with_the_fix_that_ends_its_frame() {
     // The fix's record where the records before it were: the jump is measured against them.
     events.extend(wait(&mut a, t, 401.0));
     // The fix at 400 s moved each of frame 1's lost points by its share of j1, an event each
-    // from where it was saved to where the planner now holds it.
+    // (the latest saved first) from where it was saved to where the planner now holds it.
     let saved: Vec<Vec2> = events
         .iter()
         .filter_map(|e| match e {
@@ -1389,7 +1389,8 @@ fn each_held_point_moves_with_the_fix_that_ends_its_frame() {
         })
         .collect();
     assert_eq!((saved.len(), moved.len()), (3, 3), "{events:?}");
-    for ((from, to), (p, since)) in moved.iter().zip(saved.iter().zip([51.0, 68.0, 85.0])) {
+    let saved_at = saved.iter().zip([51.0, 68.0, 85.0]);
+    for ((from, to), (p, since)) in moved.iter().rev().zip(saved_at) {
         assert_eq!(from, p);
         let share = (16.0 + 1e-4 * since * 395.0) / (32.0 + 1e-4 * 395.0 * 395.0);
         assert!(

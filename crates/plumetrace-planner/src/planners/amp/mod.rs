@@ -581,10 +581,11 @@ impl Memory {
     }
 
     /// Moves the lost points saved since the fix before `fix` by their share of its jump, an
-    /// event for each point moved.
+    /// event for each point moved, the latest saved first (as the events' readers match a move to
+    /// the latest point at its `from_m`, two points saved at one spot keep their own tracks).
     fn smooth_lost(&mut self, fix: &fixes::Fix) {
         let model = self.p.drift_model();
-        for l in &mut self.lost {
+        for l in self.lost.iter_mut().rev() {
             let share = fix.share(l.t_s, l.held_back_s, &model);
             if share > 0.0 {
                 let from_m = l.pos;
