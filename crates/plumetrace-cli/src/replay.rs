@@ -184,6 +184,9 @@ pub fn run(args: &ReplayArgs) -> Result<bool> {
 /// (the command printed before may look the same to two decimals, or be the same).
 fn what_differs(d: &plumetrace_log::snapshot::Difference) -> String {
     let parts = d.parts();
+    if parts.is_empty() {
+        return "differs in its text only".into();
+    }
     let mut text = format!("differs in {}", parts.join(", "));
     if parts.contains(&"events") {
         let kinds = |events: &[plumetrace_core::PlannerEvent]| -> String {
@@ -209,4 +212,49 @@ fn what_differs(d: &plumetrace_log::snapshot::Difference) -> String {
         );
     }
     text
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use plumetrace_core::{
+        Command, Decision, Heading, PlanStatus, PlannerEvent, Vec2, VerticalCommand,
+    };
+    use plumetrace_log::snapshot::Difference;
+
+    #[test]
+    fn a_difference_says_what_differs_and_the_events_kinds() {
+        let logged = Decision::new(
+            Command {
+                heading: Heading::from_deg(10.0),
+                speed_mps: 1.0,
+                vertical: VerticalCommand::Depth(3.0),
+            },
+            PlanStatus::Running,
+        );
+        let mut replayed = logged.clone();
+        replayed.events.push(PlannerEvent::LostPointMoved {
+            from_m: Vec2::new(0.0, 0.0),
+            to_m: Vec2::new(1.0, 0.0),
+        });
+        replayed.events.push(PlannerEvent::LostPoint {
+            pos_m: Vec2::new(2.0, 0.0),
+        });
+        let d = Difference {
+            line: 3,
+            vehicle: 0,
+            t_s: 0.1,
+            logged: logged.clone(),
+            replayed,
+        };
+        assert_eq!(
+            what_differs(&d),
+            "differs in events (logged: none; replayed: lost_point_moved lost_point)"
+        );
+        let same = Difference {
+            replayed: logged,
+            ..d
+        };
+        assert_eq!(what_differs(&same), "differs in its text only");
+    }
 }

@@ -44,8 +44,8 @@ pub struct Difference {
 }
 
 impl Difference {
-    /// The parts of the two decisions that differ, by the same test as the whole ([`same`]):
-    /// any of "command", "status", "events", "telemetry" and "messages".
+    /// The parts of the two decisions that differ, by the same test as the whole decision (their
+    /// text in the log): any of "command", "status", "events", "telemetry" and "messages".
     pub fn parts(&self) -> Vec<&'static str> {
         fn differs<T: serde::Serialize>(a: &T, b: &T) -> bool {
             !matches!(
