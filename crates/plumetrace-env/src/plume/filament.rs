@@ -1230,7 +1230,7 @@ impl ConcentrationField for FilamentPlume {
     }
     /// On the calling thread: a run samples its figure's and page's grids (about a millisecond
     /// each) once a minute of mission, and waking the pool's threads for each, which then spin
-    /// for work while the run goes on, cost a `duck-2003-st` run about 7 % more CPU on 2 threads
+    /// for work while the run goes on, cost a `duck-2003-st` run about 6 % more CPU on 2 threads
     /// (docs/results/performance.md). Points that are not the grid's are queried as a batch
     /// ([`ConcentrationField::concentrations`], in parallel).
     fn display_grid_concentrations(
