@@ -22,7 +22,7 @@
 use crate::error::ReportError;
 use crate::figure::style::{behaviour_colour, behaviour_label};
 use plumetrace_core::{BehaviourKind, Vec2};
-use plumetrace_log::snapshot::Replayed;
+use plumetrace_log::snapshot::{Replayed, same};
 use plumetrace_mission::{EventKind, EventRecord, MissionRun, PlumeFrames, lost_points};
 use serde::Serialize;
 use serde_json::{Value, json};
@@ -506,7 +506,7 @@ impl LogPageBuilder {
         let (l, d) = (r.line, r.replayed);
         let t = l.snapshot.time_s;
         let v = l.vehicle;
-        if self.divergence.is_none() && !same_decision(d, &l.decision) {
+        if self.divergence.is_none() && !same(d, &l.decision) {
             // Where the vehicle believed it was (the origin when it had no estimate).
             let p = l.snapshot.nav.pos_m.unwrap_or_default();
             self.divergence = Some(PageDivergence {
@@ -593,14 +593,6 @@ impl LogPageBuilder {
         page.replayed = true;
         page.divergence = self.divergence;
         page
-    }
-}
-
-/// Whether two decisions are the same to the bit (as the replay compares them: their text).
-fn same_decision(a: &plumetrace_core::Decision, b: &plumetrace_core::Decision) -> bool {
-    match (serde_json::to_string(a), serde_json::to_string(b)) {
-        (Ok(x), Ok(y)) => x == y,
-        _ => false,
     }
 }
 

@@ -22,6 +22,7 @@ mod replay;
 pub use file::{SnapshotLogFile, open};
 pub use replay::{
     Defaulted, Difference, ReplayError, ReplayReport, Replayed, read_header, replay, replay_with,
+    same,
 };
 
 use crate::LogError;

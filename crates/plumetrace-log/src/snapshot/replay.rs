@@ -44,25 +44,19 @@ pub struct Difference {
 }
 
 impl Difference {
-    /// The parts of the two decisions that differ, by the same test as the whole decision (their
-    /// text in the log): any of "command", "status", "events", "telemetry" and "messages".
+    /// The parts of the two decisions that differ, by the same test as the whole decision
+    /// ([`same`]): any of "command", "status", "events", "telemetry" and "messages".
     pub fn parts(&self) -> Vec<&'static str> {
-        fn differs<T: serde::Serialize>(a: &T, b: &T) -> bool {
-            !matches!(
-                (serde_json::to_string(a), serde_json::to_string(b)),
-                (Ok(x), Ok(y)) if x == y
-            )
-        }
         let (a, b) = (&self.logged, &self.replayed);
         [
-            ("command", differs(&a.command, &b.command)),
-            ("status", differs(&a.status, &b.status)),
-            ("events", differs(&a.events, &b.events)),
-            ("telemetry", differs(&a.telemetry, &b.telemetry)),
-            ("messages", differs(&a.outbox, &b.outbox)),
+            ("command", same(&a.command, &b.command)),
+            ("status", same(&a.status, &b.status)),
+            ("events", same(&a.events, &b.events)),
+            ("telemetry", same(&a.telemetry, &b.telemetry)),
+            ("messages", same(&a.outbox, &b.outbox)),
         ]
         .into_iter()
-        .filter_map(|(name, d)| d.then_some(name))
+        .filter_map(|(name, same)| (!same).then_some(name))
         .collect()
     }
 }
@@ -98,9 +92,10 @@ impl ReplayReport {
     pub const KEEP: usize = 10;
 }
 
-/// Whether two decisions are the same to the bit, non-finite numbers included (their text in the
-/// log is exact: numbers round-trip, non-finite ones are written as words).
-fn same(a: &Decision, b: &Decision) -> bool {
+/// Whether two decisions, or two parts of them, are the same to the bit, non-finite numbers
+/// included: their text in the log (exact: numbers round-trip, non-finite ones are written as
+/// words). How a replay compares what it decided with the log.
+pub fn same<T: serde::Serialize + ?Sized>(a: &T, b: &T) -> bool {
     match (serde_json::to_string(a), serde_json::to_string(b)) {
         (Ok(x), Ok(y)) => x == y,
         _ => false,
