@@ -17,7 +17,8 @@
 //!   exactly (it is symmetric, so its mean is 0).
 //!
 //! The tables are single precision (20 kB in all), so they stay in the first-level cache beside
-//! the flow's cells while filaments are stepped; the draws are widened to `f64`.
+//! the flow's cells while filaments are stepped; the draws are single precision too (the
+//! transport's), widened to `f64` by [`normal_triple`].
 //!
 //! The draws are therefore a discrete distribution of 2^21 values that follows the standard
 //! normal distribution to the resolution of 21 bits, with the tails cut beyond 5.03 standard
@@ -112,12 +113,12 @@ fn unit_variance_scale(lines: &[[f64; 2]], low_tail: &[f64]) -> f64 {
 impl Tables {
     /// The normal value of the 21-bit number `k` (its low 21 bits).
     #[inline(always)]
-    fn draw(&self, k: u32) -> f64 {
+    fn draw(&self, k: u32) -> f32 {
         let bucket = bucket(k);
         if bucket == 0 {
-            f64::from(self.low_tail[place(k)])
+            self.low_tail[place(k)]
         } else if bucket == BUCKETS - 1 {
-            -f64::from(self.low_tail[PLACES - 1 - place(k)])
+            -self.low_tail[PLACES - 1 - place(k)]
         } else {
             self.line(k)
         }
@@ -150,7 +151,7 @@ fn parts(word: u64) -> [u32; 3] {
 /// Three standard normal draws from the 64-bit word `word` (its top 63 bits, 21 per draw).
 #[inline]
 pub fn normal_triple(word: u64) -> [f64; 3] {
-    tables().triple(word)
+    tables().triple(word).map(f64::from)
 }
 
 /// Three columns of standard normal draws, row `k` from `words[k]` (as [`normal_triple`]);
@@ -159,11 +160,11 @@ pub fn normal_triple(word: u64) -> [f64; 3] {
 /// bucket's line, then the rows of any group of eight with a draw in a tail bucket (one draw in
 /// 1,024) are drawn again in full.
 #[inline(always)]
-pub fn fill_normal_columns(
+pub fn fill_normal_columns<T: From<f32> + Copy>(
     words: &[u64],
-    first: &mut [f64],
-    second: &mut [f64],
-    third: &mut [f64],
+    first: &mut [T],
+    second: &mut [T],
+    third: &mut [T],
 ) {
     const GROUP: usize = 8;
     let t = tables();
@@ -171,9 +172,9 @@ pub fn fill_normal_columns(
     let (first, second, third) = (&mut first[..n], &mut second[..n], &mut third[..n]);
     for k in 0..n {
         let [a, b, c] = t.triple_from_lines(words[k]);
-        first[k] = a;
-        second[k] = b;
-        third[k] = c;
+        first[k] = T::from(a);
+        second[k] = T::from(b);
+        third[k] = T::from(c);
     }
     for (g, group) in words.chunks(GROUP).enumerate() {
         let mut tails = false;
@@ -183,7 +184,7 @@ pub fn fill_normal_columns(
         if tails {
             for (j, w) in group.iter().enumerate() {
                 let k = g * GROUP + j;
-                [first[k], second[k], third[k]] = t.triple(*w);
+                [first[k], second[k], third[k]] = t.triple(*w).map(T::from);
             }
         }
     }
@@ -199,24 +200,24 @@ fn in_a_tail(word: u64) -> bool {
 impl Tables {
     /// Draw `k` read from its bucket's line: the draw itself unless the bucket is a tail one.
     #[inline(always)]
-    fn line(&self, k: u32) -> f64 {
+    fn line(&self, k: u32) -> f32 {
         let packed = self.lines[bucket(k)];
         let (a, rise) = (
             f32::from_bits(packed as u32),
             f32::from_bits((packed >> 32) as u32),
         );
-        f64::from(a + rise * place(k) as f32)
+        a + rise * place(k) as f32
     }
 
     /// [`Tables::triple`] read from the lines only (see [`Tables::line`]).
     #[inline(always)]
-    fn triple_from_lines(&self, word: u64) -> [f64; 3] {
+    fn triple_from_lines(&self, word: u64) -> [f32; 3] {
         parts(word).map(|k| self.line(k))
     }
 
     /// The three draws of `word`.
     #[inline(always)]
-    fn triple(&self, word: u64) -> [f64; 3] {
+    fn triple(&self, word: u64) -> [f32; 3] {
         parts(word).map(|k| self.draw(k))
     }
 }
@@ -284,7 +285,7 @@ mod tests {
         let n = f64::from(1u32 << BITS);
         let (mut s1, mut s2, mut s4, mut max) = (0.0, 0.0, 0.0, 0.0f64);
         for k in 0..(1u32 << BITS) {
-            let z = t.draw(k);
+            let z = f64::from(t.draw(k));
             s1 += z;
             s2 += z * z;
             s4 += z * z * z * z;
@@ -306,7 +307,7 @@ mod tests {
         let n = f64::from(1u32 << BITS);
         for k in (0..(1u32 << BITS)).step_by(7) {
             let exact = inverse_normal_cdf((f64::from(k) + 0.5) / n);
-            let err = (t.draw(k) - exact).abs();
+            let err = (f64::from(t.draw(k)) - exact).abs();
             let bound = if exact.abs() < 2.5 {
                 1e-4 + 1e-3 * exact.abs()
             } else {
@@ -320,7 +321,7 @@ mod tests {
     fn the_distribution_function_is_the_normal_one() {
         // The fraction of the 2^21 values below z equals Phi(z) to within a bucket's share.
         let t = tables();
-        let mut all: Vec<f64> = (0..(1u32 << BITS)).map(|k| t.draw(k)).collect();
+        let mut all: Vec<f64> = (0..(1u32 << BITS)).map(|k| f64::from(t.draw(k))).collect();
         all.sort_by(f64::total_cmp);
         for z in [-4.0, -3.0, -2.0, -1.0, -0.3, 0.0, 0.7, 1.5, 2.5, 3.5] {
             let below = all.partition_point(|v| *v < z) as f64 / all.len() as f64;

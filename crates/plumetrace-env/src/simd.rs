@@ -7,7 +7,8 @@
 //! floating-point operations in the same order (Rust never fuses a multiply and an add unless
 //! told to), so results are the same bits on any CPU; tests run every version this CPU has and
 //! compare them. The flow's batch lookup has a version of its own for AVX-512, written with its
-//! instructions (eight cells read as vectors and transposed); the sensor scan's block boxes are
+//! instructions (sixteen single-precision cells read as vectors and taken apart into lanes); the
+//! flow's cells are rebuilt with AVX-512's own version too; the sensor scan's block boxes are
 //! written with pulp's vector operations for every unit.
 
 /// The widest vector unit this CPU has (detected once, then cached by the standard library).

@@ -38,13 +38,35 @@ pub trait FlowField: Send + Sync + std::fmt::Debug {
     /// Water velocity at `pos_m` at the current time.
     fn velocity(&self, pos_m: Vec2) -> Vec2;
 
-    /// Water velocities at many positions (the filament hot path); `x`, `y`, `u`, `v` have the
+    /// Water velocities at many positions; `x`, `y`, `u`, `v` have the
     /// same length.
     fn velocities(&self, x: &[f64], y: &[f64], u: &mut [f64], v: &mut [f64]) {
         for i in 0..x.len().min(y.len()).min(u.len()).min(v.len()) {
             let w = self.velocity(Vec2::new(x[i], y[i]));
             u[i] = w.x;
             v[i] = w.y;
+        }
+    }
+
+    /// [`FlowField::velocities`] in single precision: the filament hot path (the transport
+    /// moves filaments in single precision). By default through [`FlowField::velocities`], 64
+    /// points at a time.
+    fn velocities_f32(&self, x: &[f32], y: &[f32], u: &mut [f32], v: &mut [f32]) {
+        const BATCH: usize = 64;
+        let n = x.len().min(y.len()).min(u.len()).min(v.len());
+        let (mut xd, mut yd, mut ud, mut vd) =
+            ([0.0; BATCH], [0.0; BATCH], [0.0; BATCH], [0.0; BATCH]);
+        for start in (0..n).step_by(BATCH) {
+            let m = (n - start).min(BATCH);
+            for k in 0..m {
+                xd[k] = f64::from(x[start + k]);
+                yd[k] = f64::from(y[start + k]);
+            }
+            self.velocities(&xd[..m], &yd[..m], &mut ud[..m], &mut vd[..m]);
+            for k in 0..m {
+                u[start + k] = ud[k] as f32;
+                v[start + k] = vd[k] as f32;
+            }
         }
     }
 
@@ -111,6 +133,9 @@ impl FlowField for FlowModel {
     }
     fn velocities(&self, x: &[f64], y: &[f64], u: &mut [f64], v: &mut [f64]) {
         self.inner().velocities(x, y, u, v)
+    }
+    fn velocities_f32(&self, x: &[f32], y: &[f32], u: &mut [f32], v: &mut [f32]) {
+        self.inner().velocities_f32(x, y, u, v)
     }
     fn advance(&mut self, t_new_s: f64, dt_s: f64, rng: &mut SimRng) -> Result<(), EnvError> {
         self.inner_mut().advance(t_new_s, dt_s, rng)

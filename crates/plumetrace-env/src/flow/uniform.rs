@@ -43,6 +43,10 @@ impl FlowField for UniformFlow {
         u.fill(self.current_mps.x);
         v.fill(self.current_mps.y);
     }
+    fn velocities_f32(&self, _x: &[f32], _y: &[f32], u: &mut [f32], v: &mut [f32]) {
+        u.fill(self.current_mps.x as f32);
+        v.fill(self.current_mps.y as f32);
+    }
     fn advance(&mut self, t_new_s: f64, _dt_s: f64, _rng: &mut SimRng) -> Result<(), EnvError> {
         self.time_s = t_new_s;
         self.current_mps = self.mean.velocity_at(t_new_s);

@@ -87,7 +87,7 @@ impl CellIndex {
         // entry of its own (after the filaments), and no image is taken at z = 0.
         let images: Vec<f64> = match (seabed, vertical) {
             (Some(sb), VerticalBoundary::Reflecting { .. }) => (0..n)
-                .map(|k| 2.0 * sb.height_at(px[k], py[k]) - pz[k])
+                .map(|k| 2.0 * sb.height_at(f64::from(px[k]), f64::from(py[k])) - f64::from(pz[k]))
                 .collect(),
             _ => Vec::new(),
         };
@@ -95,7 +95,7 @@ impl CellIndex {
         // Entry `e`'s filament and height.
         let of = |e: usize| -> (usize, f64) {
             if e < n {
-                (e, pz[e])
+                (e, f64::from(pz[e]))
             } else {
                 (e - n, images[e - n])
             }
@@ -122,7 +122,7 @@ impl CellIndex {
         let mut cells = Vec::with_capacity(total);
         for e in 0..total {
             let k = of(e).0;
-            let c = cell_of(px[k], py[k]);
+            let c = cell_of(f64::from(px[k]), f64::from(py[k]));
             cells.push(c as u32);
             starts[c + 1] += 1;
         }
@@ -148,8 +148,8 @@ impl CellIndex {
             let (k, z) = of(e);
             let r2 = plume.radius_sq_born(pb[k]);
             entries[slot] = Entry {
-                x: px[k],
-                y: py[k],
+                x: f64::from(px[k]),
+                y: f64::from(py[k]),
                 z,
                 lim2: cut2 * r2,
                 amp: pm[k] / (norm * r2 * r2.sqrt()),
