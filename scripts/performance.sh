@@ -4,6 +4,7 @@
 # by hand):
 #
 #   scripts/performance.sh --before BIN --before-commit HASH [--after BIN] [--pairs N] [--seeds N] [--jobs N]
+#                          [--outputs-differ]
 #
 # BIN is a built plumetrace and HASH the commit it was built from (the page names it); `--after`
 # defaults to this checkout's release build (built first).
@@ -21,7 +22,10 @@
 # - the filament step, `plumetrace bench plume` in pompy's case (5 puffs/s), at 50 puffs/s
 #   (`--release-rate 50`) and at field scale (`--case field`), once per build in each pair.
 # The two campaigns' runs.csv must be the same (apart from any run-time column); the script stops
-# if they are not.
+# if they are not. A change that alters the numbers the simulation computes (`--outputs-differ`)
+# is compared by its statistics instead: the first pair's two campaigns go through
+# scripts/two_sample.sh (Fisher's exact test for the rates, Kolmogorov-Smirnov and Mann-Whitney U
+# for the errors and times, alpha 0.01), whose table the section then holds.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 . scripts/pairs_common.sh
@@ -32,6 +36,7 @@ after=""
 pairs=3
 seeds=1000
 jobs=2
+outputs_differ=""
 while [ $# -gt 0 ]; do
     case "$1" in
         --before|--before-commit|--after|--pairs|--seeds|--jobs)
@@ -44,7 +49,8 @@ while [ $# -gt 0 ]; do
         --pairs) pairs="$2"; shift 2 ;;
         --seeds) seeds="$2"; shift 2 ;;
         --jobs) jobs="$2"; shift 2 ;;
-        -h|--help) sed -n '2,24p' "$0"; exit 0 ;;
+        --outputs-differ) outputs_differ=1; shift ;;
+        -h|--help) sed -n '2,29p' "$0"; exit 0 ;;
         *) echo "performance.sh: unknown argument $1 (see --help)" >&2; exit 2 ;;
     esac
 done
@@ -177,8 +183,8 @@ for k in $(seq 1 "$pairs"); do
         row="$(kernel "$bin" "$side-$k")"
         echo "$side $row" >> "$work/kernel"
     done
-    if ! cmp -s <(strip_times "$work/runs-before-$k.csv") <(strip_times "$work/runs-after-$k.csv"); then
-        echo "performance.sh: the two builds' runs.csv differ (pair $k): $work kept" >&2
+    if [ -z "$outputs_differ" ] && ! cmp -s <(strip_times "$work/runs-before-$k.csv") <(strip_times "$work/runs-after-$k.csv"); then
+        echo "performance.sh: the two builds' runs.csv differ (pair $k; --outputs-differ compares their statistics instead): $work kept" >&2
         trap - EXIT
         exit 1
     fi
@@ -189,6 +195,33 @@ for side in before after; do
     "$bin" bench missions --runs 48 --threads "$jobs" > "$work/bench-$side.json"
 done
 load="$(cut -d' ' -f1-3 /proc/loadavg)"
+
+# With --outputs-differ: the first pair's campaigns, one configuration each, side by side.
+two_sample=""
+if [ -n "$outputs_differ" ]; then
+    python3 - "$work/runs-before-1.csv" "$work/runs-after-1.csv" "$work/both.csv" <<'PY'
+import csv, sys
+rows, fields = [], None
+for path, name in ((sys.argv[1], "before"), (sys.argv[2], "after")):
+    with open(path, newline="") as f:
+        r = csv.DictReader(f)
+        fields = r.fieldnames
+        for row in r:
+            row["config"] = name
+            rows.append(row)
+with open(sys.argv[3], "w", newline="") as f:
+    w = csv.DictWriter(f, fieldnames=fields)
+    w.writeheader()
+    w.writerows(rows)
+PY
+    # Its exit status says whether any p-value is below alpha; the table says which.
+    two_sample="$(bash scripts/two_sample.sh "$work/both.csv" before after --alpha 0.01)" || true
+    if [ -z "$two_sample" ]; then
+        echo "performance.sh: the two-sample comparison failed: $work kept" >&2
+        trap - EXIT
+        exit 1
+    fi
+fi
 
 section="$(python3 - "$work" "$pairs" "$seeds" "$jobs" <<'PY'
 import json, statistics, sys
@@ -244,13 +277,26 @@ end="<!-- performance.sh end -->"
     echo "duck-2003-st --seed 7 --stats\` on one thread (\`RAYON_NUM_THREADS=1\`) with every default"
     echo "output; the campaign is \`plumetrace campaign FILE --out DIR --jobs $jobs\` over \`scenarios ="
     echo "[\"duck-2003-st\"]\`, \`seeds = $seeds\`, one configuration, timed as a whole process with"
-    echo "its files written; the two builds' runs.csv are the same (the script compares them, any"
-    echo "column of run times set aside, and stops if they differ). The filament step is \`plumetrace bench"
+    if [ -n "$outputs_differ" ]; then
+        echo "its files written; the change alters the numbers the simulation computes, so the two builds'"
+        echo "runs.csv differ (\`--outputs-differ\`), and the first pair's two campaigns are compared by"
+        echo "their statistics below. The filament step is \`plumetrace bench"
+    else
+        echo "its files written; the two builds' runs.csv are the same (the script compares them, any"
+        echo "column of run times set aside, and stops if they differ). The filament step is \`plumetrace bench"
+    fi
     echo "plume\` in its three cases, once per build in each pair (each call's figure the median of its"
     echo "five blocks)."
     echo
     echo "$section"
     echo
+    if [ -n "$two_sample" ]; then
+        echo "The first pair's two campaigns ($seeds seeds each, the same seeds), before against after"
+        echo "(\`scripts/two_sample.sh\`):"
+        echo
+        echo "$two_sample"
+        echo
+    fi
     echo "$end"
 } > "$work/section"
 write_section "$page" "$work/section" "$begin" "$end" "Outputs and campaign throughput, side by side"
