@@ -272,7 +272,7 @@ end="<!-- performance.sh end -->"
     echo "$begin"
     echo
     echo "**Measured** by \`scripts/performance.sh --before BIN --before-commit $before_commit --pairs $pairs"
-    echo "--seeds $seeds --jobs $jobs\` at commit \`$commit\` (after) against the build of \`$before_commit\`"
+    echo "--seeds $seeds --jobs $jobs${outputs_differ:+ --outputs-differ}\` at commit \`$commit\` (after) against the build of \`$before_commit\`"
     echo "(before) on $(date -u +%Y-%m-%d) ($cores cores, $cpu; load average $load at the end). The single run is \`plumetrace run --preset"
     echo "duck-2003-st --seed 7 --stats\` on one thread (\`RAYON_NUM_THREADS=1\`) with every default"
     echo "output; the campaign is \`plumetrace campaign FILE --out DIR --jobs $jobs\` over \`scenarios ="
