@@ -251,7 +251,8 @@ def pooled(parts):
     s1 = sum(p[0] * p[1] for p in parts)
     s2 = sum(p[0] * (p[2] ** 2 + p[1] ** 2) for p in parts)
     m = s1 / n
-    return (s2 / n - m * m) ** 0.5
+    # Rounding can take a spread of zero just below zero.
+    return max(s2 / n - m * m, 0.0) ** 0.5
 
 
 def main():

@@ -50,7 +50,7 @@ while [ $# -gt 0 ]; do
         --seeds) seeds="$2"; shift 2 ;;
         --jobs) jobs="$2"; shift 2 ;;
         --outputs-differ) outputs_differ=1; shift ;;
-        -h|--help) sed -n '2,29p' "$0"; exit 0 ;;
+        -h|--help) sed -n '2,28p' "$0"; exit 0 ;;
         *) echo "performance.sh: unknown argument $1 (see --help)" >&2; exit 2 ;;
     esac
 done
@@ -188,6 +188,14 @@ for k in $(seq 1 "$pairs"); do
         trap - EXIT
         exit 1
     fi
+    # Each build gives the same runs in every pair.
+    for side in before after; do
+        if ! cmp -s <(strip_times "$work/runs-$side-1.csv") <(strip_times "$work/runs-$side-$k.csv"); then
+            echo "performance.sh: the $side build's runs.csv differ between pairs 1 and $k: $work kept" >&2
+            trap - EXIT
+            exit 1
+        fi
+    done
 done
 for side in before after; do
     bin="$before"
@@ -214,13 +222,27 @@ with open(sys.argv[3], "w", newline="") as f:
     w.writeheader()
     w.writerows(rows)
 PY
-    # Its exit status says whether any p-value is below alpha; the table says which.
-    two_sample="$(bash scripts/two_sample.sh "$work/both.csv" before after --alpha 0.01)" || true
-    if [ -z "$two_sample" ]; then
+    # Its exit status is 1 when some p-value is below alpha (the table says which), 2 or more
+    # when the comparison itself failed.
+    status=0
+    two_sample="$(bash scripts/two_sample.sh "$work/both.csv" before after --alpha 0.01)" || status=$?
+    if [ "$status" -gt 1 ] || ! grep -q '^smallest p-value' <<<"$two_sample"; then
         echo "performance.sh: the two-sample comparison failed: $work kept" >&2
         trap - EXIT
         exit 1
     fi
+    if [ "$status" = 1 ]; then
+        echo "performance.sh: some p-value is below 0.01: the section says which" >&2
+    fi
+    # The seeds are shared, so the runs pair up: how many differ in outcome.
+    paired="$(python3 - "$work/runs-before-1.csv" "$work/runs-after-1.csv" <<'PY'
+import csv, sys
+a, b = (list(csv.DictReader(open(p))) for p in sys.argv[1:3])
+keys = ("outcome", "success", "declared", "declarations")
+differ = sum(1 for x, y in zip(a, b) if any(x[k] != y[k] for k in keys))
+print(f"{differ} of {len(a)}")
+PY
+)"
 fi
 
 section="$(python3 - "$work" "$pairs" "$seeds" "$jobs" <<'PY'
@@ -292,7 +314,9 @@ end="<!-- performance.sh end -->"
     echo
     if [ -n "$two_sample" ]; then
         echo "The first pair's two campaigns ($seeds seeds each, the same seeds), before against after"
-        echo "(\`scripts/two_sample.sh\`):"
+        echo "(\`scripts/two_sample.sh\`; its tests take the two campaigns as independent samples, which,"
+        echo "the seeds being the same, makes them conservative; run by run, $paired runs differ in"
+        echo "outcome, success or declarations):"
         echo
         echo "$two_sample"
         echo

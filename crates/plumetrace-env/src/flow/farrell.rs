@@ -618,7 +618,7 @@ impl FarrellFlow {
     /// Rebuilds the cells' bilinear coefficients from the interior nodes.
     fn build_cells(&mut self) {
         for (cells, nodes) in self.cell_rows() {
-            nodes.fill(cells, 0);
+            nodes.fill(cells);
         }
     }
 
@@ -667,15 +667,15 @@ struct RowNodes<'a> {
 }
 
 impl RowNodes<'_> {
-    /// Cells `from..` of the row, one at a time.
+    /// The row's cells, one at a time.
     #[inline(always)]
-    fn fill(&self, cells: &mut [Cell], from: usize) {
+    fn fill(&self, cells: &mut [Cell]) {
         let pairs = self
             .us
             .windows(2)
             .zip(self.un.windows(2))
             .zip(self.vs.windows(2).zip(self.vn.windows(2)));
-        for (cell, ((a, b), (c, d))) in cells.iter_mut().zip(pairs).skip(from) {
+        for (cell, ((a, b), (c, d))) in cells.iter_mut().zip(pairs) {
             cell.0 = cell_coefficients([a[0], a[1]], [b[0], b[1]], [c[0], c[1]], [d[0], d[1]])
                 .map(|c| c as f32);
         }
@@ -803,11 +803,12 @@ struct Axes32 {
 }
 
 impl FarrellFlow {
-    fn axes_f32(&self) -> Axes32 {
+    /// The grid's axes for positions measured from `origin`.
+    fn axes_f32(&self, origin: [f64; 2]) -> Axes32 {
         let (nx, ny) = (self.params.nx, self.params.ny);
         Axes32 {
-            x0: self.region.x_min_m as f32,
-            y0: self.region.y_min_m as f32,
+            x0: (self.region.x_min_m - origin[0]) as f32,
+            y0: (self.region.y_min_m - origin[1]) as f32,
             inv_dx: self.inv_dx as f32,
             inv_dy: self.inv_dy as f32,
             lx: (nx - 1) as f32,
@@ -841,6 +842,8 @@ fn cells_and_fractions(
 /// The single-precision batch lookup, as a [`pulp::WithSimd`] operation.
 struct Velocities<'a> {
     flow: &'a FarrellFlow,
+    /// The grid's axes for positions measured from the caller's origin.
+    axes: Axes32,
     x: &'a [f32],
     y: &'a [f32],
     u: &'a mut [f32],
@@ -852,8 +855,14 @@ impl pulp::WithSimd for Velocities<'_> {
 
     #[inline(always)]
     fn with_simd<S: pulp::Simd>(self, _simd: S) {
-        let Velocities { flow, x, y, u, v } = self;
-        let a = flow.axes_f32();
+        let Velocities {
+            flow,
+            axes: a,
+            x,
+            y,
+            u,
+            v,
+        } = self;
         let mut cell = [0.0; BATCH];
         let mut tx = [0.0; BATCH];
         let mut ty = [0.0; BATCH];
@@ -888,10 +897,17 @@ impl pulp::WithSimd for VelocitiesV4<'_> {
         use core::arch::x86_64::{__m256, __m512};
         let VelocitiesV4 {
             simd,
-            inner: Velocities { flow, x, y, u, v },
+            inner:
+                Velocities {
+                    flow,
+                    axes: a,
+                    x,
+                    y,
+                    u,
+                    v,
+                },
         } = self;
         let f = simd.avx512f;
-        let a = flow.axes_f32();
         let mut cell = [0.0f32; BATCH];
         let mut tx = [0.0f32; BATCH];
         let mut ty = [0.0f32; BATCH];
@@ -968,6 +984,7 @@ impl FarrellFlow {
     fn velocities_f32_on(
         &self,
         arch: pulp::Arch,
+        origin: [f64; 2],
         x: &[f32],
         y: &[f32],
         u: &mut [f32],
@@ -975,6 +992,7 @@ impl FarrellFlow {
     ) {
         let inner = Velocities {
             flow: self,
+            axes: self.axes_f32(origin),
             x,
             y,
             u,
@@ -990,9 +1008,10 @@ impl FarrellFlow {
 
 /// The cells' rebuild on AVX-512: eight cells of a row at a time, each coefficient of the eight
 /// taken in lanes (the same operations in the same order as [`FarrellFlow::build_cells`], so the
-/// same bits), then transposed into the eight cells; the cells past the last eight of a row one
-/// by one. (Compiled for AVX-512 without this, the plain loop writes each coefficient to its
-/// eight cells with scattered stores, slower than one cell at a time.)
+/// same bits), then transposed into the eight cells and rounded to single precision; the last
+/// eight cells of a row again where the row is not a multiple of eight, and a row shorter than
+/// eight one cell at a time. (Compiled for AVX-512 without this, the plain loop writes each
+/// coefficient to its eight cells with scattered stores, slower than one cell at a time.)
 #[cfg(target_arch = "x86_64")]
 struct BuildCellsV4<'a> {
     simd: pulp::x86::V4,
@@ -1013,7 +1032,7 @@ impl pulp::WithSimd for BuildCellsV4<'_> {
             }
             let row = cells.len();
             if row < 8 {
-                n.fill(cells, 0);
+                n.fill(cells);
                 continue;
             }
             // `f00, f10 - f00, f01 - f00, f11 - f10 - f01 + f00` of eight cells, left to right,
@@ -1098,8 +1117,8 @@ impl FlowField for FarrellFlow {
         let (u, v) = self.interp(pos_m.x, pos_m.y);
         Vec2::new(u, v)
     }
-    fn velocities_f32(&self, x: &[f32], y: &[f32], u: &mut [f32], v: &mut [f32]) {
-        self.velocities_f32_on(crate::simd::best(), x, y, u, v);
+    fn velocities_f32(&self, origin: [f64; 2], x: &[f32], y: &[f32], u: &mut [f32], v: &mut [f32]) {
+        self.velocities_f32_on(crate::simd::best(), origin, x, y, u, v);
     }
     fn advance(&mut self, t_new_s: f64, dt_s: f64, rng: &mut SimRng) -> Result<(), EnvError> {
         self.noise.update(dt_s, rng);
@@ -1469,20 +1488,24 @@ mod tests {
     #[test]
     fn batch_velocities_are_the_single_point_ones_bit_for_bit() {
         // The batch path (floors in floating point, sixteen points at a time on AVX-512) and a
-        // lookup of one point at a time with integer floors give the same bits everywhere:
+        // lookup of one point at a time with integer floors (written out here) give the same
+        // bits everywhere:
         // inside, on nodes, outside the grid, NaN; on every vector unit this CPU has.
         let f = meandering_pompy_flow(3);
-        let mut xs = Vec::new();
-        let mut ys = Vec::new();
-        for k in 0..997u32 {
+        // The special points first (in the vector lanes) and last (one at a time).
+        let special_x = [0.0, 5.0, 100.0, 99.999_99, f32::NAN, 50.0, f32::INFINITY];
+        let special_y = [0.0, -50.0, 50.0, 12.5, 3.0, f32::NAN, f32::NEG_INFINITY];
+        let mut xs = special_x.to_vec();
+        let mut ys = special_y.to_vec();
+        for k in 0..990u32 {
             let t = f64::from(k);
             xs.push((-20.0 + (t * 0.1371).rem_euclid(1.0) * 140.0) as f32);
             ys.push((-70.0 + (t * 0.7193).rem_euclid(1.0) * 140.0) as f32);
         }
-        xs.extend([0.0, 5.0, 100.0, 99.999_99, f32::NAN, 50.0, f32::INFINITY]);
-        ys.extend([0.0, -50.0, 50.0, 12.5, 3.0, f32::NAN, f32::NEG_INFINITY]);
+        xs.extend(special_x);
+        ys.extend(special_y);
         let (nx, ny) = (f.params.nx, f.params.ny);
-        let a = f.axes_f32();
+        let a = f.axes_f32([0.0, 0.0]);
         let weight = |p: f32, origin: f32, inv: f32, n: usize| -> (usize, f32) {
             let g = (p - origin) * inv;
             let g = if g > 0.0 { g } else { 0.0 };
@@ -1493,7 +1516,7 @@ mod tests {
         for arch in crate::simd::every() {
             let mut u = vec![0.0; xs.len()];
             let mut v = vec![0.0; xs.len()];
-            f.velocities_f32_on(arch, &xs, &ys, &mut u, &mut v);
+            f.velocities_f32_on(arch, [0.0, 0.0], &xs, &ys, &mut u, &mut v);
             for k in 0..xs.len() {
                 let (i, tx) = weight(xs[k], a.x0, a.inv_dx, nx);
                 let (j, ty) = weight(ys[k], a.y0, a.inv_dy, ny);

@@ -48,10 +48,10 @@ pub trait FlowField: Send + Sync + std::fmt::Debug {
         }
     }
 
-    /// [`FlowField::velocities`] in single precision: the filament hot path (the transport
-    /// moves filaments in single precision). By default through [`FlowField::velocities`], 64
-    /// points at a time.
-    fn velocities_f32(&self, x: &[f32], y: &[f32], u: &mut [f32], v: &mut [f32]) {
+    /// [`FlowField::velocities`] in single precision at positions measured from `origin` (the
+    /// filament hot path: the transport moves filaments in single precision, from the domain's
+    /// centre). By default through [`FlowField::velocities`], 64 points at a time.
+    fn velocities_f32(&self, origin: [f64; 2], x: &[f32], y: &[f32], u: &mut [f32], v: &mut [f32]) {
         const BATCH: usize = 64;
         let n = x.len().min(y.len()).min(u.len()).min(v.len());
         let (mut xd, mut yd, mut ud, mut vd) =
@@ -59,8 +59,8 @@ pub trait FlowField: Send + Sync + std::fmt::Debug {
         for start in (0..n).step_by(BATCH) {
             let m = (n - start).min(BATCH);
             for k in 0..m {
-                xd[k] = f64::from(x[start + k]);
-                yd[k] = f64::from(y[start + k]);
+                xd[k] = f64::from(x[start + k]) + origin[0];
+                yd[k] = f64::from(y[start + k]) + origin[1];
             }
             self.velocities(&xd[..m], &yd[..m], &mut ud[..m], &mut vd[..m]);
             for k in 0..m {
@@ -134,8 +134,8 @@ impl FlowField for FlowModel {
     fn velocities(&self, x: &[f64], y: &[f64], u: &mut [f64], v: &mut [f64]) {
         self.inner().velocities(x, y, u, v)
     }
-    fn velocities_f32(&self, x: &[f32], y: &[f32], u: &mut [f32], v: &mut [f32]) {
-        self.inner().velocities_f32(x, y, u, v)
+    fn velocities_f32(&self, origin: [f64; 2], x: &[f32], y: &[f32], u: &mut [f32], v: &mut [f32]) {
+        self.inner().velocities_f32(origin, x, y, u, v)
     }
     fn advance(&mut self, t_new_s: f64, dt_s: f64, rng: &mut SimRng) -> Result<(), EnvError> {
         self.inner_mut().advance(t_new_s, dt_s, rng)

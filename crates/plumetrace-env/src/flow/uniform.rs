@@ -43,7 +43,14 @@ impl FlowField for UniformFlow {
         u.fill(self.current_mps.x);
         v.fill(self.current_mps.y);
     }
-    fn velocities_f32(&self, _x: &[f32], _y: &[f32], u: &mut [f32], v: &mut [f32]) {
+    fn velocities_f32(
+        &self,
+        _origin: [f64; 2],
+        _x: &[f32],
+        _y: &[f32],
+        u: &mut [f32],
+        v: &mut [f32],
+    ) {
         u.fill(self.current_mps.x as f32);
         v.fill(self.current_mps.y as f32);
     }

@@ -164,8 +164,11 @@ pub struct FilamentPlume {
     sources: Vec<Source>,
     release: Vec<Option<Poisson<f64>>>,
     release_dt_s: f64,
-    /// Positions, m, in single precision (the transport's arithmetic too; every query reads
-    /// them widened to `f64`).
+    /// Where the positions are measured from: the domain's centre, so that single precision
+    /// resolves a position to within 6e-8 of the domain's half-width wherever the domain lies.
+    pub(crate) origin: [f64; 2],
+    /// Positions, m, from `origin` (`z` as it is), in single precision (the transport's
+    /// arithmetic too; every query reads them widened to `f64`).
     pub(crate) x: Column<f32>,
     pub(crate) y: Column<f32>,
     pub(crate) z: Column<f32>,
@@ -205,8 +208,9 @@ pub struct FilamentPlume {
 }
 
 /// Per run of [`STRAY_RUN`] filaments moved by the last transport (from the first), whether any
-/// of them is outside the domain or past the sink's line, as [`FilamentPlume::remove_outside`]
-/// tests them; the removal reads them instead of testing every filament again, and runs past
+/// of them may be outside the domain or past the sink's line (a test in single precision that
+/// flags at least what [`FilamentPlume::remove_outside`]'s test takes); the removal reads them
+/// instead of testing every filament again, and runs past
 /// `moved` (filaments released after the transport) are tested in full.
 #[derive(Debug, Clone, Default)]
 struct Strays {
@@ -351,6 +355,10 @@ impl FilamentPlume {
         }
         Ok(FilamentPlume {
             params,
+            origin: [
+                0.5 * (domain.x_min_m + domain.x_max_m),
+                0.5 * (domain.y_min_m + domain.y_max_m),
+            ],
             domain,
             release: vec![None; sources.len()],
             sources,
@@ -381,6 +389,7 @@ impl FilamentPlume {
     pub fn copy_state(&self) -> Self {
         FilamentPlume {
             params: self.params,
+            origin: self.origin,
             domain: self.domain,
             sources: self.sources.clone(),
             release: self.release.clone(),
@@ -457,8 +466,8 @@ impl FilamentPlume {
         (0..self.x.len()).map(|k| {
             (
                 Vec3::new(
-                    f64::from(self.x[k]),
-                    f64::from(self.y[k]),
+                    f64::from(self.x[k]) + self.origin[0],
+                    f64::from(self.y[k]) + self.origin[1],
                     f64::from(self.z[k]),
                 ),
                 self.radius_sq(k),
@@ -529,6 +538,13 @@ impl FilamentPlume {
         }
         self.index = OnceLock::new();
         self.boxes = OnceLock::new();
+        // The source from the origin, kept inside the domain (a source on its edge could
+        // otherwise round to just outside it).
+        let d = self.local_domain();
+        let x = ((s.pos_m.x - self.origin[0]) as f32)
+            .clamp(f32_at_least(d.x_min_m), f32_at_most(d.x_max_m));
+        let y = ((s.pos_m.y - self.origin[1]) as f32)
+            .clamp(f32_at_least(d.y_min_m), f32_at_most(d.y_max_m));
         let q = if s.filament_rate_hz > 0.0 {
             s.mass_rate_per_s / s.filament_rate_hz
         } else {
@@ -539,8 +555,8 @@ impl FilamentPlume {
             // happens to them; spread by SplitMix64 so that neighbouring keys are unrelated.
             let key = self.next_key();
             self.key.push(key);
-            self.x.push(s.pos_m.x as f32);
-            self.y.push(s.pos_m.y as f32);
+            self.x.push(x);
+            self.y.push(y);
             self.z.push(s.pos_m.z as f32);
             self.birth_s.push(birth_s);
             self.mass.push(q);
@@ -604,6 +620,25 @@ impl FilamentPlume {
         }
     }
 
+    /// The domain, from the origin (where the positions are measured from).
+    pub(crate) fn local_domain(&self) -> Rect {
+        let [ox, oy] = self.origin;
+        Rect {
+            x_min_m: self.domain.x_min_m - ox,
+            x_max_m: self.domain.x_max_m - ox,
+            y_min_m: self.domain.y_min_m - oy,
+            y_max_m: self.domain.y_max_m - oy,
+        }
+    }
+
+    /// The sink's direction and line, from the origin (without a sink nothing lies beyond it).
+    fn local_sink(&self) -> ([f64; 2], f64) {
+        let [ox, oy] = self.origin;
+        self.sink.map_or(([0.0, 0.0], f64::INFINITY), |s| {
+            (s.dir, s.beyond_m - (s.dir[0] * ox + s.dir[1] * oy))
+        })
+    }
+
     /// The heights where filaments reflect.
     fn floor_ceiling(&self) -> (f64, f64) {
         match self.params.vertical {
@@ -626,20 +661,16 @@ impl FilamentPlume {
         // The step's offset of every filament's noise counter (SplitMix64's increment).
         let offset = self.transport_steps.wrapping_mul(0x9e37_79b9_7f4a_7c15);
         self.transport_steps += 1;
-        // The sink's line moved out by the widest filament's cut-off (none: nothing beyond).
-        let (sink_dir, sink_line) = match self.sink {
-            Some(s) => {
-                // No filament is older than the plume's clock.
-                let widest = self.params.init_radius_m.powi(2)
-                    + self.params.growth_rate_m2ps * self.time_s.max(0.0);
-                (s.dir, s.beyond_m + self.params.cutoff_radii * widest.sqrt())
-            }
-            None => ([0.0, 0.0], f64::INFINITY),
-        };
-        let stray_line = self.sink.map_or(f64::INFINITY, |s| s.beyond_m);
+        // The sink's line (from the origin) moved out by the widest filament's cut-off (none:
+        // nothing beyond).
+        let (sink_dir, stray_line) = self.local_sink();
+        // No filament is older than the plume's clock.
+        let widest =
+            self.params.init_radius_m.powi(2) + self.params.growth_rate_m2ps * self.time_s.max(0.0);
+        let sink_line = stray_line + self.params.cutoff_radii * widest.sqrt();
         self.strays.runs.clear();
         self.strays.moved = self.x.len();
-        let d = self.domain;
+        let d = self.local_domain();
         // The removal tests the positions widened to f64; the transport's test in f32 flags at
         // least every filament that test would take (the domain's bounds rounded inwards, the
         // sink's line lowered by far more than the f32 sum's rounding).
@@ -657,9 +688,11 @@ impl FilamentPlume {
             z: &mut self.z,
             key: &self.key,
             flow,
+            origin: self.origin,
             dt_s: dt_s as f32,
             sd: [sx as f32, sy as f32, sz as f32],
-            floor_ceiling: (floor as f32, ceiling as f32),
+            // Rounded inwards, so that a reflected height stays in the water.
+            floor_ceiling: (f32_at_least(floor), f32_at_most(ceiling)),
             bounds,
             offset,
             sink: (
@@ -676,8 +709,9 @@ impl FilamentPlume {
             // The pass above reflected at the datum (the seabed's lowest point); here each
             // filament reflects at the seabed where it is.
             let (xs, ys, zs) = (&*self.x, &*self.y, &mut *self.z);
+            let [ox, oy] = self.origin;
             for k in 0..zs.len() {
-                let f = sb.height_at(f64::from(xs[k]), f64::from(ys[k]));
+                let f = sb.height_at(f64::from(xs[k]) + ox, f64::from(ys[k]) + oy);
                 let z = f64::from(zs[k]);
                 if z < f {
                     // Rounded up, so that it stays on or above the seabed.
@@ -699,6 +733,7 @@ impl FilamentPlume {
     ) -> bool {
         self.update_release_rates(dt_s);
         let (floor, ceiling) = self.floor_ceiling();
+        let local = self.local_domain();
         let mut left = false;
         for k in 0..self.sources.len() {
             let n = match &self.release[k] {
@@ -717,18 +752,22 @@ impl FilamentPlume {
                 let (sx, sy, sz) = self.walk_sd(age);
                 let n3 = crate::normal::normal_triple(rng.next_u64());
                 self.birth_s[i] = t_new_s - age;
-                let x = (src.x + vel.x * age + sx * n3[0]) as f32;
-                let y = (src.y + vel.y * age + sy * n3[1]) as f32;
+                // From the origin, the source first: the same steps wherever the domain lies.
+                let [ox, oy] = self.origin;
+                let x = ((src.x - ox) + vel.x * age + sx * n3[0]) as f32;
+                let y = ((src.y - oy) + vel.y * age + sy * n3[1]) as f32;
                 self.x[i] = x;
                 self.y[i] = y;
                 let (xw, yw) = (f64::from(x), f64::from(y));
                 let floor = match (&self.seabed, self.params.vertical) {
-                    (Some(sb), VerticalBoundary::Reflecting { .. }) => sb.height_at(xw, yw),
+                    (Some(sb), VerticalBoundary::Reflecting { .. }) => {
+                        sb.height_at(xw + ox, yw + oy)
+                    }
                     _ => floor,
                 };
                 // Rounded up, so that it stays on or above the seabed.
                 self.z[i] = f32_at_least(reflect(src.z + sz * n3[2], floor, ceiling));
-                left |= !self.domain.contains_xy(xw, yw);
+                left |= !local.contains_xy(xw, yw);
             }
         }
         left
@@ -741,19 +780,17 @@ impl FilamentPlume {
     /// filaments before the last one that goes move back over the gaps and the columns start
     /// later, so the filaments behind it are not moved (see [`Column`]).
     fn remove_outside(&mut self) {
-        let d = self.domain;
-        // Without a sink nothing lies beyond it.
-        let (dir, beyond_m) = self
-            .sink
-            .map_or(([0.0, 0.0], f64::INFINITY), |s| (s.dir, s.beyond_m));
+        // Both from the origin, as the positions are.
+        let d = self.local_domain();
+        let (dir, beyond_m) = self.local_sink();
         let cut = self.params.cutoff_radii;
         // The filaments that go, in order, each with whether it left the domain (else it lies
         // beyond the sink); most filaments are passed by comparisons alone.
         let mut gone: Vec<(usize, bool)> = Vec::new();
         // A run of filaments is passed at once when none of them is out of the domain or past
         // the sink's line: as the transport found it for the filaments it moved, else by a
-        // test without branches, which the compiler vectorises. (The transport's test is this
-        // one, on the same positions.)
+        // test without branches, which the compiler vectorises. (The transport's test, in
+        // single precision, flags at least every run this one takes on the same positions.)
         const RUN: usize = STRAY_RUN;
         let strays = &self.strays;
         let (xs, ys) = (&*self.x, &*self.y);
@@ -900,6 +937,7 @@ impl FilamentPlume {
     /// filaments' horizontal test is taken in its lanes).
     #[inline(always)]
     fn scan(&self, p: Vec3) -> f64 {
+        let p = self.measured_from_origin(p);
         let k = self.scan_terms();
         let boxes = self.boxes();
         let mut c = 0.0;
@@ -923,7 +961,14 @@ impl FilamentPlume {
     /// Concentration at `p` by scanning every filament: the reference the pruned scan is
     /// tested and benchmarked against.
     pub fn concentration_full_scan(&self, p: Vec3) -> f64 {
+        let p = self.measured_from_origin(p);
         self.sum_filaments(p, 0..self.x.len(), 0.0, &self.scan_terms())
+    }
+
+    /// `p` measured from the origin, as the positions are.
+    #[inline(always)]
+    fn measured_from_origin(&self, p: Vec3) -> Vec3 {
+        Vec3::new(p.x - self.origin[0], p.y - self.origin[1], p.z)
     }
 
     /// What a scan needs besides the point, worked out once per scan.
@@ -1013,7 +1058,7 @@ impl FilamentPlume {
         let z = f64::from(self.z[k]);
         // Over a seabed, the image is in the seabed where the filament is.
         let floor = match (&self.seabed, floor) {
-            (Some(sb), Some(_)) => Some(sb.height_at(x, y)),
+            (Some(sb), Some(_)) => Some(sb.height_at(x + self.origin[0], y + self.origin[1])),
             _ => floor,
         };
         for zc in [
@@ -1097,31 +1142,12 @@ impl pulp::WithSimd for BlockBoxes<'_> {
 
     #[inline(always)]
     fn with_simd<S: pulp::Simd>(self, simd: S) -> Vec<BlockBox> {
-        // The least and the greatest of `v`, a NaN passed over as `f64::min` does: each lane
-        // takes a value only where it compares below (above) the lane's extreme, which a NaN
-        // never does, so no lane is ever NaN (a vector minimum instruction would not do: some
-        // give NaN back, as Arm's does).
+        // The least and the greatest of positions `v`, widened, a NaN passed over as `f32::min`
+        // does: each lane takes a value only where it compares below (above) the lane's
+        // extreme, which a NaN never does, so no lane is ever NaN (a vector minimum instruction
+        // would not do: some give NaN back, as Arm's does).
         #[inline(always)]
-        fn extremes<S: pulp::Simd>(simd: S, v: &[f64], want_most: bool) -> (f64, f64) {
-            let (head, tail) = S::as_simd_f64s(v);
-            let mut least = simd.splat_f64s(f64::INFINITY);
-            let mut most = simd.splat_f64s(f64::NEG_INFINITY);
-            for &c in head {
-                least = simd.select_f64s(simd.less_than_f64s(c, least), c, least);
-                if want_most {
-                    most = simd.select_f64s(simd.greater_than_f64s(c, most), c, most);
-                }
-            }
-            let (mut l, mut m) = (simd.reduce_min_f64s(least), simd.reduce_max_f64s(most));
-            for &t in tail {
-                l = l.min(t);
-                m = m.max(t);
-            }
-            (l, m)
-        }
-        /// [`extremes`] of single-precision values, widened.
-        #[inline(always)]
-        fn extremes_f32<S: pulp::Simd>(simd: S, v: &[f32]) -> (f64, f64) {
+        fn extremes<S: pulp::Simd>(simd: S, v: &[f32]) -> (f64, f64) {
             let (head, tail) = S::as_simd_f32s(v);
             let mut least = simd.splat_f32s(f32::INFINITY);
             let mut most = simd.splat_f32s(f32::NEG_INFINITY);
@@ -1136,19 +1162,30 @@ impl pulp::WithSimd for BlockBoxes<'_> {
             }
             (f64::from(l), f64::from(m))
         }
+        // The least of release times `v`, the same way.
+        #[inline(always)]
+        fn least<S: pulp::Simd>(simd: S, v: &[f64]) -> f64 {
+            let (head, tail) = S::as_simd_f64s(v);
+            let mut least = simd.splat_f64s(f64::INFINITY);
+            for &c in head {
+                least = simd.select_f64s(simd.less_than_f64s(c, least), c, least);
+            }
+            tail.iter()
+                .fold(simd.reduce_min_f64s(least), |l, &t| l.min(t))
+        }
         let BlockBoxes { x, y, birth_s } = self;
         x.chunks(SCAN_BLOCK)
             .zip(y.chunks(SCAN_BLOCK))
             .zip(birth_s.chunks(SCAN_BLOCK))
             .map(|((bx, by), bb)| {
-                let (x_min, x_max) = extremes_f32(simd, bx);
-                let (y_min, y_max) = extremes_f32(simd, by);
+                let (x_min, x_max) = extremes(simd, bx);
+                let (y_min, y_max) = extremes(simd, by);
                 BlockBox {
                     x_min,
                     x_max,
                     y_min,
                     y_max,
-                    birth_min_s: extremes(simd, bb, false).0,
+                    birth_min_s: least(simd, bb),
                 }
             })
             .collect()
@@ -1163,6 +1200,8 @@ struct Transport<'a> {
     z: &'a mut [f32],
     key: &'a [u64],
     flow: &'a dyn FlowField,
+    /// Where the positions are measured from.
+    origin: [f64; 2],
     dt_s: f32,
     sd: [f32; 3],
     floor_ceiling: (f32, f32),
@@ -1187,6 +1226,7 @@ impl pulp::WithSimd for Transport<'_> {
             z,
             key,
             flow,
+            origin,
             dt_s,
             sd: [sx, sy, sz],
             floor_ceiling: (floor, ceiling),
@@ -1213,7 +1253,7 @@ impl pulp::WithSimd for Transport<'_> {
             .zip(key.chunks(TRANSPORT_CHUNK))
         {
             let m = xs.len();
-            flow.velocities_f32(xs, ys, &mut u[..m], &mut v[..m]);
+            flow.velocities_f32(origin, xs, ys, &mut u[..m], &mut v[..m]);
             for (w, k) in words.iter_mut().zip(keys) {
                 *w = splitmix64_mix(k.wrapping_add(offset));
             }
@@ -1393,27 +1433,40 @@ mod tests {
         };
         let mut p = plume_with_source(region, (50.0, 50.0), 1.0, params);
         p.release_at_source(0, 64 * 6);
+        // A sink line across the domain at 80 degrees, so that its test rounds in both axes.
+        let a = 80f64.to_radians();
         let sink = DownflowSink {
-            dir: [1.0, 0.0],
-            beyond_m: 90.3,
+            dir: [a.cos(), a.sin()],
+            beyond_m: 70.3,
         };
         p.set_sink(Some(sink));
+        // Positions are from the plume's origin (the domain's centre), as the removal sees them.
+        let d = p.local_domain();
+        let (dir, line) = p.local_sink();
         let near = |v: f64| [f32_at_most(v), f32_at_least(v)];
+        // The least f32 height at x = 0 past the sink's line.
+        let past = {
+            let mut y = f32_at_least(line / dir[1]);
+            while dir[1] * f64::from(y) <= line {
+                y = y.next_up();
+            }
+            y
+        };
         // Run r gets its odd filament at slot 7; run 0 none.
         let odd = [
             None,
-            Some((near(100.1)[1], 50.0)),
-            Some((near(-0.3)[0], 50.0)),
-            Some((near(90.3)[1], 50.0)),
-            Some((50.0, near(99.7)[0])),
-            Some((50.0, f32::NAN)),
+            Some((near(d.x_max_m)[1], 0.0)),
+            Some((near(d.x_min_m)[0], 0.0)),
+            Some((0.0, past)),
+            Some((near(d.x_min_m)[1], 0.0)),
+            Some((0.0, f32::NAN)),
         ];
         for (r, o) in odd.iter().enumerate() {
             for i in 0..64 {
                 let k = r * 64 + i;
                 (p.x[k], p.y[k]) = match (*o, i) {
                     (Some(xy), 7) => xy,
-                    _ => (40.0, 50.0),
+                    _ => (-10.0, -20.0),
                 };
             }
         }
@@ -1422,14 +1475,14 @@ mod tests {
             toward_deg: 0.0,
         })
         .unwrap_or_else(|e| panic!("{e}"));
-        let d = region;
+        // The removal's test.
         let takes = |x: f32, y: f32| {
             let (x, y) = (f64::from(x), f64::from(y));
             !((x >= d.x_min_m)
                 & (x <= d.x_max_m)
                 & (y >= d.y_min_m)
                 & (y <= d.y_max_m)
-                & (x <= sink.beyond_m))
+                & (dir[0] * x + dir[1] * y <= line))
         };
         for arch in crate::simd::every() {
             let mut q = p.copy_state();
@@ -1440,12 +1493,62 @@ mod tests {
             // The removal's test takes runs 1, 2, 3 and 5 (not 4, just inside), and the
             // positions did not move.
             assert_eq!(taken, [false, true, true, true, false, true], "{arch:?}");
-            assert_eq!(q.x[64 + 7], near(100.1)[1]);
+            assert_eq!(q.y[3 * 64 + 7], past);
             for (r, &t) in taken.iter().enumerate() {
                 assert!(q.strays.runs[r] || !t, "run {r} not flagged on {arch:?}");
             }
             assert!(!q.strays.runs[0], "a run well inside flagged on {arch:?}");
         }
+    }
+
+    #[test]
+    fn a_domain_far_from_the_frame_s_origin_moves_its_filaments_as_one_near_it() {
+        // Positions are kept from the domain's centre: the same plume 500 km east and 5,000 km
+        // north (coordinates as large as UTM's) takes the same steps, bit for bit, where
+        // positions from the frame's origin would be rounded to 0.5 m.
+        let (dx, dy) = (500_000.0, 5_000_000.0);
+        let near = Rect {
+            x_min_m: 0.0,
+            x_max_m: 1000.0,
+            y_min_m: 0.0,
+            y_max_m: 400.0,
+        };
+        let far = Rect {
+            x_min_m: near.x_min_m + dx,
+            x_max_m: near.x_max_m + dx,
+            y_min_m: near.y_min_m + dy,
+            y_max_m: near.y_max_m + dy,
+        };
+        let flow = crate::flow::UniformFlow::new(MeanFlow::Steady {
+            speed_mps: 0.1,
+            toward_deg: 80.0,
+        })
+        .unwrap_or_else(|e| panic!("{e}"));
+        let params = FilamentParams::default();
+        let mut a = plume_with_source(near, (100.0, 200.0), 2.0, params);
+        let mut b = plume_with_source(far, (100.0 + dx, 200.0 + dy), 2.0, params);
+        let (mut ra, mut rb) = (
+            stream_rng(5, StreamId::Plume),
+            stream_rng(5, StreamId::Plume),
+        );
+        for k in 1..=300u32 {
+            a.step(&flow, f64::from(k), 1.0, &mut ra);
+            b.step(&flow, f64::from(k), 1.0, &mut rb);
+        }
+        assert!(a.len() > 400, "{} filaments", a.len());
+        let bits = |p: &FilamentPlume| -> Vec<[u32; 3]> {
+            (0..p.len())
+                .map(|k| [p.x[k].to_bits(), p.y[k].to_bits(), p.z[k].to_bits()])
+                .collect()
+        };
+        assert!(bits(&a) == bits(&b));
+        // Read back in the frame, a filament of the far plume is its near twin moved by (dx, dy).
+        for ((pa, _), (pb, _)) in a.filaments().zip(b.filaments()) {
+            assert!((pb.x - pa.x - dx).abs() < 1e-6 && (pb.y - pa.y - dy).abs() < 1e-6);
+        }
+        let q = |p: &FilamentPlume, x: f64, y: f64| p.concentration_full_scan(Vec3::new(x, y, 1.0));
+        let (ca, cb) = (q(&a, 130.0, 205.0), q(&b, 130.0 + dx, 205.0 + dy));
+        assert!(ca > 0.0 && (ca - cb).abs() <= 1e-6 * ca, "{ca} {cb}");
     }
 
     /// A Farrell flow over `region` with a mean of `speed_mps` toward 80 degrees, stepped at
@@ -1487,11 +1590,13 @@ mod tests {
                     5 => (80.05, 50.0, true),
                     _ => (10.0 + (k % 60) as f64, 50.0, true),
                 };
-                p.x[k] = x as f32;
-                p.y[k] = y as f32;
+                // Stored from the plume's origin.
+                let (x, y) = ((x - p.origin[0]) as f32, (y - p.origin[1]) as f32);
+                p.x[k] = x;
+                p.y[k] = y;
                 p.mass[k] = k as f64;
                 if stays {
-                    kept.push((x as f32, k as f64, p.key[k]));
+                    kept.push((x, k as f64, p.key[k]));
                 }
             }
             let before = p.stats();
@@ -1543,7 +1648,8 @@ mod tests {
             p.transport(&flow, dt);
             p.release_at_source(0, 3);
             let last = p.len() - 1;
-            p.x[last] = -5.0;
+            // At x = -5 m, from the origin.
+            p.x[last] = (-5.0 - p.origin[0]) as f32;
             flagged += p.strays.runs.iter().filter(|&&r| r).count();
             let mut full = p.copy_state();
             assert!(full.strays.runs.is_empty());
@@ -1598,8 +1704,8 @@ mod tests {
         for k in 0..p.len() {
             // Clusters 20 m wide, so that some blocks are near a point and others not.
             let centre = (k / 64 % 4) as f64 * 25.0 + 10.0;
-            p.x[k] = (centre + rng.random::<f64>() * 20.0) as f32;
-            p.y[k] = (centre + rng.random::<f64>() * 20.0) as f32;
+            p.x[k] = (centre + rng.random::<f64>() * 20.0 - p.origin[0]) as f32;
+            p.y[k] = (centre + rng.random::<f64>() * 20.0 - p.origin[1]) as f32;
             p.z[k] = (rng.random::<f64>() * 3.0) as f32;
             p.birth_s[k] = rng.random::<f64>() * 600.0;
             p.mass[k] = 1.0 + rng.random::<f64>();
@@ -1616,7 +1722,11 @@ mod tests {
                 rng.random::<f64>() * 100.0,
                 if i % 3 == 0 { 0.5 } else { 2.0 },
             );
-            let plain = (0..p.len()).fold(0.0, |c, k| p.add_filament(q, k, c, &terms));
+            // `add_filament` takes the point from the origin, as the scan gives it.
+            let measured_from_origin = p.measured_from_origin(q);
+            let plain = (0..p.len()).fold(0.0, |c, k| {
+                p.add_filament(measured_from_origin, k, c, &terms)
+            });
             reached += usize::from(plain > 0.0);
             for arch in crate::simd::every() {
                 let scanned = arch.dispatch(Scan { plume: &p, p: q });

@@ -83,11 +83,15 @@ impl CellIndex {
             &*plume.birth_s,
             &*plume.mass,
         );
+        // Filament k's position in the plane, back from the plume's origin.
+        let [ox, oy] = plume.origin;
+        let wide_x = |k: usize| f64::from(px[k]) + ox;
+        let wide_y = |k: usize| f64::from(py[k]) + oy;
         // Over a seabed each filament's image in the seabed where it is joins the index as an
         // entry of its own (after the filaments), and no image is taken at z = 0.
         let images: Vec<f64> = match (seabed, vertical) {
             (Some(sb), VerticalBoundary::Reflecting { .. }) => (0..n)
-                .map(|k| 2.0 * sb.height_at(f64::from(px[k]), f64::from(py[k])) - f64::from(pz[k]))
+                .map(|k| 2.0 * sb.height_at(wide_x(k), wide_y(k)) - f64::from(pz[k]))
                 .collect(),
             _ => Vec::new(),
         };
@@ -122,7 +126,7 @@ impl CellIndex {
         let mut cells = Vec::with_capacity(total);
         for e in 0..total {
             let k = of(e).0;
-            let c = cell_of(f64::from(px[k]), f64::from(py[k]));
+            let c = cell_of(wide_x(k), wide_y(k));
             cells.push(c as u32);
             starts[c + 1] += 1;
         }
@@ -148,8 +152,8 @@ impl CellIndex {
             let (k, z) = of(e);
             let r2 = plume.radius_sq_born(pb[k]);
             entries[slot] = Entry {
-                x: f64::from(px[k]),
-                y: f64::from(py[k]),
+                x: wide_x(k),
+                y: wide_y(k),
                 z,
                 lim2: cut2 * r2,
                 amp: pm[k] / (norm * r2 * r2.sqrt()),
