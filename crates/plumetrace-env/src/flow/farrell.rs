@@ -839,6 +839,13 @@ fn cells_and_fractions(
     m
 }
 
+/// The cell of whole-number index `at` (below the cell count, exactly; the last cell for
+/// anything beyond).
+#[inline(always)]
+fn cell_at(cells: &[Cell], at: f32) -> &Cell {
+    &cells[(at as usize).min(cells.len() - 1)]
+}
+
 /// The single-precision batch lookup, as a [`pulp::WithSimd`] operation.
 struct Velocities<'a> {
     flow: &'a FarrellFlow,
@@ -872,8 +879,7 @@ impl pulp::WithSimd for Velocities<'_> {
         for ((xs, ys), (us, vs)) in points.zip(places) {
             let m = cells_and_fractions(a, xs, ys, &mut cell, &mut tx, &mut ty);
             for (k, (u, v)) in us.iter_mut().zip(vs.iter_mut()).enumerate().take(m) {
-                let c = &cells[(cell[k] as usize).min(cells.len() - 1)];
-                (*u, *v) = bilinear_f32(c, tx[k], ty[k]);
+                (*u, *v) = bilinear_f32(cell_at(cells, cell[k]), tx[k], ty[k]);
             }
         }
     }
@@ -972,8 +978,7 @@ impl pulp::WithSimd for VelocitiesV4<'_> {
                 *v = pulp::cast(sum(&cv));
             }
             for k in m / 16 * 16..m {
-                let c = &cells[(cell[k] as usize).min(cells.len() - 1)];
-                (us[k], vs[k]) = bilinear_f32(c, tx[k], ty[k]);
+                (us[k], vs[k]) = bilinear_f32(cell_at(cells, cell[k]), tx[k], ty[k]);
             }
         }
     }

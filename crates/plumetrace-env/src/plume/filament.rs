@@ -621,7 +621,7 @@ impl FilamentPlume {
     }
 
     /// The domain, from the origin (where the positions are measured from).
-    pub(crate) fn local_domain(&self) -> Rect {
+    fn local_domain(&self) -> Rect {
         let [ox, oy] = self.origin;
         Rect {
             x_min_m: self.domain.x_min_m - ox,
