@@ -102,6 +102,7 @@ impl Environment {
         crate::error::require_positive("dt_s", dt_s)?;
         let mut plume = plume;
         if let Plume::Filaments(p) = &mut plume {
+            p.check_step(dt_s, &flow)?;
             p.set_key_seed(stream_rng(seed, StreamId::PlumeKeys).next_u64());
         }
         Ok(Environment {
@@ -119,6 +120,17 @@ impl Environment {
         })
     }
 
+    /// Refuses a step of `dt_s` that moves a filament plume's filaments by too little for their
+    /// single-precision positions ([`FilamentPlume::check_step`]; key `dt_s`). [`Environment::new`]
+    /// checks its step and [`Environment::spin_up`] its own; a caller that names its keys
+    /// otherwise checks them first.
+    pub fn check_step(&self, dt_s: f64) -> Result<(), EnvError> {
+        match &self.plume {
+            Plume::Filaments(p) => p.check_step(dt_s, &self.flow),
+            Plume::Steady(_) => Ok(()),
+        }
+    }
+
     /// Develops the plume before the run starts: `duration_s` of simulated time in steps of
     /// `dt_s` (coarser than the run's step: the physics does not depend on the step, and a
     /// kilometre of plume in a 0.1 m/s current needs hours to form). The run's clock then starts
@@ -127,6 +139,10 @@ impl Environment {
     pub fn spin_up(&mut self, duration_s: f64, dt_s: f64) -> Result<(), EnvError> {
         crate::error::require_non_negative("spinup_s", duration_s)?;
         crate::error::require_positive("spinup_dt_s", dt_s)?;
+        if duration_s > 0.0 {
+            self.check_step(dt_s)
+                .map_err(|e| e.renamed("spinup_dt_s"))?;
+        }
         let n = (duration_s / dt_s).round() as u64;
         let start = self.elapsed_s();
         for k in 1..=n {

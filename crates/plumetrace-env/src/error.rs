@@ -41,6 +41,17 @@ impl EnvError {
         }
     }
 
+    /// The error with its parameter `dt_s` named `key` instead (a caller that calls a step by
+    /// its own name); other errors are returned as they are.
+    pub fn renamed(self, key: &str) -> Self {
+        match self {
+            EnvError::InvalidParameter { key: k, message } if k == "dt_s" => {
+                EnvError::invalid(key, message)
+            }
+            other => other,
+        }
+    }
+
     /// The error with its parameter placed under `path` ([`join_key`]): a model names only its
     /// own fields, and whoever holds it says where it sits (`vehicles[0].nav` of a scenario).
     /// Other errors are returned as they are.

@@ -1020,3 +1020,48 @@ fn a_display_grid_is_within_a_few_units_in_the_last_place_and_the_same_whatever_
         assert!(nonzero > 100, "{nonzero} points with a concentration");
     }
 }
+
+#[test]
+fn the_environment_refuses_steps_too_short_for_single_precision_positions() {
+    // A 200 km strip: positions 100 km from its centre round to 3.9 mm, and a walk of 0.01
+    // m^2/s moves filaments 1.4 cm in 0.01 s (refused) and 4.5 cm in 0.1 s.
+    let domain = rect(0.0, 200_000.0, 0.0, 100.0);
+    let src = Source {
+        pos_m: Vec3::new(150_000.0, 50.0, 1.0),
+        mass_rate_per_s: 1.0,
+        filament_rate_hz: 1.0,
+    };
+    let params = FilamentParams {
+        dispersion: Dispersion::Physical {
+            horizontal_m2ps: 0.01,
+            vertical_m2ps: 0.001,
+        },
+        ..FilamentParams::default()
+    };
+    let env = |dt: f64| {
+        let plume = FilamentPlume::new(domain, vec![src], params).unwrap();
+        let flow = FlowModel::Uniform(UniformFlow::new(east(0.1)).unwrap());
+        let plume = Plume::Filaments(Box::new(plume));
+        Environment::new(domain, flow, plume, ObstacleSet::default(), dt, 1)
+    };
+    let e = env(0.01).err().map(|e| e.to_string()).unwrap_or_default();
+    assert!(
+        e.starts_with("dt_s: a step of 0.01 s moves filaments east"),
+        "{e}"
+    );
+    let mut ok = env(0.1).unwrap();
+    // The spin-up checks its own step, and a spin-up of no time has none.
+    let e = ok
+        .spin_up(10.0, 0.01)
+        .err()
+        .map(|e| e.to_string())
+        .unwrap_or_default();
+    assert!(
+        e.starts_with("spinup_dt_s: a step of 0.01 s moves filaments east"),
+        "{e}"
+    );
+    assert_eq!(ok.elapsed_s(), 0.0, "nothing stepped before the error");
+    ok.spin_up(0.0, 0.01).unwrap();
+    ok.spin_up(1.0, 0.1).unwrap();
+    assert!((ok.elapsed_s() - 1.0).abs() < 1e-12);
+}

@@ -5,7 +5,8 @@
 //! matched to its key (array indices written `[]`), so a value out of range is refused with its key
 //! path and the bound, and a number whose key has no entry is refused too (a key added to the file
 //! format without a bound fails the tests). Planner keys are the planner registry's to check.
-//! Bounds that involve several keys (steps per run, positions inside the domain, stable steps)
+//! Bounds that involve several keys (steps per run, positions inside the domain, stable steps, a
+//! filament plume's steps long enough for its single-precision positions)
 //! are checked when the models are built.
 //!
 //! Each key's bound lives here alone: the build checks no number against a bound of its own.

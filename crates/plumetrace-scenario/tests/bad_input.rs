@@ -860,6 +860,65 @@ fn flow_sub_steps_count_in_the_step_budget_with_their_grid() {
 }
 
 #[test]
+fn a_step_too_short_for_single_precision_positions_names_its_key() {
+    // Filament positions are single precision, from the domain's centre: in a 200 km domain
+    // a walk of 1.4 cm a step (0.01 m^2/s over 0.01 s) is less than five roundings (3.9 mm).
+    let wide = demo_with(|t| {
+        t.replacen("x_max_m = 200.0", "x_max_m = 200000.0", 1)
+            .replacen("dt_s = 0.1", "dt_s = 0.01", 1)
+            .replacen(
+                "horizontal_diffusivity_m2ps = 0.02",
+                "horizontal_diffusivity_m2ps = 0.01",
+                1,
+            )
+    });
+    let e = error_of(&wide);
+    assert!(
+        e.contains("scenario.toml: sim.dt_s: a step of 0.01 s moves filaments east by about")
+            && e.contains("lengthen the step or narrow the domain"),
+        "{e}"
+    );
+    let longer_step = demo_with(|t| {
+        t.replacen("x_max_m = 200.0", "x_max_m = 200000.0", 1)
+            .replacen(
+                "horizontal_diffusivity_m2ps = 0.02",
+                "horizontal_diffusivity_m2ps = 0.01",
+                1,
+            )
+    });
+    assert_eq!(error_of(&longer_step), "accepted");
+    // A mission's plume steps at mission.env_dt_s, and at mission.spinup_dt_s in its spin-up:
+    // heights up to 8 m round to 0.48 micrometres, and a vertical walk of 1e-6 m is lost.
+    let demo = |kv: &str, spinup_dt: &str| {
+        find_preset("demo")
+            .unwrap()
+            .toml
+            .replacen(
+                "vertical_diffusivity_m2ps = 0.001",
+                &format!("vertical_diffusivity_m2ps = {kv}"),
+                1,
+            )
+            .replacen(
+                "spinup_dt_s = 30.0",
+                &format!("spinup_dt_s = {spinup_dt}"),
+                1,
+            )
+    };
+    let e = error_of(&demo("1e-13", "30.0"));
+    assert!(
+        e.contains("mission.env_dt_s: a step of 5 s moves filaments up by about 1.000e-6 m")
+            && e.contains("at the water's depth, 8 m"),
+        "{e}"
+    );
+    let e = error_of(&demo("1e-12", "1.0"));
+    assert!(
+        e.contains("mission.spinup_dt_s: a step of 1 s moves filaments up"),
+        "{e}"
+    );
+    assert_eq!(error_of(&demo("1e-12", "30.0")), "accepted");
+}
+
+#[test]
 fn a_key_that_is_not_bare_is_quoted_in_the_error_path() {
     let demo = find_preset("demo").unwrap().toml;
     let text = format!("{demo}\n[planners]\n\"\" = \"x\"\n");

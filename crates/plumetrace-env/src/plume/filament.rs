@@ -438,6 +438,98 @@ impl FilamentPlume {
         &self.params
     }
 
+    /// The least a step may move filaments along an axis, in units of the largest rounding of a
+    /// stored position along it ([`FilamentPlume::check_step`]). Where the walk is at least this
+    /// move, the rounding adds at most 1.3 % to its variance per step (`1 / (3 x 5^2)`: a
+    /// rounding lies evenly within its bound), and less away from the domain's edges and the
+    /// surface; where the current is, the rounding is at most a fifth of its move.
+    pub const MIN_MOVE_IN_ROUNDINGS: f64 = 5.0;
+
+    /// The largest rounding of a stored position, m, east, north and up: half the spacing of
+    /// `f32` at the farthest a filament can be from where it is measured from (the domain's
+    /// half-width and half-height from its centre; for heights, from the datum up to the
+    /// water's depth, `None` where no depth bounds them).
+    pub fn position_rounding_m(&self) -> [Option<f64>; 3] {
+        fn half_spacing(m: f64) -> f64 {
+            // The spacing just above `m`: at a power of two, the wider of the two around it.
+            let f = (m.abs() as f32).max(f32::MIN_POSITIVE);
+            0.5 * (f64::from(f.next_up()) - f64::from(f))
+        }
+        let height = match self.params.vertical {
+            VerticalBoundary::Reflecting { depth_m: Some(d) } => Some(half_spacing(d)),
+            _ => None,
+        };
+        [
+            Some(half_spacing(0.5 * self.domain.width_m())),
+            Some(half_spacing(0.5 * self.domain.height_m())),
+            height,
+        ]
+    }
+
+    /// Refuses a step of `dt_s` that moves filaments too little for single-precision positions
+    /// to hold the move ([`FilamentPlume::MIN_MOVE_IN_ROUNDINGS`] times
+    /// [`FilamentPlume::position_rounding_m`]): a very wide domain stepped very often. A step's
+    /// move east or north is the larger of the random walk's standard deviation over it and the
+    /// current's move at the sources (`flow` as it is now); up, the walk's. An axis that does not
+    /// move at all is not checked. The error's key is `dt_s`.
+    pub fn check_step(&self, dt_s: f64, flow: &dyn FlowField) -> Result<(), EnvError> {
+        let walk = self.walk_sd(dt_s);
+        let rounding = self.position_rounding_m();
+        let depth = match self.params.vertical {
+            VerticalBoundary::Reflecting { depth_m: Some(d) } => d,
+            _ => 0.0,
+        };
+        let current = self
+            .sources
+            .iter()
+            .map(|s| flow.velocity(s.pos_m.xy()).norm())
+            .fold(0.0, f64::max)
+            * dt_s;
+        let axes = [
+            ("east", walk.0, current, rounding[0]),
+            ("north", walk.1, current, rounding[1]),
+            ("up", walk.2, 0.0, rounding[2]),
+        ];
+        for (axis, walk, current, rounding) in axes {
+            let (step, what) = if walk >= current {
+                (walk, "the random walk's standard deviation")
+            } else {
+                (current, "the current at the sources")
+            };
+            let Some(r) = rounding else { continue };
+            if step > 0.0 && step < Self::MIN_MOVE_IN_ROUNDINGS * r {
+                let (far, cure) = match axis {
+                    "up" => (
+                        format!("at the water's depth, {depth} m"),
+                        "lengthen the step or raise the vertical diffusivity",
+                    ),
+                    _ => (
+                        format!(
+                            "at the domain's edge, {} m from its centre",
+                            0.5 * if axis == "east" {
+                                self.domain.width_m()
+                            } else {
+                                self.domain.height_m()
+                            }
+                        ),
+                        "lengthen the step or narrow the domain",
+                    ),
+                };
+                return Err(EnvError::invalid(
+                    "dt_s",
+                    format!(
+                        "a step of {dt_s} s moves filaments {axis} by about {step:.3e} m ({what}), \
+                         less than {} times the largest rounding of a position kept in single \
+                         precision ({r:.3e} m, {far}): the positions could not hold the \
+                         move; {cure}",
+                        Self::MIN_MOVE_IN_ROUNDINGS
+                    ),
+                ));
+            }
+        }
+        Ok(())
+    }
+
     /// Running totals.
     pub fn stats(&self) -> PlumeStats {
         PlumeStats {
@@ -1549,6 +1641,119 @@ mod tests {
         let q = |p: &FilamentPlume, x: f64, y: f64| p.concentration_full_scan(Vec3::new(x, y, 1.0));
         let (ca, cb) = (q(&a, 130.0, 205.0), q(&b, 130.0 + dx, 205.0 + dy));
         assert!(ca > 0.0 && (ca - cb).abs() <= 1e-6 * ca, "{ca} {cb}");
+    }
+
+    /// A still or steady current of `speed_mps` toward the east.
+    fn current_east(speed_mps: f64) -> crate::flow::UniformFlow {
+        crate::flow::UniformFlow::new(MeanFlow::Steady {
+            speed_mps,
+            toward_deg: 90.0,
+        })
+        .unwrap_or_else(|e| panic!("{e}"))
+    }
+
+    /// 200 km east by 100 m north: positions 100 km from the centre round to 3.9 mm.
+    fn long_strip() -> Rect {
+        Rect::new(0.0, 200_000.0, 0.0, 100.0).unwrap_or_else(|e| panic!("{e}"))
+    }
+
+    #[test]
+    fn a_step_too_short_for_single_precision_positions_is_refused() {
+        let walk = |horizontal_m2ps, vertical_m2ps, depth_m| FilamentParams {
+            dispersion: Dispersion::Physical {
+                horizontal_m2ps,
+                vertical_m2ps,
+            },
+            vertical: VerticalBoundary::Reflecting { depth_m },
+            ..FilamentParams::default()
+        };
+        let still = current_east(0.0);
+        let wide = plume_with_source(long_strip(), (150_000.0, 50.0), 1.0, walk(0.01, 0.0, None));
+        let [east, north, up] = wide.position_rounding_m();
+        assert_eq!(
+            east,
+            Some(1.0 / 256.0),
+            "half of f32's spacing between 65,536 and 131,072"
+        );
+        assert!(north.is_some_and(|r| r < 1e-5) && up.is_none());
+        // The walk: sqrt(2 K dt) = 1.4 cm at 0.01 s, under 5 x 3.9 mm; 4.5 cm at 0.1 s.
+        let e = wide.check_step(0.01, &still).err().map(|e| e.to_string());
+        let e = e.unwrap_or_else(|| panic!("a 0.01 s step over 200 km accepted"));
+        for part in [
+            "dt_s: a step of 0.01 s moves filaments east",
+            "random walk",
+            "narrow",
+        ] {
+            assert!(e.contains(part), "{part:?} not in {e}");
+        }
+        assert!(wide.check_step(0.1, &still).is_ok());
+        // Without a walk, the current's move: 0.5 m/s moves 5 mm in 0.01 s, 5 cm in 0.1 s.
+        let drift = plume_with_source(long_strip(), (150_000.0, 50.0), 1.0, walk(0.0, 0.0, None));
+        let e = drift
+            .check_step(0.01, &current_east(0.5))
+            .err()
+            .map(|e| e.to_string());
+        assert!(e.is_some_and(|e| e.contains("the current at the sources")));
+        assert!(drift.check_step(0.1, &current_east(0.5)).is_ok());
+        // Nothing moves, nothing to hold.
+        assert!(drift.check_step(0.01, &still).is_ok());
+        // Heights up to a 6,000 m depth round to 0.24 mm: a vertical walk of 4.5e-6 m is lost.
+        let deep = plume_with_source(square(), (50.0, 50.0), 1.0, walk(0.01, 1e-9, Some(6000.0)));
+        let e = deep.check_step(0.01, &still).err().map(|e| e.to_string());
+        assert!(e.is_some_and(|e| e.contains("filaments up") && e.contains("6000 m")));
+        let shallow = plume_with_source(square(), (50.0, 50.0), 1.0, walk(0.01, 1e-9, Some(10.0)));
+        assert!(shallow.check_step(0.01, &still).is_ok());
+        // Every preset-sized domain passes at its step (a test of the scenario crate checks the
+        // presets themselves).
+        assert!(
+            plume_with_source(square(), (50.0, 50.0), 1.0, walk(0.02, 0.002, None))
+                .check_step(0.01, &still)
+                .is_ok()
+        );
+    }
+
+    #[test]
+    fn a_walk_at_the_refused_bound_keeps_its_variance_and_one_below_it_is_lost() {
+        // 20,000 filaments 99 km east of the centre of a 200 km strip (positions rounded to
+        // 3.9 mm), walking 100 steps in still water with a standard deviation of `sd` a step:
+        // the spread of their moves against the walk's own, 100 sd^2.
+        let spread = |sd: f64| -> f64 {
+            let k = 0.01;
+            let dt = sd * sd / (2.0 * k);
+            let params = FilamentParams {
+                dispersion: Dispersion::Physical {
+                    horizontal_m2ps: k,
+                    vertical_m2ps: 0.0,
+                },
+                ..FilamentParams::default()
+            };
+            let mut p = plume_with_source(long_strip(), (199_000.0, 50.0), 1.0, params);
+            p.set_key_seed(11);
+            p.release_at_source(0, 20_000);
+            let start: Vec<f64> = p.x.iter().map(|&x| f64::from(x)).collect();
+            assert!(start.iter().all(|&x| x == 99_000.0));
+            let still = current_east(0.0);
+            for _ in 0..100 {
+                p.transport_on(crate::simd::best(), &still, dt);
+            }
+            let moves: Vec<f64> =
+                p.x.iter()
+                    .zip(&start)
+                    .map(|(&x, s)| f64::from(x) - s)
+                    .collect();
+            let n = moves.len() as f64;
+            let mean = moves.iter().sum::<f64>() / n;
+            let var = moves.iter().map(|m| (m - mean).powi(2)).sum::<f64>() / (n - 1.0);
+            var / (100.0 * sd * sd)
+        };
+        let r = 1.0 / 256.0;
+        // At the bound the rounding adds at most 1.3 % (the estimate's own error is about 1 %).
+        let at_bound = spread(FilamentPlume::MIN_MOVE_IN_ROUNDINGS * r);
+        assert!((at_bound - 1.0).abs() < 0.05, "{at_bound}");
+        // A walk of a quarter of the rounding is all but lost: a move shorter than the rounding
+        // leaves a position where it was.
+        let lost = spread(0.25 * r);
+        assert!(lost < 0.1, "{lost}");
     }
 
     /// A Farrell flow over `region` with a mean of `speed_mps` toward 80 degrees, stepped at

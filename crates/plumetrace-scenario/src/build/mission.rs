@@ -41,7 +41,16 @@ pub(super) fn mission(
             }
             None
         }
-        Some(m) => Some(mission_spec(m, domain, timing, env.flow())?),
+        Some(m) => {
+            let spec = mission_spec(m, domain, timing, env.flow())?;
+            // The spin-up's step moves the filaments by enough for their positions (by default
+            // it is ten environment steps, which move them farther than one).
+            if spec.spinup_s > 0.0 {
+                env.check_step(spec.spinup_dt_s)
+                    .map_err(|e| Invalid::env("mission", e.renamed("spinup_dt_s")))?;
+            }
+            Some(spec)
+        }
     };
     let mean = flow::mean(&cfg.flow)?;
     if let (Some(spec), Some(m), Some(mean)) = (&mission, &cfg.mission, mean)

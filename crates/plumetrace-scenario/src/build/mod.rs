@@ -235,6 +235,11 @@ fn build_sections(
     let vehicles = vehicles::vehicles(cfg, &domain, seabed.as_deref())?;
     obstacles::starts_clear(cfg, &obstacles)?;
     let comms = comms::comms(&cfg.comms)?;
+    // The environment's step is `mission.env_dt_s` where given, else `sim.dt_s`.
+    let env_dt_key = match cfg.mission.as_ref().and_then(|m| m.env_dt_s) {
+        Some(_) => ("mission", "env_dt_s"),
+        None => ("sim", "dt_s"),
+    };
     let mut env = Environment::new(
         domain,
         flow,
@@ -243,7 +248,7 @@ fn build_sections(
         timing.env_dt_s,
         seed,
     )
-    .map_err(|e| Invalid::env("sim", e))?;
+    .map_err(|e| Invalid::env(env_dt_key.0, e.renamed(env_dt_key.1)))?;
     let depth_m = seabed
         .as_ref()
         .map(|s| s.surface_m())
