@@ -139,11 +139,11 @@ impl Environment {
     pub fn spin_up(&mut self, duration_s: f64, dt_s: f64) -> Result<(), EnvError> {
         crate::error::require_non_negative("spinup_s", duration_s)?;
         crate::error::require_positive("spinup_dt_s", dt_s)?;
-        if duration_s > 0.0 {
+        let n = (duration_s / dt_s).round() as u64;
+        if n > 0 {
             self.check_step(dt_s)
                 .map_err(|e| e.renamed("spinup_dt_s"))?;
         }
-        let n = (duration_s / dt_s).round() as u64;
         let start = self.elapsed_s();
         for k in 1..=n {
             let t = start + k as f64 * dt_s;

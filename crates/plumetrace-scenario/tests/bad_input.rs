@@ -875,7 +875,8 @@ fn a_step_too_short_for_single_precision_positions_names_its_key() {
     let e = error_of(&wide);
     assert!(
         e.contains("scenario.toml: sim.dt_s: a step of 0.01 s moves filaments east by about")
-            && e.contains("lengthen the step or narrow the domain"),
+            && e.contains("it takes a step of at least 1.907e-2 s")
+            && !e.contains("mission.env_dt_s"),
         "{e}"
     );
     let longer_step = demo_with(|t| {
@@ -888,7 +889,8 @@ fn a_step_too_short_for_single_precision_positions_names_its_key() {
     });
     assert_eq!(error_of(&longer_step), "accepted");
     // A mission's plume steps at mission.env_dt_s, and at mission.spinup_dt_s in its spin-up:
-    // heights up to 8 m round to 0.48 micrometres, and a vertical walk of 1e-6 m is lost.
+    // heights 7 m up (the source) round to 0.24 micrometres, and a vertical walk of 1e-6 m a
+    // step is lost.
     let demo = |kv: &str, spinup_dt: &str| {
         find_preset("demo")
             .unwrap()
@@ -903,19 +905,29 @@ fn a_step_too_short_for_single_precision_positions_names_its_key() {
                 &format!("spinup_dt_s = {spinup_dt}"),
                 1,
             )
+            .replacen("z_m = 0.0", "z_m = 7.0", 1)
     };
     let e = error_of(&demo("1e-13", "30.0"));
     assert!(
         e.contains("mission.env_dt_s: a step of 5 s moves filaments up by about 1.000e-6 m")
-            && e.contains("at the water's depth, 8 m"),
+            && e.contains("at the highest a filament is carried to, 7.0 m up")
+            && e.contains("a larger plume.vertical_diffusivity_m2ps"),
         "{e}"
     );
-    let e = error_of(&demo("1e-12", "1.0"));
+    let e = error_of(&demo("5e-13", "1.0"));
     assert!(
         e.contains("mission.spinup_dt_s: a step of 1 s moves filaments up"),
         "{e}"
     );
-    assert_eq!(error_of(&demo("1e-12", "30.0")), "accepted");
+    assert_eq!(error_of(&demo("5e-13", "30.0")), "accepted");
+    // Without mission.env_dt_s the plume steps at sim.dt_s, and the error says where the
+    // plume's own step is set.
+    let e = error_of(&demo("5e-13", "30.0").replacen("env_dt_s = 5.0", "", 1));
+    assert!(
+        e.contains("sim.dt_s: a step of 0.1 s moves filaments up")
+            && e.contains("mission.env_dt_s steps the plume and flow apart from the vehicles"),
+        "{e}"
+    );
 }
 
 #[test]

@@ -438,94 +438,169 @@ impl FilamentPlume {
         &self.params
     }
 
-    /// The least a step may move filaments along an axis, in units of the largest rounding of a
-    /// stored position along it ([`FilamentPlume::check_step`]). Where the walk is at least this
-    /// move, the rounding adds at most 1.3 % to its variance per step (`1 / (3 x 5^2)`: a
-    /// rounding lies evenly within its bound), and less away from the domain's edges and the
-    /// surface; where the current is, the rounding is at most a fifth of its move.
-    pub const MIN_MOVE_IN_ROUNDINGS: f64 = 5.0;
+    /// The least random walk a step may take along an axis, in units of the largest rounding of
+    /// a stored position along it ([`FilamentPlume::check_step`]). At the bound the rounding
+    /// adds at most 1.3 % to the walk's variance per step (`1 / (3 x 5^2)`: a rounding lies
+    /// evenly within its bound once the walk spreads positions over more than its spacing), and
+    /// the walk's spread leaves the current's move unbiased.
+    pub const MIN_WALK_IN_ROUNDINGS: f64 = 5.0;
 
-    /// The largest rounding of a stored position, m, east, north and up: half the spacing of
-    /// `f32` at the farthest a filament can be from where it is measured from (the domain's
-    /// half-width and half-height from its centre; for heights, from the datum up to the
-    /// water's depth, `None` where no depth bounds them).
-    pub fn position_rounding_m(&self) -> [Option<f64>; 3] {
+    /// The least move of the current a step may take along an axis where there is no random
+    /// walk, in units of the largest rounding ([`FilamentPlume::check_step`]): without a walk a
+    /// steady move is rounded the same way step after step, so the rounding is a bias, at most
+    /// a hundredth of the move here.
+    pub const MIN_DRIFT_IN_ROUNDINGS: f64 = 100.0;
+
+    /// The largest rounding of a stored position, m, east, north and up, and where it is taken:
+    /// half the spacing of `f32` at the domain's half-width and half-height from its centre
+    /// (filaments are carried to the domain's edges), and for heights at the highest source
+    /// (a random walk of a few roundings a step would need far more steps than a run may take
+    /// to carry a filament high enough above its source for the rounding to grow tenfold), or
+    /// over a seabed at the surface (the current carries filaments up the seabed's slopes).
+    pub fn position_rounding_m(&self) -> [(f64, f64); 3] {
         fn half_spacing(m: f64) -> f64 {
             // The spacing just above `m`: at a power of two, the wider of the two around it.
             let f = (m.abs() as f32).max(f32::MIN_POSITIVE);
             0.5 * (f64::from(f.next_up()) - f64::from(f))
         }
-        let height = match self.params.vertical {
-            VerticalBoundary::Reflecting { depth_m: Some(d) } => Some(half_spacing(d)),
-            _ => None,
+        let (w, h) = (0.5 * self.domain.width_m(), 0.5 * self.domain.height_m());
+        let source = self
+            .sources
+            .iter()
+            .map(|s| s.pos_m.z.abs())
+            .fold(0.0, f64::max);
+        // Over a seabed, the current carries filaments up its slopes: heights up to the surface.
+        let top = match &self.seabed {
+            Some(sb) => source.max(sb.surface_m()),
+            None => source,
         };
         [
-            Some(half_spacing(0.5 * self.domain.width_m())),
-            Some(half_spacing(0.5 * self.domain.height_m())),
-            height,
+            (half_spacing(w), w),
+            (half_spacing(h), h),
+            (half_spacing(top), top),
         ]
     }
 
-    /// Refuses a step of `dt_s` that moves filaments too little for single-precision positions
-    /// to hold the move ([`FilamentPlume::MIN_MOVE_IN_ROUNDINGS`] times
-    /// [`FilamentPlume::position_rounding_m`]): a very wide domain stepped very often. A step's
-    /// move east or north is the larger of the random walk's standard deviation over it and the
-    /// current's move at the sources (`flow` as it is now); up, the walk's. An axis that does not
-    /// move at all is not checked. The error's key is `dt_s`.
+    /// Refuses a step of `dt_s` that moves filaments too little for their single-precision
+    /// positions to hold the move (see [`FilamentPlume::position_rounding_m`]): a random walk
+    /// under [`FilamentPlume::MIN_WALK_IN_ROUNDINGS`] roundings a step along any axis, or,
+    /// where nothing walks across the plane, the current's move under
+    /// [`FilamentPlume::MIN_DRIFT_IN_ROUNDINGS`] of the coarser horizontal rounding (the
+    /// slowest current at a source, `flow` as it is now; still water moves nothing). The
+    /// error's key is `dt_s`; it says the shortest step that would do.
     pub fn check_step(&self, dt_s: f64, flow: &dyn FlowField) -> Result<(), EnvError> {
         let walk = self.walk_sd(dt_s);
         let rounding = self.position_rounding_m();
-        let depth = match self.params.vertical {
-            VerticalBoundary::Reflecting { depth_m: Some(d) } => d,
-            _ => 0.0,
-        };
-        let current = self
+        // The slowest current at a source: without a walk, the move the rounding must not bias.
+        let speed = self
             .sources
             .iter()
             .map(|s| flow.velocity(s.pos_m.xy()).norm())
-            .fold(0.0, f64::max)
-            * dt_s;
-        let axes = [
-            ("east", walk.0, current, rounding[0]),
-            ("north", walk.1, current, rounding[1]),
-            ("up", walk.2, 0.0, rounding[2]),
-        ];
-        for (axis, walk, current, rounding) in axes {
-            let (step, what) = if walk >= current {
-                (walk, "the random walk's standard deviation")
+            .fold(f64::INFINITY, f64::min);
+        let speed = if speed.is_finite() { speed } else { 0.0 };
+        let pompy = matches!(self.params.dispersion, Dispersion::PompyCompatible { .. });
+        // The step at which the walk along an axis is `target` m (a walk grows as the step's
+        // square root, or in proportion with pompy's scaling).
+        let walk_step = |walk: f64, target: f64| {
+            if pompy {
+                dt_s * target / walk
             } else {
-                (current, "the current at the sources")
-            };
-            let Some(r) = rounding else { continue };
-            if step > 0.0 && step < Self::MIN_MOVE_IN_ROUNDINGS * r {
-                let (far, cure) = match axis {
-                    "up" => (
-                        format!("at the water's depth, {depth} m"),
-                        "lengthen the step or raise the vertical diffusivity",
-                    ),
-                    _ => (
-                        format!(
-                            "at the domain's edge, {} m from its centre",
-                            0.5 * if axis == "east" {
-                                self.domain.width_m()
-                            } else {
-                                self.domain.height_m()
-                            }
-                        ),
-                        "lengthen the step or narrow the domain",
-                    ),
-                };
-                return Err(EnvError::invalid(
-                    "dt_s",
-                    format!(
-                        "a step of {dt_s} s moves filaments {axis} by about {step:.3e} m ({what}), \
-                         less than {} times the largest rounding of a position kept in single \
-                         precision ({r:.3e} m, {far}): the positions could not hold the \
-                         move; {cure}",
-                        Self::MIN_MOVE_IN_ROUNDINGS
-                    ),
-                ));
+                dt_s * (target / walk).powi(2)
             }
+        };
+        // Without a walk, the current's move across the plane against the coarser of the two
+        // horizontal roundings.
+        let plane = if rounding[0].0 >= rounding[1].0 {
+            rounding[0]
+        } else {
+            rounding[1]
+        };
+        let axes = [
+            (
+                "east",
+                walk.0,
+                rounding[0],
+                "at the domain's edge,",
+                "from its centre",
+            ),
+            (
+                "north",
+                walk.1,
+                rounding[1],
+                "at the domain's edge,",
+                "from its centre",
+            ),
+            (
+                "across the plane",
+                0.0,
+                plane,
+                "at the domain's edge,",
+                "from its centre",
+            ),
+            (
+                "up",
+                walk.2,
+                rounding[2],
+                "at the highest a filament is carried to,",
+                "up",
+            ),
+        ];
+        // The current is checked once, across the plane, and only where nothing walks there.
+        let drift = if walk.0.max(walk.1) > 0.0 { 0.0 } else { speed };
+        for (axis, walk, (r, at), where_, from) in axes {
+            let speed = if axis == "across the plane" {
+                drift
+            } else {
+                0.0
+            };
+            let (step, what, least, shortest) = if walk > 0.0 {
+                let least = Self::MIN_WALK_IN_ROUNDINGS * r;
+                (
+                    walk,
+                    "the random walk's standard deviation",
+                    least,
+                    walk_step(walk, least),
+                )
+            } else {
+                let least = Self::MIN_DRIFT_IN_ROUNDINGS * r;
+                let what = "the current at the sources, with no random walk";
+                (speed * dt_s, what, least, least / speed)
+            };
+            if step <= 0.0 || step >= least {
+                continue;
+            }
+            let walk_key = match (pompy, axis) {
+                (true, _) => "plume.pompy_diff_scale_mps",
+                (false, "up") => "plume.vertical_diffusivity_m2ps",
+                (false, _) => "plume.horizontal_diffusivity_m2ps",
+            };
+            let cure = if axis == "up" {
+                format!("a step of at least {shortest:.3e} s, or a larger {walk_key}")
+            } else if walk > 0.0 {
+                format!(
+                    "a step of at least {shortest:.3e} s, a larger {walk_key}, or a narrower \
+                     domain"
+                )
+            } else {
+                format!(
+                    "a step of at least {shortest:.3e} s, a random walk ({walk_key}), or a \
+                     narrower domain"
+                )
+            };
+            return Err(EnvError::invalid(
+                "dt_s",
+                format!(
+                    "a step of {dt_s} s moves filaments {axis} by about {step:.3e} m ({what}), \
+                     less than {least:.3e} m, {} times the largest rounding of a position kept \
+                     in single precision ({r:.3e} m, {where_} {at:.1} m {from}): the positions \
+                     could not hold the move; it takes {cure}",
+                    if walk > 0.0 {
+                        Self::MIN_WALK_IN_ROUNDINGS
+                    } else {
+                        Self::MIN_DRIFT_IN_ROUNDINGS
+                    }
+                ),
+            ));
         }
         Ok(())
     }
@@ -1659,56 +1734,110 @@ mod tests {
 
     #[test]
     fn a_step_too_short_for_single_precision_positions_is_refused() {
-        let walk = |horizontal_m2ps, vertical_m2ps, depth_m| FilamentParams {
+        let walk = |horizontal_m2ps, vertical_m2ps| FilamentParams {
             dispersion: Dispersion::Physical {
                 horizontal_m2ps,
                 vertical_m2ps,
             },
-            vertical: VerticalBoundary::Reflecting { depth_m },
             ..FilamentParams::default()
         };
+        let err = |p: &FilamentPlume, dt: f64, flow: &dyn FlowField| {
+            p.check_step(dt, flow).err().map(|e| e.to_string())
+        };
         let still = current_east(0.0);
-        let wide = plume_with_source(long_strip(), (150_000.0, 50.0), 1.0, walk(0.01, 0.0, None));
+        let wide = plume_with_source(long_strip(), (150_000.0, 50.0), 1.0, walk(0.01, 0.0));
         let [east, north, up] = wide.position_rounding_m();
-        assert_eq!(
-            east,
-            Some(1.0 / 256.0),
-            "half of f32's spacing between 65,536 and 131,072"
+        // Half of f32's spacing between 65,536 and 131,072; the source is 1 m up.
+        assert_eq!(east, (1.0 / 256.0, 100_000.0));
+        assert!(
+            north.0 < 1e-5 && up == (0.5f64.powi(24), 1.0),
+            "{north:?} {up:?}"
         );
-        assert!(north.is_some_and(|r| r < 1e-5) && up.is_none());
-        // The walk: sqrt(2 K dt) = 1.4 cm at 0.01 s, under 5 x 3.9 mm; 4.5 cm at 0.1 s.
-        let e = wide.check_step(0.01, &still).err().map(|e| e.to_string());
-        let e = e.unwrap_or_else(|| panic!("a 0.01 s step over 200 km accepted"));
+        // The walk: sqrt(2 K dt) = 1.4 cm at 0.01 s, under 5 x 3.9 mm; the error says that
+        // 0.01 (0.0195 / 0.0141)^2 = 0.019 s would do, and it does.
+        let e = err(&wide, 0.01, &still).unwrap_or_else(|| panic!("0.01 s over 200 km accepted"));
         for part in [
-            "dt_s: a step of 0.01 s moves filaments east",
-            "random walk",
-            "narrow",
+            "dt_s: a step of 0.01 s moves filaments east by about 1.414e-2 m",
+            "less than 1.953e-2 m, 5 times",
+            "at the domain's edge, 100000.0 m from its centre",
+            "a step of at least 1.907e-2 s, a larger plume.horizontal_diffusivity_m2ps, or a \
+             narrower domain",
         ] {
             assert!(e.contains(part), "{part:?} not in {e}");
         }
-        assert!(wide.check_step(0.1, &still).is_ok());
-        // Without a walk, the current's move: 0.5 m/s moves 5 mm in 0.01 s, 5 cm in 0.1 s.
-        let drift = plume_with_source(long_strip(), (150_000.0, 50.0), 1.0, walk(0.0, 0.0, None));
-        let e = drift
-            .check_step(0.01, &current_east(0.5))
-            .err()
-            .map(|e| e.to_string());
-        assert!(e.is_some_and(|e| e.contains("the current at the sources")));
-        assert!(drift.check_step(0.1, &current_east(0.5)).is_ok());
+        assert_eq!(err(&wide, 0.0191, &still), None);
+        // A current does not make up for a walk that is lost.
+        assert!(err(&wide, 0.01, &current_east(5.0)).is_some());
+        // Without a walk, the current's component along each axis, against 100 roundings (a
+        // steady move is rounded the same way at every step): 0.5 m/s east moves 5 mm in
+        // 0.01 s (refused) and 0.5 m in 1 s; east and a little north, the north part is lost.
+        let drift = plume_with_source(long_strip(), (150_000.0, 50.0), 1.0, walk(0.0, 0.0));
+        let e = err(&drift, 0.01, &current_east(0.5)).unwrap_or_default();
+        for part in [
+            "moves filaments across the plane by about 5.000e-3 m (the current at the sources, \
+             with no random walk), less than 3.906e-1 m, 100 times",
+            "a step of at least 7.812e-1 s, a random walk (plume.horizontal_diffusivity_m2ps)",
+        ] {
+            assert!(e.contains(part), "{part:?} not in {e}");
+        }
+        assert_eq!(err(&drift, 0.79, &current_east(0.5)), None);
+        // The bias is a hundredth of the whole move at most, whichever way it points: a
+        // current toward 8 degrees of 0.5 m/s over 0.01 s is refused as the eastward one is.
+        let toward_8 = crate::flow::UniformFlow::new(MeanFlow::Steady {
+            speed_mps: 0.5,
+            toward_deg: 8.0,
+        })
+        .unwrap_or_else(|e| panic!("{e}"));
+        assert!(err(&drift, 0.01, &toward_8).is_some());
         // Nothing moves, nothing to hold.
-        assert!(drift.check_step(0.01, &still).is_ok());
-        // Heights up to a 6,000 m depth round to 0.24 mm: a vertical walk of 4.5e-6 m is lost.
-        let deep = plume_with_source(square(), (50.0, 50.0), 1.0, walk(0.01, 1e-9, Some(6000.0)));
-        let e = deep.check_step(0.01, &still).err().map(|e| e.to_string());
-        assert!(e.is_some_and(|e| e.contains("filaments up") && e.contains("6000 m")));
-        let shallow = plume_with_source(square(), (50.0, 50.0), 1.0, walk(0.01, 1e-9, Some(10.0)));
-        assert!(shallow.check_step(0.01, &still).is_ok());
-        // Every preset-sized domain passes at its step (a test of the scenario crate checks the
-        // presets themselves).
+        assert_eq!(err(&drift, 0.01, &still), None);
+        // Heights at the highest source: a vertical walk of 4.5e-6 m a step is lost 5,000 m
+        // up (0.24 mm roundings) and held near the seabed.
+        let mut high = walk(0.01, 1e-9);
+        high.vertical = VerticalBoundary::Reflecting {
+            depth_m: Some(6000.0),
+        };
+        let source = |z: f64| Source {
+            pos_m: Vec3::new(50.0, 50.0, z),
+            mass_rate_per_s: 1.0,
+            filament_rate_hz: 1.0,
+        };
+        let at = |z: f64| {
+            FilamentPlume::new(square(), vec![source(z)], high).unwrap_or_else(|e| panic!("{e}"))
+        };
+        let e = err(&at(5000.0), 0.01, &still).unwrap_or_default();
         assert!(
-            plume_with_source(square(), (50.0, 50.0), 1.0, walk(0.02, 0.002, None))
-                .check_step(0.01, &still)
-                .is_ok()
+            e.contains("filaments up")
+                && e.contains("at the highest a filament is carried to, 5000.0 m up"),
+            "{e}"
+        );
+        assert!(
+            e.contains("a larger plume.vertical_diffusivity_m2ps"),
+            "{e}"
+        );
+        assert_eq!(err(&at(0.0), 0.01, &still), None);
+        assert_eq!(err(&at(1.0), 0.01, &still), None);
+        // Over a seabed 100 m to 6,000 m deep the current carries filaments up its slope: a
+        // source on its deepest floor counts the surface, 6,000 m above the datum.
+        let slope = Seabed::from_depths(square(), 2, 2, &[6000.0, 100.0, 6000.0, 100.0])
+            .unwrap_or_else(|e| panic!("{e}"));
+        let mut floor = at(0.0);
+        floor.set_seabed(Some(Arc::new(slope)));
+        let e = err(&floor, 0.01, &still).unwrap_or_default();
+        assert!(e.contains("carried to, 6000.0 m up"), "{e}");
+        // pompy's scaling: the key to raise is its scale.
+        let pompy = FilamentParams {
+            dispersion: Dispersion::PompyCompatible {
+                scale_mps: [2.0, 2.0, 1e-7],
+            },
+            ..high
+        };
+        let p = FilamentPlume::new(square(), vec![source(5000.0)], pompy)
+            .unwrap_or_else(|e| panic!("{e}"));
+        let e = err(&p, 0.01, &still).unwrap_or_default();
+        assert!(
+            e.contains("up") && e.contains("a larger plume.pompy_diff_scale_mps"),
+            "{e}"
         );
     }
 
@@ -1748,12 +1877,42 @@ mod tests {
         };
         let r = 1.0 / 256.0;
         // At the bound the rounding adds at most 1.3 % (the estimate's own error is about 1 %).
-        let at_bound = spread(FilamentPlume::MIN_MOVE_IN_ROUNDINGS * r);
+        let at_bound = spread(FilamentPlume::MIN_WALK_IN_ROUNDINGS * r);
         assert!((at_bound - 1.0).abs() < 0.05, "{at_bound}");
         // A walk of a quarter of the rounding is all but lost: a move shorter than the rounding
         // leaves a position where it was.
         let lost = spread(0.25 * r);
         assert!(lost < 0.1, "{lost}");
+    }
+
+    #[test]
+    fn without_a_walk_a_steady_move_is_rounded_the_same_way_every_step() {
+        // A filament 99 km east of the strip's centre (roundings of 3.9 mm) carried east by a
+        // steady current with no random walk, 1,000 steps: its speed against the current's.
+        let speed_ratio = |move_in_roundings: f64| -> f64 {
+            let r = 1.0 / 256.0;
+            let params = FilamentParams {
+                dispersion: Dispersion::Physical {
+                    horizontal_m2ps: 0.0,
+                    vertical_m2ps: 0.0,
+                },
+                ..FilamentParams::default()
+            };
+            let mut p = plume_with_source(long_strip(), (199_000.0, 50.0), 1.0, params);
+            p.release_at_source(0, 1);
+            let flow = current_east(1.0);
+            let dt = move_in_roundings * r;
+            for _ in 0..1000 {
+                p.transport_on(crate::simd::best(), &flow, dt);
+            }
+            (f64::from(p.x[0]) - 99_000.0) / (1000.0 * dt)
+        };
+        // 5.5 roundings a step come out as 6 (three spacings): 9 % fast.
+        let coarse = speed_ratio(5.5);
+        assert!((coarse - 6.0 / 5.5).abs() < 1e-9, "{coarse}");
+        // At the bound for a move without a walk the bias is at most a hundredth.
+        let fine = speed_ratio(FilamentPlume::MIN_DRIFT_IN_ROUNDINGS + 1.3);
+        assert!((fine - 1.0).abs() <= 0.01, "{fine}");
     }
 
     /// A Farrell flow over `region` with a mean of `speed_mps` toward 80 degrees, stepped at

@@ -248,7 +248,17 @@ fn build_sections(
         timing.env_dt_s,
         seed,
     )
-    .map_err(|e| Invalid::env(env_dt_key.0, e.renamed(env_dt_key.1)))?;
+    .map_err(|e| {
+        let mut e = Invalid::env(env_dt_key.0, e.renamed(env_dt_key.1));
+        if e.path == "sim.dt_s" && cfg.mission.is_some() {
+            // The vehicles keep their step; the plume may take a longer one.
+            e.message.push_str(
+                " (in a mission, mission.env_dt_s steps the plume and flow apart from the \
+                 vehicles)",
+            );
+        }
+        e
+    })?;
     let depth_m = seabed
         .as_ref()
         .map(|s| s.surface_m())
