@@ -1062,6 +1062,9 @@ fn the_environment_refuses_steps_too_short_for_single_precision_positions() {
     );
     assert_eq!(ok.elapsed_s(), 0.0, "nothing stepped before the error");
     ok.spin_up(0.0, 0.01).unwrap();
+    // 0.004 s in steps of 0.01 s rounds to no step: nothing to check.
+    ok.spin_up(0.004, 0.01).unwrap();
+    assert_eq!(ok.elapsed_s(), 0.0);
     ok.spin_up(1.0, 0.1).unwrap();
     assert!((ok.elapsed_s() - 1.0).abs() < 1e-12);
 }

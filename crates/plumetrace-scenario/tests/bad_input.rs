@@ -875,7 +875,7 @@ fn a_step_too_short_for_single_precision_positions_names_its_key() {
     let e = error_of(&wide);
     assert!(
         e.contains("scenario.toml: sim.dt_s: a step of 0.01 s moves filaments east by about")
-            && e.contains("it takes a step of at least 1.907e-2 s")
+            && e.contains("it takes a step of at least 1.908e-2 s")
             && !e.contains("mission.env_dt_s"),
         "{e}"
     );
