@@ -86,6 +86,11 @@ pub struct Seabed {
 }
 
 impl Seabed {
+    /// The deepest water a seabed may hold, m: the deepest ocean. A deeper value in a file is a
+    /// unit or a sign gone wrong (and its surface would be where no filament's height could be
+    /// kept to the millimetre).
+    pub const MAX_DEPTH_M: f64 = 11_000.0;
+
     /// A seabed from water depths (positive, m) at the `nx * ny` nodes of an even grid over
     /// `area`, row by row from the south. Errors name `depths[k]` or the grid's size.
     pub fn from_depths(area: Rect, nx: usize, ny: usize, depths: &[f64]) -> Result<Self, EnvError> {
@@ -101,10 +106,15 @@ impl Seabed {
                 format!("{} values for {nx} x {ny} nodes", depths.len()),
             ));
         }
-        if let Some(k) = depths.iter().position(|d| !(d.is_finite() && *d > 0.0)) {
+        let valid = |d: f64| d.is_finite() && d > 0.0 && d <= Self::MAX_DEPTH_M;
+        if let Some(k) = depths.iter().position(|&d| !valid(d)) {
             return Err(EnvError::invalid(
                 format!("depths[{k}]"),
-                format!("must be a finite depth > 0 m, got {:?}", depths[k]),
+                format!(
+                    "must be a finite depth > 0 m and at most {} m (the deepest ocean), got {:?}",
+                    Self::MAX_DEPTH_M,
+                    depths[k]
+                ),
             ));
         }
         let surface_m = depths.iter().copied().fold(0.0, f64::max);
@@ -377,6 +387,15 @@ fn sample(
                 ));
             }
             dry.push(out.len());
+        } else if d > Seabed::MAX_DEPTH_M {
+            return Err(err(
+                path,
+                format!(
+                    "{what}: a depth of {d:.1} m at ({x:.1}, {y:.1}) m, deeper than the deepest \
+                     ocean ({} m): check the values' units (metres) and sign",
+                    Seabed::MAX_DEPTH_M
+                ),
+            ));
         }
         out.push(d);
     }

@@ -290,13 +290,29 @@ fn filaments_never_go_below_a_sloping_seabed() {
 }
 
 #[test]
+fn a_file_deeper_than_the_deepest_ocean_is_refused_with_where() {
+    // The projected grid's 10-30 m read as kilometres: 30,000 m is a unit gone wrong.
+    let e = read("km.nc", &projected_with(Some("km"), None), &options()).unwrap_err();
+    assert!(
+        e.contains(
+            "km.nc: variable depth: a depth of 30000.0 m at (0.0, 0.0) m, deeper than \
+             the deepest ocean (11000 m)"
+        ),
+        "{e}"
+    );
+}
+
+#[test]
 fn from_depths_refuses_what_is_not_water() {
     let area = rect(0.0, 1.0, 0.0, 1.0);
     let e = Seabed::from_depths(area, 2, 2, &[1.0, 2.0, 0.0, 3.0]).unwrap_err();
     assert_eq!(
         e.to_string(),
-        "depths[2]: must be a finite depth > 0 m, got 0.0"
+        "depths[2]: must be a finite depth > 0 m and at most 11000 m (the deepest ocean), got 0.0"
     );
+    let e = Seabed::from_depths(area, 2, 2, &[1.0, 2.0, 11_000.5, 3.0]).unwrap_err();
+    assert!(e.to_string().starts_with("depths[2]: "), "{e}");
+    assert!(Seabed::from_depths(area, 2, 2, &[1.0, 2.0, 11_000.0, 3.0]).is_ok());
     assert!(Seabed::from_depths(area, 1, 2, &[1.0, 2.0]).is_err());
     assert!(Seabed::from_depths(area, 2, 2, &[1.0]).is_err());
 }
