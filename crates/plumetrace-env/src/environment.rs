@@ -131,6 +131,15 @@ impl Environment {
         }
     }
 
+    /// [`Environment::check_step`] for a spin-up of `duration_s` in steps of `dt_s`, its error
+    /// keyed `spinup_dt_s`; a spin-up that takes no step has none to check.
+    pub fn check_spin_up(&self, duration_s: f64, dt_s: f64) -> Result<(), EnvError> {
+        if (duration_s / dt_s).round() < 1.0 {
+            return Ok(());
+        }
+        self.check_step(dt_s).map_err(|e| e.renamed("spinup_dt_s"))
+    }
+
     /// Develops the plume before the run starts: `duration_s` of simulated time in steps of
     /// `dt_s` (coarser than the run's step: the physics does not depend on the step, and a
     /// kilometre of plume in a 0.1 m/s current needs hours to form). The run's clock then starts
@@ -139,11 +148,8 @@ impl Environment {
     pub fn spin_up(&mut self, duration_s: f64, dt_s: f64) -> Result<(), EnvError> {
         crate::error::require_non_negative("spinup_s", duration_s)?;
         crate::error::require_positive("spinup_dt_s", dt_s)?;
+        self.check_spin_up(duration_s, dt_s)?;
         let n = (duration_s / dt_s).round() as u64;
-        if n > 0 {
-            self.check_step(dt_s)
-                .map_err(|e| e.renamed("spinup_dt_s"))?;
-        }
         let start = self.elapsed_s();
         for k in 1..=n {
             let t = start + k as f64 * dt_s;

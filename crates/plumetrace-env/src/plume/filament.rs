@@ -521,8 +521,9 @@ impl FilamentPlume {
     /// error's key is `dt_s`; it gives the shortest step, to four digits, that passes on every
     /// axis.
     pub fn check_step(&self, dt_s: f64, flow: &dyn FlowField) -> Result<(), EnvError> {
-        let walk_at = |dt: f64| self.walk_sd(dt);
-        let all = self.short_axes(dt_s, flow, walk_at(dt_s));
+        // Without a walk, the move the rounding must not bias.
+        let speed = self.slowest_current(flow);
+        let all = self.short_axes(dt_s, speed, self.walk_sd(dt_s));
         let Some(&short) = all.first() else {
             return Ok(());
         };
@@ -532,7 +533,7 @@ impl FilamentPlume {
         let mut shortest = up_to_four_digits(needed);
         for _ in 0..100 {
             if self
-                .short_axes(shortest, flow, walk_at(shortest))
+                .short_axes(shortest, speed, self.walk_sd(shortest))
                 .is_empty()
             {
                 break;
@@ -562,9 +563,9 @@ impl FilamentPlume {
             (true, _) => {
                 // A walk too small to hold may be no walk at all where the current's move alone
                 // is held.
-                let (_, _, up) = walk_at(dt_s);
-                let drifts = self.slowest_current(flow) > 0.0;
-                let cure = if drifts && self.short_axes(dt_s, flow, (0.0, 0.0, up)).is_empty() {
+                let (_, _, up) = self.walk_sd(dt_s);
+                let cure = if speed > 0.0 && self.short_axes(dt_s, speed, (0.0, 0.0, up)).is_empty()
+                {
                     format!(
                         "a larger {walk_key}, a narrower domain, or no random walk ({walk_key} \
                          = 0: the current's move alone is held)"
@@ -615,11 +616,10 @@ impl FilamentPlume {
     }
 
     /// The axes along which a step of `dt_s` moves filaments too little
-    /// ([`FilamentPlume::check_step`]), in the order east, north, across the plane, up.
-    fn short_axes(&self, dt_s: f64, flow: &dyn FlowField, walk: (f64, f64, f64)) -> Vec<ShortAxis> {
+    /// ([`FilamentPlume::check_step`]), in the order east, north, across the plane, up: `speed`
+    /// is the slowest current at a source, `walk` the random walk's standard deviations.
+    fn short_axes(&self, dt_s: f64, speed: f64, walk: (f64, f64, f64)) -> Vec<ShortAxis> {
         let rounding = self.position_rounding_m();
-        // Without a walk, the move the rounding must not bias.
-        let speed = self.slowest_current(flow);
         let pompy = matches!(self.params.dispersion, Dispersion::PompyCompatible { .. });
         // Without a walk, the current's move across the plane against the coarser of the two
         // horizontal roundings.
@@ -636,7 +636,7 @@ impl FilamentPlume {
             ("up", walk.2, 0.0, rounding[2]),
         ];
         let mut short = Vec::new();
-        for (axis, walk, speed, (r, at)) in axes {
+        for (axis, walk, current, (r, at)) in axes {
             let (step, least, shortest_s) = if walk > 0.0 {
                 let least = Self::MIN_WALK_IN_ROUNDINGS * r;
                 // A walk grows as the step's square root (in proportion, with pompy's scaling).
@@ -645,7 +645,7 @@ impl FilamentPlume {
                 (walk, least, dt_s * shortest)
             } else {
                 let least = Self::MIN_DRIFT_IN_ROUNDINGS * r;
-                (speed * dt_s, least, least / speed)
+                (current * dt_s, least, least / current)
             };
             if step > 0.0 && step < least {
                 short.push(ShortAxis {

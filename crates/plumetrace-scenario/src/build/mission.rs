@@ -45,10 +45,8 @@ pub(super) fn mission(
             let spec = mission_spec(m, domain, timing, env.flow())?;
             // The spin-up's step moves the filaments by enough for their positions (by default
             // it is ten environment steps, which move them farther than one).
-            if (spec.spinup_s / spec.spinup_dt_s).round() >= 1.0 {
-                env.check_step(spec.spinup_dt_s)
-                    .map_err(|e| Invalid::env("mission", e.renamed("spinup_dt_s")))?;
-            }
+            env.check_spin_up(spec.spinup_s, spec.spinup_dt_s)
+                .map_err(|e| Invalid::env("mission", e))?;
             Some(spec)
         }
     };
