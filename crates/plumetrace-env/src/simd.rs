@@ -6,10 +6,16 @@
 //! checks so that the compiler can run them in vector lanes. Every version does the same
 //! floating-point operations in the same order (Rust never fuses a multiply and an add unless
 //! told to), so results are the same bits on any CPU; tests run every version this CPU has and
-//! compare them. The flow's batch lookup has a version of its own for AVX-512, written with its
-//! instructions (sixteen single-precision cells read as vectors and taken apart into lanes); the
-//! flow's cells are rebuilt with AVX-512's own version too; the sensor scan's block boxes are
-//! written with pulp's vector operations for every unit.
+//! compare them. The flow's batch lookup has versions of its own for AVX-512 and for AVX2,
+//! written with their instructions (sixteen or eight single-precision cells read as vectors and
+//! taken apart into lanes; compiled from the plain loop, AVX2's read each cell's coefficients one
+//! at a time, and the whole filament step took 1.35-1.4 times as long); the flow's cells are
+//! rebuilt with each unit's own version too; the sensor scan's block boxes are written with
+//! pulp's vector operations for every unit.
+//!
+//! AVX2's versions use macros, not closures, for their repeated parts: a closure is compiled
+//! without the unit's instructions unless it is inlined, and written with closures, AVX2's
+//! lookup called each instruction and ran three times slower than the plain loop.
 
 /// The widest vector unit this CPU has (detected once, then cached by the standard library).
 #[inline]

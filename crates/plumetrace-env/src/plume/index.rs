@@ -267,12 +267,14 @@ fn axis_span(c: f64, half: f64, origin: f64, inv_step: f64) -> [f64; 2] {
 }
 
 /// The whole indices `a..b` of an [`axis_span`]: the floor of `lo` and one past the floor of
-/// `hi`, neither below zero (truncation is the floor of a value that is not negative).
+/// `hi`, neither below zero (truncation is the floor of a value that is not negative). Through
+/// `i64`, which x86-64 converts in one instruction where `usize` takes several: a value that
+/// does not fit either way (beyond 2^63) is cut to the grid by the caller just the same.
 #[inline(always)]
 fn whole_span([lo, hi]: [f64; 2]) -> (usize, usize) {
-    let a = if lo > 0.0 { lo as usize } else { 0 };
+    let a = if lo > 0.0 { lo as i64 as usize } else { 0 };
     let b = if hi >= 0.0 {
-        (hi as usize).saturating_add(1)
+        (hi as i64 as usize).saturating_add(1)
     } else {
         0
     };
@@ -324,34 +326,40 @@ struct Gathered {
     /// The filament's peak.
     amp: Vec<f64>,
     n: usize,
+    /// Room for this many terms, a power of two (`mask + 1`, the columns' length).
     cap: usize,
+    mask: usize,
 }
 
 impl Gathered {
-    fn with_room(cap: usize) -> Self {
+    /// Room for at least `room` terms.
+    fn with_room(room: usize) -> Self {
+        let cap = room.next_power_of_two();
         Gathered {
             at: vec![0; cap],
             arg: vec![0.0; cap],
             amp: vec![0.0; cap],
             n: 0,
             cap,
+            mask: cap - 1,
         }
     }
 
-    /// Keeps a term if `keep`: the slot past the last kept term is written either way and only a
-    /// kept term takes it (no branch to mispredict on a filament's ragged edge).
-    #[inline(always)]
-    fn push_if(&mut self, keep: bool, at: usize, arg: f64, amp: f64) {
-        self.at[self.n] = at as u32;
-        self.arg[self.n] = arg;
-        self.amp[self.n] = amp;
-        self.n += usize::from(keep);
-    }
-
     /// The terms of filament `e` at the points `xs` of a row (`at`: the first one's place),
-    /// `dy2` from the row, with the `N` heights `dz2` (in order).
+    /// `dy2` from the row, with the `N` heights `dz2` (in order); the caller has made room for
+    /// them all. Each is kept if it is within the cut-off: the slot past the last kept term is
+    /// written either way and only a kept term takes it (no branch to mispredict on a
+    /// filament's ragged edge). The slots are taken modulo the room, which changes none of
+    /// them (there is room) but lets the compiler drop the bounds checks.
     #[inline(always)]
     fn row<const N: usize>(&mut self, e: &Entry, xs: &[f64], at: usize, dy2: f64, dz2: &[f64; 3]) {
+        let mask = self.mask;
+        let (ats, args, amps) = (
+            &mut self.at[..=mask],
+            &mut self.arg[..=mask],
+            &mut self.amp[..=mask],
+        );
+        let mut n = self.n;
         for (i, &x) in xs.iter().enumerate() {
             let dx = x - e.x;
             // The point query's sums: d2 = (dx^2 + dy^2) + dz^2, a term where d2 is below
@@ -359,9 +367,14 @@ impl Gathered {
             let dxy2 = dx * dx + dy2;
             for &t in &dz2[..N] {
                 let d2 = dxy2 + t;
-                self.push_if(d2 < e.lim2, at + i, d2 * e.neg_inv_2r2, e.amp);
+                let slot = n & mask;
+                ats[slot] = (at + i) as u32;
+                args[slot] = d2 * e.neg_inv_2r2;
+                amps[slot] = e.amp;
+                n += usize::from(d2 < e.lim2);
             }
         }
+        self.n = n;
     }
 
     /// Evaluates the terms gathered and adds each to its point, in order.
