@@ -9,9 +9,9 @@
 //! compare them. The flow's batch lookup has versions of its own for AVX-512 and for AVX2,
 //! written with their instructions (sixteen or eight single-precision cells read as vectors and
 //! taken apart into lanes; compiled from the plain loop, AVX2's read each cell's coefficients one
-//! at a time, and the whole filament step took 1.35-1.4 times as long); the flow's cells are
-//! rebuilt with each unit's own version too; the sensor scan's block boxes are written with
-//! pulp's vector operations for every unit.
+//! at a time, and with it the whole filament step took 1.37-1.42 times as long); the flow's
+//! cells are rebuilt with each unit's own version too; the sensor scan's block boxes are written
+//! with pulp's vector operations for every unit.
 //!
 //! AVX2's versions use macros, not closures, for their repeated parts: a closure is compiled
 //! without the unit's instructions unless it is inlined, and written with closures, AVX2's

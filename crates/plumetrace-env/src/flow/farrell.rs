@@ -1765,8 +1765,8 @@ mod tests {
     fn every_vector_unit_steps_the_grid_to_the_same_bits() {
         // Rows of 20 cells (pompy's grid): two groups of eight and the last eight again on
         // AVX-512, five groups of four on AVX2; of 22: the last four again on AVX2 too; of 10:
-        // one cell at a time on AVX-512, and the last four again on AVX2; of 3: one cell at a
-        // time on both.
+        // one group and the last eight again on AVX-512, two groups and the last four again on
+        // AVX2; of 3: one cell at a time on both.
         for nx in [21, 23, 11, 4] {
             let params = FarrellParams {
                 nx,

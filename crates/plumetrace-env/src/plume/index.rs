@@ -353,6 +353,10 @@ impl Gathered {
     /// them (there is room) but lets the compiler drop the bounds checks.
     #[inline(always)]
     fn row<const N: usize>(&mut self, e: &Entry, xs: &[f64], at: usize, dy2: f64, dz2: &[f64; 3]) {
+        debug_assert!(
+            self.n + xs.len() * N <= self.cap,
+            "no room for a row's terms"
+        );
         let mask = self.mask;
         let (ats, args, amps) = (
             &mut self.at[..=mask],
