@@ -287,6 +287,8 @@ print("\n".join(out))
 PY
 )"
 
+# The vector unit the after build's filament step ran on (its `bench plume` says).
+unit="$(python3 -c 'import json, sys; print(json.load(open(sys.argv[1])).get("vector_unit", "unknown"))' "$work/plume-after-1-pompy.json")"
 page="docs/results/performance.md"
 begin="<!-- performance.sh begin -->"
 end="<!-- performance.sh end -->"
@@ -295,7 +297,7 @@ end="<!-- performance.sh end -->"
     echo
     echo "**Measured** by \`scripts/performance.sh --before BIN --before-commit $before_commit --pairs $pairs"
     echo "--seeds $seeds --jobs $jobs${outputs_differ:+ --outputs-differ}\` at commit \`$commit\` (after) against the build of \`$before_commit\`"
-    echo "(before) on $(date -u +%Y-%m-%d) ($cores cores, $cpu; load average $load at the end). The single run is \`plumetrace run --preset"
+    echo "(before) on $(date -u +%Y-%m-%d) ($cores cores, $cpu, vector unit $unit; load average $load at the end). The single run is \`plumetrace run --preset"
     echo "duck-2003-st --seed 7 --stats\` on one thread (\`RAYON_NUM_THREADS=1\`) with every default"
     echo "output; the campaign is \`plumetrace campaign FILE --out DIR --jobs $jobs\` over \`scenarios ="
     echo "[\"duck-2003-st\"]\`, \`seeds = $seeds\`, one configuration, timed as a whole process with"

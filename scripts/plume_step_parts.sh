@@ -120,6 +120,9 @@ if pompy:
 print("\n".join(out))
 PY
 )"
+# The vector unit the filament step ran on (its `bench plume` says).
+first_rate="${rates%%,*}"
+unit="$(python3 -c 'import json, sys; print(json.load(open(sys.argv[1])).get("vector_unit", "unknown"))' "$work/$first_rate-1.json")"
 page="docs/results/performance.md"
 begin="<!-- plume_step_parts.sh begin -->"
 end="<!-- plume_step_parts.sh end -->"
@@ -127,7 +130,7 @@ end="<!-- plume_step_parts.sh end -->"
     echo "$begin"
     echo
     echo "**Measured** by \`scripts/plume_step_parts.sh --rates $rates --repeats $repeats --duration"
-    echo "$duration\` at commit \`$commit\` on $(date -u +%Y-%m-%d) ($(nproc) cores, $cpu): \`plumetrace"
+    echo "$duration\` at commit \`$commit\` on $(date -u +%Y-%m-%d) ($(nproc) cores, $cpu, vector unit $unit): \`plumetrace"
     echo "bench plume --release-rate R --duration $duration --queries 1000\` in pompy's case at each rate,"
     echo "$repeats times."
     echo

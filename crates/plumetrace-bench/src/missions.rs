@@ -43,6 +43,8 @@ pub struct MissionBench {
     pub stages_s_per_mission: StageSplit,
     /// The machine's load average (1 minute) when the benchmark ended, if known.
     pub load_average: Option<f64>,
+    /// The vector unit the filament step ran on ([`plumetrace_env::vector_unit`]).
+    pub vector_unit: &'static str,
 }
 
 /// The missions of one thread count.
@@ -201,6 +203,7 @@ pub fn missions(a: &MissionBenchOptions) -> Result<MissionBench, BenchError> {
         scaling: last / first,
         stages_s_per_mission: stages,
         load_average: load_average(),
+        vector_unit: plumetrace_env::vector_unit(),
     })
 }
 

@@ -118,6 +118,8 @@ pub struct PlumeBench {
     pub crossflow_samples: BTreeMap<String, u64>,
     /// Threads used.
     pub threads: usize,
+    /// The vector unit the filament step ran on ([`plumetrace_env::vector_unit`]).
+    pub vector_unit: &'static str,
 }
 
 /// The benchmark's environment: the case's preset with the options applied to its parsed config.
@@ -315,6 +317,7 @@ pub fn plume(
         crossflow_mean_m: centre,
         crossflow_samples: samples,
         threads: 1,
+        vector_unit: plumetrace_env::vector_unit(),
     })
 }
 

@@ -55,6 +55,8 @@ pub struct RasterBench {
     pub figure: RasterGrid,
     /// The replay page's frame grid.
     pub page: RasterGrid,
+    /// The vector unit the queries ran on ([`plumetrace_env::vector_unit`]).
+    pub vector_unit: &'static str,
 }
 
 /// Times the two display grids of a run of `a.preset` on one thread, after the plume's
@@ -139,5 +141,6 @@ pub fn raster(a: &RasterBenchOptions) -> Result<RasterBench, BenchError> {
         ms_per_sample: ms_per_index_build + figure.ms_per_query_display + page.ms_per_query_display,
         figure,
         page,
+        vector_unit: plumetrace_env::vector_unit(),
     })
 }

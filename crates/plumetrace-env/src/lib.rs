@@ -23,6 +23,7 @@ pub mod plume;
 pub mod rng;
 pub mod seabed;
 mod simd;
+pub use simd::vector_unit;
 pub mod steady;
 #[cfg(test)]
 mod test_files;

@@ -17,6 +17,20 @@
 //! without the unit's instructions unless it is inlined, and written with closures, AVX2's
 //! lookup called each instruction and ran three times slower than the plain loop.
 
+/// The name of the vector unit the hot loops run on here ([`best`]): `"avx512"` (x86-64-v4),
+/// `"avx2"` (x86-64-v3, with FMA) or `"portable"` (the version for any CPU of the target). The
+/// benchmarks report it: the same code takes about twice as long a filament-step on AVX2 as on
+/// AVX-512 (docs/results/performance.md).
+pub fn vector_unit() -> &'static str {
+    match best() {
+        #[cfg(target_arch = "x86_64")]
+        pulp::Arch::V4(_) => "avx512",
+        #[cfg(target_arch = "x86_64")]
+        pulp::Arch::V3(_) => "avx2",
+        _ => "portable",
+    }
+}
+
 /// The widest vector unit this CPU has (detected once, then cached by the standard library).
 #[inline]
 pub(crate) fn best() -> pulp::Arch {
@@ -38,4 +52,22 @@ pub(crate) fn every() -> Vec<pulp::Arch> {
         }
     }
     all
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_vector_unit_named_is_the_widest_this_cpu_runs() {
+        // `every` lists the versions this CPU can run, widest last; `best` must be that one.
+        let widest = match every().last() {
+            #[cfg(target_arch = "x86_64")]
+            Some(pulp::Arch::V4(_)) => "avx512",
+            #[cfg(target_arch = "x86_64")]
+            Some(pulp::Arch::V3(_)) => "avx2",
+            _ => "portable",
+        };
+        assert_eq!(vector_unit(), widest);
+    }
 }
