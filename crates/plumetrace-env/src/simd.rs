@@ -22,7 +22,12 @@
 /// benchmarks report it: the same code takes about twice as long a filament-step on AVX2 as on
 /// AVX-512 (docs/results/performance.md).
 pub fn vector_unit() -> &'static str {
-    match best() {
+    name(best())
+}
+
+/// The name of the version `arch` runs (see [`vector_unit`]).
+fn name(arch: pulp::Arch) -> &'static str {
+    match arch {
         #[cfg(target_arch = "x86_64")]
         pulp::Arch::V4(_) => "avx512",
         #[cfg(target_arch = "x86_64")]
@@ -61,13 +66,7 @@ mod tests {
     #[test]
     fn the_vector_unit_named_is_the_widest_this_cpu_runs() {
         // `every` lists the versions this CPU can run, widest last; `best` must be that one.
-        let widest = match every().last() {
-            #[cfg(target_arch = "x86_64")]
-            Some(pulp::Arch::V4(_)) => "avx512",
-            #[cfg(target_arch = "x86_64")]
-            Some(pulp::Arch::V3(_)) => "avx2",
-            _ => "portable",
-        };
+        let widest = every().last().map_or("portable", |&arch| name(arch));
         assert_eq!(vector_unit(), widest);
     }
 }

@@ -848,7 +848,7 @@ fn cell_at(cells: &[Cell], at: f32) -> &Cell {
     &cells[(at as usize).min(cells.len() - 1)]
 }
 
-/// The single-precision batch lookup, as a [`pulp::WithSimd`] operation.
+/// The single-precision batch lookup's points and where their velocities go.
 struct Velocities<'a> {
     flow: &'a FarrellFlow,
     /// The grid's axes for positions measured from the caller's origin.
@@ -859,38 +859,10 @@ struct Velocities<'a> {
     v: &'a mut [f32],
 }
 
-impl pulp::WithSimd for Velocities<'_> {
-    type Output = ();
-
-    #[inline(always)]
-    fn with_simd<S: pulp::Simd>(self, _simd: S) {
-        let Velocities {
-            flow,
-            axes: a,
-            x,
-            y,
-            u,
-            v,
-        } = self;
-        let mut cell = [0.0; BATCH];
-        let mut tx = [0.0; BATCH];
-        let mut ty = [0.0; BATCH];
-        let cells = &flow.cells[..];
-        let points = x.chunks(BATCH).zip(y.chunks(BATCH));
-        let places = u.chunks_mut(BATCH).zip(v.chunks_mut(BATCH));
-        for ((xs, ys), (us, vs)) in points.zip(places) {
-            let m = cells_and_fractions(a, xs, ys, &mut cell, &mut tx, &mut ty);
-            for (k, (u, v)) in us.iter_mut().zip(vs.iter_mut()).enumerate().take(m) {
-                (*u, *v) = bilinear_f32(cell_at(cells, cell[k]), tx[k], ty[k]);
-            }
-        }
-    }
-}
-
 /// A vector unit's lookup of `L` points at once (their cells' indices as whole `f32`s, below the
 /// cell count, and their fractions), the same operations in the same order as
-/// [`bilinear_f32`], written with the unit's instructions (see `crate::simd` on closures).
-#[cfg(target_arch = "x86_64")]
+/// [`bilinear_f32`]: one point at a time ([`OneByOne`], for any CPU), or written with a unit's
+/// instructions (see `crate::simd` on closures).
 trait LookupGroup<const L: usize>: Copy {
     /// The velocities `(u, v)` of the `L` points.
     fn lookup(
@@ -906,7 +878,6 @@ trait LookupGroup<const L: usize>: Copy {
 
 /// [`Velocities`] in groups of `L` points looked up by `group`, the points left over one at a
 /// time.
-#[cfg(target_arch = "x86_64")]
 #[inline(always)]
 fn velocities_in_groups<const L: usize>(group: impl LookupGroup<L>, inner: Velocities<'_>) {
     let Velocities {
@@ -939,6 +910,26 @@ fn velocities_in_groups<const L: usize>(group: impl LookupGroup<L>, inner: Veloc
         for k in m / L * L..m {
             (us[k], vs[k]) = bilinear_f32(cell_at(cells, cell[k]), tx[k], ty[k]);
         }
+    }
+}
+
+/// The plain lookup, one point at a time (the portable version; compiled for a vector unit, the
+/// compiler may take several points at once).
+#[derive(Clone, Copy)]
+struct OneByOne;
+
+impl LookupGroup<1> for OneByOne {
+    #[inline(always)]
+    fn lookup(
+        self,
+        cells: &[Cell],
+        at: &[f32; 1],
+        tx: [f32; 1],
+        ty: [f32; 1],
+        u: &mut [f32; 1],
+        v: &mut [f32; 1],
+    ) {
+        (u[0], v[0]) = bilinear_f32(cell_at(cells, at[0]), tx[0], ty[0]);
     }
 }
 
@@ -1080,25 +1071,13 @@ impl LookupGroup<8> for GroupV3 {
     }
 }
 
-/// [`Velocities`] in groups of a vector unit's own lookup, as a [`pulp::WithSimd`] operation.
-#[cfg(target_arch = "x86_64")]
-struct VelocitiesIn<'a, G> {
+/// [`Velocities`] in groups of `L` points of a lookup, as a [`pulp::WithSimd`] operation.
+struct VelocitiesIn<'a, G, const L: usize> {
     group: G,
     inner: Velocities<'a>,
 }
 
-#[cfg(target_arch = "x86_64")]
-impl pulp::WithSimd for VelocitiesIn<'_, GroupV4> {
-    type Output = ();
-
-    #[inline(always)]
-    fn with_simd<S: pulp::Simd>(self, _simd: S) {
-        velocities_in_groups(self.group, self.inner);
-    }
-}
-
-#[cfg(target_arch = "x86_64")]
-impl pulp::WithSimd for VelocitiesIn<'_, GroupV3> {
+impl<G: LookupGroup<L>, const L: usize> pulp::WithSimd for VelocitiesIn<'_, G, L> {
     type Output = ();
 
     #[inline(always)]
@@ -1137,7 +1116,10 @@ impl FarrellFlow {
                 let group = GroupV3(simd);
                 pulp::Simd::vectorize(simd, VelocitiesIn { group, inner })
             }
-            _ => arch.dispatch(inner),
+            _ => arch.dispatch(VelocitiesIn {
+                group: OneByOne,
+                inner,
+            }),
         }
     }
 }

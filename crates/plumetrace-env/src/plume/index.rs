@@ -326,9 +326,8 @@ struct Gathered {
     /// The filament's peak.
     amp: Vec<f64>,
     n: usize,
-    /// Room for this many terms, a power of two (`mask + 1`, the columns' length).
+    /// Room for this many terms, a power of two (the columns' length).
     cap: usize,
-    mask: usize,
 }
 
 impl Gathered {
@@ -341,7 +340,6 @@ impl Gathered {
             amp: vec![0.0; cap],
             n: 0,
             cap,
-            mask: cap - 1,
         }
     }
 
@@ -357,7 +355,7 @@ impl Gathered {
             self.n + xs.len() * N <= self.cap,
             "no room for a row's terms"
         );
-        let mask = self.mask;
+        let mask = self.cap - 1;
         let (ats, args, amps) = (
             &mut self.at[..=mask],
             &mut self.arg[..=mask],
