@@ -118,8 +118,8 @@ impl CellIndex {
         let ncy = ((h / cell).ceil() as usize).max(1);
         let inv_cell = 1.0 / cell;
         let cell_of = |x: f64, y: f64| -> usize {
-            let i = (((x - domain.x_min_m) * inv_cell) as usize).min(ncx - 1);
-            let j = (((y - domain.y_min_m) * inv_cell) as usize).min(ncy - 1);
+            let i = floor_index((x - domain.x_min_m) * inv_cell).min(ncx - 1);
+            let j = floor_index((y - domain.y_min_m) * inv_cell).min(ncy - 1);
             j * ncx + i
         };
         let mut starts = vec![0u32; ncx * ncy + 1];
@@ -266,13 +266,20 @@ fn axis_span(c: f64, half: f64, origin: f64, inv_step: f64) -> [f64; 2] {
     [lo, hi]
 }
 
+/// The floor of `f`, at least zero (NaN too; truncation is the floor of a value that is not
+/// negative). Through `i64`, which x86-64 converts in one instruction where `usize` takes
+/// several: a value that does not fit either way (beyond 2^63) is cut to the grid or the cells
+/// by the caller just the same.
+#[inline(always)]
+fn floor_index(f: f64) -> usize {
+    if f > 0.0 { f as i64 as usize } else { 0 }
+}
+
 /// The whole indices `a..b` of an [`axis_span`]: the floor of `lo` and one past the floor of
-/// `hi`, neither below zero (truncation is the floor of a value that is not negative). Through
-/// `i64`, which x86-64 converts in one instruction where `usize` takes several: a value that
-/// does not fit either way (beyond 2^63) is cut to the grid by the caller just the same.
+/// `hi`, neither below zero ([`floor_index`]).
 #[inline(always)]
 fn whole_span([lo, hi]: [f64; 2]) -> (usize, usize) {
-    let a = if lo > 0.0 { lo as i64 as usize } else { 0 };
+    let a = floor_index(lo);
     let b = if hi >= 0.0 {
         (hi as i64 as usize).saturating_add(1)
     } else {
