@@ -82,7 +82,7 @@ enum Command {
     /// and print the first error with its key path and line, and a warning for each key that has
     /// no effect.
     Check(load::ScenarioArgs),
-    /// Feed a snapshot log (`snapshots.jsonl` of a run) to fresh planners and report the
+    /// Feed a snapshot log (`snapshots.jsonl.gz` of a run) to fresh planners and report the
     /// decisions that differ from the logged ones.
     Replay(replay::ReplayArgs),
     /// Fly a planner on a vehicle: read navigation and the chemical sensor from a front-seat link

@@ -77,6 +77,38 @@ fn planner_table(mut file: toml::Table) -> Result<(toml::Table, String)> {
     }
 }
 
+/// That the log's header names vehicle `o` among its planned vehicles: else `--vehicle o` would
+/// replace no planner and every decision would replay as logged. A log whose header cannot be
+/// read passes here; the replay then says what is wrong with it.
+fn check_vehicle(log: &std::path::Path, o: u32) -> Result<()> {
+    use std::io::BufRead;
+    let mut first = String::new();
+    let header = plumetrace_log::snapshot::open(log)
+        .and_then(|mut r| r.read_line(&mut first))
+        .ok()
+        .and_then(|_| plumetrace_log::snapshot::read_header(first.trim_end()).ok());
+    let Some(header) = header else {
+        return Ok(());
+    };
+    if header.vehicles.iter().any(|v| v.id == o) {
+        return Ok(());
+    }
+    let names: Vec<String> = header
+        .vehicles
+        .iter()
+        .map(|v| format!("{} ({})", v.id, v.name))
+        .collect();
+    anyhow::bail!(
+        "--vehicle {o}: {} has no vehicle {o} with a planner; its vehicles with planners: {}",
+        log.display(),
+        if names.is_empty() {
+            "none".to_string()
+        } else {
+            names.join(", ")
+        }
+    )
+}
+
 /// The exit status when decisions differ.
 pub const DIFFER: i32 = 3;
 
@@ -102,6 +134,9 @@ pub fn run(args: &ReplayArgs) -> Result<bool> {
         }
         None => None,
     };
+    if let Some(o) = args.vehicle {
+        check_vehicle(&args.log, o)?;
+    }
     let log = plumetrace_log::snapshot::open(&args.log)
         .with_context(|| format!("opening {}", args.log.display()))?;
     let only = args.vehicle;

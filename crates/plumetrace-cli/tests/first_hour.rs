@@ -421,6 +421,42 @@ fn replay_takes_the_planner_table_of_a_scenario_file() {
 }
 
 #[test]
+fn replay_refuses_a_vehicle_the_log_does_not_have() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let log = short_demo_log(d);
+    // Another planner table: replayed for vehicle 3 of a one-vehicle log, it would replace no
+    // planner and every decision would replay as logged.
+    std::fs::write(d.join("p.toml"), "kind = \"lawnmower\"\n").unwrap();
+    let log_arg = log.to_str().unwrap();
+    let replay = |vehicle: &str| {
+        plumetrace(
+            d,
+            &[
+                "replay",
+                log_arg,
+                "--planner-file",
+                "p.toml",
+                "--vehicle",
+                vehicle,
+            ],
+        )
+    };
+    let (status, out, err) = replay("3");
+    assert_eq!(status, 1, "{out}");
+    assert_eq!(
+        err,
+        format!(
+            "error: --vehicle 3: {} has no vehicle 3 with a planner; its vehicles with \
+             planners: 0 (auv)\n",
+            log.display()
+        )
+    );
+    let (status, out, err) = replay("0");
+    assert_eq!(status, 3, "another planner differs: {out}{err}");
+}
+
+#[test]
 fn a_log_from_before_a_key_existed_replays_with_a_note_naming_it() {
     use std::io::BufRead;
     let dir = tempfile::tempdir().unwrap();
