@@ -54,7 +54,14 @@ pub(crate) fn onboard_file(
     let mut file = toml::Table::new();
     file.insert("name".into(), format!("{} on a vehicle", setup.name).into());
     file.insert("mission".into(), mission.into());
-    file.insert("planner".into(), p.config.to_table()?.into());
+    // Every key the planner reads, but those that have no effect at its values (say, the AMP's
+    // map keys without a map declaration): they would take their defaults just the same, and a
+    // file this command writes checks without a warning.
+    let mut planner = p.config.to_table()?;
+    for (key, _) in p.config.keys_without_effect(&planner) {
+        planner.remove(key);
+    }
+    file.insert("planner".into(), planner.into());
     file.insert("link".into(), link.clone().into());
     if flow {
         // The current meter's sentences travel on the vehicle link.

@@ -48,6 +48,13 @@ fn the_onboard_file_names_this_front_seat_and_reads_back() {
         "the current readings travel on the link"
     );
     assert_eq!(format!("{:?}", o.planner.kind()), "Amp");
+    // The planner table sets no key that has no effect (the AMP's map keys without a map
+    // declaration), so the file checks without warnings.
+    let table: toml::Table = text.parse().unwrap();
+    let planner = table["planner"].as_table().unwrap();
+    assert!(planner.contains_key("threshold_v"), "{planner:?}");
+    assert!(!planner.contains_key("map_radius_m"), "{planner:?}");
+    assert_eq!(o.planner.keys_without_effect(planner), vec![]);
 
     let no_flow = FrontSeatOptions {
         flow: false,
