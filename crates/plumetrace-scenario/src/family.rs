@@ -1245,7 +1245,13 @@ impl Site {
             f.name.replace('\n', " ")
         );
         for (k, v) in Site::COLUMNS.iter().zip(self.values()) {
-            out.push_str(&format!("#   {} = {v}\n", k.trim_start_matches("site_")));
+            let k = k.trim_start_matches("site_");
+            // An empty value is a key the family does not draw (its column is empty too).
+            if v.is_empty() {
+                out.push_str(&format!("#   {k}: not drawn (the base scenario's)\n"));
+            } else {
+                out.push_str(&format!("#   {k} = {v}\n"));
+            }
         }
         for (k, v) in self
             .team
@@ -1316,6 +1322,28 @@ mod tests {
             assert!((0.0..=90.0).contains(&site.flow_to_axis_deg));
             assert_eq!(site.values().len(), Site::COLUMNS.len());
         }
+    }
+
+    #[test]
+    fn a_site_file_says_what_it_draws_and_what_it_leaves_to_the_base() {
+        let f = coastal();
+        let site = f.draw(3);
+        assert!(
+            site.mass_rate_per_s.is_none(),
+            "coastal draws no release rate"
+        );
+        let text = site.to_toml(&f.file, &f.base, 3, "coastal-site-003");
+        assert!(
+            text.contains("\n#   mass_rate_per_s: not drawn (the base scenario's)\n"),
+            "{text}"
+        );
+        assert!(text.contains("\n#   length_m = "), "{text}");
+        assert!(
+            text.lines()
+                .filter(|l| l.starts_with("#   "))
+                .all(|l| !l.trim_end().ends_with('=')),
+            "a drawn line without its value: {text}"
+        );
     }
 
     #[test]
