@@ -50,6 +50,7 @@ pub enum ShareArg {
 
 /// Runs (or resumes) a campaign and prints where the results are.
 pub fn run(args: &CampaignArgs) -> Result<()> {
+    crate::check_other::refuse_other_kind(&args.file, crate::check_other::FileKind::Campaign)?;
     let c = Campaign::load_with(
         &args.file,
         args.seeds,

@@ -79,6 +79,71 @@ impl FileKind {
     }
 }
 
+impl FileKind {
+    /// What `path` is when its top-level keys tell (a key only that kind of file has, in the
+    /// order of [`FileKind::of`]) or, failing them, its name ends in `.family.toml`; with what
+    /// told. `None` when nothing tells, or the file does not read or parse (the command's own
+    /// reading then says what is wrong).
+    fn told(path: &Path) -> Option<(FileKind, String)> {
+        let keyed = plumetrace_env::input::read_text(path, plumetrace_env::input::MAX_TEXT_BYTES)
+            .ok()
+            .and_then(|text| text.parse::<toml::Table>().ok())
+            .and_then(|table| {
+                let has =
+                    |keys: &[&'static str]| keys.iter().find(|k| table.contains_key(**k)).copied();
+                let (kind, key) = if let Some(k) = has(&SCENARIO_KEYS) {
+                    (FileKind::Scenario, k)
+                } else if let Some(k) = has(&CAMPAIGN_KEYS) {
+                    (FileKind::Campaign, k)
+                } else {
+                    (FileKind::Family, has(&FAMILY_KEYS)?)
+                };
+                Some((kind, format!("it has `{key}`")))
+            });
+        keyed.or_else(|| {
+            path.to_string_lossy().ends_with(".family.toml").then(|| {
+                (
+                    FileKind::Family,
+                    "its name ends in `.family.toml`".to_string(),
+                )
+            })
+        })
+    }
+
+    /// The kind, and the command that takes it.
+    fn what(self, path: &Path) -> (&'static str, String) {
+        let p = path.display();
+        match self {
+            FileKind::Scenario => ("a scenario file", format!("plumetrace run {p} --out DIR")),
+            FileKind::Campaign => (
+                "a campaign file",
+                format!("plumetrace campaign {p} --out DIR"),
+            ),
+            FileKind::Family => (
+                "a family file",
+                format!("plumetrace family {p} --sample N --out DIR"),
+            ),
+        }
+    }
+}
+
+/// Refuses a file that tells it is of another kind than `want` (a campaign given to `run`, a
+/// scenario to `campaign`, ...), naming what it is and the command that takes it, instead of
+/// letting `want`'s reader call its first key unknown.
+pub fn refuse_other_kind(path: &Path, want: FileKind) -> Result<()> {
+    match FileKind::told(path) {
+        Some((kind, why)) if kind != want => {
+            let (is, command) = kind.what(path);
+            let (wanted, _) = want.what(path);
+            bail!(
+                "{}: is {is} ({why}), not {wanted}: run it with `{command}`",
+                path.display()
+            )
+        }
+        _ => Ok(()),
+    }
+}
+
 /// How many sites `check` draws from a family (seed 1, as `plumetrace family` draws by default).
 const FAMILY_SITES: u64 = 8;
 

@@ -124,7 +124,10 @@ impl Place {
 /// Reads, changes and builds the scenario; `seed` overrides the file's.
 pub fn load(a: &ScenarioArgs, seed: Option<u64>) -> Result<Loaded> {
     let (text, origin) = match (&a.scenario, &a.preset) {
-        (Some(path), None) => (read_file(path)?, Origin::File(path.clone())),
+        (Some(path), None) => {
+            crate::check_other::refuse_other_kind(path, crate::check_other::FileKind::Scenario)?;
+            (read_file(path)?, Origin::File(path.clone()))
+        }
         (None, Some(name)) => match plumetrace_scenario::find_preset(name) {
             Some(p) => (p.toml.to_string(), Origin::Preset(name.clone())),
             // The preset registry's error, with the nearest name.

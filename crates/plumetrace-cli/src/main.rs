@@ -204,6 +204,7 @@ struct FamilyArgs {
 /// `plumetrace family FILE --sample N --out DIR`: draws N sites and writes each as a scenario
 /// file (with the drawn values in its opening comment), checked by the same build as `run`.
 fn family(a: &FamilyArgs) -> Result<()> {
+    check_other::refuse_other_kind(&a.file, check_other::FileKind::Family)?;
     let f = plumetrace_scenario::Family::load(&a.file)?;
     if !a.test_seeds {
         let set = plumetrace_campaign::benchmark::TaskSet::builtin()?;

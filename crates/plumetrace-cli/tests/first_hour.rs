@@ -548,6 +548,51 @@ fn the_readme_has_the_preset_table() {
 }
 
 #[test]
+fn a_file_of_another_kind_is_named_with_the_command_that_takes_it() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+    let copy = |from: &str, to: &str| {
+        std::fs::copy(root.join(from), d.join(to)).unwrap();
+    };
+    copy("examples/campaigns/amp-vs-lawnmower.toml", "c.toml");
+    copy("examples/families/coastal.family.toml", "f.toml");
+    let (status, scenario, _) = plumetrace(d, &["presets", "--show", "demo"]);
+    assert_eq!(status, 0);
+    std::fs::write(d.join("s.toml"), scenario).unwrap();
+    let refused = |args: &[&str], says: &str| {
+        let (status, out, err) = plumetrace(d, args);
+        assert_eq!((status, out.as_str()), (1, ""), "{args:?}: {err}");
+        assert_eq!(err, format!("error: {says}\n"), "{args:?}");
+    };
+    let campaign = "c.toml: is a campaign file (it has `scenarios`), not a";
+    let family = "f.toml: is a family file (it has `base`), not a";
+    let scenario = "s.toml: is a scenario file (it has `sim`), not a";
+    refused(
+        &["run", "c.toml", "--out", "o"],
+        &format!("{campaign} scenario file: run it with `plumetrace campaign c.toml --out DIR`"),
+    );
+    refused(
+        &["run", "f.toml", "--out", "o"],
+        &format!(
+            "{family} scenario file: run it with `plumetrace family f.toml --sample N --out DIR`"
+        ),
+    );
+    refused(
+        &["campaign", "s.toml", "--out", "o"],
+        &format!("{scenario} campaign file: run it with `plumetrace run s.toml --out DIR`"),
+    );
+    refused(
+        &["family", "c.toml", "--sample", "1", "--out", "o"],
+        &format!("{campaign} family file: run it with `plumetrace campaign c.toml --out DIR`"),
+    );
+    assert!(!d.join("o").exists(), "nothing was written");
+    // Each file is taken by its own command.
+    let (status, _, err) = plumetrace(d, &["run", "s.toml", "--out", "o"]);
+    assert_eq!(status, 0, "{err}");
+}
+
+#[test]
 fn check_takes_campaign_and_family_files_too() {
     let dir = tempfile::tempdir().unwrap();
     let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
