@@ -26,13 +26,27 @@ pub fn write_results(
         plumetrace_mission::output::write_atomic(&p, bytes).map_err(|e| CampaignError::io(&p, e))
     };
     write(RUNS_FILE, rows_text(rows)?.as_bytes())?;
-    let groups = summarise(c, rows);
+    // A call with fewer seeds than an earlier one into the same directory summarises its own
+    // seeds; the runs of the others stay in runs.csv.
+    let (asked, beyond): (Vec<_>, Vec<_>) = rows
+        .iter()
+        .cloned()
+        .partition(|(k, _)| k.seed_index < c.file.seeds);
+    let groups = summarise(c, &asked);
     write("summary.csv", summary_csv(&groups).as_bytes())?;
     let expected = c.runs().len() as u64;
     let mut md = summary_md(c, &groups, expected);
-    md.push_str(&crate::stats::sites_md(c, rows));
+    if !beyond.is_empty() {
+        md.push_str(&format!(
+            "\n{} more runs in `runs.csv`, of seeds beyond the {} per group this call asked for \
+             (recorded by a call with more seeds), are left out of this summary and the charts.\n",
+            beyond.len(),
+            c.file.seeds
+        ));
+    }
+    md.push_str(&crate::stats::sites_md(c, &asked));
     write("summary.md", md.as_bytes())?;
-    crate::charts::write_charts(c, out, &groups, rows)?;
+    crate::charts::write_charts(c, out, &groups, &asked)?;
     #[cfg(feature = "parquet")]
     crate::parquet_out::write_parquet(&out.join("runs.parquet"), rows)?;
     Ok(groups)

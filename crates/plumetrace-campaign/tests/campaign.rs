@@ -179,6 +179,30 @@ fn resuming_skips_recorded_runs_cuts_a_partial_row_and_extends_seeds() {
     let report = run_campaign(&c, &dir, RunOptions::default(), &|_, _| {}).unwrap();
     assert_eq!((report.skipped, report.ran), (6, 0));
     assert_eq!(read(&dir.join("runs.csv")), want);
+    let summary_of_3 = read(&dir.join("summary.csv"));
+
+    // Fewer seeds than recorded: the call summarises its own seeds, as a directory of that
+    // many would, and says what it left out; runs.csv keeps every run.
+    let c = Campaign::load(&file, Some(2)).unwrap();
+    let report = run_campaign(&c, &dir, RunOptions::default(), &|_, _| {}).unwrap();
+    assert_eq!((report.planned, report.skipped, report.ran), (4, 4, 0));
+    assert_eq!(read(&dir.join("runs.csv")), want);
+    let two = tmp.path().join("two");
+    run(&file, &two, RunOptions::default(), Some(2));
+    assert_eq!(
+        read(&dir.join("summary.csv")),
+        read(&two.join("summary.csv"))
+    );
+    assert_ne!(read(&dir.join("summary.csv")), summary_of_3);
+    let md = read(&dir.join("summary.md"));
+    assert!(md.contains("4 of 4 runs recorded"), "{md}");
+    assert!(
+        md.contains(
+            "2 more runs in `runs.csv`, of seeds beyond the 2 per group this call asked for"
+        ),
+        "{md}"
+    );
+    assert!(!read(&two.join("summary.md")).contains("more runs in"));
 }
 
 #[test]
