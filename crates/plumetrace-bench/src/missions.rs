@@ -117,9 +117,15 @@ fn load_average() -> Option<f64> {
 
 /// The preset's scenario with `KEY=VALUE` overrides applied.
 fn preset_with_sets(preset: &str, sets: &[String]) -> Result<ScenarioConfig, BenchError> {
-    let text = plumetrace_scenario::find_preset(preset)
-        .ok_or_else(|| BenchError::UnknownPreset(preset.to_string()))?
-        .toml;
+    // An unknown name gets the preset registry's error, with the nearest name.
+    let text = match plumetrace_scenario::find_preset(preset) {
+        Some(p) => p.toml,
+        None => {
+            return Err(plumetrace_scenario::load_preset(preset)
+                .err()
+                .map_or_else(|| BenchError::UnknownPreset(preset.to_string()), Into::into));
+        }
+    };
     let mut table: toml::Table = toml::from_str(text)?;
     plumetrace_scenario::overrides::apply_sets(&mut table, sets)?;
     Ok(plumetrace_scenario::from_table(
@@ -239,9 +245,17 @@ mod tests {
             e.starts_with("--set \"sim.dt_s=[1,\": the value is not TOML: "),
             "{e}"
         );
-        assert_eq!(
-            refused(&options("nowhere", &[])),
-            "unknown preset 'nowhere' (see `plumetrace presets`)"
+        assert!(
+            refused(&options("nowhere", &[]))
+                .starts_with("no preset named 'nowhere' (known: demo,"),
+            "{}",
+            refused(&options("nowhere", &[]))
+        );
+        assert!(
+            refused(&options("dmeo", &[]))
+                .starts_with("no preset named 'dmeo'; did you mean 'demo'?"),
+            "{}",
+            refused(&options("dmeo", &[]))
         );
     }
 
