@@ -63,6 +63,7 @@ pub fn run(args: &CampaignArgs) -> Result<()> {
     for w in &c.warnings {
         eprintln!("warning: {}: {w}", args.file.display());
     }
+    crate::output::create_out_dir(&args.out)?;
     let started = Instant::now();
     let planned = c.shard_runs(args.shard).len() as u64;
     let progress = crate::progress::Progress::new(planned, "runs");

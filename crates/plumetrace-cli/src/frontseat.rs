@@ -166,7 +166,7 @@ pub fn run(args: &FrontseatArgs) -> Result<()> {
         }
     );
     if let Some(out) = &args.out {
-        std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
+        crate::output::create_out_dir(out)?;
         crate::output::write_atomic(
             &out.join("frontseat.json"),
             serde_json::to_string_pretty(s)?.as_bytes(),

@@ -250,7 +250,7 @@ fn family(a: &FamilyArgs) -> Result<()> {
         plumetrace_scenario::builds(&text, &plumetrace_scenario::Origin::File(path.clone()))?;
         sites.push((path, text));
     }
-    std::fs::create_dir_all(&a.out).with_context(|| format!("creating {}", a.out.display()))?;
+    crate::output::create_out_dir(&a.out)?;
     for (path, text) in &sites {
         crate::output::write_atomic(path, text.as_bytes())?;
     }

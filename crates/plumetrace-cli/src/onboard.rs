@@ -155,8 +155,7 @@ pub fn run(args: &OnboardArgs) -> Result<()> {
         );
         return Ok(());
     }
-    std::fs::create_dir_all(&args.out)
-        .with_context(|| format!("creating {}", args.out.display()))?;
+    crate::output::create_out_dir(&args.out)?;
     fly(&onboard, args)
 }
 

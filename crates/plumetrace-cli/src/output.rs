@@ -9,6 +9,18 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
         .with_context(|| format!("writing {}", path.display()))
 }
 
+/// Creates the output directory `out` (and its parents) if needed; a file already there is
+/// refused as such, rather than with the system's "File exists".
+pub fn create_out_dir(out: &Path) -> Result<()> {
+    if out.exists() && !out.is_dir() {
+        anyhow::bail!(
+            "--out {}: is a file, not a directory; give a directory (created if needed)",
+            out.display()
+        );
+    }
+    std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))
+}
+
 /// Refuses a run whose output directory would overwrite its own input file.
 pub fn refuse_overwriting(input: &Path, out: &Path, outputs: &[&str]) -> Result<()> {
     let Ok(input) = std::fs::canonicalize(input) else {

@@ -6,7 +6,7 @@
 //! and when `[output]` asks for them the probe series and filament snapshots (with the `netcdf`
 //! feature also `plume.nc`).
 
-use anyhow::{Context, Result};
+use anyhow::Result;
 use plumetrace_scenario::BuiltScenario;
 use std::path::{Path, PathBuf};
 
@@ -52,8 +52,7 @@ pub fn load(
 /// Runs the scenario: a mission when it has one, otherwise the plume alone.
 pub fn run(args: &RunArgs) -> Result<()> {
     let crate::load::Loaded { built: sc, place } = crate::load::load(&args.scenario, args.seed)?;
-    std::fs::create_dir_all(&args.out)
-        .with_context(|| format!("creating {}", args.out.display()))?;
+    crate::output::create_out_dir(&args.out)?;
     if let Some(path) = &args.scenario.scenario {
         crate::output::refuse_overwriting(path, &args.out, OUTPUTS)?;
     }

@@ -344,6 +344,33 @@ fn family_out_at_a_file_says_so_and_writes_nothing() {
 }
 
 #[test]
+fn run_and_campaign_out_at_a_file_say_so_and_write_nothing() {
+    let dir = tempfile::tempdir().unwrap();
+    let file = dir.path().join("plain");
+    std::fs::write(&file, "x").unwrap();
+    let out = file.to_str().unwrap();
+    let campaign = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../examples/campaigns/amp-vs-lawnmower.toml"
+    );
+    for args in [
+        vec!["run", "--preset", "demo", "--out", out],
+        vec!["campaign", campaign, "--seeds", "1", "--out", out],
+    ] {
+        let e = fails(&args);
+        assert_eq!(
+            e,
+            format!(
+                "error: --out {out}: is a file, not a directory; give a directory (created if \
+                 needed)\n"
+            ),
+            "{args:?}"
+        );
+        assert_eq!(std::fs::read_to_string(&file).unwrap(), "x");
+    }
+}
+
+#[test]
 fn a_start_inside_an_obstacle_is_refused_by_check() {
     let dir = tempfile::tempdir().unwrap();
     let file = dir.path().join("walled.toml");
