@@ -527,6 +527,52 @@ fn a_value_of_the_wrong_type_is_told_the_keys_bounds() {
     );
 }
 
+/// `text` with its wall time (`0.2 s of wall time`) left out, which depends on the machine.
+fn without_wall_time(text: &str) -> String {
+    let Some(at) = text.find(" s of wall time") else {
+        return text.to_string();
+    };
+    let start = text[..at].rfind(' ').map_or(0, |i| i + 1);
+    format!("{}W{}", &text[..start], &text[at..])
+}
+
+#[test]
+fn the_guide_quotes_the_demo_s_line_as_it_flies() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+    let read = |p: &str| std::fs::read_to_string(root.join(p)).unwrap();
+    let (status, demo, err) = plumetrace(d, &["run", "--preset", "demo", "--out", "out/demo"]);
+    assert_eq!(status, 0, "{err}");
+    let demo = without_wall_time(demo.trim_end());
+    // The README wraps the line in its command block.
+    let readme = read("README.md");
+    let start = readme
+        .find("\n    demo: located")
+        .expect("README.md quotes the demo's line")
+        + 1;
+    let end = start + readme[start..].find("\n\n").unwrap();
+    let quoted = readme[start..end].trim_start().replace("\n    ", " ");
+    assert_eq!(without_wall_time(&quoted), demo, "README.md");
+    // The commands page quotes it (with `--out out`) and the figures page its title.
+    let demo_out = demo.replace("wrote out/demo", "wrote out");
+    let commands = read("docs/commands.md");
+    assert!(
+        commands
+            .lines()
+            .any(|l| without_wall_time(l.trim_start()) == demo_out),
+        "docs/commands.md has no line {demo_out}"
+    );
+    let verdict = demo
+        .strip_prefix("demo: ")
+        .and_then(|v| v.split(';').next())
+        .unwrap();
+    assert!(
+        read("docs/figures.md").contains(&format!("`demo (seed 1): {verdict}`")),
+        "docs/figures.md: demo (seed 1): {verdict}"
+    );
+}
+
 #[test]
 fn the_readme_has_the_preset_table() {
     let md = String::from_utf8(run_ok(&["presets", "--markdown"]).stdout).unwrap();
