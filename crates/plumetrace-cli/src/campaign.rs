@@ -130,8 +130,13 @@ pub fn run_merge(args: &MergeArgs) -> Result<()> {
     }
     let missing = report.expected.saturating_sub(report.runs);
     crate::outln!(
-        "merged {} directories: {} of {} runs{}; wrote {}",
+        "merged {} {}: {} of {} runs{}; wrote {}",
         args.dirs.len(),
+        if args.dirs.len() == 1 {
+            "directory"
+        } else {
+            "directories"
+        },
         report.runs,
         report.expected,
         if missing > 0 {

@@ -265,9 +265,19 @@ fn results_are_never_written_over() {
     assert!(e.contains("would be lost"), "{e}");
     assert_eq!(std::fs::read(d.join("theirs/runs.csv")).unwrap(), theirs);
     // Merging one shard into a directory that already holds every run keeps them all.
-    run_ok(&["merge", &out("s1"), &out("s2"), "--out", &out("full")]);
+    let said = run_ok(&["merge", &out("s1"), &out("s2"), "--out", &out("full")]).stdout;
+    assert!(
+        String::from_utf8_lossy(&said).starts_with("merged 2 directories: "),
+        "{}",
+        String::from_utf8_lossy(&said)
+    );
     let all = std::fs::read(d.join("full/runs.csv")).unwrap();
-    run_ok(&["merge", &out("s1"), "--out", &out("full")]);
+    let said = run_ok(&["merge", &out("s1"), "--out", &out("full")]).stdout;
+    assert!(
+        String::from_utf8_lossy(&said).starts_with("merged 1 directory: "),
+        "{}",
+        String::from_utf8_lossy(&said)
+    );
     assert_eq!(
         std::fs::read(d.join("full/runs.csv")).unwrap(),
         all,
