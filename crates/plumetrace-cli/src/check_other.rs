@@ -1,5 +1,7 @@
-//! `plumetrace check` on a campaign or a family file: the checks `plumetrace campaign` and
-//! `plumetrace family` make before they fly or write anything, with their messages.
+//! What kind of file a TOML file is (scenario, campaign, family), and `plumetrace check` on a
+//! campaign or a family file: the checks `plumetrace campaign` and `plumetrace family` make
+//! before they fly or write anything, with their messages. `run`, `campaign` and `family` refuse
+//! a file of another kind with [`refuse_other_kind`].
 
 use anyhow::{Result, bail};
 use std::path::Path;
