@@ -924,10 +924,13 @@ fn scenario_entry(
         (Origin::Preset(s.to_string()), p.toml.to_string())
     } else {
         let known: Vec<&str> = PRESETS.iter().map(|p| p.name).collect();
+        let near = plumetrace_core::closest(s, &known)
+            .map(|n| format!("; did you mean '{n}'?"))
+            .unwrap_or_default();
         return Err(invalid(
             format!("scenarios[{i}]"),
             format!(
-                "'{s}' is neither a preset ({}) nor a path ending in .toml",
+                "'{s}' is neither a preset ({}) nor a path ending in .toml{near}",
                 known.join(", ")
             ),
         ));

@@ -256,10 +256,14 @@ fn load_err(text: &str) -> CampaignError {
 
 #[test]
 fn malformed_campaigns_are_rejected_with_their_key_path() {
-    let cases: [(&str, &str); 7] = [
+    let cases: [(&str, &str); 8] = [
         (
             "name = \"x\"\nseed = 1\nseeds = 2\nscenarios = [\"demo\"]\ntypo = 3\n",
             "unknown field `typo`",
+        ),
+        (
+            "name = \"x\"\nseed = 1\nseeds = 2\nscenarios = [\"demo\", \"duck-2003\"]\n",
+            "scenarios[1]: 'duck-2003' is neither a preset (demo, ",
         ),
         (
             "name = \"x\"\nseed = 1\nseeds = \"many\"\nscenarios = [\"demo\"]\n",
@@ -291,6 +295,12 @@ fn malformed_campaigns_are_rejected_with_their_key_path() {
         assert!(msg.contains(key), "expected '{key}' in: {msg}");
         assert!(msg.contains("campaign.toml"), "no file in: {msg}");
     }
+    // A near miss of a preset's name is told the name.
+    let msg = load_err(cases[1].0).to_string();
+    assert!(
+        msg.ends_with("nor a path ending in .toml; did you mean 'duck-2003-st'?"),
+        "{msg}"
+    );
 }
 
 #[test]
