@@ -64,8 +64,32 @@ impl Place {
         plumetrace_scenario::locate::line_of(self.text.as_deref()?, path)
     }
 
-    /// `e` with its key's line, when it names a key written in the file.
+    /// `e` with its key's line, when it names a key written in the file (and, for an unknown
+    /// planner key after `--set planner.kind=...`, why: [`Place::kind_set_hint`]).
     pub fn locate(&self, e: anyhow::Error) -> anyhow::Error {
+        let e = self.locate_key(e);
+        self.kind_set_hint(e)
+    }
+
+    /// An unknown key after `--set planner.kind=...` (or `strategy`, or a named planner's): the
+    /// table kept the keys of the planner before, which the new kind does not read; `--planner
+    /// KIND` replaces the whole table.
+    fn kind_set_hint(&self, e: anyhow::Error) -> anyhow::Error {
+        let kind_set = self.changed.iter().find(|key| {
+            let last = key.rsplit('.').next().unwrap_or(key);
+            key.starts_with("planner") && (last == "kind" || last == "strategy")
+        });
+        match kind_set {
+            Some(key) if e.to_string().contains("unknown field") => anyhow!(
+                "{e:#}; --set {key} changes the planner's kind but keeps the keys of the one \
+                 before, which this kind does not read: `--planner KIND` replaces the whole \
+                 planner table"
+            ),
+            _ => e,
+        }
+    }
+
+    fn locate_key(&self, e: anyhow::Error) -> anyhow::Error {
         let e = match e.downcast::<ScenarioError>() {
             Ok(se) => {
                 return match (&self.text, se.key_path().map(str::to_string)) {

@@ -25,6 +25,11 @@ fn plumetrace(dir: &Path, args: &[&str]) -> (i32, String, String) {
     )
 }
 
+/// `check --preset demo --set SET` in `dir`.
+fn check_demo_set(dir: &Path, set: &str) -> (i32, String, String) {
+    plumetrace(dir, &["check", "--preset", "demo", "--set", set])
+}
+
 /// `check FILE` of `text` written as `name` in `dir`: its standard error (and whether it passed).
 fn check(dir: &Path, name: &str, text: &str) -> (bool, String) {
     std::fs::write(dir.join(name), text).unwrap();
@@ -507,16 +512,7 @@ fn a_log_from_before_a_key_existed_replays_with_a_note_naming_it() {
 #[test]
 fn a_value_of_the_wrong_type_is_told_the_keys_bounds() {
     let dir = tempfile::tempdir().unwrap();
-    let (status, _, err) = plumetrace(
-        dir.path(),
-        &[
-            "check",
-            "--preset",
-            "demo",
-            "--set",
-            "declaration_fix_frames=2.5",
-        ],
-    );
+    let (status, _, err) = check_demo_set(dir.path(), "declaration_fix_frames=2.5");
     assert_eq!(status, 1);
     assert!(
         err.contains(
@@ -591,6 +587,25 @@ fn the_readme_has_the_preset_table() {
     for p in plumetrace_scenario::PRESETS {
         assert!(md.contains(&format!("| `{}` | {} |", p.name, p.summary)));
     }
+}
+
+#[test]
+fn a_planner_kind_changed_by_set_is_told_of_the_planner_flag() {
+    let dir = tempfile::tempdir().unwrap();
+    let (status, _, err) = check_demo_set(dir.path(), "planner.kind=\"moth\"");
+    assert_eq!(status, 1);
+    assert_eq!(
+        err,
+        "error: preset 'demo': planner.mapping_length_m: unknown field `mapping_length_m` \
+         (`plumetrace planners` lists every key); --set planner.kind changes the planner's kind \
+         but keeps the keys of the one before, which this kind does not read: `--planner KIND` \
+         replaces the whole planner table\n"
+    );
+    let (status, _, err) = plumetrace(
+        dir.path(),
+        &["check", "--preset", "demo", "--planner", "moth"],
+    );
+    assert_eq!(status, 0, "{err}");
 }
 
 #[test]
