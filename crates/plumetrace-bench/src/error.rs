@@ -34,9 +34,6 @@ pub enum BenchError {
     /// The preset is not a mission.
     #[error("preset '{0}' is not a mission")]
     NotAMission(String),
-    /// No preset has this name.
-    #[error("unknown preset '{0}' (see `plumetrace presets`)")]
-    UnknownPreset(String),
     /// A `--set` override that could not be applied.
     #[error(transparent)]
     Set(#[from] plumetrace_scenario::overrides::SetError),

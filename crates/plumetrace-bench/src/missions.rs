@@ -117,15 +117,7 @@ fn load_average() -> Option<f64> {
 
 /// The preset's scenario with `KEY=VALUE` overrides applied.
 fn preset_with_sets(preset: &str, sets: &[String]) -> Result<ScenarioConfig, BenchError> {
-    // An unknown name gets the preset registry's error, with the nearest name.
-    let text = match plumetrace_scenario::find_preset(preset) {
-        Some(p) => p.toml,
-        None => {
-            return Err(plumetrace_scenario::load_preset(preset)
-                .err()
-                .map_or_else(|| BenchError::UnknownPreset(preset.to_string()), Into::into));
-        }
-    };
+    let text = plumetrace_scenario::preset(preset)?.toml;
     let mut table: toml::Table = toml::from_str(text)?;
     plumetrace_scenario::overrides::apply_sets(&mut table, sets)?;
     Ok(plumetrace_scenario::from_table(

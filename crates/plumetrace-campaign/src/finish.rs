@@ -28,19 +28,26 @@ pub fn write_results(
     write(RUNS_FILE, rows_text(rows)?.as_bytes())?;
     // A call with fewer seeds than an earlier one into the same directory summarises its own
     // seeds; the runs of the others stay in runs.csv.
-    let (asked, beyond): (Vec<_>, Vec<_>) = rows
-        .iter()
-        .cloned()
-        .partition(|(k, _)| k.seed_index < c.file.seeds);
+    let asked_for = |(k, _): &&(RunKey, RunRow)| k.seed_index < c.file.seeds;
+    let asked: std::borrow::Cow<[(RunKey, RunRow)]> = if rows.iter().all(|r| asked_for(&r)) {
+        rows.into()
+    } else {
+        rows.iter()
+            .filter(asked_for)
+            .cloned()
+            .collect::<Vec<_>>()
+            .into()
+    };
+    let beyond = rows.len() - asked.len();
     let groups = summarise(c, &asked);
     write("summary.csv", summary_csv(&groups).as_bytes())?;
     let expected = c.runs().len() as u64;
     let mut md = summary_md(c, &groups, expected);
-    if !beyond.is_empty() {
+    if beyond > 0 {
         md.push_str(&format!(
-            "\n{} more runs in `runs.csv`, of seeds beyond the {} per group this call asked for \
-             (recorded by a call with more seeds), are left out of this summary and the charts.\n",
-            beyond.len(),
+            "\n{beyond} more runs in `runs.csv`, of seeds beyond the {} per group this call asked \
+             for (recorded by a call with more seeds), are left out of this summary and the \
+             charts.\n",
             c.file.seeds
         ));
     }

@@ -61,55 +61,38 @@ impl FileKind {
         if path.to_string_lossy().ends_with(".family.toml") {
             return FileKind::Family;
         }
-        let Ok(text) =
-            plumetrace_env::input::read_text(path, plumetrace_env::input::MAX_TEXT_BYTES)
-        else {
-            return FileKind::Scenario;
-        };
-        let Ok(table) = text.parse::<toml::Table>() else {
-            return FileKind::Scenario;
-        };
-        if SCENARIO_KEYS.iter().any(|k| table.contains_key(*k)) {
-            FileKind::Scenario
-        } else if CAMPAIGN_KEYS.iter().any(|k| table.contains_key(*k)) {
-            FileKind::Campaign
-        } else if FAMILY_KEYS.iter().any(|k| table.contains_key(*k)) {
-            FileKind::Family
+        FileKind::keyed(path).map_or(FileKind::Scenario, |(kind, _)| kind)
+    }
+
+    /// The kind `path`'s top-level keys tell (in the order of [`FileKind::of`]), with the key
+    /// that told; `None` when no key tells or the file does not read or parse.
+    fn keyed(path: &Path) -> Option<(FileKind, &'static str)> {
+        let text =
+            plumetrace_env::input::read_text(path, plumetrace_env::input::MAX_TEXT_BYTES).ok()?;
+        let table = text.parse::<toml::Table>().ok()?;
+        let has = |keys: &[&'static str]| keys.iter().find(|k| table.contains_key(**k)).copied();
+        if let Some(k) = has(&SCENARIO_KEYS) {
+            Some((FileKind::Scenario, k))
+        } else if let Some(k) = has(&CAMPAIGN_KEYS) {
+            Some((FileKind::Campaign, k))
         } else {
-            FileKind::Scenario
+            has(&FAMILY_KEYS).map(|k| (FileKind::Family, k))
         }
     }
-}
 
-impl FileKind {
-    /// What `path` is when its top-level keys tell (a key only that kind of file has, in the
-    /// order of [`FileKind::of`]) or, failing them, its name ends in `.family.toml`; with what
-    /// told. `None` when nothing tells, or the file does not read or parse (the command's own
-    /// reading then says what is wrong).
+    /// What `path` is when its top-level keys tell ([`FileKind::keyed`]) or, failing them, its
+    /// name ends in `.family.toml`; with what told. `None` when nothing tells, or the file does
+    /// not read or parse (the command's own reading then says what is wrong).
     fn told(path: &Path) -> Option<(FileKind, String)> {
-        let keyed = plumetrace_env::input::read_text(path, plumetrace_env::input::MAX_TEXT_BYTES)
-            .ok()
-            .and_then(|text| text.parse::<toml::Table>().ok())
-            .and_then(|table| {
-                let has =
-                    |keys: &[&'static str]| keys.iter().find(|k| table.contains_key(**k)).copied();
-                let (kind, key) = if let Some(k) = has(&SCENARIO_KEYS) {
-                    (FileKind::Scenario, k)
-                } else if let Some(k) = has(&CAMPAIGN_KEYS) {
-                    (FileKind::Campaign, k)
-                } else {
-                    (FileKind::Family, has(&FAMILY_KEYS)?)
-                };
-                Some((kind, format!("it has `{key}`")))
-            });
-        keyed.or_else(|| {
-            path.to_string_lossy().ends_with(".family.toml").then(|| {
+        match FileKind::keyed(path) {
+            Some((kind, key)) => Some((kind, format!("it has `{key}`"))),
+            None => path.to_string_lossy().ends_with(".family.toml").then(|| {
                 (
                     FileKind::Family,
                     "its name ends in `.family.toml`".to_string(),
                 )
-            })
-        })
+            }),
+        }
     }
 
     /// The kind, and the command that takes it.

@@ -152,15 +152,10 @@ pub fn load(a: &ScenarioArgs, seed: Option<u64>) -> Result<Loaded> {
             crate::check_other::refuse_other_kind(path, crate::check_other::FileKind::Scenario)?;
             (read_file(path)?, Origin::File(path.clone()))
         }
-        (None, Some(name)) => match plumetrace_scenario::find_preset(name) {
-            Some(p) => (p.toml.to_string(), Origin::Preset(name.clone())),
-            // The preset registry's error, with the nearest name.
-            None => {
-                return Err(plumetrace_scenario::load_preset(name)
-                    .err()
-                    .map_or_else(|| anyhow!("no preset named '{name}'"), Into::into));
-            }
-        },
+        (None, Some(name)) => (
+            plumetrace_scenario::preset(name)?.toml.to_string(),
+            Origin::Preset(name.clone()),
+        ),
         (None, None) => bail!("give a scenario file or --preset NAME (see `plumetrace presets`)"),
         (Some(_), Some(_)) => bail!("give a scenario file or --preset, not both"),
     };

@@ -219,19 +219,21 @@ pub fn load_file(path: &Path) -> Result<ScenarioConfig, ScenarioError> {
     parse(&text, &origin)
 }
 
+/// The built-in preset `name`, or an error naming the nearest one and every one.
+pub fn preset(name: &str) -> Result<&'static Preset, ScenarioError> {
+    find_preset(name).ok_or_else(|| {
+        let names: Vec<&str> = PRESETS.iter().map(|p| p.name).collect();
+        ScenarioError::UnknownPreset {
+            name: name.to_string(),
+            near: plumetrace_core::closest(name, &names).map(str::to_string),
+            known: names.join(", "),
+        }
+    })
+}
+
 /// Parses a built-in preset by name.
 pub fn load_preset(name: &str) -> Result<ScenarioConfig, ScenarioError> {
-    let names: Vec<&str> = PRESETS.iter().map(|p| p.name).collect();
-    let preset = find_preset(name).ok_or_else(|| ScenarioError::UnknownPreset {
-        name: name.to_string(),
-        near: plumetrace_core::closest(name, &names).map(str::to_string),
-        known: PRESETS
-            .iter()
-            .map(|p| p.name)
-            .collect::<Vec<_>>()
-            .join(", "),
-    })?;
-    parse(preset.toml, &Origin::Preset(name.to_string()))
+    parse(preset(name)?.toml, &Origin::Preset(name.to_string()))
 }
 
 /// The first date/time value in a TOML tree, with its key path.
